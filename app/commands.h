@@ -1,0 +1,29 @@
+// The strata program's subcommands; main.cpp parses the command line and prints errors.
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "engine/context.h"
+#include "engine/error.h"
+#include "engine/render_graph.h"
+
+namespace strata::app {
+
+// Options every subcommand that opens a device shares.
+struct DeviceOptions {
+  std::string device;     // --device NAME|INDEX
+  bool validate = false;  // --validate (also STRATA_VALIDATE=1; always on in debug builds)
+  ContextOptions context() const;
+};
+
+// "1024" or "1024x768"; throws Error naming the option when it is neither.
+graph::Extent parse_size(const std::string& text, const char* option);
+
+void add_devices_command(CLI::App& app, DeviceOptions& device);
+void add_render_command(CLI::App& app, DeviceOptions& device);
+void add_view_command(CLI::App& app, DeviceOptions& device);
+void add_bench_command(CLI::App& app, DeviceOptions& device);
+
+}  // namespace strata::app

@@ -1,0 +1,92 @@
+// Runs a compiled render graph on a device: creates its transient resources for a viewport,
+// records every pass behind the barriers compile() derived, and wraps each pass in timestamps.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "engine/render_graph.h"
+#include "engine/resources.h"
+#include "engine/shader_library.h"
+
+namespace strata {
+class Context;
+}
+
+namespace strata::graph {
+
+class GraphRunner;
+
+// What a pass's record function sees: its command buffer, the viewport, and its resources.
+class PassContext {
+ public:
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  Extent viewport;
+
+  VkBuffer buffer(ResourceId id) const;
+  VkImage image(ResourceId id) const;
+  VkImageView view(ResourceId id) const;
+  // Binds `pipeline` and pushes every resource this pass declared with a binding index.
+  void bind(const ComputePipeline& pipeline) const;
+
+ private:
+  friend class GraphRunner;
+  const GraphRunner* runner_ = nullptr;
+  uint32_t pass_ = 0;
+};
+
+struct PassTiming {
+  std::string name;
+  std::string group;
+  double ms = 0.0;
+  double begin_ms = 0.0;  // from the start of the run, so a group's span can be taken
+  double end_ms = 0.0;
+};
+
+class GraphRunner {
+ public:
+  GraphRunner(Context& ctx, Graph graph);
+  ~GraphRunner();
+
+  // Creates (or re-creates, when it changed) every transient resource for `viewport`.
+  void set_viewport(Extent viewport);
+  Extent viewport() const { return viewport_; }
+
+  // Imported resources are bound before each record.
+  void bind_buffer(ResourceId id, VkBuffer buffer);
+  void bind_image(ResourceId id, VkImage image, VkImageView view, VkFormat format);
+
+  void record(VkCommandBuffer cmd);
+  // Records into a fresh command buffer, submits and waits (headless runs, benchmarks, tests).
+  void run_now();
+
+  // GPU time of each pass of the last completed run.
+  std::vector<PassTiming> timings() const;
+
+  const Graph& graph() const { return graph_; }
+  // Mutable so that a test can drop a barrier and show that validation catches it.
+  CompiledGraph& compiled() { return compiled_; }
+
+ private:
+  friend class PassContext;
+  struct Bound {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkImage image = VK_NULL_HANDLE;
+    VkImageView view = VK_NULL_HANDLE;
+    VkFormat format = VK_FORMAT_UNDEFINED;
+  };
+  void emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) const;
+
+  Context& ctx_;
+  Graph graph_;
+  CompiledGraph compiled_;
+  Extent viewport_{};
+  std::vector<std::variant<std::monostate, Buffer, Image>> owned_;
+  std::vector<Bound> bound_;
+  VkQueryPool queries_ = VK_NULL_HANDLE;
+};
+
+}  // namespace strata::graph

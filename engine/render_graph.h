@@ -1,0 +1,155 @@
+// The render graph: passes declare what they touch and how; compile() derives every barrier and
+// image layout from those declarations alone (plain C++, no device, unit-tested), and GraphRunner
+// (graph_runner.h) creates the resources, records the passes and times each one on the GPU.
+//
+// Passes run in the order they are added. A resource is transient (created by the graph, sized
+// from the viewport) or imported (owned outside, bound before each run: a swapchain image, an
+// uploaded volume, a buffer the host reads afterwards).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+namespace strata {
+class ComputePipeline;
+}
+
+namespace strata::graph {
+
+using ResourceId = uint32_t;
+
+struct Extent {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  bool operator==(const Extent&) const = default;
+};
+
+enum class PassKind { compute, graphics, transfer };
+
+// How a pass touches a resource. Writes that are not also reads (storage_write, transfer_dst,
+// color_attachment) need no earlier content; every read needs a writer or imported content.
+enum class Use {
+  sampled,             // image read through a sampler
+  storage_read,        // storage buffer or image, read
+  storage_write,       // storage buffer or image, overwritten
+  storage_read_write,  // storage buffer or image, read and written (atomics, accumulation)
+  uniform,             // uniform buffer
+  indirect,            // indirect dispatch or draw arguments
+  color_attachment,    // rendered to (cleared or overwritten)
+  depth_attachment,    // depth test and write
+  transfer_src,
+  transfer_dst,
+  host_read,           // only as an import's final use: the host reads it after the run
+  present,             // only as an import's final use: handed to the presentation engine
+};
+
+const char* to_string(Use use);
+
+struct ResourceUse {
+  ResourceId resource = 0;
+  Use use = Use::storage_read;
+  // Descriptor binding in the pass's shader (shaders/shared/*.h); PassContext::bind pushes it.
+  std::optional<uint32_t> binding;
+};
+
+struct ImageInfo {
+  VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
+  // Size: the viewport when `fixed` is zero, else `fixed`.
+  Extent fixed{};
+};
+
+struct BufferInfo {
+  std::function<VkDeviceSize(Extent viewport)> size;
+};
+
+// Where an imported resource starts and how it must be left.
+struct ImportInfo {
+  bool is_image = false;
+  bool has_content = false;
+  VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  std::optional<Use> final_use;  // host_read, present, transfer_src, sampled, ...
+  // The stage at which the outside producer's dependency ends (for a swapchain image, the wait
+  // stage of the acquire semaphore), so the first barrier chains onto it.
+  VkPipelineStageFlags2 initial_stage = VK_PIPELINE_STAGE_2_NONE;
+};
+
+class PassContext;
+
+struct PassInfo {
+  std::string name;
+  PassKind kind = PassKind::compute;
+  std::vector<ResourceUse> uses;
+  std::function<void(PassContext&)> record;
+  std::string group;  // timings of passes that share a group are also reported together
+};
+
+struct ResourceInfo {
+  std::string name;
+  bool is_image = false;
+  bool imported = false;
+  ImageInfo image;
+  BufferInfo buffer;
+  ImportInfo import;
+};
+
+class Graph {
+ public:
+  ResourceId add_image(std::string name, ImageInfo info);
+  ResourceId add_buffer(std::string name, BufferInfo info);
+  ResourceId import_resource(std::string name, ImportInfo info);
+  void add_pass(PassInfo pass);
+
+  const std::vector<ResourceInfo>& resources() const { return resources_; }
+  const std::vector<PassInfo>& passes() const { return passes_; }
+
+ private:
+  std::vector<ResourceInfo> resources_;
+  std::vector<PassInfo> passes_;
+};
+
+struct Barrier {
+  ResourceId resource = 0;
+  bool is_image = false;
+  VkPipelineStageFlags2 src_stage = VK_PIPELINE_STAGE_2_NONE;
+  VkAccessFlags2 src_access = VK_ACCESS_2_NONE;
+  VkPipelineStageFlags2 dst_stage = VK_PIPELINE_STAGE_2_NONE;
+  VkAccessFlags2 dst_access = VK_ACCESS_2_NONE;
+  VkImageLayout old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkImageLayout new_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+};
+
+// What one use of a resource means to Vulkan, in a pass of a given kind.
+struct Access {
+  VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
+  VkAccessFlags2 access = VK_ACCESS_2_NONE;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;  // images only
+  bool reads = false;
+  bool writes = false;
+};
+
+Access access_of(Use use, PassKind kind, bool is_image);
+
+struct CompiledGraph {
+  std::vector<std::vector<Barrier>> pass_barriers;  // before each pass, in pass order
+  std::vector<Barrier> final_barriers;              // after the last pass (imports' final uses)
+  std::vector<VkFlags> usage;                       // per resource: VkImageUsageFlags or
+                                                    // VkBufferUsageFlags derived from its uses
+  // The layout of `resource` while `pass` runs (images; UNDEFINED when the pass does not use it).
+  std::vector<std::vector<VkImageLayout>> layout;   // [pass][resource]
+};
+
+// A graph that cannot run: the message names the pass and the resource.
+class GraphError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+CompiledGraph compile(const Graph& graph);
+
+}  // namespace strata::graph

@@ -1,0 +1,93 @@
+// Buffers and images with their own memory, moved not copied, freed with their owner.
+// Device-local resources are filled through a staging buffer (upload) and read back through one
+// (download); both wait on the GPU and are meant for setup and tests, never inside a frame.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+namespace strata {
+
+class Context;
+
+enum class MemoryKind { device_local, host_upload, host_readback };
+
+class Buffer {
+ public:
+  Buffer() = default;
+  Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind);
+  ~Buffer();
+  Buffer(Buffer&& other) noexcept;
+  Buffer& operator=(Buffer&& other) noexcept;
+
+  VkBuffer handle() const { return buffer_; }
+  VkDeviceSize size() const { return size_; }
+  // Host-visible buffers stay mapped for their whole life; nullptr for device-local ones.
+  std::byte* mapped() const { return mapped_; }
+
+ private:
+  void release();
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkDeviceSize size_ = 0;
+  std::byte* mapped_ = nullptr;
+};
+
+struct ImageDesc {
+  VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
+  VkExtent3D extent{1, 1, 1};
+  VkImageType type = VK_IMAGE_TYPE_2D;
+  VkImageUsageFlags usage = 0;
+};
+
+class Image {
+ public:
+  Image() = default;
+  Image(Context& ctx, const ImageDesc& desc);
+  ~Image();
+  Image(Image&& other) noexcept;
+  Image& operator=(Image&& other) noexcept;
+
+  VkImage handle() const { return image_; }
+  VkImageView view() const { return view_; }
+  const ImageDesc& desc() const { return desc_; }
+
+ private:
+  void release();
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkImage image_ = VK_NULL_HANDLE;
+  VkImageView view_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  ImageDesc desc_;
+};
+
+// Bytes per texel of the colour formats strata uses; throws for others.
+uint32_t texel_size(VkFormat format);
+
+// Copies `data` into a device-local buffer at offset 0 and waits.
+void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data);
+// Reads a whole buffer back to the host and waits.
+std::vector<std::byte> download(Context& ctx, const Buffer& src);
+// Reads a 2D image (in `layout`, left in it) back as tightly packed texels and waits.
+std::vector<std::byte> download(Context& ctx, const Image& src, VkImageLayout layout);
+
+template <typename T>
+std::span<const std::byte> as_bytes(const std::vector<T>& v) {
+  return std::as_bytes(std::span(v));
+}
+
+template <typename T>
+std::vector<T> download_as(Context& ctx, const Buffer& src) {
+  const std::vector<std::byte> bytes = download(ctx, src);
+  std::vector<T> out(bytes.size() / sizeof(T));
+  std::memcpy(out.data(), bytes.data(), out.size() * sizeof(T));
+  return out;
+}
+
+}  // namespace strata

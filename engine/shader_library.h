@@ -1,0 +1,76 @@
+// Shaders by name from the SPIR-V embedded at build time, and compute pipelines whose descriptor
+// and push-constant layouts come from SPIR-V reflection: binding types are never typed in C++.
+// Descriptors are pushed (VK_KHR_push_descriptor), so a pass needs no pools or sets.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+namespace strata {
+
+class Context;
+
+// The SPIR-V of shaders/<name> (e.g. "summed_area_table_tiles.comp"); throws Error if unknown.
+std::span<const uint32_t> shader_code(std::string_view name);
+std::vector<std::string_view> shader_names();
+
+struct ShaderReflection {
+  std::vector<VkDescriptorSetLayoutBinding> bindings;  // set 0, sorted by binding
+  uint32_t push_constant_size = 0;
+  std::array<uint32_t, 3> local_size{1, 1, 1};  // compute only
+};
+
+// Reads set-0 bindings, push-constant size and workgroup size; throws Error on bad SPIR-V or
+// descriptors outside set 0.
+ShaderReflection reflect(std::span<const uint32_t> spirv, VkShaderStageFlags stage,
+                         std::string_view name);
+
+// One resource for one binding; buffers bind whole, images with the layout they are in.
+struct DescriptorResource {
+  uint32_t binding = 0;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkSampler sampler = VK_NULL_HANDLE;
+};
+
+class ComputePipeline {
+ public:
+  ComputePipeline(Context& ctx, std::string_view shader);
+  ~ComputePipeline();
+  ComputePipeline(const ComputePipeline&) = delete;
+  ComputePipeline& operator=(const ComputePipeline&) = delete;
+
+  const std::string& name() const { return name_; }
+  const ShaderReflection& reflection() const { return reflection_; }
+  std::array<uint32_t, 3> local_size() const { return reflection_.local_size; }
+
+  // Binds the pipeline and pushes one descriptor per reflected binding; throws Error naming the
+  // shader and binding when `resources` leaves one out.
+  void bind(VkCommandBuffer cmd, std::span<const DescriptorResource> resources) const;
+  void push_constants(VkCommandBuffer cmd, const void* data, uint32_t size) const;
+  template <typename T>
+  void push_constants(VkCommandBuffer cmd, const T& value) const {
+    push_constants(cmd, &value, sizeof(T));
+  }
+
+ private:
+  VkDevice device_ = VK_NULL_HANDLE;
+  std::string name_;
+  ShaderReflection reflection_;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
+};
+
+// Workgroups needed to cover `items` with groups of `group` (ceil division).
+inline uint32_t group_count(uint32_t items, uint32_t group) { return (items + group - 1) / group; }
+
+}  // namespace strata

@@ -1,0 +1,82 @@
+#include "passes/summed_area_table.h"
+
+#include "engine/graph_runner.h"
+#include "shared/summed_area_table.h"
+
+namespace strata {
+
+using graph::ResourceId;
+using graph::Use;
+
+namespace {
+
+gpu::SatParams params_for(graph::Extent e) {
+  return {e.width, e.height, group_count(e.width, SAT_TILE), group_count(e.height, SAT_TILE)};
+}
+
+}  // namespace
+
+SummedAreaTable::SummedAreaTable(Context& ctx)
+    : sums_(ctx, "summed_area_table_sums.comp"),
+      carries_(ctx, "summed_area_table_carries.comp"),
+      scan_(ctx, "summed_area_table_scan.comp") {}
+
+void SummedAreaTable::add_to(graph::Graph& graph, ResourceId input, ResourceId output,
+                             const std::string& group) const {
+  const ResourceId row_carry = graph.add_buffer(
+      group + ".row_carry", {[](graph::Extent e) {
+        return VkDeviceSize{params_for(e).tiles_x} * e.height * sizeof(float);
+      }});
+  const ResourceId column_carry = graph.add_buffer(
+      group + ".column_carry", {[](graph::Extent e) {
+        return VkDeviceSize{params_for(e).tiles_y} * e.width * sizeof(float);
+      }});
+
+  // The three passes differ only in pipeline, resources and workgroup count.
+  const auto add = [&](const char* name, const ComputePipeline& pipeline,
+                       std::vector<graph::ResourceUse> uses, bool per_tile) {
+    graph.add_pass({group + "." + name, graph::PassKind::compute, std::move(uses),
+                    [&pipeline, per_tile](graph::PassContext& pc) {
+                      const gpu::SatParams p = params_for(pc.viewport);
+                      pc.bind(pipeline);
+                      pipeline.push_constants(pc.cmd, p);
+                      if (per_tile) {
+                        vkCmdDispatch(pc.cmd, p.tiles_x, p.tiles_y, 1);
+                      } else {
+                        vkCmdDispatch(pc.cmd, group_count(p.width + p.height, SAT_CARRY_GROUP), 1, 1);
+                      }
+                    },
+                    group});
+  };
+  add("sums", sums_,
+      {{input, Use::storage_read, SAT_BINDING_INPUT},
+       {row_carry, Use::storage_write, SAT_BINDING_ROW_CARRY},
+       {column_carry, Use::storage_write, SAT_BINDING_COLUMN_CARRY}},
+      true);
+  add("carries", carries_,
+      {{row_carry, Use::storage_read_write, SAT_BINDING_ROW_CARRY},
+       {column_carry, Use::storage_read_write, SAT_BINDING_COLUMN_CARRY}},
+      false);
+  add("scan", scan_,
+      {{input, Use::storage_read, SAT_BINDING_INPUT},
+       {row_carry, Use::storage_read, SAT_BINDING_ROW_CARRY},
+       {column_carry, Use::storage_read, SAT_BINDING_COLUMN_CARRY},
+       {output, Use::storage_write, SAT_BINDING_OUTPUT}},
+      true);
+}
+
+std::vector<double> summed_area_table_reference(std::span<const float> values, uint32_t width,
+                                                uint32_t height) {
+  std::vector<double> out(size_t{width} * height);
+  for (uint32_t y = 0; y < height; ++y) {
+    double row = 0.0;
+    for (uint32_t x = 0; x < width; ++x) {
+      const size_t i = size_t{y} * width + x;
+      row += values[i];
+      out[i] = row + (y > 0 ? out[i - width] : 0.0);
+    }
+  }
+  return out;
+}
+
+}  // namespace strata

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs every Debian package strata needs to build, test and run. Idempotent: when everything is
+# present it only checks (dpkg-query) and returns in well under a second.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  cmake ninja-build g++ pkg-config make
+  # Vulkan: headers, loader, lavapipe (CPU device), validation layers, shader compiler and tools
+  libvulkan-dev vulkan-tools mesa-vulkan-drivers vulkan-validationlayers glslang-tools spirv-tools
+  libspirv-cross-c-shared-dev
+  # libraries
+  libglm-dev libglfw3-dev libimgui-dev doctest-dev libcli11-dev libstb-dev
+  # window tests without a display
+  xvfb xauth
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
+  [[ $status == installed ]] || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}"
+sudo=""
+if [[ $(id -u) != 0 ]]; then sudo=sudo; fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -q
+$sudo apt-get install -y -q --no-install-recommends "${missing[@]}"

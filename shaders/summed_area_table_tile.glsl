@@ -1,0 +1,19 @@
+// Shared by the summed-area-table shaders: one tile of the input in shared memory.
+layout(local_size_x = SAT_TILE, local_size_y = SAT_GROUP_ROWS) in;
+
+layout(binding = SAT_BINDING_INPUT, std430) readonly buffer Input { float values[]; } src;
+layout(push_constant) uniform Push { SatParams p; };
+
+shared float tile[SAT_TILE][SAT_TILE + 1];  // +1: no bank conflicts down a column
+
+uvec2 tile_origin() { return gl_WorkGroupID.xy * SAT_TILE; }
+
+// Coalesced: each pass of the loop reads SAT_GROUP_ROWS rows of 32 consecutive floats.
+void load_tile() {
+  const uvec2 origin = tile_origin();
+  const uint x = origin.x + gl_LocalInvocationID.x;
+  for (uint r = gl_LocalInvocationID.y; r < SAT_TILE; r += SAT_GROUP_ROWS) {
+    const uint y = origin.y + r;
+    tile[r][gl_LocalInvocationID.x] = (x < p.width && y < p.height) ? src.values[y * p.width + x] : 0.0;
+  }
+}

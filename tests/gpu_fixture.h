@@ -1,0 +1,31 @@
+// One lavapipe (or STRATA_DEVICE) context for the whole GPU test run, with the Khronos validation
+// layer and synchronization validation on. Every GPU test uses GpuTest, which fails the test if the
+// layer said anything while it ran.
+#pragma once
+
+#include <string>
+
+#include "engine/context.h"
+
+namespace strata::test {
+
+Context& gpu();
+
+struct GpuTest {
+  Context& ctx = gpu();
+  GpuTest();
+  ~GpuTest();
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs the strata binary built with these tests, with `args` (shell syntax), and captures it.
+CommandResult run_strata(const std::string& args, const std::string& env = "");
+
+// A folder for files the tests write (created on first use).
+std::string output_dir();
+
+}  // namespace strata::test

@@ -1,0 +1,50 @@
+// Descriptor layouts come from SPIR-V reflection of the embedded shaders.
+#include <doctest/doctest.h>
+
+#include "engine/error.h"
+#include "engine/shader_library.h"
+#include "shared/summed_area_table.h"
+#include "shared/test_pattern.h"
+
+namespace strata {
+
+TEST_SUITE("cpu") {
+  TEST_CASE("reflection_reads_bindings_push_constants_and_workgroup_size") {
+    const ShaderReflection r =
+        reflect(shader_code("summed_area_table_scan.comp"), VK_SHADER_STAGE_COMPUTE_BIT, "scan");
+    REQUIRE(r.bindings.size() == 4);
+    for (uint32_t i = 0; i < 4; ++i) {
+      CHECK(r.bindings[i].binding == i);
+      CHECK(r.bindings[i].descriptorType == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    }
+    CHECK(r.push_constant_size == sizeof(gpu::SatParams));
+    CHECK(r.local_size[0] == SAT_TILE);
+    CHECK(r.local_size[1] == SAT_GROUP_ROWS);
+    CHECK(r.local_size[2] == 1);
+  }
+
+  TEST_CASE("reflection_tells_storage_images_from_buffers") {
+    const ShaderReflection r =
+        reflect(shader_code("test_pattern_blur.comp"), VK_SHADER_STAGE_COMPUTE_BIT, "blur");
+    REQUIRE(r.bindings.size() == 3);
+    CHECK(r.bindings[0].binding == TEST_PATTERN_BINDING_COLOR);
+    CHECK(r.bindings[0].descriptorType == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
+    CHECK(r.bindings[1].binding == TEST_PATTERN_BINDING_TABLE);
+    CHECK(r.bindings[1].descriptorType == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    CHECK(r.bindings[2].binding == TEST_PATTERN_BINDING_OUTPUT);
+    CHECK(r.bindings[2].descriptorType == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
+  }
+
+  TEST_CASE("every_embedded_shader_reflects_and_unknown_names_are_errors") {
+    CHECK(shader_names().size() >= 5);
+    for (std::string_view name : shader_names()) {
+      CHECK_NOTHROW(reflect(shader_code(name), VK_SHADER_STAGE_COMPUTE_BIT, name));
+    }
+    CHECK_THROWS_WITH_AS(shader_code("missing.comp"), doctest::Contains("no shader named 'missing.comp'"),
+                         Error);
+    const std::vector<uint32_t> garbage = {1, 2, 3, 4, 5, 6};
+    CHECK_THROWS_AS(reflect(garbage, VK_SHADER_STAGE_COMPUTE_BIT, "garbage"), Error);
+  }
+}
+
+}  // namespace strata
