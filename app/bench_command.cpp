@@ -101,7 +101,8 @@ void bench_sat(DeviceOptions& device, graph::Extent size, uint32_t runs) {
   const std::vector<double> cpu = summed_area_table_reference(values, size.width, size.height);
   double max_relative = 0.0;
   for (size_t i = 0; i < count; ++i) {
-    max_relative = std::max(max_relative, std::abs(gpu[i] - cpu[i]) / std::max(1.0, std::abs(cpu[i])));
+    max_relative =
+        std::max(max_relative, std::abs(gpu[i] - cpu[i]) / std::max(1.0, std::abs(cpu[i])));
   }
   char header[256];
   std::snprintf(header, sizeof header,

@@ -5,7 +5,8 @@
 namespace strata::app {
 
 void add_devices_command(CLI::App& app, DeviceOptions& device) {
-  CLI::App* cmd = app.add_subcommand("devices", "List Vulkan devices and whether strata can use each");
+  CLI::App* cmd =
+      app.add_subcommand("devices", "List Vulkan devices and whether strata can use each");
   cmd->callback([&device] {
     const ContextOptions options = device.context();
     Instance instance(options.validation, {});
@@ -21,10 +22,11 @@ void add_devices_command(CLI::App& app, DeviceOptions& device) {
       chosen_error = e.what();
     }
     for (const DeviceReport& d : devices) {
-      std::printf("%s%u: %s (%s), Vulkan %u.%u.%u, driver %s\n", int(d.index) == chosen ? "* " : "  ",
-                  d.index, d.name.c_str(), to_string(d.type), VK_API_VERSION_MAJOR(d.caps.api_version),
-                  VK_API_VERSION_MINOR(d.caps.api_version), VK_API_VERSION_PATCH(d.caps.api_version),
-                  d.driver.c_str());
+      std::printf("%s%u: %s (%s), Vulkan %u.%u.%u, driver %s\n",
+                  int(d.index) == chosen ? "* " : "  ", d.index, d.name.c_str(), to_string(d.type),
+                  VK_API_VERSION_MAJOR(d.caps.api_version),
+                  VK_API_VERSION_MINOR(d.caps.api_version),
+                  VK_API_VERSION_PATCH(d.caps.api_version), d.driver.c_str());
       if (d.missing.empty()) {
         std::printf("     usable: has everything strata needs\n");
       } else {

@@ -25,7 +25,8 @@ graph::Extent parse_size(const std::string& text, const char* option) {
   const int n = std::sscanf(text.c_str(), "%u%c%u%c", &w, &x, &h, &extra);
   if (n == 1) h = w;
   if ((n != 1 && !(n == 3 && x == 'x')) || w == 0 || h == 0 || w > 16384 || h > 16384) {
-    throw strata::Error(std::string(option) + ": '" + text + "' is not a size (N or WxH, 1 to 16384)");
+    throw strata::Error(std::string(option) + ": '" + text +
+                        "' is not a size (N or WxH, 1 to 16384)");
   }
   return {w, h};
 }
@@ -37,8 +38,9 @@ int main(int argc, char** argv) {
   CLI::App app{"strata: label placement in volume-rendered medical scenes (Vulkan)"};
   app.require_subcommand(1);
   DeviceOptions device;
-  app.add_option("--device", device.device,
-                 "Vulkan device by index or part of its name (default: STRATA_DEVICE, else the best)");
+  app.add_option(
+      "--device", device.device,
+      "Vulkan device by index or part of its name (default: STRATA_DEVICE, else the best)");
   app.add_flag("--validate", device.validate,
                "Khronos validation with synchronization validation (always on in debug builds)");
   add_devices_command(app, device);

@@ -18,9 +18,12 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
     uint32_t blur = 12;
   };
   auto options = std::make_shared<Options>();
-  cmd->add_option("--size", options->size, "window size in screen units, N or WxH")->capture_default_str();
-  cmd->add_option("--frames", options->frames, "close after this many frames (0: when the window closes)");
-  cmd->add_option("--blur", options->blur, "box-filter radius of the demo's right half")->capture_default_str();
+  cmd->add_option("--size", options->size, "window size in screen units, N or WxH")
+      ->capture_default_str();
+  cmd->add_option("--frames", options->frames,
+                  "close after this many frames (0: when the window closes)");
+  cmd->add_option("--blur", options->blur, "box-filter radius of the demo's right half")
+      ->capture_default_str();
   cmd->callback([&device, options] {
     const graph::Extent size = parse_size(options->size, "--size");
     Glfw glfw;
@@ -31,8 +34,8 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
 
     glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
     glfwWindowHint(GLFW_SCALE_TO_MONITOR, GLFW_TRUE);  // HiDPI: the framebuffer follows the scale
-    GLFWwindow* window = glfwCreateWindow(static_cast<int>(size.width), static_cast<int>(size.height),
-                                          "strata", nullptr, nullptr);
+    GLFWwindow* window = glfwCreateWindow(
+        static_cast<int>(size.width), static_cast<int>(size.height), "strata", nullptr, nullptr);
     if (!window) throw strata::Error("cannot create a window of " + options->size);
     struct Closer {
       GLFWwindow* w;

@@ -15,9 +15,9 @@ namespace {
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
-VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(
-    VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
-    const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+VKAPI_ATTR VkBool32 VKAPI_CALL
+on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
   std::string message = data->pMessage ? data->pMessage : "(no message)";
   std::fprintf(stderr, "strata: validation: %s\n", message.c_str());
   static_cast<ValidationLog*>(user)->add(std::move(message));
@@ -29,8 +29,9 @@ bool has_layer(const char* name) {
   vkEnumerateInstanceLayerProperties(&count, nullptr);
   std::vector<VkLayerProperties> layers(count);
   vkEnumerateInstanceLayerProperties(&count, layers.data());
-  return std::any_of(layers.begin(), layers.end(),
-                     [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+  return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) {
+    return std::strcmp(l.layerName, name) == 0;
+  });
 }
 
 bool has_device_extension(VkPhysicalDevice device, const char* name) {
@@ -122,8 +123,8 @@ std::string join(const std::vector<std::string>& items) {
 }
 
 std::string unusable(const DeviceReport& d) {
-  return "device " + std::to_string(d.index) + " '" + d.name + "' lacks what strata needs: " +
-         join(d.missing);
+  return "device " + std::to_string(d.index) + " '" + d.name +
+         "' lacks what strata needs: " + join(d.missing);
 }
 
 }  // namespace
@@ -165,11 +166,13 @@ const char* to_string(VkPhysicalDeviceType type) {
 
 uint32_t choose_device(const std::vector<DeviceReport>& devices, std::string_view selector) {
   if (devices.empty()) {
-    throw Error("no Vulkan device found (is a Vulkan driver installed? on Debian: mesa-vulkan-drivers)");
+    throw Error(
+        "no Vulkan device found (is a Vulkan driver installed? on Debian: mesa-vulkan-drivers)");
   }
   if (!selector.empty()) {
     uint32_t index = 0;
-    const auto [end, ec] = std::from_chars(selector.data(), selector.data() + selector.size(), index);
+    const auto [end, ec] =
+        std::from_chars(selector.data(), selector.data() + selector.size(), index);
     const bool numeric = ec == std::errc() && end == selector.data() + selector.size();
     const DeviceReport* match = nullptr;
     for (const auto& d : devices) {
@@ -224,7 +227,8 @@ Instance::Instance(bool validation, const std::vector<const char*>& extensions) 
   app.pApplicationName = "strata";
   app.apiVersion = VK_API_VERSION_1_3;
 
-  VkDebugUtilsMessengerCreateInfoEXT messenger{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  VkDebugUtilsMessengerCreateInfoEXT messenger{
+      VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
   messenger.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
                               VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
   messenger.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |

@@ -1,9 +1,9 @@
 // The Vulkan instance, the chosen device and its one graphics+compute queue.
 //
-// Device choice: discrete GPU first, then integrated, virtual, CPU (lavapipe). `--device NAME|INDEX`
-// or STRATA_DEVICE overrides. What strata needs (64-bit buffer atomics, fragment stores and atomics,
-// synchronization2, dynamic rendering, timeline semaphores, ...) is checked up front, and a device
-// that lacks any of it is refused with one message that lists everything missing.
+// Device choice: discrete GPU first, then integrated, virtual, CPU (lavapipe). `--device
+// NAME|INDEX` or STRATA_DEVICE overrides. What strata needs (64-bit buffer atomics, fragment stores
+// and atomics, synchronization2, dynamic rendering, timeline semaphores, ...) is checked up front,
+// and a device that lacks any of it is refused with one message that lists everything missing.
 #pragma once
 
 #include <cstdint>
@@ -32,7 +32,8 @@ struct DeviceCapabilities {
   bool graphics_compute_queue_with_timestamps = false;
 };
 
-// Names of the requirements `caps` does not meet, in a fixed order; empty when the device is usable.
+// Names of the requirements `caps` does not meet, in a fixed order; empty when the device is
+// usable.
 std::vector<std::string> missing_requirements(const DeviceCapabilities& caps);
 
 struct DeviceReport {

@@ -5,9 +5,15 @@
 
 namespace strata::graph {
 
-VkBuffer PassContext::buffer(ResourceId id) const { return runner_->bound_.at(id).buffer; }
-VkImage PassContext::image(ResourceId id) const { return runner_->bound_.at(id).image; }
-VkImageView PassContext::view(ResourceId id) const { return runner_->bound_.at(id).view; }
+VkBuffer PassContext::buffer(ResourceId id) const {
+  return runner_->bound_.at(id).buffer;
+}
+VkImage PassContext::image(ResourceId id) const {
+  return runner_->bound_.at(id).image;
+}
+VkImageView PassContext::view(ResourceId id) const {
+  return runner_->bound_.at(id).view;
+}
 
 void PassContext::bind(const ComputePipeline& pipeline) const {
   std::vector<DescriptorResource> resources;
@@ -15,7 +21,8 @@ void PassContext::bind(const ComputePipeline& pipeline) const {
   for (const ResourceUse& u : pass.uses) {
     if (!u.binding) continue;
     const GraphRunner::Bound& b = runner_->bound_.at(u.resource);
-    resources.push_back({*u.binding, b.buffer, b.view, runner_->compiled_.layout[pass_][u.resource]});
+    resources.push_back(
+        {*u.binding, b.buffer, b.view, runner_->compiled_.layout[pass_][u.resource]});
   }
   pipeline.bind(cmd, resources);
 }
@@ -30,7 +37,9 @@ GraphRunner::GraphRunner(Context& ctx, Graph graph)
   STRATA_VK(vkCreateQueryPool(ctx_.device(), &info, nullptr, &queries_));
 }
 
-GraphRunner::~GraphRunner() { vkDestroyQueryPool(ctx_.device(), queries_, nullptr); }
+GraphRunner::~GraphRunner() {
+  vkDestroyQueryPool(ctx_.device(), queries_, nullptr);
+}
 
 void GraphRunner::set_viewport(Extent viewport) {
   if (viewport == viewport_) return;
@@ -46,13 +55,16 @@ void GraphRunner::set_viewport(Extent viewport) {
       bound_[i] = {VK_NULL_HANDLE, image.handle(), image.view(), r.image.format};
     } else {
       const VkDeviceSize size = std::max<VkDeviceSize>(4, r.buffer.size(viewport));
-      Buffer& buffer = owned_[i].emplace<Buffer>(ctx_, size, compiled_.usage[i], MemoryKind::device_local);
+      Buffer& buffer =
+          owned_[i].emplace<Buffer>(ctx_, size, compiled_.usage[i], MemoryKind::device_local);
       bound_[i] = {buffer.handle()};
     }
   }
 }
 
-void GraphRunner::bind_buffer(ResourceId id, VkBuffer buffer) { bound_.at(id) = {buffer}; }
+void GraphRunner::bind_buffer(ResourceId id, VkBuffer buffer) {
+  bound_.at(id) = {buffer};
+}
 
 void GraphRunner::bind_image(ResourceId id, VkImage image, VkImageView view, VkFormat format) {
   bound_.at(id) = {VK_NULL_HANDLE, image, view, format};
@@ -74,8 +86,8 @@ void GraphRunner::emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) c
       ib.newLayout = b.new_layout;
       ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
       ib.image = r.image;
-      const VkImageAspectFlags aspect = r.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                                                         : VK_IMAGE_ASPECT_COLOR_BIT;
+      const VkImageAspectFlags aspect =
+          r.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
       ib.subresourceRange = {aspect, 0, 1, 0, 1};
       images.push_back(ib);
     } else {
@@ -102,7 +114,8 @@ void GraphRunner::record(VkCommandBuffer cmd) {
   if (viewport_.width == 0) throw Error("render graph: set_viewport() before record()");
   for (size_t i = 0; i < bound_.size(); ++i) {
     if (!bound_[i].buffer && !bound_[i].image) {
-      throw Error("render graph: imported resource '" + graph_.resources()[i].name + "' is not bound");
+      throw Error("render graph: imported resource '" + graph_.resources()[i].name +
+                  "' is not bound");
     }
   }
   const auto& passes = graph_.passes();
@@ -129,9 +142,10 @@ std::vector<PassTiming> GraphRunner::timings() const {
   const auto& passes = graph_.passes();
   std::vector<uint64_t> stamps(2 * passes.size());
   if (!passes.empty()) {
-    STRATA_VK(vkGetQueryPoolResults(ctx_.device(), queries_, 0, static_cast<uint32_t>(stamps.size()),
-                                    stamps.size() * sizeof(uint64_t), stamps.data(), sizeof(uint64_t),
-                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    STRATA_VK(
+        vkGetQueryPoolResults(ctx_.device(), queries_, 0, static_cast<uint32_t>(stamps.size()),
+                              stamps.size() * sizeof(uint64_t), stamps.data(), sizeof(uint64_t),
+                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   }
   std::vector<PassTiming> out;
   const double to_ms = ctx_.timestamp_period_ns() * 1e-6;

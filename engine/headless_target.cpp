@@ -3,8 +3,8 @@
 namespace strata {
 
 void HeadlessTarget::add_output(graph::Graph& graph, graph::ResourceId frame) {
-  readback_id_ = graph.import_resource("readback", {false, false, VK_IMAGE_LAYOUT_UNDEFINED,
-                                                    graph::Use::host_read});
+  readback_id_ = graph.import_resource(
+      "readback", {false, false, VK_IMAGE_LAYOUT_UNDEFINED, graph::Use::host_read});
   const graph::ResourceId readback = readback_id_;
   graph.add_pass({"readback",
                   graph::PassKind::transfer,
@@ -13,7 +13,8 @@ void HeadlessTarget::add_output(graph::Graph& graph, graph::ResourceId frame) {
                     VkBufferImageCopy region{};
                     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
                     region.imageExtent = {pc.viewport.width, pc.viewport.height, 1};
-                    vkCmdCopyImageToBuffer(pc.cmd, pc.image(frame), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                    vkCmdCopyImageToBuffer(pc.cmd, pc.image(frame),
+                                           VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                                            pc.buffer(readback), 1, &region);
                   }});
 }

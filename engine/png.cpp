@@ -13,8 +13,8 @@ void write_png(const std::string& path, uint32_t width, uint32_t height,
     throw Error(path + ": " + std::to_string(rgba.size()) + " bytes is not a " +
                 std::to_string(width) + "x" + std::to_string(height) + " rgba8 image");
   }
-  if (!stbi_write_png(path.c_str(), static_cast<int>(width), static_cast<int>(height), 4, rgba.data(),
-                      static_cast<int>(width * 4))) {
+  if (!stbi_write_png(path.c_str(), static_cast<int>(width), static_cast<int>(height), 4,
+                      rgba.data(), static_cast<int>(width * 4))) {
     throw Error(path + ": cannot write PNG (does the folder exist and is it writable?)");
   }
 }

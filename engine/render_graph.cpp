@@ -6,9 +6,9 @@ namespace strata::graph {
 namespace {
 
 constexpr VkPipelineStageFlags2 kShaderStages[] = {
-    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,                                         // compute
+    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,                                           // compute
     VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,  // graphics
-    VK_PIPELINE_STAGE_2_NONE,                                                       // transfer
+    VK_PIPELINE_STAGE_2_NONE,                                                         // transfer
 };
 
 bool image_only(Use use) {
@@ -27,7 +27,8 @@ VkFlags usage_flag(Use use, bool is_image) {
     case Use::storage_read:
     case Use::storage_write:
     case Use::storage_read_write:
-      return is_image ? VkFlags{VK_IMAGE_USAGE_STORAGE_BIT} : VkFlags{VK_BUFFER_USAGE_STORAGE_BUFFER_BIT};
+      return is_image ? VkFlags{VK_IMAGE_USAGE_STORAGE_BIT}
+                      : VkFlags{VK_BUFFER_USAGE_STORAGE_BUFFER_BIT};
     case Use::uniform:
       return VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT;
     case Use::indirect:
@@ -37,9 +38,11 @@ VkFlags usage_flag(Use use, bool is_image) {
     case Use::depth_attachment:
       return VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
     case Use::transfer_src:
-      return is_image ? VkFlags{VK_IMAGE_USAGE_TRANSFER_SRC_BIT} : VkFlags{VK_BUFFER_USAGE_TRANSFER_SRC_BIT};
+      return is_image ? VkFlags{VK_IMAGE_USAGE_TRANSFER_SRC_BIT}
+                      : VkFlags{VK_BUFFER_USAGE_TRANSFER_SRC_BIT};
     case Use::transfer_dst:
-      return is_image ? VkFlags{VK_IMAGE_USAGE_TRANSFER_DST_BIT} : VkFlags{VK_BUFFER_USAGE_TRANSFER_DST_BIT};
+      return is_image ? VkFlags{VK_IMAGE_USAGE_TRANSFER_DST_BIT}
+                      : VkFlags{VK_BUFFER_USAGE_TRANSFER_DST_BIT};
     case Use::host_read:
     case Use::present:
       return 0;
@@ -52,7 +55,7 @@ struct State {
   bool has_content = false;
   VkPipelineStageFlags2 write_stage = VK_PIPELINE_STAGE_2_NONE;  // last write (or transition)
   VkAccessFlags2 write_access = VK_ACCESS_2_NONE;
-  VkPipelineStageFlags2 read_stages = VK_PIPELINE_STAGE_2_NONE;  // reads since that write
+  VkPipelineStageFlags2 read_stages = VK_PIPELINE_STAGE_2_NONE;     // reads since that write
   VkPipelineStageFlags2 visible_stages = VK_PIPELINE_STAGE_2_NONE;  // made visible since then
   VkAccessFlags2 visible_access = VK_ACCESS_2_NONE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
@@ -74,10 +77,11 @@ std::optional<Barrier> step(State& state, const Access& a, ResourceId id, bool i
     const bool needed = transition || b.src_stage != VK_PIPELINE_STAGE_2_NONE;
     // A transition happens before this pass's accesses, which see its result.
     state.write_stage = a.stage;
-    state.write_access = a.writes ? (a.access & ~VkAccessFlags2{VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
-                                                               VK_ACCESS_2_SHADER_SAMPLED_READ_BIT |
-                                                               VK_ACCESS_2_TRANSFER_READ_BIT})
-                                  : VK_ACCESS_2_NONE;
+    state.write_access = a.writes
+                             ? (a.access & ~VkAccessFlags2{VK_ACCESS_2_SHADER_STORAGE_READ_BIT |
+                                                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT |
+                                                           VK_ACCESS_2_TRANSFER_READ_BIT})
+                             : VK_ACCESS_2_NONE;
     state.read_stages = a.reads ? a.stage : VK_PIPELINE_STAGE_2_NONE;
     // Nothing has seen this pass's own writes yet; a bare transition is seen by this pass.
     state.visible_stages = a.writes ? VK_PIPELINE_STAGE_2_NONE : a.stage;
@@ -88,8 +92,8 @@ std::optional<Barrier> step(State& state, const Access& a, ResourceId id, bool i
   }
   // A read with no transition: wait for the last write unless a barrier already covers it.
   state.read_stages |= a.stage;
-  const bool covered = (state.visible_stages & a.stage) == a.stage &&
-                       (state.visible_access & a.access) == a.access;
+  const bool covered =
+      (state.visible_stages & a.stage) == a.stage && (state.visible_access & a.access) == a.access;
   if (state.write_stage == VK_PIPELINE_STAGE_2_NONE || covered) return std::nullopt;
   b.src_stage = state.write_stage;
   b.src_access = state.write_access;
@@ -149,18 +153,30 @@ std::vector<MergedUse> merge_uses(const PassInfo& pass, const Graph& graph) {
 
 const char* to_string(Use use) {
   switch (use) {
-    case Use::sampled: return "sampled";
-    case Use::storage_read: return "storage_read";
-    case Use::storage_write: return "storage_write";
-    case Use::storage_read_write: return "storage_read_write";
-    case Use::uniform: return "uniform";
-    case Use::indirect: return "indirect";
-    case Use::color_attachment: return "color_attachment";
-    case Use::depth_attachment: return "depth_attachment";
-    case Use::transfer_src: return "transfer_src";
-    case Use::transfer_dst: return "transfer_dst";
-    case Use::host_read: return "host_read";
-    case Use::present: return "present";
+    case Use::sampled:
+      return "sampled";
+    case Use::storage_read:
+      return "storage_read";
+    case Use::storage_write:
+      return "storage_write";
+    case Use::storage_read_write:
+      return "storage_read_write";
+    case Use::uniform:
+      return "uniform";
+    case Use::indirect:
+      return "indirect";
+    case Use::color_attachment:
+      return "color_attachment";
+    case Use::depth_attachment:
+      return "depth_attachment";
+    case Use::transfer_src:
+      return "transfer_src";
+    case Use::transfer_dst:
+      return "transfer_dst";
+    case Use::host_read:
+      return "host_read";
+    case Use::present:
+      return "present";
   }
   return "?";
 }
@@ -170,7 +186,8 @@ Access access_of(Use use, PassKind kind, bool is_image) {
   const VkImageLayout general = is_image ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_UNDEFINED;
   switch (use) {
     case Use::sampled:
-      return {shader, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, true, false};
+      return {shader, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+              true, false};
     case Use::storage_read:
       return {shader, VK_ACCESS_2_SHADER_STORAGE_READ_BIT, general, true, false};
     case Use::storage_write:
@@ -188,19 +205,25 @@ Access access_of(Use use, PassKind kind, bool is_image) {
               VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
               VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, false, true};
     case Use::depth_attachment:
-      return {VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+      return {VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                  VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
               VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, false, true};
     case Use::transfer_src:
       return {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
-              is_image ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED, true, false};
+              is_image ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED, true,
+              false};
     case Use::transfer_dst:
       return {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-              is_image ? VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED, false, true};
+              is_image ? VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED, false,
+              true};
     case Use::host_read:
-      return {VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED, true, false};
+      return {VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+              true, false};
     case Use::present:
-      return {VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, true, false};
+      return {VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, true,
+              false};
   }
   return {};
 }
@@ -226,7 +249,9 @@ ResourceId Graph::import_resource(std::string name, ImportInfo info) {
   return static_cast<ResourceId>(resources_.size() - 1);
 }
 
-void Graph::add_pass(PassInfo pass) { passes_.push_back(std::move(pass)); }
+void Graph::add_pass(PassInfo pass) {
+  passes_.push_back(std::move(pass));
+}
 
 CompiledGraph compile(const Graph& graph) {
   const auto& resources = graph.resources();
@@ -254,7 +279,8 @@ CompiledGraph compile(const Graph& graph) {
         throw GraphError("pass '" + pass.name + "' reads '" + r.name +
                          "', which no earlier pass writes and which is not imported with content");
       }
-      if (auto b = step(states[m.resource], m.access, m.resource, r.is_image)) barriers.push_back(*b);
+      if (auto b = step(states[m.resource], m.access, m.resource, r.is_image))
+        barriers.push_back(*b);
       layouts[m.resource] = m.access.layout;
     }
     out.pass_barriers.push_back(std::move(barriers));

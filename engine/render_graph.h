@@ -45,8 +45,8 @@ enum class Use {
   depth_attachment,    // depth test and write
   transfer_src,
   transfer_dst,
-  host_read,           // only as an import's final use: the host reads it after the run
-  present,             // only as an import's final use: handed to the presentation engine
+  host_read,  // only as an import's final use: the host reads it after the run
+  present,    // only as an import's final use: handed to the presentation engine
 };
 
 const char* to_string(Use use);
@@ -141,7 +141,7 @@ struct CompiledGraph {
   std::vector<VkFlags> usage;                       // per resource: VkImageUsageFlags or
                                                     // VkBufferUsageFlags derived from its uses
   // The layout of `resource` while `pass` runs (images; UNDEFINED when the pass does not use it).
-  std::vector<std::vector<VkImageLayout>> layout;   // [pass][resource]
+  std::vector<std::vector<VkImageLayout>> layout;  // [pass][resource]
 };
 
 // A graph that cannot run: the message names the pass and the resource.

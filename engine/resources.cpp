@@ -20,7 +20,8 @@ VkMemoryPropertyFlags properties_for(MemoryKind kind) {
   return 0;
 }
 
-VkDeviceMemory allocate(Context& ctx, const VkMemoryRequirements& req, VkMemoryPropertyFlags props) {
+VkDeviceMemory allocate(Context& ctx, const VkMemoryRequirements& req,
+                        VkMemoryPropertyFlags props) {
   VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   info.allocationSize = req.size;
   info.memoryTypeIndex = ctx.memory_type(req.memoryTypeBits, props);
@@ -74,9 +75,13 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
   }
 }
 
-Buffer::~Buffer() { release(); }
+Buffer::~Buffer() {
+  release();
+}
 
-Buffer::Buffer(Buffer&& other) noexcept { *this = std::move(other); }
+Buffer::Buffer(Buffer&& other) noexcept {
+  *this = std::move(other);
+}
 
 Buffer& Buffer::operator=(Buffer&& other) noexcept {
   if (this != &other) {
@@ -122,9 +127,13 @@ Image::Image(Context& ctx, const ImageDesc& desc) : device_(ctx.device()), desc_
   STRATA_VK(vkCreateImageView(device_, &view, nullptr, &view_));
 }
 
-Image::~Image() { release(); }
+Image::~Image() {
+  release();
+}
 
-Image::Image(Image&& other) noexcept { *this = std::move(other); }
+Image::Image(Image&& other) noexcept {
+  *this = std::move(other);
+}
 
 Image& Image::operator=(Image&& other) noexcept {
   if (this != &other) {
@@ -193,8 +202,8 @@ std::vector<std::byte> download(Context& ctx, const Buffer& src) {
 
 std::vector<std::byte> download(Context& ctx, const Image& src, VkImageLayout layout) {
   const ImageDesc& d = src.desc();
-  const VkDeviceSize size = VkDeviceSize{d.extent.width} * d.extent.height * d.extent.depth *
-                            texel_size(d.format);
+  const VkDeviceSize size =
+      VkDeviceSize{d.extent.width} * d.extent.height * d.extent.depth * texel_size(d.format);
   Buffer staging(ctx, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback);
   ctx.run_now([&](VkCommandBuffer cmd) {
     VkBufferImageCopy region{};

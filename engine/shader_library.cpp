@@ -62,7 +62,8 @@ ShaderReflection reflect(std::span<const uint32_t> spirv, VkShaderStageFlags sta
       spvc_context_create_compiler(ctx.handle, SPVC_BACKEND_NONE, ir,
                                    SPVC_CAPTURE_MODE_TAKE_OWNERSHIP, &compiler) != SPVC_SUCCESS ||
       spvc_compiler_create_shader_resources(compiler, &resources) != SPVC_SUCCESS) {
-    throw Error(who + ": SPIR-V reflection failed: " + spvc_context_get_last_error_string(ctx.handle));
+    throw Error(who +
+                ": SPIR-V reflection failed: " + spvc_context_get_last_error_string(ctx.handle));
   }
 
   ShaderReflection out;
@@ -102,8 +103,8 @@ ShaderReflection reflect(std::span<const uint32_t> spirv, VkShaderStageFlags sta
   }
   if (stage == VK_SHADER_STAGE_COMPUTE_BIT) {
     for (unsigned axis = 0; axis < 3; ++axis) {
-      out.local_size[axis] =
-          spvc_compiler_get_execution_mode_argument_by_index(compiler, SpvExecutionModeLocalSize, axis);
+      out.local_size[axis] = spvc_compiler_get_execution_mode_argument_by_index(
+          compiler, SpvExecutionModeLocalSize, axis);
     }
   }
   return out;
@@ -139,7 +140,8 @@ ComputePipeline::ComputePipeline(Context& ctx, std::string_view shader)
   info.stage.module = module;
   info.stage.pName = "main";
   info.layout = layout_;
-  const VkResult result = vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_);
+  const VkResult result =
+      vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_);
   vkDestroyShaderModule(device_, module, nullptr);
   check_vk(result, ("vkCreateComputePipelines(" + name_ + ")").c_str());
 
@@ -153,7 +155,8 @@ ComputePipeline::~ComputePipeline() {
   vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
 }
 
-void ComputePipeline::bind(VkCommandBuffer cmd, std::span<const DescriptorResource> resources) const {
+void ComputePipeline::bind(VkCommandBuffer cmd,
+                           std::span<const DescriptorResource> resources) const {
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   if (reflection_.bindings.empty()) return;
   std::vector<VkDescriptorBufferInfo> buffers(reflection_.bindings.size());
@@ -161,8 +164,9 @@ void ComputePipeline::bind(VkCommandBuffer cmd, std::span<const DescriptorResour
   std::vector<VkWriteDescriptorSet> writes;
   for (size_t i = 0; i < reflection_.bindings.size(); ++i) {
     const VkDescriptorSetLayoutBinding& b = reflection_.bindings[i];
-    const auto it = std::find_if(resources.begin(), resources.end(),
-                                 [&](const DescriptorResource& r) { return r.binding == b.binding; });
+    const auto it =
+        std::find_if(resources.begin(), resources.end(),
+                     [&](const DescriptorResource& r) { return r.binding == b.binding; });
     if (it == resources.end()) {
       throw Error("shader '" + name_ + "': nothing bound to binding " + std::to_string(b.binding));
     }

@@ -71,6 +71,8 @@ class ComputePipeline {
 };
 
 // Workgroups needed to cover `items` with groups of `group` (ceil division).
-inline uint32_t group_count(uint32_t items, uint32_t group) { return (items + group - 1) / group; }
+inline uint32_t group_count(uint32_t items, uint32_t group) {
+  return (items + group - 1) / group;
+}
 
 }  // namespace strata

@@ -45,7 +45,9 @@ Glfw::Glfw() {
   }
 }
 
-Glfw::~Glfw() { glfwTerminate(); }
+Glfw::~Glfw() {
+  glfwTerminate();
+}
 
 std::vector<const char*> Glfw::instance_extensions() const {
   uint32_t count = 0;
@@ -56,7 +58,8 @@ std::vector<const char*> Glfw::instance_extensions() const {
 WindowTarget::WindowTarget(Context& ctx, GLFWwindow* window) : ctx_(ctx), window_(window) {
   STRATA_VK(glfwCreateWindowSurface(ctx.instance(), window, nullptr, &surface_));
   VkBool32 supported = VK_FALSE;
-  vkGetPhysicalDeviceSurfaceSupportKHR(ctx.physical_device(), ctx.queue_family(), surface_, &supported);
+  vkGetPhysicalDeviceSurfaceSupportKHR(ctx.physical_device(), ctx.queue_family(), surface_,
+                                       &supported);
   if (!supported) throw Error("device '" + ctx.report().name + "' cannot present to this window");
 
   VkSemaphoreCreateInfo sem{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
@@ -103,8 +106,8 @@ void WindowTarget::add_output(graph::Graph& graph, graph::ResourceId frame) {
                     region.dstSubresource = region.srcSubresource;
                     region.dstOffsets[1] = {w, h, 1};
                     vkCmdBlitImage(pc.cmd, pc.image(frame), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                   pc.image(target), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region,
-                                   VK_FILTER_NEAREST);
+                                   pc.image(target), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                                   &region, VK_FILTER_NEAREST);
                   }});
 }
 
@@ -121,7 +124,8 @@ void WindowTarget::create_swapchain(graph::Extent framebuffer) {
   STRATA_VK(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(ctx_.physical_device(), surface_, &caps));
   const VkSurfaceFormatKHR format = choose_format(ctx_.physical_device(), surface_);
   graph::Extent extent = framebuffer;
-  if (caps.currentExtent.width != UINT32_MAX) extent = {caps.currentExtent.width, caps.currentExtent.height};
+  if (caps.currentExtent.width != UINT32_MAX)
+    extent = {caps.currentExtent.width, caps.currentExtent.height};
   extent.width = std::clamp(extent.width, caps.minImageExtent.width, caps.maxImageExtent.width);
   extent.height = std::clamp(extent.height, caps.minImageExtent.height, caps.maxImageExtent.height);
 
@@ -168,8 +172,8 @@ bool WindowTarget::draw(graph::GraphRunner& runner) {
   VkDevice device = ctx_.device();
   STRATA_VK(vkWaitForFences(device, 1, &frame_done_, VK_TRUE, UINT64_MAX));
   uint32_t index = 0;
-  const VkResult acquired = vkAcquireNextImageKHR(device, swapchain_, UINT64_MAX, acquired_,
-                                                  VK_NULL_HANDLE, &index);
+  const VkResult acquired =
+      vkAcquireNextImageKHR(device, swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
   if (acquired == VK_ERROR_OUT_OF_DATE_KHR) {
     out_of_date_ = true;
     return false;

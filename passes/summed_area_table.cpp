@@ -23,14 +23,14 @@ SummedAreaTable::SummedAreaTable(Context& ctx)
 
 void SummedAreaTable::add_to(graph::Graph& graph, ResourceId input, ResourceId output,
                              const std::string& group) const {
-  const ResourceId row_carry = graph.add_buffer(
-      group + ".row_carry", {[](graph::Extent e) {
-        return VkDeviceSize{params_for(e).tiles_x} * e.height * sizeof(float);
-      }});
-  const ResourceId column_carry = graph.add_buffer(
-      group + ".column_carry", {[](graph::Extent e) {
-        return VkDeviceSize{params_for(e).tiles_y} * e.width * sizeof(float);
-      }});
+  const ResourceId row_carry =
+      graph.add_buffer(group + ".row_carry", {[](graph::Extent e) {
+                         return VkDeviceSize{params_for(e).tiles_x} * e.height * sizeof(float);
+                       }});
+  const ResourceId column_carry =
+      graph.add_buffer(group + ".column_carry", {[](graph::Extent e) {
+                         return VkDeviceSize{params_for(e).tiles_y} * e.width * sizeof(float);
+                       }});
 
   // The three passes differ only in pipeline, resources and workgroup count.
   const auto add = [&](const char* name, const ComputePipeline& pipeline,
@@ -43,7 +43,8 @@ void SummedAreaTable::add_to(graph::Graph& graph, ResourceId input, ResourceId o
                       if (per_tile) {
                         vkCmdDispatch(pc.cmd, p.tiles_x, p.tiles_y, 1);
                       } else {
-                        vkCmdDispatch(pc.cmd, group_count(p.width + p.height, SAT_CARRY_GROUP), 1, 1);
+                        vkCmdDispatch(pc.cmd, group_count(p.width + p.height, SAT_CARRY_GROUP), 1,
+                                      1);
                       }
                     },
                     group});

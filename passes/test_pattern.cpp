@@ -14,7 +14,9 @@ TestPattern::TestPattern(Context& ctx)
     : draw_(ctx, "test_pattern.comp"), blur_(ctx, "test_pattern_blur.comp"), table_(ctx) {}
 
 graph::ResourceId TestPattern::add_to(graph::Graph& graph, uint32_t blur_radius) const {
-  const auto floats = [](graph::Extent e) { return VkDeviceSize{e.width} * e.height * sizeof(float); };
+  const auto floats = [](graph::Extent e) {
+    return VkDeviceSize{e.width} * e.height * sizeof(float);
+  };
   const graph::ResourceId color = graph.add_image("pattern.color", {VK_FORMAT_R8G8B8A8_UNORM});
   const graph::ResourceId luminance = graph.add_buffer("pattern.luminance", {floats});
   const graph::ResourceId table = graph.add_buffer("pattern.table", {floats});
@@ -68,7 +70,8 @@ std::vector<uint8_t> test_pattern_reference(uint32_t width, uint32_t height, uin
       glm::vec3 c = color[i];
       if (x >= width / 2) {
         const int x0 = std::max(int(x) - r, 0) - 1, y0 = std::max(int(y) - r, 0) - 1;
-        const int x1 = std::min(int(x) + r, int(width) - 1), y1 = std::min(int(y) + r, int(height) - 1);
+        const int x1 = std::min(int(x) + r, int(width) - 1),
+                  y1 = std::min(int(y) + r, int(height) - 1);
         const double sum = at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0);
         const float mean = static_cast<float>(sum / ((x1 - x0) * (y1 - y0)));
         c = mean * glm::vec3(1.0f, 0.9f, 0.7f);

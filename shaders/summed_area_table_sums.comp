@@ -6,19 +6,33 @@
 layout(binding = SAT_BINDING_ROW_CARRY, std430) writeonly buffer RowCarry { float row_carry[]; };
 layout(binding = SAT_BINDING_COLUMN_CARRY, std430) writeonly buffer ColumnCarry { float column_carry[]; };
 
+const uint kRuns = SAT_TILE / SAT_RUN;  // runs per tile line; kRuns * SAT_TILE == threads
+shared float row_parts[SAT_TILE][kRuns];
+shared float column_parts[SAT_TILE][kRuns];
+
 void main() {
   load_tile();
   barrier();
-  const uvec2 origin = tile_origin();
+  // Every thread sums one run of a row and one run of a column; then 64 threads add the runs.
   const uint t = gl_LocalInvocationIndex;
-  if (t < SAT_TILE) {
+  const uint line = t / kRuns, run = t % kRuns;
+  float row = 0.0, column = 0.0;
+  for (uint j = 0; j < SAT_RUN; ++j) {
+    row += tile[line][run * SAT_RUN + j];
+    column += tile[run * SAT_RUN + j][line];
+  }
+  row_parts[line][run] = row;
+  column_parts[line][run] = column;
+  barrier();
+  const uvec2 origin = tile_origin();
+  if (t < 2 * SAT_TILE) {
+    const uint l = t % SAT_TILE;
     float sum = 0.0;
-    for (uint c = 0; c < SAT_TILE; ++c) sum += tile[t][c];
-    if (origin.y + t < p.height) row_carry[gl_WorkGroupID.x * p.height + origin.y + t] = sum;
-  } else if (t < 2 * SAT_TILE) {
-    const uint c = t - SAT_TILE;
-    float sum = 0.0;
-    for (uint r = 0; r < SAT_TILE; ++r) sum += tile[r][c];
-    if (origin.x + c < p.width) column_carry[gl_WorkGroupID.y * p.width + origin.x + c] = sum;
+    for (uint r = 0; r < kRuns; ++r) sum += t < SAT_TILE ? row_parts[l][r] : column_parts[l][r];
+    if (t < SAT_TILE && origin.y + l < p.height) {
+      row_carry[gl_WorkGroupID.x * p.height + origin.y + l] = sum;
+    } else if (t >= SAT_TILE && origin.x + l < p.width) {
+      column_carry[gl_WorkGroupID.y * p.width + origin.x + l] = sum;
+    }
   }
 }

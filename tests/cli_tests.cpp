@@ -39,7 +39,9 @@ TEST_SUITE("cli") {
   }
 
   TEST_CASE("no_vulkan_driver_is_one_clear_error_and_exit_1") {
-    const auto r = run_strata("render -o /dev/null", "VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json");
+    const auto r =
+        run_strata("render -o /dev/null",
+                   "VK_DRIVER_FILES=/nonexistent/icd.json VK_ICD_FILENAMES=/nonexistent/icd.json");
     CHECK(r.exit_code == 1);
     CHECK(r.output.find("strata: error: no Vulkan") != std::string::npos);
     CHECK(r.output.find("Segmentation") == std::string::npos);

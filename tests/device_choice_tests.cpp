@@ -11,7 +11,8 @@ DeviceCapabilities everything() {
   DeviceCapabilities c;
   c.api_version = VK_API_VERSION_1_3;
   c.shader_int64 = c.buffer_int64_atomics = c.fragment_stores_and_atomics = true;
-  c.synchronization2 = c.dynamic_rendering = c.maintenance4 = c.timeline_semaphore = c.push_descriptor = true;
+  c.synchronization2 = c.dynamic_rendering = c.maintenance4 = c.timeline_semaphore =
+      c.push_descriptor = true;
   c.subgroup_arithmetic_in_compute = c.graphics_compute_queue_with_timestamps = true;
   return c;
 }
@@ -63,8 +64,8 @@ TEST_SUITE("cpu") {
     CHECK(choose_device(devices, "0") == 0);
     CHECK(choose_device(devices, "LLVMPIPE") == 0);
     CHECK(choose_device(devices, "h100") == 1);
-    CHECK_THROWS_WITH_AS(choose_device(devices, "radeon"), doctest::Contains("no Vulkan device matches 'radeon'"),
-                         Error);
+    CHECK_THROWS_WITH_AS(choose_device(devices, "radeon"),
+                         doctest::Contains("no Vulkan device matches 'radeon'"), Error);
     CHECK_THROWS_AS(choose_device(devices, "7"), Error);
   }
 
@@ -72,12 +73,14 @@ TEST_SUITE("cpu") {
     DeviceCapabilities c = everything();
     c.fragment_stores_and_atomics = false;
     c.timeline_semaphore = false;
-    const std::vector<DeviceReport> devices = {device(0, "tiny GPU", VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU, c)};
+    const std::vector<DeviceReport> devices = {
+        device(0, "tiny GPU", VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU, c)};
     CHECK_THROWS_WITH_AS(choose_device(devices, "0"),
                          "device 0 'tiny GPU' lacks what strata needs: fragmentStoresAndAtomics, "
                          "timelineSemaphore",
                          Error);
-    CHECK_THROWS_WITH_AS(choose_device(devices, ""), doctest::Contains("no usable Vulkan device"), Error);
+    CHECK_THROWS_WITH_AS(choose_device(devices, ""), doctest::Contains("no usable Vulkan device"),
+                         Error);
   }
 
   TEST_CASE("no_device_at_all_is_one_clear_error") {

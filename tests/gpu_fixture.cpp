@@ -19,7 +19,9 @@ Context& gpu() {
   return ctx;
 }
 
-GpuTest::GpuTest() { ctx.validation_log().take(); }
+GpuTest::GpuTest() {
+  ctx.validation_log().take();
+}
 
 GpuTest::~GpuTest() {
   for (const std::string& message : ctx.validation_log().take()) {

@@ -117,13 +117,14 @@ TEST_SUITE("cpu") {
     Graph g;
     const ResourceId b = g.add_buffer("saliency", any_size());
     g.add_pass(pass("integral_costs", PassKind::compute, {{b, Use::storage_read}}));
-    CHECK_THROWS_WITH_AS(compile(g),
-                         doctest::Contains("pass 'integral_costs' reads 'saliency'"), GraphError);
+    CHECK_THROWS_WITH_AS(compile(g), doctest::Contains("pass 'integral_costs' reads 'saliency'"),
+                         GraphError);
   }
 
   TEST_CASE("an_import_with_content_can_be_read_without_a_writer") {
     Graph g;
-    const ResourceId volume = g.import_resource("volume", {true, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+    const ResourceId volume =
+        g.import_resource("volume", {true, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
     g.add_pass(pass("raycast", PassKind::compute, {{volume, Use::sampled}}));
     const CompiledGraph c = compile(g);
     CHECK(c.pass_barriers[0].empty());  // already in the layout it is read in, nothing to wait for
@@ -131,11 +132,13 @@ TEST_SUITE("cpu") {
 
   TEST_CASE("final_uses_of_imports_get_their_barriers_after_the_last_pass") {
     Graph g;
-    const ResourceId swapchain = g.import_resource(
-        "swapchain", {true, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::present,
-                      VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT});
-    const ResourceId readback = g.import_resource("positions", {false, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::host_read});
-    g.add_pass(pass("blit", PassKind::transfer, {{swapchain, Use::transfer_dst}, {readback, Use::transfer_dst}}));
+    const ResourceId swapchain =
+        g.import_resource("swapchain", {true, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::present,
+                                        VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT});
+    const ResourceId readback =
+        g.import_resource("positions", {false, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::host_read});
+    g.add_pass(pass("blit", PassKind::transfer,
+                    {{swapchain, Use::transfer_dst}, {readback, Use::transfer_dst}}));
     const CompiledGraph c = compile(g);
     REQUIRE(c.pass_barriers[0].size() == 1);  // the swapchain transition chains on the acquire wait
     CHECK(c.pass_barriers[0][0].src_stage == VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT);
@@ -157,15 +160,16 @@ TEST_SUITE("cpu") {
     const ResourceId img = g.add_image("frame", {});
     g.add_pass(pass("draw", PassKind::compute, {{img, Use::storage_write}}));
     g.add_pass(pass("both", PassKind::compute, {{img, Use::sampled}, {img, Use::storage_write}}));
-    CHECK_THROWS_WITH_AS(compile(g), doctest::Contains("pass 'both' uses image 'frame' in two layouts"),
-                         GraphError);
+    CHECK_THROWS_WITH_AS(
+        compile(g), doctest::Contains("pass 'both' uses image 'frame' in two layouts"), GraphError);
   }
 
   TEST_CASE("two_uses_of_one_buffer_in_a_pass_merge_into_one_barrier") {
     Graph g;
     const ResourceId b = g.add_buffer("hash", any_size());
     g.add_pass(pass("clear", PassKind::compute, {{b, Use::storage_write}}));
-    g.add_pass(pass("insert", PassKind::graphics, {{b, Use::storage_read, 0}, {b, Use::storage_write, 1}}));
+    g.add_pass(pass("insert", PassKind::graphics,
+                    {{b, Use::storage_read, 0}, {b, Use::storage_write, 1}}));
     const CompiledGraph c = compile(g);
     REQUIRE(c.pass_barriers[1].size() == 1);
     CHECK(c.pass_barriers[1][0].dst_access ==
@@ -178,13 +182,16 @@ TEST_SUITE("cpu") {
     const ResourceId img = g.add_image("image", {});
     Graph g1 = g;
     g1.add_pass(pass("p", PassKind::compute, {{b, Use::sampled}}));
-    CHECK_THROWS_WITH_AS(compile(g1), doctest::Contains("cannot use buffer 'buffer' as sampled"), GraphError);
+    CHECK_THROWS_WITH_AS(compile(g1), doctest::Contains("cannot use buffer 'buffer' as sampled"),
+                         GraphError);
     Graph g2 = g;
     g2.add_pass(pass("p", PassKind::compute, {{img, Use::indirect}}));
     CHECK_THROWS_AS(compile(g2), GraphError);
     Graph g3 = g;
-    g3.add_pass(pass("p", PassKind::compute, {{b, Use::storage_write, 2}, {img, Use::storage_write, 2}}));
-    CHECK_THROWS_WITH_AS(compile(g3), doctest::Contains("binds two resources to binding 2"), GraphError);
+    g3.add_pass(
+        pass("p", PassKind::compute, {{b, Use::storage_write, 2}, {img, Use::storage_write, 2}}));
+    CHECK_THROWS_WITH_AS(compile(g3), doctest::Contains("binds two resources to binding 2"),
+                         GraphError);
     Graph g4 = g;
     g4.add_pass(pass("p", PassKind::compute, {{ResourceId{99}, Use::storage_write}}));
     CHECK_THROWS_WITH_AS(compile(g4), doctest::Contains("resource #99"), GraphError);

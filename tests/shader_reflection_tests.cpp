@@ -40,8 +40,8 @@ TEST_SUITE("cpu") {
     for (std::string_view name : shader_names()) {
       CHECK_NOTHROW(reflect(shader_code(name), VK_SHADER_STAGE_COMPUTE_BIT, name));
     }
-    CHECK_THROWS_WITH_AS(shader_code("missing.comp"), doctest::Contains("no shader named 'missing.comp'"),
-                         Error);
+    CHECK_THROWS_WITH_AS(shader_code("missing.comp"),
+                         doctest::Contains("no shader named 'missing.comp'"), Error);
     const std::vector<uint32_t> garbage = {1, 2, 3, 4, 5, 6};
     CHECK_THROWS_AS(reflect(garbage, VK_SHADER_STAGE_COMPUTE_BIT, "garbage"), Error);
   }

@@ -20,8 +20,8 @@ std::vector<float> gpu_table(Context& ctx, const std::vector<float>& values, gra
   SummedAreaTable sat(ctx);
   graph::Graph graph;
   const auto in = graph.import_resource("input", {false, true});
-  const auto out = graph.import_resource("output", {false, false, VK_IMAGE_LAYOUT_UNDEFINED,
-                                                    graph::Use::transfer_src});
+  const auto out = graph.import_resource(
+      "output", {false, false, VK_IMAGE_LAYOUT_UNDEFINED, graph::Use::transfer_src});
   sat.add_to(graph, in, out);
   graph::GraphRunner runner(ctx, std::move(graph));
   runner.set_viewport(size);
@@ -34,7 +34,8 @@ std::vector<float> gpu_table(Context& ctx, const std::vector<float>& values, gra
 }  // namespace
 
 TEST_SUITE("gpu") {
-  TEST_CASE_FIXTURE(test::GpuTest, "summed_area_table_matches_cpu_reference_on_odd_and_large_sizes") {
+  TEST_CASE_FIXTURE(test::GpuTest,
+                    "summed_area_table_matches_cpu_reference_on_odd_and_large_sizes") {
     const graph::Extent sizes[] = {{1, 1}, {7, 3}, {64, 64}, {257, 129}, {1024, 768}};
     std::mt19937 rng(1234);
     std::uniform_real_distribution<float> dist(-1.0f, 1.0f);
@@ -50,7 +51,8 @@ TEST_SUITE("gpu") {
       const std::vector<double> cpu = summed_area_table_reference(values, size.width, size.height);
       // float32 sums of up to W*H terms: the error is bounded by a small multiple of machine
       // epsilon times the sum of magnitudes under the rectangle (the condition of the sum).
-      const std::vector<double> scale = summed_area_table_reference(magnitude, size.width, size.height);
+      const std::vector<double> scale =
+          summed_area_table_reference(magnitude, size.width, size.height);
       size_t bad = 0;
       for (size_t i = 0; i < values.size(); ++i) {
         const double tolerance = 1e-5 * scale[i] + 1e-6;

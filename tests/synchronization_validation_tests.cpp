@@ -42,7 +42,8 @@ TEST_SUITE("gpu") {
     REQUIRE(!messages.empty());
     bool read_after_write = false;
     for (const std::string& m : messages) {
-      read_after_write = read_after_write || m.find("SYNC-HAZARD-READ-AFTER-WRITE") != std::string::npos ||
+      read_after_write = read_after_write ||
+                         m.find("SYNC-HAZARD-READ-AFTER-WRITE") != std::string::npos ||
                          m.find("SYNC-HAZARD-READ_AFTER_WRITE") != std::string::npos;
     }
     CHECK_MESSAGE(read_after_write, "first message: " << messages.front());

@@ -31,7 +31,8 @@ TEST_SUITE("gpu") {
     // Tolerance: 2 of 255 per channel (float pow/sqrt differ slightly between CPU and GPU, and
     // the GPU box-filters the float luminance while the colour passes through rgba8).
     int worst = 0;
-    for (size_t i = 0; i < expected.size(); ++i) worst = std::max(worst, std::abs(actual[i] - expected[i]));
+    for (size_t i = 0; i < expected.size(); ++i)
+      worst = std::max(worst, std::abs(actual[i] - expected[i]));
     if (worst > 2) {
       write_png(test::output_dir() + "/demo.actual.png", size.width, size.height, actual);
       write_png(test::output_dir() + "/demo.expected.png", size.width, size.height, expected);
