@@ -23,14 +23,12 @@ SummedAreaTable::SummedAreaTable(Context& ctx)
 
 void SummedAreaTable::add_to(graph::Graph& graph, ResourceId input, ResourceId output,
                              const std::string& group) const {
-  const ResourceId row_carry =
-      graph.add_buffer(group + ".row_carry", {[](graph::Extent e) {
-                         return VkDeviceSize{params_for(e).tiles_x} * e.height * sizeof(float);
-                       }});
-  const ResourceId column_carry =
-      graph.add_buffer(group + ".column_carry", {[](graph::Extent e) {
-                         return VkDeviceSize{params_for(e).tiles_y} * e.width * sizeof(float);
-                       }});
+  const ResourceId carries = graph.add_buffer(
+      group + ".carries", {[](graph::Extent e) {
+        const gpu::SatParams p = params_for(e);
+        return (VkDeviceSize{p.tiles_x} * e.height + VkDeviceSize{p.tiles_y} * e.width) *
+               sizeof(float);
+      }});
 
   // The three passes differ only in pipeline, resources and workgroup count.
   const auto add = [&](const char* name, const ComputePipeline& pipeline,
@@ -51,17 +49,12 @@ void SummedAreaTable::add_to(graph::Graph& graph, ResourceId input, ResourceId o
   };
   add("sums", sums_,
       {{input, Use::storage_read, SAT_BINDING_INPUT},
-       {row_carry, Use::storage_write, SAT_BINDING_ROW_CARRY},
-       {column_carry, Use::storage_write, SAT_BINDING_COLUMN_CARRY}},
+       {carries, Use::storage_write, SAT_BINDING_CARRIES}},
       true);
-  add("carries", carries_,
-      {{row_carry, Use::storage_read_write, SAT_BINDING_ROW_CARRY},
-       {column_carry, Use::storage_read_write, SAT_BINDING_COLUMN_CARRY}},
-      false);
+  add("carries", carries_, {{carries, Use::storage_read_write, SAT_BINDING_CARRIES}}, false);
   add("scan", scan_,
       {{input, Use::storage_read, SAT_BINDING_INPUT},
-       {row_carry, Use::storage_read, SAT_BINDING_ROW_CARRY},
-       {column_carry, Use::storage_read, SAT_BINDING_COLUMN_CARRY},
+       {carries, Use::storage_read, SAT_BINDING_CARRIES},
        {output, Use::storage_write, SAT_BINDING_OUTPUT}},
       true);
 }

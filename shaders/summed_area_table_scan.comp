@@ -6,8 +6,7 @@
 #include "summed_area_table_tile.glsl"
 
 layout(binding = SAT_BINDING_OUTPUT, std430) writeonly buffer Output { float values[]; } dst;
-layout(binding = SAT_BINDING_ROW_CARRY, std430) readonly buffer RowCarry { float row_carry[]; };
-layout(binding = SAT_BINDING_COLUMN_CARRY, std430) readonly buffer ColumnCarry { float column_carry[]; };
+layout(binding = SAT_BINDING_CARRIES, std430) readonly buffer Carries { float carries[]; };
 
 const uint kRuns = SAT_TILE / SAT_RUN;  // runs per tile line; kRuns * SAT_TILE == threads
 
@@ -44,15 +43,15 @@ void main() {
   const uvec2 origin = tile_origin();
   const uint t = gl_LocalInvocationIndex;
   if (t < SAT_TILE) {
-    left[t] = origin.y + t < p.height ? row_carry[gl_WorkGroupID.x * p.height + origin.y + t] : 0.0;
+    left[t] = origin.y + t < p.height ? carries[row_carry_index(gl_WorkGroupID.x, origin.y + t)] : 0.0;
   } else if (t < 2 * SAT_TILE) {
     const uint c = t - SAT_TILE;
-    above[c] = origin.x + c < p.width ? column_carry[gl_WorkGroupID.y * p.width + origin.x + c] : 0.0;
+    above[c] = origin.x + c < p.width ? carries[column_carry_index(gl_WorkGroupID.y, origin.x + c)] : 0.0;
   }
   // Everything above and to the left of the tile: the column carries of the columns to its left.
   float part = 0.0;
   for (uint x = t; x < origin.x; x += SAT_TILE * SAT_GROUP_ROWS) {
-    part += column_carry[gl_WorkGroupID.y * p.width + x];
+    part += carries[column_carry_index(gl_WorkGroupID.y, x)];
   }
   part = subgroupAdd(part);
   if (subgroupElect()) corner_parts[gl_SubgroupID] = part;

@@ -3,8 +3,7 @@
 #include "shared/summed_area_table.h"
 #include "summed_area_table_tile.glsl"
 
-layout(binding = SAT_BINDING_ROW_CARRY, std430) writeonly buffer RowCarry { float row_carry[]; };
-layout(binding = SAT_BINDING_COLUMN_CARRY, std430) writeonly buffer ColumnCarry { float column_carry[]; };
+layout(binding = SAT_BINDING_CARRIES, std430) writeonly buffer Carries { float carries[]; };
 
 const uint kRuns = SAT_TILE / SAT_RUN;  // runs per tile line; kRuns * SAT_TILE == threads
 shared float row_parts[SAT_TILE][kRuns];
@@ -30,9 +29,9 @@ void main() {
     float sum = 0.0;
     for (uint r = 0; r < kRuns; ++r) sum += t < SAT_TILE ? row_parts[l][r] : column_parts[l][r];
     if (t < SAT_TILE && origin.y + l < p.height) {
-      row_carry[gl_WorkGroupID.x * p.height + origin.y + l] = sum;
+      carries[row_carry_index(gl_WorkGroupID.x, origin.y + l)] = sum;
     } else if (t >= SAT_TILE && origin.x + l < p.width) {
-      column_carry[gl_WorkGroupID.y * p.width + origin.x + l] = sum;
+      carries[column_carry_index(gl_WorkGroupID.y, origin.x + l)] = sum;
     }
   }
 }

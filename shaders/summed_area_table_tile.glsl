@@ -8,6 +8,11 @@ shared float tile[SAT_TILE][SAT_TILE + 1];  // +1: no bank conflicts down a colu
 
 uvec2 tile_origin() { return gl_WorkGroupID.xy * SAT_TILE; }
 
+// Where the carries of image row y (for tile column tx) and of image column x (for tile row ty)
+// live in the carries buffer.
+uint row_carry_index(uint tx, uint y) { return tx * p.height + y; }
+uint column_carry_index(uint ty, uint x) { return p.tiles_x * p.height + ty * p.width + x; }
+
 // Coalesced: each pass of the loop reads SAT_GROUP_ROWS rows of 32 consecutive floats.
 void load_tile() {
   const uvec2 origin = tile_origin();

@@ -11,8 +11,38 @@
 #include "passes/test_pattern.h"
 
 namespace strata {
+namespace {
+
+// The largest per-channel difference; over `tolerance`, the actual, expected and difference
+// images are written to the test output folder and the first bad pixel is reported.
+int compare_images(std::span<const uint8_t> actual, const std::vector<uint8_t>& expected,
+                   graph::Extent size, int tolerance, const std::string& name) {
+  REQUIRE(actual.size() == expected.size());
+  int worst = 0;
+  std::vector<uint8_t> difference(expected.size(), 255);
+  for (size_t i = 0; i < expected.size(); ++i) {
+    const int d = std::abs(actual[i] - expected[i]);
+    if (d > tolerance && worst <= tolerance) {
+      MESSAGE(name << ": pixel " << (i / 4) % size.width << "," << (i / 4) / size.width
+                   << " channel " << i % 4 << ": " << int(actual[i]) << " vs " << int(expected[i]));
+    }
+    worst = std::max(worst, d);
+    if (i % 4 != 3) difference[i] = static_cast<uint8_t>(std::min(255, d * 16));
+  }
+  if (worst > tolerance) {
+    const std::string base = test::output_dir() + "/" + name;
+    write_png(base + ".actual.png", size.width, size.height, actual);
+    write_png(base + ".expected.png", size.width, size.height, expected);
+    write_png(base + ".difference.png", size.width, size.height, difference);
+  }
+  return worst;
+}
+
+}  // namespace
 
 TEST_SUITE("gpu") {
+  // Tolerance: 2 of 255 per channel (float pow/sqrt differ slightly between CPU and GPU, and
+  // the GPU box-filters the float luminance while the colour passes through rgba8).
   TEST_CASE_FIXTURE(test::GpuTest, "demo_image_matches_cpu_reference_within_two_levels") {
     const graph::Extent size{96, 64};
     const uint32_t radius = 5;
@@ -24,20 +54,8 @@ TEST_SUITE("gpu") {
     runner.set_viewport(size);
     target.bind(runner);
     runner.run_now();
-
     const std::vector<uint8_t> expected = test_pattern_reference(size.width, size.height, radius);
-    const std::span<const uint8_t> actual = target.pixels();
-    REQUIRE(actual.size() == expected.size());
-    // Tolerance: 2 of 255 per channel (float pow/sqrt differ slightly between CPU and GPU, and
-    // the GPU box-filters the float luminance while the colour passes through rgba8).
-    int worst = 0;
-    for (size_t i = 0; i < expected.size(); ++i)
-      worst = std::max(worst, std::abs(actual[i] - expected[i]));
-    if (worst > 2) {
-      write_png(test::output_dir() + "/demo.actual.png", size.width, size.height, actual);
-      write_png(test::output_dir() + "/demo.expected.png", size.width, size.height, expected);
-    }
-    CHECK(worst <= 2);
+    CHECK(compare_images(target.pixels(), expected, size, 2, "demo") <= 2);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "graph_follows_a_viewport_resize") {
@@ -47,16 +65,13 @@ TEST_SUITE("gpu") {
     target.add_output(g, pattern.add_to(g, 3));
     graph::GraphRunner runner(ctx, std::move(g));
     for (const graph::Extent size : {graph::Extent{40, 30}, graph::Extent{17, 50}}) {
+      CAPTURE(size.width);
       runner.set_viewport(size);
       target.bind(runner);
       runner.run_now();
       const std::vector<uint8_t> expected = test_pattern_reference(size.width, size.height, 3);
-      REQUIRE(target.pixels().size() == expected.size());
-      int worst = 0;
-      for (size_t i = 0; i < expected.size(); ++i) {
-        worst = std::max(worst, std::abs(target.pixels()[i] - expected[i]));
-      }
-      CHECK(worst <= 2);
+      CHECK(compare_images(target.pixels(), expected, size, 2,
+                           "resize-" + std::to_string(size.width)) <= 2);
       const auto timings = runner.timings();
       CHECK(timings.size() == runner.graph().passes().size());
       for (const auto& t : timings) CHECK(t.ms >= 0.0);

@@ -17,8 +17,7 @@
 
 #define SAT_BINDING_INPUT 0
 #define SAT_BINDING_OUTPUT 1
-#define SAT_BINDING_ROW_CARRY 2     // [tiles_x][height]
-#define SAT_BINDING_COLUMN_CARRY 3  // [tiles_y][width]
+#define SAT_BINDING_CARRIES 2  // row carries [tiles_x][height], then column carries [tiles_y][width]
 
 STRATA_BEGIN
 struct SatParams {

@@ -31,14 +31,13 @@ using namespace glm;  // GLSL's vector types and functions, by the same names
 #define STRATA_INLINE
 #endif
 
-// uv in [0, 1]^2, y down. Returns linear RGB in [0, 1].
+// uv in [0, 1]^2, y down. Returns linear RGB in [0, 1]. Every edge is a narrow smooth ramp, not
+// a step: CPU and GPU round divisions differently, and a step at a pixel centre would flip.
 STRATA_INLINE vec3 test_pattern(vec2 uv) {
   vec3 sky = mix(vec3(0.55f, 0.70f, 0.95f), vec3(0.10f, 0.20f, 0.45f), uv.y);
-  vec3 color = sky;
-  if (uv.y > 0.65f) {
-    float checker = mod(floor(uv.x * 12.0f) + floor(uv.y * 24.0f), 2.0f);
-    color = mix(vec3(0.25f, 0.22f, 0.20f), vec3(0.85f, 0.82f, 0.78f), checker);
-  }
+  float checker = clamp(0.5f + 6.0f * sin(uv.x * 37.699f) * sin(uv.y * 75.398f), 0.0f, 1.0f);
+  vec3 floor_color = mix(vec3(0.25f, 0.22f, 0.20f), vec3(0.85f, 0.82f, 0.78f), checker);
+  vec3 color = mix(sky, floor_color, smoothstep(0.64f, 0.66f, uv.y));
   vec2 d = (uv - vec2(0.5f, 0.45f)) / 0.3f;
   float r2 = dot(d, d);
   if (r2 < 1.0f) {
@@ -47,7 +46,8 @@ STRATA_INLINE vec3 test_pattern(vec2 uv) {
     vec3 half_vector = normalize(light + vec3(0.0f, 0.0f, 1.0f));
     float diffuse = max(dot(n, light), 0.0f);
     float specular = pow(max(dot(n, half_vector), 0.0f), 40.0f);
-    color = vec3(0.80f, 0.25f, 0.20f) * (0.15f + 0.85f * diffuse) + vec3(specular);
+    vec3 sphere = vec3(0.80f, 0.25f, 0.20f) * (0.15f + 0.85f * diffuse) + vec3(specular);
+    color = mix(color, sphere, smoothstep(1.0f, 0.96f, r2));
   }
   return clamp(color, vec3(0.0f), vec3(1.0f));
 }
