@@ -190,6 +190,59 @@ void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data) {
   });
 }
 
+namespace {
+
+VkDeviceSize image_bytes(const ImageDesc& d) {
+  return VkDeviceSize{d.extent.width} * d.extent.height * d.extent.depth * texel_size(d.format);
+}
+
+void transition(VkCommandBuffer cmd, const Image& image, VkImageLayout from, VkImageLayout to,
+                VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) {
+  VkImageMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+  barrier.srcStageMask = src_stage;
+  barrier.srcAccessMask = src_access;
+  barrier.dstStageMask = dst_stage;
+  barrier.dstAccessMask = dst_access;
+  barrier.oldLayout = from;
+  barrier.newLayout = to;
+  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.image = image.handle();
+  barrier.subresourceRange = {aspect_of(image.desc().format), 0, 1, 0, 1};
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.imageMemoryBarrierCount = 1;
+  dep.pImageMemoryBarriers = &barrier;
+  vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+}  // namespace
+
+void upload(Context& ctx, const Image& dst, std::span<const std::byte> data,
+            VkImageLayout final_layout) {
+  const VkDeviceSize size = image_bytes(dst.desc());
+  if (data.size() != size) {
+    throw Error("upload: " + std::to_string(data.size()) + " bytes for an image of " +
+                std::to_string(size));
+  }
+  Buffer staging(ctx, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::host_upload);
+  std::memcpy(staging.mapped(), data.data(), size);
+  ctx.run_now([&](VkCommandBuffer cmd) {
+    // Setup code outside any graph: the image is new, so it starts undefined and is then handed
+    // to every later stage (the graph imports it with content in `final_layout`).
+    transition(cmd, dst, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+               VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT,
+               VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {aspect_of(dst.desc().format), 0, 0, 1};
+    region.imageExtent = dst.desc().extent;
+    vkCmdCopyBufferToImage(cmd, staging.handle(), dst.handle(),
+                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    transition(cmd, dst, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout,
+               VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+               VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+  });
+}
+
 std::vector<std::byte> download(Context& ctx, const Buffer& src) {
   Buffer staging(ctx, src.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback);
   ctx.run_now([&](VkCommandBuffer cmd) {

@@ -72,6 +72,9 @@ uint32_t texel_size(VkFormat format);
 
 // Copies `data` into a device-local buffer at offset 0 and waits.
 void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data);
+// Fills a whole image (2D or 3D, tightly packed texels) and leaves it in `final_layout`; waits.
+void upload(Context& ctx, const Image& dst, std::span<const std::byte> data,
+            VkImageLayout final_layout);
 // Reads a whole buffer back to the host and waits.
 std::vector<std::byte> download(Context& ctx, const Buffer& src);
 // Reads a 2D image (in `layout`, left in it) back as tightly packed texels and waits.
