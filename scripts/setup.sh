@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs every Debian package strata needs to build, test and run. Idempotent: when everything is
-# present it only checks (dpkg-query) and returns in well under a second.
+# Installs every Debian package strata needs to build, test and run, then fetches the demo and test
+# data (scripts/fetch-data.sh). Idempotent: when everything is present it only checks (dpkg-query,
+# sha256sum) and returns in well under a second.
 set -euo pipefail
 
 packages=(
@@ -11,22 +12,27 @@ packages=(
   libspirv-cross-c-shared-dev
   # libraries
   libglm-dev libglfw3-dev libimgui-dev doctest-dev libcli11-dev libstb-dev
+  # file formats: gzip, DICOM, meshes, JSON, XML
+  zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev
   # window tests without a display
   xvfb xauth
 )
+
+cd "$(dirname "$0")/.."
 
 missing=()
 for p in "${packages[@]}"; do
   status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
   [[ $status == installed ]] || missing+=("$p")
 done
-if ((${#missing[@]} == 0)); then
-  exit 0
+if ((${#missing[@]} > 0)); then
+  echo "setup: installing ${missing[*]}"
+  sudo=""
+  if [[ $(id -u) != 0 ]]; then sudo=sudo; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -q
+  $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-echo "setup: installing ${missing[*]}"
-sudo=""
-if [[ $(id -u) != 0 ]]; then sudo=sudo; fi
-export DEBIAN_FRONTEND=noninteractive
-$sudo apt-get update -q
-$sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+# Real data: downloaded into assets/cache and checksum-verified, not installed.
+scripts/fetch-data.sh

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Downloads the real data strata's demo and tests use, from Debian's archive, into the git-ignored
+# assets/cache (nothing is installed system-wide): `apt-get download` fetches the .deb (apt checks
+# it against the archive's signed index), `dpkg -x` unpacks it, and every file we use is checked
+# against the SHA-256 pinned here. Idempotent: files already in place and verified are kept.
+#   mricron-data:   ch2.nii.gz (Colin27 T1 head MRI), aal.nii.gz + aal.nii.txt (116 AAL regions)
+#   python3-pydicom: its DICOM test series dicomdirtests/98892001/CT5N (5 CT slices)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cache=assets/cache
+mkdir -p "$cache"
+
+# package  file-inside-the-package  destination  sha256
+files=(
+  "mricron-data usr/share/mricron/templates/ch2.nii.gz mricron/ch2.nii.gz a009051127f64dc3dd554d5f5b589870ea72106d9642c21b4e7093e478cfc309"
+  "mricron-data usr/share/mricron/templates/aal.nii.gz mricron/aal.nii.gz b512dcd3f36b77f56be7a9a038134096e66314b7e8c31d25875b96bcf6991454"
+  "mricron-data usr/share/mricron/templates/aal.nii.txt mricron/aal.nii.txt 1788d6556a9ec056de9867b2382cf1ce1b51b87ae4cfd9cd25de48ae4dde709e"
+)
+ct5n=usr/lib/python3/dist-packages/pydicom/data/test_files/dicomdirtests/98892001/CT5N
+files+=(
+  "python3-pydicom $ct5n/2062 dicom/CT5N/2062 27f8126485634a817f0941cc727094e8cfacb18341fbc317d175ff373804118b"
+  "python3-pydicom $ct5n/2392 dicom/CT5N/2392 02b0af20eeae95f6d42554c53a630babaa5ed2519657208137d3c7418b6acb81"
+  "python3-pydicom $ct5n/2693 dicom/CT5N/2693 6020fdffd513017e7b2d5dc52435b2bbf27209aabee183a30207a149dccecb2e"
+  "python3-pydicom $ct5n/3023 dicom/CT5N/3023 4f7f4f2b3c79acdd5e0fc23fdd9f6bae6e6da9dccfadd1f9147b7bff53756653"
+  "python3-pydicom $ct5n/3353 dicom/CT5N/3353 5eaa662118b8d87601a14231893cb7ecf1737a434c95120cfb4076cfce667b18"
+)
+
+verified() { [[ -f $1 ]] && echo "$2  $1" | sha256sum --check --status; }
+
+unpacked=()
+for entry in "${files[@]}"; do
+  read -r package inside dest sum <<<"$entry"
+  dest=$cache/$dest
+  verified "$dest" "$sum" && continue
+  if [[ ! " ${unpacked[*]} " == *" $package "* ]]; then
+    echo "fetch-data: downloading $package from Debian's archive"
+    rm -rf "$cache/deb-$package" && mkdir -p "$cache/deb-$package"
+    (cd "$cache/deb-$package" && apt-get download "$package" >/dev/null 2>&1) || {
+      # apt's lists may be missing on a fresh machine
+      apt-get update -q >/dev/null && (cd "$cache/deb-$package" && apt-get download "$package" >/dev/null)
+    }
+    dpkg -x "$cache"/deb-"$package"/*.deb "$cache/deb-$package/root"
+    unpacked+=("$package")
+  fi
+  mkdir -p "$(dirname "$dest")"
+  cp "$cache/deb-$package/root/$inside" "$dest"
+  if ! verified "$dest" "$sum"; then
+    echo "fetch-data: $dest: SHA-256 does not match the pinned value (package $package changed?)" >&2
+    rm -f "$dest"
+    exit 1
+  fi
+done
+rm -rf "$cache"/deb-*
