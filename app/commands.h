@@ -25,5 +25,6 @@ void add_devices_command(CLI::App& app, DeviceOptions& device);
 void add_render_command(CLI::App& app, DeviceOptions& device);
 void add_view_command(CLI::App& app, DeviceOptions& device);
 void add_bench_command(CLI::App& app, DeviceOptions& device);
+void add_info_command(CLI::App& app);
 
 }  // namespace strata::app

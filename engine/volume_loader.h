@@ -20,6 +20,7 @@ Volume load_dicom_series(const std::filesystem::path& folder);
 
 // Writes .mha (header and data in one file) or .mhd (+ .raw beside it), optionally
 // zlib-compressed; reading it back gives the same voxels, spacing, origin and direction.
-void write_metaimage(const std::filesystem::path& path, const Volume& volume, bool compress = false);
+void write_metaimage(const std::filesystem::path& path, const Volume& volume,
+                     bool compress = false);
 
 }  // namespace strata

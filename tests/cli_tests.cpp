@@ -1,6 +1,7 @@
 // The strata program end to end: exit codes, messages and files.
 #include <doctest/doctest.h>
 
+#include <cstdio>
 #include <filesystem>
 
 #include "engine/png.h"
@@ -54,6 +55,38 @@ TEST_SUITE("cli") {
     const auto env = run_strata("render -o /dev/null", "STRATA_DEVICE=9");
     CHECK(env.exit_code == 1);
     CHECK(env.output.find("no Vulkan device matches '9'") != std::string::npos);
+  }
+
+  TEST_CASE("info_describes_the_head_demo_scene") {
+    const auto r = run_strata(std::string("info ") + STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    CHECK(r.exit_code == 0);
+    CHECK(r.output.find("181x217x181") != std::string::npos);
+    CHECK(r.output.find("uint8") != std::string::npos);
+    CHECK(r.output.find("Precentral L") != std::string::npos);
+    CHECK(r.output.find("Cerebelum 6 R") != std::string::npos);
+    CHECK(r.output.find("front") != std::string::npos);
+    CHECK(r.output.find("oblique") != std::string::npos);
+  }
+
+  TEST_CASE("info_imports_a_thesis_scene_and_warns_about_its_missing_volume") {
+    const auto r = run_strata(std::string("info ") + STRATA_SOURCE_DIR
+                              "/../shared/data/voly-labeller/scenes/dice.xml");
+    CHECK(r.exit_code == 0);
+    CHECK(r.output.find("N11") != std::string::npos);
+    CHECK(r.output.find("dice.mha") != std::string::npos);
+  }
+
+  TEST_CASE("info_of_a_broken_file_is_one_error_naming_it") {
+    const std::string path = test::output_dir() + "/broken.json";
+    {
+      std::FILE* f = std::fopen(path.c_str(), "w");
+      REQUIRE(f != nullptr);
+      std::fputs("{\"strata_scene\": 1, \"labels\": [", f);
+      std::fclose(f);
+    }
+    const auto r = run_strata("info " + path);
+    CHECK(r.exit_code == 1);
+    CHECK(r.output.find("strata: error: " + path) != std::string::npos);
   }
 
   TEST_CASE("bad_sizes_and_unwritable_outputs_are_errors_naming_the_culprit") {

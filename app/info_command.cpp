@@ -1,0 +1,175 @@
+// `strata info FILE`: what a scene, volume, mesh or transfer-function file holds, as plain text.
+// Needs no device, so it also checks scene files on machines without Vulkan.
+#include <cstdarg>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "app/commands.h"
+#include "engine/mesh_loader.h"
+#include "engine/scene_loader.h"
+#include "engine/transfer_function_loader.h"
+#include "engine/volume_loader.h"
+
+namespace strata::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string format(const char* pattern, ...) __attribute__((format(printf, 1, 2)));
+std::string format(const char* pattern, ...) {
+  char text[1024];
+  va_list args;
+  va_start(args, pattern);
+  std::vsnprintf(text, sizeof text, pattern, args);
+  va_end(args);
+  return text;
+}
+
+// Adding 0 turns the -0 that inverted view matrices give into 0.
+std::string vec(glm::vec3 v) {
+  return format("(%.6g, %.6g, %.6g)", v.x + 0.0f, v.y + 0.0f, v.z + 0.0f);
+}
+std::string rgba(glm::vec4 c) {
+  return format("(%.3g, %.3g, %.3g, %.3g)", c.r, c.g, c.b, c.a);
+}
+
+std::string bytes(size_t count) {
+  return format("%zu bytes (%.1f MiB)", count, double(count) / (1024.0 * 1024.0));
+}
+
+void describe_volumes(const Scene& scene, std::string& out) {
+  out += format("volumes: %zu\n", scene.volumes.size());
+  for (const Volume& v : scene.volumes) {
+    const auto [lo, hi] = v.world_bounds();
+    out += format("  %s: %ux%ux%u %s\n", v.name.c_str(), v.dims.x, v.dims.y, v.dims.z,
+                  to_string(v.type));
+    if (!v.source.empty()) out += "    file: " + v.source.string() + "\n";
+    out += format("    spacing: %g x %g x %g mm\n", v.spacing.x, v.spacing.y, v.spacing.z);
+    out += "    world bounds: " + vec(lo) + " .. " + vec(hi) + "\n";
+    out += "    voxels: " + bytes(v.byte_size()) + "\n";
+    out += format("    values: %g .. %g\n", v.value_range.x, v.value_range.y);
+    if (v.transfer_function >= 0 && size_t(v.transfer_function) < scene.transfer_functions.size()) {
+      out +=
+          "    transfer function: " + scene.transfer_functions[size_t(v.transfer_function)].name +
+          "\n";
+    } else {
+      out += "    transfer function: none\n";
+    }
+  }
+}
+
+void describe_transfer_functions(const Scene& scene, std::string& out) {
+  out += format("transfer functions: %zu\n", scene.transfer_functions.size());
+  for (const TransferFunction& tf : scene.transfer_functions) {
+    out += format("  %s: %zu stops", tf.name.c_str(), tf.stops.size());
+    out += tf.source.empty() ? "\n" : " (" + tf.source.string() + ")\n";
+    for (const TransferFunction::Stop& stop : tf.stops) {
+      out += format("    %-9.6g rgba ", stop.position) + rgba(stop.color) + "\n";
+    }
+  }
+}
+
+void describe_meshes(const Scene& scene, std::string& out) {
+  out += format("meshes: %zu\n", scene.meshes.size());
+  for (const Mesh& m : scene.meshes) {
+    out += format("  %s: %zu triangles, %zu vertices, colour ", m.name.c_str(), m.triangle_count(),
+                  m.positions.size());
+    out += rgba(m.color) + (m.transform != glm::mat4(1.0f) ? ", transformed" : "") + "\n";
+    if (!m.source.empty()) out += "    file: " + m.source.string() + "\n";
+  }
+}
+
+void describe_labels(const Scene& scene, std::string& out) {
+  out += format("labels: %zu\n", scene.labels.size());
+  for (const Label& l : scene.labels) {
+    const std::string size = l.size == glm::vec2(0.0f) ? std::string("from the text")
+                                                       : format("%gx%g", l.size.x, l.size.y);
+    out += format("  %4d  %-24s anchor ", l.id, ("\"" + l.text + "\"").c_str()) + vec(l.anchor) +
+           "  size " + size + "\n";
+  }
+}
+
+void describe_camera_and_settings(const Scene& scene, std::string& out) {
+  const Camera& c = scene.camera;
+  const glm::vec3 eye = glm::vec3(glm::inverse(c.view)[3]);
+  out += format("camera: fov_y %g degrees, near %g, far %g, eye ", c.fov_y_degrees, c.near_plane,
+                c.far_plane) +
+         vec(eye) + "\n";
+  out += format("  positions: %zu\n", c.positions.size());
+  for (const CameraPose& p : c.positions) {
+    out += "    " + p.name + ": eye " + vec(glm::vec3(glm::inverse(p.view)[3])) + "\n";
+  }
+  const CostWeights& w = scene.settings.weights;
+  out += format("settings: %d layers\n", scene.settings.layer_count);
+  out += format(
+      "  weights: label_shadow %g, anchor_constraint %g, connector_shadow %g, integral_costs %g,\n"
+      "           distance_to_anchor %g, connector_direction %g, previous_position %g\n",
+      w.label_shadow, w.anchor_constraint, w.connector_shadow, w.integral_costs,
+      w.distance_to_anchor, w.connector_direction, w.previous_position);
+}
+
+// A single volume, mesh or transfer-function file shows only its own section; a scene shows all.
+std::string describe(const Scene& scene, bool whole_scene) {
+  std::string out;
+  if (whole_scene || !scene.volumes.empty()) describe_volumes(scene, out);
+  if (whole_scene || !scene.transfer_functions.empty()) describe_transfer_functions(scene, out);
+  if (whole_scene || !scene.meshes.empty()) describe_meshes(scene, out);
+  if (!whole_scene) return out;
+  describe_labels(scene, out);
+  describe_camera_and_settings(scene, out);
+  out += format("warnings: %zu\n", scene.warnings.size());
+  for (const std::string& w : scene.warnings) out += "  " + w + "\n";
+  return out;
+}
+
+bool is_volume_file(const fs::path& path) {
+  if (fs::is_directory(path)) return true;  // a DICOM series
+  const std::string name = path.filename().string();
+  for (const char* ending : {".nii", ".nii.gz", ".mha", ".mhd", ".nrrd", ".nhdr"}) {
+    const std::string e = ending;
+    if (name.size() > e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0) {
+      return true;
+    }
+  }
+  return false;
+}
+
+bool is_scene_file(const fs::path& path) {
+  return !is_volume_file(path) && !is_transfer_function_file(path) &&
+         (path.extension() == ".json" || path.extension() == ".xml");
+}
+
+// A scene holding the one volume, transfer function or mesh file, for describe().
+Scene load_single_file(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error(path.string() + ": no such file");
+  Scene scene;
+  scene.source = path;
+  if (is_volume_file(path)) {
+    scene.volumes.push_back(load_volume(path));
+  } else if (is_transfer_function_file(path)) {
+    scene.transfer_functions.push_back(load_transfer_function(path));
+  } else {
+    scene.meshes = load_meshes(path);
+  }
+  return scene;
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app) {
+  CLI::App* cmd = app.add_subcommand(
+      "info", "Describe a scene (.json, thesis .xml), volume, mesh or transfer-function file");
+  auto file = std::make_shared<std::string>();
+  cmd->add_option("FILE", *file, "the file to describe")->required();
+  cmd->callback([file] {
+    const fs::path path(*file);
+    const bool whole_scene = is_scene_file(path);
+    const Scene scene = whole_scene ? load_scene(path) : load_single_file(path);
+    std::printf("%s\n%s", file->c_str(), describe(scene, whole_scene).c_str());
+  });
+}
+
+}  // namespace strata::app
