@@ -8,27 +8,17 @@
 
 #include "engine/error.h"
 #include "engine/mesh_loader.h"
+#include "test_files.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
 fs::path write_file(const std::string& name, const std::string& text) {
-  const fs::path folder = fs::path(STRATA_TEST_OUTPUT) / "mesh_loader_tests";
-  fs::create_directories(folder);
-  std::ofstream(folder / name, std::ios::binary) << text;
-  return folder / name;
+  return strata::test::write_file(fs::path(STRATA_TEST_OUTPUT) / "mesh_loader_tests" / name, text);
 }
 
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const strata::Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using strata::test::error_of;
 
 struct Bounds {
   glm::vec3 lo{1e30f}, hi{-1e30f};

@@ -11,6 +11,7 @@
 #include "engine/scene_loader.h"
 #include "engine/transfer_function_loader.h"
 #include "engine/volume_loader.h"
+#include "test_files.h"
 
 namespace {
 
@@ -18,29 +19,12 @@ namespace fs = std::filesystem;
 
 const fs::path voly_scenes = fs::path(STRATA_SHARED_DATA) / "voly-labeller/scenes";
 
-// A fresh folder per test, so files from one test never satisfy another's references.
 fs::path test_folder(const std::string& name) {
-  const fs::path folder = fs::path(STRATA_TEST_OUTPUT) / "scene_loader_tests" / name;
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
+  return strata::test::fresh_folder("scene_loader_tests", name);
 }
 
-fs::path write_file(const fs::path& path, const std::string& text) {
-  fs::create_directories(path.parent_path());
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
-
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const strata::Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using strata::test::error_of;
+using strata::test::write_file;
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -6,6 +6,7 @@
 
 #include "engine/error.h"
 #include "engine/transfer_function_loader.h"
+#include "test_files.h"
 
 namespace {
 
@@ -18,20 +19,10 @@ fs::path output_folder() {
 }
 
 fs::path write_file(const std::string& name, const std::string& text) {
-  const fs::path path = output_folder() / name;
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
+  return strata::test::write_file(output_folder() / name, text);
 }
 
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const strata::Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using strata::test::error_of;
 
 void check_stop(const strata::TransferFunction::Stop& stop, float position, int r, int g, int b,
                 int a) {

@@ -83,6 +83,7 @@ void operator delete(void* p, const std::nothrow_t&) noexcept {
 void operator delete[](void* p, const std::nothrow_t&) noexcept {
   counted_free(p);
 }
+#include "test_files.h"
 
 namespace {
 
@@ -93,28 +94,17 @@ using strata::VoxelType;
 const fs::path cache = STRATA_DATA_CACHE;
 
 fs::path output_folder(const std::string& name) {
-  const fs::path folder = fs::path(STRATA_TEST_OUTPUT) / "volume_loader" / name;
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
+  return strata::test::fresh_folder("volume_loader", name);
 }
 
-void write_file(const fs::path& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  REQUIRE(out.good());
-}
+using strata::test::read_file;
+using strata::test::write_file;
 
 void write_gzip(const fs::path& path, const std::string& bytes) {
   gzFile file = gzopen(path.c_str(), "wb");
   REQUIRE(file != nullptr);
   CHECK(gzwrite(file, bytes.data(), static_cast<unsigned>(bytes.size())) == int(bytes.size()));
   CHECK(gzclose(file) == Z_OK);
-}
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 // The values as bytes in the given order.
@@ -131,12 +121,7 @@ std::string element_bytes(const std::vector<T>& values, bool big_endian = false)
 }
 
 std::string load_error(const fs::path& path) {
-  try {
-    strata::load_volume(path);
-  } catch (const strata::Error& error) {
-    return error.what();
-  }
-  return "<no error>";
+  return strata::test::error_of([&] { strata::load_volume(path); });
 }
 
 // One error whose message names the file and says the reason.

@@ -1,0 +1,46 @@
+// Small helpers for tests that write files and expect errors.
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <string_view>
+
+#include "engine/error.h"
+
+namespace strata::test {
+
+// An empty folder STRATA_TEST_OUTPUT/<suite>/<name>, so one test's files never satisfy another's.
+inline std::filesystem::path fresh_folder(const std::string& suite, const std::string& name) {
+  const std::filesystem::path folder = std::filesystem::path(STRATA_TEST_OUTPUT) / suite / name;
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  return folder;
+}
+
+inline std::filesystem::path write_file(const std::filesystem::path& path, std::string_view bytes) {
+  std::filesystem::create_directories(path.parent_path());
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!out) throw Error(path.string() + ": test could not write the file");
+  return path;
+}
+
+inline std::string read_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The message of the strata::Error that f throws, or "(no error)".
+template <typename F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace strata::test
