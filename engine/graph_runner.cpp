@@ -15,14 +15,15 @@ VkImageView PassContext::view(ResourceId id) const {
   return runner_->bound_.at(id).view;
 }
 
-void PassContext::bind(const ComputePipeline& pipeline) const {
+void PassContext::bind(const Pipeline& pipeline) const {
   std::vector<DescriptorResource> resources;
   const PassInfo& pass = runner_->graph_.passes()[pass_];
   for (const ResourceUse& u : pass.uses) {
     if (!u.binding) continue;
     const GraphRunner::Bound& b = runner_->bound_.at(u.resource);
-    resources.push_back(
-        {*u.binding, b.buffer, b.view, runner_->compiled_.layout[pass_][u.resource]});
+    const VkSampler sampler = u.use == Use::sampled ? runner_->linear_sampler_ : VK_NULL_HANDLE;
+    resources.push_back({*u.binding, u.array_element, b.buffer, b.view,
+                         runner_->compiled_.layout[pass_][u.resource], sampler});
   }
   pipeline.bind(cmd, resources);
 }
@@ -35,9 +36,16 @@ GraphRunner::GraphRunner(Context& ctx, Graph graph)
   info.queryType = VK_QUERY_TYPE_TIMESTAMP;
   info.queryCount = static_cast<uint32_t>(2 * std::max<size_t>(1, graph_.passes().size()));
   STRATA_VK(vkCreateQueryPool(ctx_.device(), &info, nullptr, &queries_));
+  VkSamplerCreateInfo sampler{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  sampler.magFilter = sampler.minFilter = VK_FILTER_LINEAR;
+  sampler.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  sampler.addressModeU = sampler.addressModeV = sampler.addressModeW =
+      VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  STRATA_VK(vkCreateSampler(ctx_.device(), &sampler, nullptr, &linear_sampler_));
 }
 
 GraphRunner::~GraphRunner() {
+  vkDestroySampler(ctx_.device(), linear_sampler_, nullptr);
   vkDestroyQueryPool(ctx_.device(), queries_, nullptr);
 }
 
@@ -50,7 +58,8 @@ void GraphRunner::set_viewport(Extent viewport) {
     if (r.imported) continue;
     if (r.is_image) {
       const Extent e = r.image.fixed.width ? r.image.fixed : viewport;
-      ImageDesc desc{r.image.format, {e.width, e.height, 1}, VK_IMAGE_TYPE_2D, compiled_.usage[i]};
+      ImageDesc desc{r.image.format, {e.width, e.height, 1}, VK_IMAGE_TYPE_2D, compiled_.usage[i],
+                     r.image.layers};
       Image& image = owned_[i].emplace<Image>(ctx_, desc);
       bound_[i] = {VK_NULL_HANDLE, image.handle(), image.view(), r.image.format};
     } else {
@@ -60,6 +69,22 @@ void GraphRunner::set_viewport(Extent viewport) {
       bound_[i] = {buffer.handle()};
     }
   }
+}
+
+void GraphRunner::reallocate() {
+  const Extent viewport = viewport_;
+  viewport_ = {};
+  set_viewport(viewport);
+}
+
+std::vector<std::byte> GraphRunner::download_image(ResourceId id) {
+  const Image* image = std::get_if<Image>(&owned_.at(id));
+  if (!image) throw Error("render graph: '" + graph_.resources()[id].name + "' is not a transient image");
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  for (const auto& pass_layouts : compiled_.layout) {
+    if (pass_layouts[id] != VK_IMAGE_LAYOUT_UNDEFINED) layout = pass_layouts[id];
+  }
+  return download(ctx_, *image, layout);
 }
 
 void GraphRunner::bind_buffer(ResourceId id, VkBuffer buffer) {
@@ -88,7 +113,7 @@ void GraphRunner::emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) c
       ib.image = r.image;
       const VkImageAspectFlags aspect =
           r.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
-      ib.subresourceRange = {aspect, 0, 1, 0, 1};
+      ib.subresourceRange = {aspect, 0, 1, 0, VK_REMAINING_ARRAY_LAYERS};
       images.push_back(ib);
     } else {
       VkBufferMemoryBarrier2 bb{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};

@@ -29,8 +29,9 @@ class PassContext {
   VkBuffer buffer(ResourceId id) const;
   VkImage image(ResourceId id) const;
   VkImageView view(ResourceId id) const;
-  // Binds `pipeline` and pushes every resource this pass declared with a binding index.
-  void bind(const ComputePipeline& pipeline) const;
+  // Binds `pipeline` and pushes every resource this pass declared with a binding index (sampled
+  // images with the graph's linear clamp-to-edge sampler).
+  void bind(const Pipeline& pipeline) const;
 
  private:
   friend class GraphRunner;
@@ -63,6 +64,12 @@ class GraphRunner {
   // Records into a fresh command buffer, submits and waits (headless runs, benchmarks, tests).
   void run_now();
 
+  // Re-creates the transient resources (after a size function's answer changed, e.g. a grown
+  // hash table), keeping the viewport.
+  void reallocate();
+  // The texels of a transient image after the last completed run (waits; for tools and tests).
+  std::vector<std::byte> download_image(ResourceId id);
+
   // GPU time of each pass of the last completed run.
   std::vector<PassTiming> timings() const;
 
@@ -87,6 +94,7 @@ class GraphRunner {
   std::vector<std::variant<std::monostate, Buffer, Image>> owned_;
   std::vector<Bound> bound_;
   VkQueryPool queries_ = VK_NULL_HANDLE;
+  VkSampler linear_sampler_ = VK_NULL_HANDLE;
 };
 
 }  // namespace strata::graph

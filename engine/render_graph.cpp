@@ -124,11 +124,12 @@ std::vector<MergedUse> merge_uses(const PassInfo& pass, const Graph& graph) {
                        " '" + r.name + "' as " + to_string(u.use));
     }
     if (u.binding) {
-      if (std::find(bindings.begin(), bindings.end(), *u.binding) != bindings.end()) {
+      const uint32_t slot = (*u.binding << 16) | u.array_element;
+      if (std::find(bindings.begin(), bindings.end(), slot) != bindings.end()) {
         throw GraphError("pass '" + pass.name + "' binds two resources to binding " +
                          std::to_string(*u.binding));
       }
-      bindings.push_back(*u.binding);
+      bindings.push_back(slot);
     }
     const Access a = access_of(u.use, pass.kind, r.is_image);
     auto it = std::find_if(merged.begin(), merged.end(),

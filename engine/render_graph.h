@@ -56,12 +56,14 @@ struct ResourceUse {
   Use use = Use::storage_read;
   // Descriptor binding in the pass's shader (shaders/shared/*.h); PassContext::bind pushes it.
   std::optional<uint32_t> binding;
+  uint32_t array_element = 0;  // for array bindings (e.g. one element per volume)
 };
 
 struct ImageInfo {
   VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
   // Size: the viewport when `fixed` is zero, else `fixed`.
   Extent fixed{};
+  uint32_t layers = 1;  // more than one: a 2D array image (e.g. one layer per depth layer)
 };
 
 struct BufferInfo {

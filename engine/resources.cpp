@@ -39,6 +39,11 @@ VkImageAspectFlags aspect_of(VkFormat format) {
   return format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
 }
 
+VkDeviceSize image_bytes(const ImageDesc& d) {
+  return VkDeviceSize{d.extent.width} * d.extent.height * d.extent.depth * d.layers *
+         texel_size(d.format);
+}
+
 // Makes a copy's writes visible to the host that reads the staging buffer after the fence.
 void copy_to_host_barrier(VkCommandBuffer cmd) {
   VkMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
@@ -108,7 +113,7 @@ Image::Image(Context& ctx, const ImageDesc& desc) : device_(ctx.device()), desc_
   info.format = desc.format;
   info.extent = desc.extent;
   info.mipLevels = 1;
-  info.arrayLayers = 1;
+  info.arrayLayers = desc.layers;
   info.samples = VK_SAMPLE_COUNT_1_BIT;
   info.tiling = VK_IMAGE_TILING_OPTIMAL;
   info.usage = desc.usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
@@ -121,9 +126,11 @@ Image::Image(Context& ctx, const ImageDesc& desc) : device_(ctx.device()), desc_
 
   VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   view.image = image_;
-  view.viewType = desc.type == VK_IMAGE_TYPE_3D ? VK_IMAGE_VIEW_TYPE_3D : VK_IMAGE_VIEW_TYPE_2D;
+  view.viewType = desc.type == VK_IMAGE_TYPE_3D ? VK_IMAGE_VIEW_TYPE_3D
+                  : desc.layers > 1              ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                                                 : VK_IMAGE_VIEW_TYPE_2D;
   view.format = desc.format;
-  view.subresourceRange = {aspect_of(desc.format), 0, 1, 0, 1};
+  view.subresourceRange = {aspect_of(desc.format), 0, 1, 0, desc.layers};
   STRATA_VK(vkCreateImageView(device_, &view, nullptr, &view_));
 }
 
@@ -192,10 +199,6 @@ void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data) {
 
 namespace {
 
-VkDeviceSize image_bytes(const ImageDesc& d) {
-  return VkDeviceSize{d.extent.width} * d.extent.height * d.extent.depth * texel_size(d.format);
-}
-
 void transition(VkCommandBuffer cmd, const Image& image, VkImageLayout from, VkImageLayout to,
                 VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                 VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) {
@@ -208,7 +211,7 @@ void transition(VkCommandBuffer cmd, const Image& image, VkImageLayout from, VkI
   barrier.newLayout = to;
   barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   barrier.image = image.handle();
-  barrier.subresourceRange = {aspect_of(image.desc().format), 0, 1, 0, 1};
+  barrier.subresourceRange = {aspect_of(image.desc().format), 0, 1, 0, image.desc().layers};
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.imageMemoryBarrierCount = 1;
   dep.pImageMemoryBarriers = &barrier;
@@ -233,7 +236,7 @@ void upload(Context& ctx, const Image& dst, std::span<const std::byte> data,
                VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT,
                VK_ACCESS_2_TRANSFER_WRITE_BIT);
     VkBufferImageCopy region{};
-    region.imageSubresource = {aspect_of(dst.desc().format), 0, 0, 1};
+    region.imageSubresource = {aspect_of(dst.desc().format), 0, 0, dst.desc().layers};
     region.imageExtent = dst.desc().extent;
     vkCmdCopyBufferToImage(cmd, staging.handle(), dst.handle(),
                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
@@ -255,12 +258,11 @@ std::vector<std::byte> download(Context& ctx, const Buffer& src) {
 
 std::vector<std::byte> download(Context& ctx, const Image& src, VkImageLayout layout) {
   const ImageDesc& d = src.desc();
-  const VkDeviceSize size =
-      VkDeviceSize{d.extent.width} * d.extent.height * d.extent.depth * texel_size(d.format);
+  const VkDeviceSize size = image_bytes(d);
   Buffer staging(ctx, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback);
   ctx.run_now([&](VkCommandBuffer cmd) {
     VkBufferImageCopy region{};
-    region.imageSubresource = {aspect_of(d.format), 0, 0, 1};
+    region.imageSubresource = {aspect_of(d.format), 0, 0, d.layers};
     region.imageExtent = d.extent;
     vkCmdCopyImageToBuffer(cmd, src.handle(), layout, staging.handle(), 1, &region);
     copy_to_host_barrier(cmd);

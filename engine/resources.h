@@ -44,6 +44,7 @@ struct ImageDesc {
   VkExtent3D extent{1, 1, 1};
   VkImageType type = VK_IMAGE_TYPE_2D;
   VkImageUsageFlags usage = 0;
+  uint32_t layers = 1;  // array layers (2D only); more than one gives a 2D-array view
 };
 
 class Image {

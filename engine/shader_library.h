@@ -31,28 +31,31 @@ struct ShaderReflection {
 ShaderReflection reflect(std::span<const uint32_t> spirv, VkShaderStageFlags stage,
                          std::string_view name);
 
-// One resource for one binding; buffers bind whole, images with the layout they are in.
+// One resource for one binding (and array element); buffers bind whole, images with the layout
+// they are in.
 struct DescriptorResource {
   uint32_t binding = 0;
+  uint32_t array_element = 0;
   VkBuffer buffer = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
   VkSampler sampler = VK_NULL_HANDLE;
 };
 
-class ComputePipeline {
+// What compute and graphics pipelines share: a layout reflected from their shaders, push
+// descriptors and push constants.
+class Pipeline {
  public:
-  ComputePipeline(Context& ctx, std::string_view shader);
-  ~ComputePipeline();
-  ComputePipeline(const ComputePipeline&) = delete;
-  ComputePipeline& operator=(const ComputePipeline&) = delete;
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+  virtual ~Pipeline();
 
   const std::string& name() const { return name_; }
   const ShaderReflection& reflection() const { return reflection_; }
-  std::array<uint32_t, 3> local_size() const { return reflection_.local_size; }
 
   // Binds the pipeline and pushes one descriptor per reflected binding; throws Error naming the
-  // shader and binding when `resources` leaves one out.
+  // pipeline and binding when `resources` leaves one out. Elements of an array binding that
+  // `resources` does not name repeat its element 0 (so every element is valid).
   void bind(VkCommandBuffer cmd, std::span<const DescriptorResource> resources) const;
   void push_constants(VkCommandBuffer cmd, const void* data, uint32_t size) const;
   template <typename T>
@@ -60,14 +63,40 @@ class ComputePipeline {
     push_constants(cmd, &value, sizeof(T));
   }
 
- private:
+ protected:
+  Pipeline(Context& ctx, std::string name, ShaderReflection reflection, VkShaderStageFlags stages,
+           VkPipelineBindPoint bind_point);
+  VkShaderModule create_module(std::span<const uint32_t> code) const;
+
   VkDevice device_ = VK_NULL_HANDLE;
   std::string name_;
   ShaderReflection reflection_;
+  VkShaderStageFlags stages_ = 0;
+  VkPipelineBindPoint bind_point_ = VK_PIPELINE_BIND_POINT_COMPUTE;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
   PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
+};
+
+class ComputePipeline : public Pipeline {
+ public:
+  ComputePipeline(Context& ctx, std::string_view shader);
+  std::array<uint32_t, 3> local_size() const { return reflection_.local_size; }
+};
+
+// Rasterisation state strata's graphics passes choose from; everything else is fixed (triangle
+// lists, no vertex input: vertices are pulled from storage buffers; dynamic viewport/scissor).
+struct GraphicsState {
+  VkCullModeFlags cull = VK_CULL_MODE_NONE;
+  std::vector<VkFormat> color_formats;  // dynamic rendering attachments; may be empty
+  bool blend = false;                   // premultiplied-alpha "over" blending on every attachment
+};
+
+class GraphicsPipeline : public Pipeline {
+ public:
+  GraphicsPipeline(Context& ctx, std::string_view vertex_shader, std::string_view fragment_shader,
+                   const GraphicsState& state);
 };
 
 // Workgroups needed to cover `items` with groups of `group` (ceil division).

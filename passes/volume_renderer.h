@@ -1,0 +1,116 @@
+// The renderer: transparent meshes and volume proxy boxes hashed into the HA-Buffer by one thin
+// graphics pass, then one compute pass that sorts each pixel's fragments, ray-casts the volumes
+// live between them from the volume atlas, and writes one premultiplied image per depth layer,
+// the label-free final image and a depth image. docs/ARCHITECTURE.md, "Rendering", says why.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "engine/graph_runner.h"
+#include "engine/render_graph.h"
+#include "engine/resources.h"
+#include "engine/scene.h"
+#include "engine/shader_library.h"
+#include "shared/volume_render.h"
+
+namespace strata {
+
+struct RenderSettings {
+  uint32_t layer_count = 4;   // 1 .. 8
+  std::vector<float> splits;  // layer_count - 1 eye depths; empty: even over the scene's depth
+  float step = 0.0f;          // world units between samples; 0: half the finest voxel spacing
+  bool skip_empty = true;     // empty-space skipping with the per-volume brick grids
+  float termination_alpha = 0.99f;
+  float depth_alpha = 0.5f;
+  glm::vec3 background{0.0f};
+  float expected_depth_complexity = 4.0f;  // HA-Buffer sizing: fragments per pixel expected
+  float load_factor = 0.5f;                // ... and the share of slots they should fill
+};
+
+// What the GPU counted during the last completed frame.
+struct RenderStats {
+  uint32_t overflow = 0;          // fragments that found no slot (the table grows)
+  uint32_t fragments = 0;         // fragments in the table
+  uint32_t resolve_overflow = 0;  // fragments beyond the resolve's per-pixel capacity
+  uint64_t samples = 0;           // volume samples
+  uint32_t table_size = 0;        // slots during that frame
+  double load_factor() const { return table_size ? double(fragments) / table_size : 0.0; }
+};
+
+struct CameraSetup {
+  glm::mat4 view{1.0f};
+  float fov_y_degrees = 45.0f;
+  float near_plane = 0.1f;
+  float far_plane = 100.0f;
+};
+
+// The scene's camera, or its named position `name` (Error listing the names if there is none).
+CameraSetup camera_for(const Scene& scene, const std::string& name);
+
+class VolumeRenderer {
+ public:
+  struct Outputs {
+    graph::ResourceId layers;  // rgba16f array, one layer per depth layer, premultiplied
+    graph::ResourceId final;   // rgba8, layers over the background
+    graph::ResourceId depth;   // r32f eye depth, 0 where nothing is opaque enough
+  };
+
+  // Uploads the scene once: volumes into the atlas, transfer functions into their table, the
+  // empty-space grids, meshes into one vertex and one index buffer.
+  VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings settings = {});
+
+  Outputs add_to(graph::Graph& graph);
+  // Binds the uploaded scene and the counter readback; call after the runner has its viewport.
+  void bind(graph::GraphRunner& runner);
+
+  void set_camera(const CameraSetup& camera) { camera_ = camera; }
+  RenderSettings& settings() { return settings_; }
+  // Rebuilds volume v's empty-space grid and its transfer-function row.
+  void set_transfer_function(uint32_t volume, const TransferFunction& tf);
+  // Forces the HA-Buffer's slot count (tests force overflow with a tiny table); collect() grows it.
+  void set_table_size(uint32_t slots);
+  uint32_t table_slots(graph::Extent viewport) const { return slots_for(viewport); }
+
+  // Reads the counters of the last completed frame; grows the table (and reallocates the
+  // runner's transients) when fragments overflowed or it is fuller than 0.75. Returns the stats.
+  RenderStats collect(graph::GraphRunner& runner);
+
+  // The layer boundaries the next frame uses (eye depths).
+  std::vector<float> split_depths(graph::Extent viewport) const;
+
+ private:
+  gpu::FrameGpu frame_data(graph::Extent viewport) const;
+  uint32_t slots_for(graph::Extent viewport) const;
+  void upload_transfer_table();
+  void upload_occupancy();
+  void record_build(graph::PassContext& pc) const;
+
+  Context& ctx_;
+  RenderSettings settings_;
+  CameraSetup camera_;
+  std::vector<TransferFunction> transfer_functions_;  // one per volume (transparent if none)
+  std::vector<gpu::VolumeGpu> volume_info_;
+  std::vector<glm::vec2> brick_ranges_;  // per brick: min and max normalised value (dilated)
+  glm::vec3 scene_min_{0.0f}, scene_max_{0.0f};
+  float finest_spacing_ = 1.0f;
+  struct MeshDraw {
+    uint32_t first_index, index_count;
+    glm::vec4 color;
+    glm::mat4 transform;
+  };
+  std::vector<MeshDraw> mesh_draws_;
+
+  Image atlas_;
+  Image transfer_table_;
+  Buffer volumes_, occupancy_, vertices_, indices_, counters_readback_;
+  uint32_t forced_slots_ = 0;  // 0: sized from the viewport
+
+  GraphicsPipeline build_;
+  ComputePipeline resolve_;
+  struct Ids {
+    graph::ResourceId atlas, transfer, volumes, occupancy, vertices, indices, readback;
+  } ids_{};
+};
+
+}  // namespace strata

@@ -1,0 +1,20 @@
+// The HA-Buffer in storage buffers, shared by its build and its resolve.
+// A key is 64 bits: eye depth (float bits, positive so they order like the floats) in the high
+// word, then the age (probe number, 8 bits) and the pixel index (24 bits). Slot of (pixel, age):
+// pixel + age * golden ratio, modulo the table: age 1 keeps neighbouring pixels in neighbouring
+// slots (coherent, as in Lefebvre et al.'s HA-Buffer), later ages scatter.
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+
+layout(binding = VR_BINDING_KEYS, std430) buffer Keys { uint64_t keys[]; };
+layout(binding = VR_BINDING_PAYLOAD, std430) buffer Payload { uvec2 payload[]; };
+layout(binding = VR_BINDING_MAX_AGE, std430) buffer MaxAge { uint max_age[]; };
+layout(binding = VR_BINDING_COUNTERS, std430) buffer Counters { uint counters[VR_COUNTER_COUNT]; };
+
+uint habuffer_slot(uint pixel, uint age, uint table_size) {
+  return (pixel + age * 0x9E3779B1u) % table_size;
+}
+
+uint64_t habuffer_key(float depth, uint age, uint pixel) {
+  return (uint64_t(floatBitsToUint(depth)) << 32) | (uint64_t(age) << 24) | uint64_t(pixel);
+}

@@ -1,0 +1,77 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#include "shared/volume_shading.h"
+#include "habuffer.glsl"
+
+layout(local_size_x = VR_RESOLVE_GROUP, local_size_y = VR_RESOLVE_GROUP) in;
+layout(binding = VR_BINDING_FRAME) uniform Frame { FrameGpu frame; };
+layout(binding = VR_BINDING_VOLUMES, std430) readonly buffer Volumes { VolumeGpu volumes[]; };
+layout(binding = VR_BINDING_ATLAS) uniform sampler3D atlas;
+layout(binding = VR_BINDING_TRANSFER) uniform sampler2D transfer_table;
+layout(binding = VR_BINDING_OCCUPANCY, std430) readonly buffer Occupancy { uint occupancy[]; };
+layout(binding = VR_BINDING_LAYERS, rgba16f) writeonly uniform image2DArray layers;
+layout(binding = VR_BINDING_FINAL, rgba8) writeonly uniform image2D final_image;
+layout(binding = VR_BINDING_DEPTH, r32f) writeonly uniform image2D depth_image;
+
+VolumeGpu volume_info(uint v) { return volumes[v]; }
+float volume_sample(uint v, vec3 tc) {
+  return texture(atlas, volumes[v].atlas_offset.xyz + tc * volumes[v].atlas_scale.xyz).r;
+}
+vec4 transfer(uint v, float t) { return texture(transfer_table, vec2(t, volumes[v].atlas_offset.w)); }
+bool brick_empty(uint v, vec3 tc) {
+  const uvec3 b = min(uvec3(tc / (volumes[v].texel.xyz * float(VR_BRICK))), volumes[v].bricks.xyz - 1u);
+  const uvec4 g = volumes[v].bricks;
+  return occupancy[g.w + (b.z * g.y + b.y) * g.x + b.x] == 0u;
+}
+
+#include "shared/resolve_walk.h"
+
+void main() {
+  const uvec2 px = gl_GlobalInvocationID.xy;
+  const bool inside = px.x < frame.width && px.y < frame.height;
+  uint count = 0u, dropped = 0u;
+  float depths[VR_MAX_FRAGMENTS];
+  uvec2 payloads[VR_MAX_FRAGMENTS];
+  if (inside) {
+    // Gather this pixel's fragments (every age up to its largest), then sort them by depth.
+    const uint pixel = px.y * frame.width + px.x;
+    const uint ages = max_age[pixel];
+    for (uint age = 1u; age <= ages; ++age) {
+      const uint slot = habuffer_slot(pixel, age, frame.table_size);
+      const uint64_t key = keys[slot];
+      if (uint(key & 0xFFFFFFul) != pixel || uint((key >> 24) & 0xFFul) != age) continue;
+      if (count == VR_MAX_FRAGMENTS) {
+        ++dropped;
+        continue;
+      }
+      const float d = uintBitsToFloat(uint(key >> 32));
+      const uvec2 p = payload[slot];
+      uint j = count++;
+      for (; j > 0u && depths[j - 1u] > d; --j) {
+        depths[j] = depths[j - 1u];
+        payloads[j] = payloads[j - 1u];
+      }
+      depths[j] = d;
+      payloads[j] = p;
+    }
+  }
+  PixelResult r;
+  if (inside) r = resolve_pixel(vec2(px) + 0.5, count, depths, payloads);
+  const uint found = subgroupAdd(count + dropped);
+  const uint lost = subgroupAdd(dropped);
+  const uint samples = subgroupAdd(inside ? r.samples : 0u);
+  if (subgroupElect()) {
+    atomicAdd(counters[VR_COUNTER_FRAGMENTS], found);
+    if (lost > 0u) atomicAdd(counters[VR_COUNTER_RESOLVE_OVERFLOW], lost);
+    atomicAdd(counters[VR_COUNTER_SAMPLES], samples);
+  }
+  if (!inside) return;
+  vec4 all = vec4(0.0);
+  for (uint l = 0u; l < frame.layer_count; ++l) {
+    imageStore(layers, ivec3(px, l), r.layers[l]);
+    all = over(all, r.layers[l]);
+  }
+  imageStore(final_image, ivec2(px), vec4(all.rgb + (1.0 - all.a) * frame.background.rgb, 1.0));
+  imageStore(depth_image, ivec2(px), vec4(r.depth));
+}

@@ -1,0 +1,153 @@
+// The resolve of one pixel, written once for the GPU (habuffer_resolve.comp) and the CPU
+// reference (passes/volume_render_reference.cpp). The includer provides:
+//   frame                                  FrameGpu
+//   VolumeGpu volume_info(uint v)
+//   float volume_sample(uint v, vec3 tc)   trilinear normalised intensity at tc in [0,1]^3
+//   vec4 transfer(uint v, float t)         straight RGBA, linear between table entries
+//   bool brick_empty(uint v, vec3 tc)      transfer function is transparent in tc's brick
+// and the fragments of the pixel sorted front to back: their eye depths and payloads.
+//
+// The ray is parametrised by eye depth z: point(z) = origin + direction * z. Samples lie on one
+// grid for the whole ray (near + (k + 0.5) * dz), so segments between fragments join seamlessly.
+
+struct PixelResult {
+  vec4 layers[VR_MAX_LAYERS];  // premultiplied, each its own slab
+  float depth;                 // eye depth where the total alpha first reaches depth_alpha, or 0
+  uint samples;
+};
+
+uint layer_of(float z) {
+  uint layer = 0u;
+  for (uint i = 0u; i + 1u < frame.layer_count; ++i) {
+    if (z >= split_depth(frame.splits, i)) layer = i + 1u;
+  }
+  return layer;
+}
+
+bool inside_unit_box(vec3 tc) {
+  return tc.x >= 0.0f && tc.y >= 0.0f && tc.z >= 0.0f && tc.x <= 1.0f && tc.y <= 1.0f &&
+         tc.z <= 1.0f;
+}
+
+// The sum of every live (entered, not yet left) volume's shaded, opacity-corrected sample at p (premultiplied).
+vec4 sample_volumes(uint live, vec3 p, vec3 to_eye, float step_world) {
+  vec4 sum = vec4(0.0f);
+  for (uint v = 0u; v < frame.volume_count; ++v) {
+    if ((live & (1u << v)) == 0u) continue;
+    VolumeGpu vol = volume_info(v);
+    vec3 tc = vec3(vol.world_to_texture * vec4(p, 1.0f));
+    if (!inside_unit_box(tc)) continue;
+    vec4 c = transfer(v, volume_sample(v, tc));
+    if (c.a <= 0.0f) continue;
+    vec3 h = vec3(vol.texel);
+    vec3 g = vec3(volume_sample(v, tc + vec3(h.x, 0.0f, 0.0f)) - volume_sample(v, tc - vec3(h.x, 0.0f, 0.0f)),
+                  volume_sample(v, tc + vec3(0.0f, h.y, 0.0f)) - volume_sample(v, tc - vec3(0.0f, h.y, 0.0f)),
+                  volume_sample(v, tc + vec3(0.0f, 0.0f, h.z)) - volume_sample(v, tc - vec3(0.0f, 0.0f, h.z)));
+    // Gradients transform with the transpose of the world-to-texture map.
+    vec3 normal = transpose(mat3(vol.world_to_texture)) * (g / (2.0f * h));
+    float alpha = corrected_alpha(c.a, step_world, vol.atlas_scale.w);
+    vec4 shaded = length(normal) > 1e-6f ? shade_blinn_phong(vec4(vec3(c), 1.0f), -normal, to_eye)
+                                         : vec4(vec3(c), 1.0f);
+    sum += vec4(vec3(shaded) * alpha, alpha);
+  }
+  if (sum.a > 1.0f) sum /= sum.a;
+  return sum;
+}
+
+// The eye depth at which the ray leaves the current brick of every live volume (the next
+// place a sample could be visible), or z itself when some live volume is not empty here.
+float skip_to(uint live, vec3 origin, vec3 direction, float z) {
+  float exit_z = 3.4e38f;
+  for (uint v = 0u; v < frame.volume_count; ++v) {
+    if ((live & (1u << v)) == 0u) continue;
+    VolumeGpu vol = volume_info(v);
+    vec3 tc = vec3(vol.world_to_texture * vec4(origin + direction * z, 1.0f));
+    if (!inside_unit_box(tc)) continue;
+    if (!brick_empty(v, tc)) return z;
+    vec3 d = mat3(vol.world_to_texture) * direction;  // texture units per unit eye depth
+    // Bricks are VR_BRICK voxels wide: brick coordinates = voxel coordinates / VR_BRICK.
+    vec3 per_unit = 1.0f / (vec3(vol.texel) * float(VR_BRICK));
+    vec3 cell = floor(tc * per_unit);
+    float t = 3.4e38f;
+    if (abs(d.x) > 1e-12f) t = min(t, ((cell.x + (d.x > 0.0f ? 1.0f : 0.0f)) / per_unit.x - tc.x) / d.x);
+    if (abs(d.y) > 1e-12f) t = min(t, ((cell.y + (d.y > 0.0f ? 1.0f : 0.0f)) / per_unit.y - tc.y) / d.y);
+    if (abs(d.z) > 1e-12f) t = min(t, ((cell.z + (d.z > 0.0f ? 1.0f : 0.0f)) / per_unit.z - tc.z) / d.z);
+    exit_z = min(exit_z, z + max(t, 0.0f));
+  }
+  return exit_z;
+}
+
+float grid_depth(float k, float dz) { return frame.near_depth + (k + 0.5f) * dz; }
+float grid_index_at_or_after(float z, float dz) {
+  return max(ceil((z - frame.near_depth) / dz - 0.5f), 0.0f);
+}
+
+PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS],
+                          uvec2 payloads[VR_MAX_FRAGMENTS]) {
+  PixelResult r;
+  for (uint l = 0u; l < VR_MAX_LAYERS; ++l) r.layers[l] = vec4(0.0f);
+  r.depth = 0.0f;
+  r.samples = 0u;
+
+  vec2 ndc = pixel / vec2(float(frame.width), float(frame.height)) * 2.0f - 1.0f;
+  vec4 far_point = frame.clip_to_view * vec4(ndc, 1.0f, 1.0f);
+  vec3 view_direction = vec3(far_point) / far_point.w;
+  view_direction = view_direction / -view_direction.z;  // one unit of eye depth
+  vec3 origin = vec3(frame.view_to_world * vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  vec3 direction = mat3(frame.view_to_world) * view_direction;
+  vec3 to_eye = -normalize(direction);
+  float dz = frame.step / length(direction);
+
+  // Volumes the near plane cuts: their rays start at the near plane.
+  uint live = 0u;
+  for (uint v = 0u; v < frame.volume_count; ++v) {
+    vec3 tc = vec3(volume_info(v).world_to_texture * vec4(origin + direction * frame.near_depth, 1.0f));
+    if (inside_unit_box(tc)) live |= 1u << v;
+  }
+
+  float total = 0.0f;
+  float z = frame.near_depth;
+  for (uint i = 0u; i <= count; ++i) {
+    float z_end = i < count ? depths[i] : frame.far_depth;
+    float k = grid_index_at_or_after(z, dz);
+    while (live != 0u && grid_depth(k, dz) < z_end) {
+      float zs = grid_depth(k, dz);
+      uint l = layer_of(zs);
+      if (r.layers[l].a >= frame.termination_alpha) {  // this slab is opaque: go to the next one
+        if (l + 1u >= frame.layer_count) break;
+        k = max(grid_index_at_or_after(split_depth(frame.splits, l), dz), k + 1.0f);
+        continue;
+      }
+      if (frame.skip_empty != 0u) {
+        float next = skip_to(live, origin, direction, zs);
+        if (next > zs) {
+          k = max(grid_index_at_or_after(next, dz), k + 1.0f);
+          continue;
+        }
+      }
+      vec4 c = sample_volumes(live, origin + direction * zs, to_eye, frame.step);
+      r.samples += 1u;
+      r.layers[l] = over(r.layers[l], c);
+      float before = total;
+      total = total + (1.0f - total) * c.a;
+      if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = zs;
+      k += 1.0f;
+    }
+    if (i == count) break;
+    uvec2 p = payloads[i];
+    uint kind = (p.y >> 8u) & 3u;
+    if (kind == VR_KIND_MESH) {
+      vec4 c = unpackUnorm4x8(p.x);
+      uint l = layer_of(z_end);
+      r.layers[l] = over(r.layers[l], c);
+      float before = total;
+      total = total + (1.0f - total) * c.a;
+      if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = z_end;
+    } else {
+      uint bit = 1u << (p.y & 255u);
+      live = ((p.y >> 10u) & 1u) != 0u ? (live | bit) : (live & ~bit);
+    }
+    z = z_end;
+  }
+  return r;
+}
