@@ -2,13 +2,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <random>
 
 #include "app/commands.h"
 #include "engine/graph_runner.h"
 #include "engine/resources.h"
+#include "engine/scene_loader.h"
 #include "passes/summed_area_table.h"
+#include "passes/volume_renderer.h"
 
 namespace strata::app {
 namespace {
@@ -34,13 +37,19 @@ std::string json_escape(const std::string& s) {
   return out;
 }
 
-// Runs the graph `warmup + runs` times and prints per-pass and per-group GPU times.
-void print_timings(Context& ctx, graph::GraphRunner& runner, uint32_t warmup, uint32_t runs,
-                   const std::string& header) {
+struct Timings {
+  std::vector<std::pair<std::string, Stat>> passes, groups;
+};
+
+// Runs the graph `warmup + runs` times (calling after_run after each) and takes per-pass and
+// per-group (first pass begin to last pass end) GPU times.
+Timings measure(graph::GraphRunner& runner, uint32_t warmup, uint32_t runs,
+                const std::function<void()>& after_run = {}) {
   std::map<std::string, std::vector<double>> passes, groups;
   std::vector<std::string> pass_order, group_order;
   for (uint32_t i = 0; i < warmup + runs; ++i) {
     runner.run_now();
+    if (after_run) after_run();
     if (i < warmup) continue;
     std::map<std::string, std::pair<double, double>> spans;
     for (const graph::PassTiming& t : runner.timings()) {
@@ -54,23 +63,32 @@ void print_timings(Context& ctx, graph::GraphRunner& runner, uint32_t warmup, ui
     }
     for (const auto& [group, span] : spans) groups[group].push_back(span.second - span.first);
   }
-  const auto print_list = [](const char* key, const std::vector<std::string>& order,
-                             std::map<std::string, std::vector<double>>& samples) {
+  Timings out;
+  for (const auto& name : pass_order) out.passes.emplace_back(name, stat_of(passes[name]));
+  for (const auto& name : group_order) out.groups.emplace_back(name, stat_of(groups[name]));
+  return out;
+}
+
+// {"device", "driver", <header>, "runs", "passes", "groups"<tail>}: header and tail are JSON
+// members ("key": value) each followed by ",\n" (header) or preceded by ",\n" (tail).
+void print_json(Context& ctx, const std::string& header, uint32_t runs, const Timings& t,
+                const std::string& tail = "") {
+  const auto print_list = [](const char* key,
+                             const std::vector<std::pair<std::string, Stat>>& list) {
     std::printf("  \"%s\": [", key);
-    for (size_t i = 0; i < order.size(); ++i) {
-      const Stat s = stat_of(samples[order[i]]);
+    for (size_t i = 0; i < list.size(); ++i) {
       std::printf("%s\n    {\"name\": \"%s\", \"median_ms\": %.6f, \"min_ms\": %.6f}", i ? "," : "",
-                  json_escape(order[i]).c_str(), s.median, s.min);
+                  json_escape(list[i].first).c_str(), list[i].second.median, list[i].second.min);
     }
     std::printf("\n  ]");
   };
   std::printf("{\n  \"device\": \"%s\",\n  \"driver\": \"%s\",\n%s  \"runs\": %u,\n",
               json_escape(ctx.report().name).c_str(), json_escape(ctx.report().driver).c_str(),
               header.c_str(), runs);
-  print_list("passes", pass_order, passes);
+  print_list("passes", t.passes);
   std::printf(",\n");
-  print_list("groups", group_order, groups);
-  std::printf("\n}\n");
+  print_list("groups", t.groups);
+  std::printf("%s\n}\n", tail.c_str());
 }
 
 void bench_sat(DeviceOptions& device, graph::Extent size, uint32_t runs) {
@@ -109,7 +127,62 @@ void bench_sat(DeviceOptions& device, graph::Extent size, uint32_t runs) {
                 "  \"benchmark\": \"sat\",\n  \"width\": %u,\n  \"height\": %u,\n"
                 "  \"max_relative_error\": %.3g,\n",
                 size.width, size.height, max_relative);
-  print_timings(ctx, runner, 3, runs, header);
+  print_json(ctx, header, runs, measure(runner, 3, runs));
+}
+
+struct RenderBenchOptions {
+  std::string scene = "assets/scenes/head.json";
+  std::string size = "1024";
+  std::string camera;
+  uint32_t layers = 4;
+  bool no_skipping = false;
+};
+
+void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t runs) {
+  const graph::Extent size = parse_size(o.size, "--size");
+  const Scene scene = load_scene(o.scene);
+  Context ctx(device.context());
+  RenderSettings settings;
+  settings.layer_count = o.layers;
+  settings.skip_empty = !o.no_skipping;
+  VolumeRenderer renderer(ctx, scene, settings);
+  renderer.set_camera(camera_for(scene, o.camera));
+  graph::Graph graph;
+  renderer.add_to(graph);
+  graph::GraphRunner runner(ctx, std::move(graph));
+  runner.set_viewport(size);
+  renderer.bind(runner);
+  RenderStats last;
+  const Timings t = measure(runner, 3, runs, [&] {
+    renderer.bind(runner);
+    last = renderer.collect(runner);
+  });
+  double resolve_ms = 0.0;
+  for (const auto& [name, stat] : t.passes) {
+    if (name == "render.resolve") resolve_ms = stat.median;
+  }
+  // Texture fetches: every sample reads the atlas and the transfer table once per live volume;
+  // a shaded sample reads six more atlas texels for its gradient.
+  const double rays = double(size.width) * size.height;
+  const double fetches = 2.0 * double(last.samples) + 6.0 * double(last.shaded);
+  char header[512], tail[768];
+  std::snprintf(
+      header, sizeof header,
+      "  \"benchmark\": \"render\",\n  \"scene\": \"%s\",\n  \"camera\": \"%s\",\n"
+      "  \"width\": %u,\n  \"height\": %u,\n  \"layers\": %u,\n  \"empty_space_skipping\": %s,\n",
+      json_escape(o.scene).c_str(), json_escape(o.camera).c_str(), size.width, size.height,
+      o.layers, o.no_skipping ? "false" : "true");
+  std::snprintf(
+      tail, sizeof tail,
+      ",\n  \"samples_per_ray\": %.2f,\n  \"shaded_samples_per_ray\": %.2f,\n"
+      "  \"habuffer_fragments\": %u,\n  \"habuffer_slots\": %u,\n  \"habuffer_load_factor\": "
+      "%.3f,\n"
+      "  \"habuffer_overflow\": %u,\n  \"resolve_overflow\": %u,\n"
+      "  \"texture_fetches_per_frame\": %.0f,\n  \"resolve_fetch_rate_gtexel_per_s\": %.3f",
+      double(last.samples) / rays, double(last.shaded) / rays, last.fragments, last.table_size,
+      last.load_factor(), last.overflow, last.resolve_overflow, fetches,
+      resolve_ms > 0.0 ? fetches / (resolve_ms * 1e-3) * 1e-9 : 0.0);
+  print_json(ctx, header, runs, t, tail);
 }
 
 }  // namespace
@@ -130,6 +203,19 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   sat->callback([&device, options] {
     bench_sat(device, parse_size(options->size, "--size"), options->runs);
   });
+
+  auto render = std::make_shared<RenderBenchOptions>();
+  CLI::App* render_cmd = cmd->add_subcommand("render", "HA-Buffer build and resolve of a scene");
+  render_cmd->add_option("--scene", render->scene, "scene file")->capture_default_str();
+  render_cmd->add_option("--size", render->size, "N or WxH")->capture_default_str();
+  render_cmd->add_option("--camera", render->camera, "named camera position");
+  render_cmd->add_option("--layers", render->layers, "depth layers, 1 to 8")->capture_default_str();
+  render_cmd->add_flag("--no-skipping", render->no_skipping, "turn empty-space skipping off");
+  render_cmd->add_option("--runs", options->runs, "timed runs after 3 warm-up runs")
+      ->capture_default_str()
+      ->check(CLI::Range(1u, 100000u));
+  render_cmd->callback(
+      [&device, render, options] { bench_render(device, *render, options->runs); });
 }
 
 }  // namespace strata::app

@@ -38,7 +38,8 @@ void dump_layers(graph::GraphRunner& runner, graph::ResourceId layers, graph::Ex
       glm::vec4 c;
       for (int ch = 0; ch < 4; ++ch) c[ch] = glm::unpackHalf1x16(half[(l * pixels + p) * 4 + ch]);
       const glm::vec3 straight = c.a > 0.0f ? glm::vec3(c) / c.a : glm::vec3(0.0f);
-      for (int ch = 0; ch < 3; ++ch) rgba[p * 4 + ch] = uint8_t(std::clamp(straight[ch], 0.0f, 1.0f) * 255.0f + 0.5f);
+      for (int ch = 0; ch < 3; ++ch)
+        rgba[p * 4 + ch] = uint8_t(std::clamp(straight[ch], 0.0f, 1.0f) * 255.0f + 0.5f);
       rgba[p * 4 + 3] = uint8_t(std::clamp(c.a, 0.0f, 1.0f) * 255.0f + 0.5f);
     }
     const std::string path = folder + "/layer-" + std::to_string(l) + ".png";
@@ -50,7 +51,8 @@ void dump_layers(graph::GraphRunner& runner, graph::ResourceId layers, graph::Ex
 void render_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const Scene scene = load_scene(o.scene);
-  for (const std::string& warning : scene.warnings) std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
+  for (const std::string& warning : scene.warnings)
+    std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
   Context ctx(device.context());
   RenderSettings settings;
   settings.layer_count = o.layers;
@@ -101,7 +103,8 @@ void render_test_pattern(DeviceOptions& device, const RenderOptions& o) {
 void add_render_command(CLI::App& app, DeviceOptions& device) {
   CLI::App* cmd = app.add_subcommand("render", "Render a scene offline and write it as PNG");
   auto o = std::make_shared<RenderOptions>();
-  cmd->add_option("scene", o->scene, "scene file (.json, or .xml of the thesis program); none: a test pattern");
+  cmd->add_option("scene", o->scene,
+                  "scene file (.json, or .xml of the thesis program); none: a test pattern");
   cmd->add_option("-o,--output", o->output, "PNG file to write")->capture_default_str();
   cmd->add_option("--size", o->size, "image size, N or WxH")->capture_default_str();
   cmd->add_option("--camera", o->camera, "named camera position of the scene");

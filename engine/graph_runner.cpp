@@ -58,7 +58,10 @@ void GraphRunner::set_viewport(Extent viewport) {
     if (r.imported) continue;
     if (r.is_image) {
       const Extent e = r.image.fixed.width ? r.image.fixed : viewport;
-      ImageDesc desc{r.image.format, {e.width, e.height, 1}, VK_IMAGE_TYPE_2D, compiled_.usage[i],
+      ImageDesc desc{r.image.format,
+                     {e.width, e.height, 1},
+                     VK_IMAGE_TYPE_2D,
+                     compiled_.usage[i],
                      r.image.layers};
       Image& image = owned_[i].emplace<Image>(ctx_, desc);
       bound_[i] = {VK_NULL_HANDLE, image.handle(), image.view(), r.image.format};
@@ -79,7 +82,8 @@ void GraphRunner::reallocate() {
 
 std::vector<std::byte> GraphRunner::download_image(ResourceId id) {
   const Image* image = std::get_if<Image>(&owned_.at(id));
-  if (!image) throw Error("render graph: '" + graph_.resources()[id].name + "' is not a transient image");
+  if (!image)
+    throw Error("render graph: '" + graph_.resources()[id].name + "' is not a transient image");
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
   for (const auto& pass_layouts : compiled_.layout) {
     if (pass_layouts[id] != VK_IMAGE_LAYOUT_UNDEFINED) layout = pass_layouts[id];

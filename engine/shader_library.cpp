@@ -113,7 +113,8 @@ ShaderReflection reflect(std::span<const uint32_t> spirv, VkShaderStageFlags sta
 namespace {
 
 // Bindings of two stages merged: the same binding must have the same type and count in both.
-ShaderReflection merge(const ShaderReflection& a, const ShaderReflection& b, const std::string& name) {
+ShaderReflection merge(const ShaderReflection& a, const ShaderReflection& b,
+                       const std::string& name) {
   ShaderReflection out = a;
   for (const VkDescriptorSetLayoutBinding& binding : b.bindings) {
     auto it = std::find_if(out.bindings.begin(), out.bindings.end(),
@@ -203,8 +204,9 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, std::string_view vertex_shader,
                VK_PIPELINE_BIND_POINT_GRAPHICS) {
   VkShaderModule vertex = create_module(shader_code(vertex_shader));
   VkShaderModule fragment = create_module(shader_code(fragment_shader));
-  VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
-                                               {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
+  VkPipelineShaderStageCreateInfo stages[2] = {
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
   stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
   stages[0].module = vertex;
   stages[0].pName = "main";
@@ -212,20 +214,25 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, std::string_view vertex_shader,
   stages[1].module = fragment;
   stages[1].pName = "main";
 
-  VkPipelineVertexInputStateCreateInfo vertex_input{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-  VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  VkPipelineVertexInputStateCreateInfo vertex_input{
+      VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  VkPipelineInputAssemblyStateCreateInfo assembly{
+      VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
   assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
   VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
   viewport.viewportCount = 1;
   viewport.scissorCount = 1;
-  VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  VkPipelineRasterizationStateCreateInfo raster{
+      VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
   raster.polygonMode = VK_POLYGON_MODE_FILL;
   raster.cullMode = state.cull;
   raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
   raster.lineWidth = 1.0f;
-  VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  VkPipelineMultisampleStateCreateInfo multisample{
+      VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
   multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-  VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+  VkPipelineDepthStencilStateCreateInfo depth{
+      VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
   std::vector<VkPipelineColorBlendAttachmentState> attachments(state.color_formats.size());
   for (auto& a : attachments) {
     a.blendEnable = state.blend;
@@ -238,7 +245,8 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, std::string_view vertex_shader,
     a.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                        VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
   }
-  VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+  VkPipelineColorBlendStateCreateInfo blend{
+      VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
   blend.attachmentCount = static_cast<uint32_t>(attachments.size());
   blend.pAttachments = attachments.data();
   const VkDynamicState dynamic_states[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
@@ -279,9 +287,10 @@ void Pipeline::bind(VkCommandBuffer cmd, std::span<const DescriptorResource> res
   images.reserve(descriptors);
   std::vector<VkWriteDescriptorSet> writes;
   for (const VkDescriptorSetLayoutBinding& b : reflection_.bindings) {
-    const auto first = std::find_if(resources.begin(), resources.end(), [&](const DescriptorResource& r) {
-      return r.binding == b.binding && r.array_element == 0;
-    });
+    const auto first =
+        std::find_if(resources.begin(), resources.end(), [&](const DescriptorResource& r) {
+          return r.binding == b.binding && r.array_element == 0;
+        });
     if (first == resources.end()) {
       throw Error("shader '" + name_ + "': nothing bound to binding " + std::to_string(b.binding));
     }
@@ -291,15 +300,19 @@ void Pipeline::bind(VkCommandBuffer cmd, std::span<const DescriptorResource> res
     write.descriptorType = b.descriptorType;
     const bool is_buffer = b.descriptorType == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER ||
                            b.descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-    if (is_buffer) write.pBufferInfo = buffers.data() + buffers.size();
-    else write.pImageInfo = images.data() + images.size();
+    if (is_buffer)
+      write.pBufferInfo = buffers.data() + buffers.size();
+    else
+      write.pImageInfo = images.data() + images.size();
     for (uint32_t element = 0; element < b.descriptorCount; ++element) {
       auto it = std::find_if(resources.begin(), resources.end(), [&](const DescriptorResource& r) {
         return r.binding == b.binding && r.array_element == element;
       });
       const DescriptorResource& r = it == resources.end() ? *first : *it;
-      if (is_buffer) buffers.push_back({r.buffer, 0, VK_WHOLE_SIZE});
-      else images.push_back({r.sampler, r.view, r.layout});
+      if (is_buffer)
+        buffers.push_back({r.buffer, 0, VK_WHOLE_SIZE});
+      else
+        images.push_back({r.sampler, r.view, r.layout});
     }
     writes.push_back(write);
   }

@@ -80,7 +80,9 @@ float finest_world_spacing(const glm::mat4& texture_to_world, glm::uvec3 dims) {
   return finest;
 }
 
-VkDeviceSize at_least(VkDeviceSize bytes) { return std::max<VkDeviceSize>(bytes, 64); }
+VkDeviceSize at_least(VkDeviceSize bytes) {
+  return std::max<VkDeviceSize>(bytes, 64);
+}
 
 }  // namespace
 
@@ -96,235 +98,258 @@ CameraSetup camera_for(const Scene& scene, const std::string& name) {
     }
     names += (names.empty() ? "" : ", ") + pose.name;
   }
-  throw Error(scene.source.string() + ": no camera position named '" + name + "' (the scene has: " +
-              (names.empty() ? "none" : names) + ")");
+  throw Error(scene.source.string() + ": no camera position named '" + name +
+              "' (the scene has: " + (names.empty() ? "none" : names) + ")");
 }
 
-VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings settings)
-    : ctx_(ctx),
-      settings_(std::move(settings)),
-      build_(ctx, "habuffer_build.vert", "habuffer_build.frag", {}),
-      resolve_(ctx, "habuffer_resolve.comp") {
+RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d) {
   if (scene.volumes.size() > VR_MAX_VOLUMES) {
     throw Error(scene.source.string() + ": " + std::to_string(scene.volumes.size()) +
                 " volumes; strata renders at most " + std::to_string(VR_MAX_VOLUMES));
   }
-  if (settings_.layer_count < 1 || settings_.layer_count > VR_MAX_LAYERS) {
-    throw Error("layers: " + std::to_string(settings_.layer_count) + " is not in 1.." +
-                std::to_string(VR_MAX_LAYERS));
-  }
-  camera_ = camera_for(scene, "");
-  scene_min_ = glm::vec3(3.4e38f);
-  scene_max_ = glm::vec3(-3.4e38f);
-  finest_spacing_ = 3.4e38f;
+  RenderInputs in;
+  in.scene_min = glm::vec3(3.4e38f);
+  in.scene_max = glm::vec3(-3.4e38f);
+  in.finest_spacing = 3.4e38f;
+  const auto extend = [&](const glm::vec3& p) {
+    in.scene_min = glm::min(in.scene_min, p);
+    in.scene_max = glm::max(in.scene_max, p);
+  };
 
   // The atlas: every volume stacked along z with a border of replicated edge voxels.
-  glm::uvec3 atlas_dims(1, 1, 0);
+  glm::uvec3 dims(1, 1, 0);
   for (const Volume& v : scene.volumes) {
-    atlas_dims.x = std::max(atlas_dims.x, v.dims.x + 2 * VR_ATLAS_BORDER);
-    atlas_dims.y = std::max(atlas_dims.y, v.dims.y + 2 * VR_ATLAS_BORDER);
-    atlas_dims.z += v.dims.z + 2 * VR_ATLAS_BORDER;
+    dims.x = std::max(dims.x, v.dims.x + 2 * VR_ATLAS_BORDER);
+    dims.y = std::max(dims.y, v.dims.y + 2 * VR_ATLAS_BORDER);
+    dims.z += v.dims.z + 2 * VR_ATLAS_BORDER;
   }
-  atlas_dims.z = std::max(atlas_dims.z, 1u);
-  const uint32_t max_3d = ctx.properties().limits.maxImageDimension3D;
-  if (atlas_dims.x > max_3d || atlas_dims.y > max_3d || atlas_dims.z > max_3d) {
-    throw Error(scene.source.string() + ": the volumes need a " + std::to_string(atlas_dims.x) + "x" +
-                std::to_string(atlas_dims.y) + "x" + std::to_string(atlas_dims.z) +
-                " atlas; this device allows " + std::to_string(max_3d) + " per side");
+  dims.z = std::max(dims.z, 1u);
+  if (dims.x > max_image_dimension_3d || dims.y > max_image_dimension_3d ||
+      dims.z > max_image_dimension_3d) {
+    throw Error(scene.source.string() + ": the volumes need a " + std::to_string(dims.x) + "x" +
+                std::to_string(dims.y) + "x" + std::to_string(dims.z) +
+                " atlas; this device allows " + std::to_string(max_image_dimension_3d) +
+                " per side");
   }
-  std::vector<uint16_t> atlas(size_t(atlas_dims.x) * atlas_dims.y * atlas_dims.z, 0);
+  in.atlas_dims = dims;
+  in.atlas.assign(size_t(dims.x) * dims.y * dims.z, 0);
   uint32_t z0 = 0, first_brick = 0;
   for (uint32_t index = 0; index < scene.volumes.size(); ++index) {
     const Volume& v = scene.volumes[index];
     const std::vector<uint16_t> t = normalised(v);
-    const glm::ivec3 dims(v.dims);
+    const glm::ivec3 vd(v.dims);
     for (uint32_t az = 0; az < v.dims.z + 2 * VR_ATLAS_BORDER; ++az) {
-      const int k = std::clamp(int(az) - int(VR_ATLAS_BORDER), 0, dims.z - 1);
-      for (uint32_t ay = 0; ay < atlas_dims.y; ++ay) {
-        const int j = std::clamp(int(ay) - int(VR_ATLAS_BORDER), 0, dims.y - 1);
-        uint16_t* row = &atlas[(size_t(z0 + az) * atlas_dims.y + ay) * atlas_dims.x];
-        for (uint32_t ax = 0; ax < atlas_dims.x; ++ax) {
-          const int i = std::clamp(int(ax) - int(VR_ATLAS_BORDER), 0, dims.x - 1);
-          row[ax] = t[(size_t(k) * dims.y + j) * dims.x + i];
+      const int k = std::clamp(int(az) - int(VR_ATLAS_BORDER), 0, vd.z - 1);
+      for (uint32_t ay = 0; ay < dims.y; ++ay) {
+        const int j = std::clamp(int(ay) - int(VR_ATLAS_BORDER), 0, vd.y - 1);
+        uint16_t* row = &in.atlas[(size_t(z0 + az) * dims.y + ay) * dims.x];
+        for (uint32_t ax = 0; ax < dims.x; ++ax) {
+          const int i = std::clamp(int(ax) - int(VR_ATLAS_BORDER), 0, vd.x - 1);
+          row[ax] = t[(size_t(k) * vd.y + j) * vd.x + i];
         }
       }
     }
     gpu::VolumeGpu info{};
     info.texture_to_world = texture_to_world(v);
     info.world_to_texture = glm::inverse(info.texture_to_world);
-    const glm::vec3 atlas_size(atlas_dims);
-    info.atlas_offset = glm::vec4(glm::vec3(VR_ATLAS_BORDER, VR_ATLAS_BORDER, z0 + VR_ATLAS_BORDER) / atlas_size,
-                                  (float(index) + 0.5f) / float(scene.volumes.size()));
+    const glm::vec3 atlas_size(dims);
+    info.atlas_offset =
+        glm::vec4(glm::vec3(VR_ATLAS_BORDER, VR_ATLAS_BORDER, z0 + VR_ATLAS_BORDER) / atlas_size,
+                  (float(index) + 0.5f) / float(scene.volumes.size()));
     const float spacing = finest_world_spacing(info.texture_to_world, v.dims);
     info.atlas_scale = glm::vec4(glm::vec3(v.dims) / atlas_size, spacing);
     info.texel = glm::vec4(1.0f / glm::vec3(v.dims), 0.0f);
     const glm::uvec3 bricks = (v.dims + uint32_t(VR_BRICK - 1)) / uint32_t(VR_BRICK);
     info.bricks = glm::uvec4(bricks, first_brick);
-    brick_ranges(t, v.dims, bricks, brick_ranges_);
+    brick_ranges(t, v.dims, bricks, in.brick_ranges);
     first_brick += bricks.x * bricks.y * bricks.z;
-    volume_info_.push_back(info);
-    finest_spacing_ = std::min(finest_spacing_, spacing);
+    in.volumes.push_back(info);
+    in.finest_spacing = std::min(in.finest_spacing, spacing);
     for (int c = 0; c < 8; ++c) {
-      const glm::vec3 corner(c & 1, (c >> 1) & 1, (c >> 2) & 1);
-      const glm::vec3 p(info.texture_to_world * glm::vec4(corner, 1.0f));
-      scene_min_ = glm::min(scene_min_, p);
-      scene_max_ = glm::max(scene_max_, p);
+      extend(glm::vec3(info.texture_to_world * glm::vec4(c & 1, (c >> 1) & 1, (c >> 2) & 1, 1.0f)));
     }
-    transfer_functions_.push_back(v.transfer_function >= 0
-                                      ? scene.transfer_functions.at(size_t(v.transfer_function))
-                                      : TransferFunction{});
+    in.transfer_functions.push_back(v.transfer_function >= 0
+                                        ? scene.transfer_functions.at(size_t(v.transfer_function))
+                                        : TransferFunction{});
     z0 += v.dims.z + 2 * VR_ATLAS_BORDER;
   }
-  atlas_ = Image(ctx, {kAtlasFormat, {atlas_dims.x, atlas_dims.y, atlas_dims.z}, VK_IMAGE_TYPE_3D,
-                       VK_IMAGE_USAGE_SAMPLED_BIT});
-  upload(ctx, atlas_, as_bytes(atlas), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 
   // Meshes: one vertex buffer (position, normal as vec4 pairs) and one index buffer.
-  std::vector<glm::vec4> vertices;
-  std::vector<uint32_t> indices;
   for (const Mesh& mesh : scene.meshes) {
-    const uint32_t base = static_cast<uint32_t>(vertices.size() / 2);
+    const uint32_t base = static_cast<uint32_t>(in.vertices.size() / 2);
     for (size_t i = 0; i < mesh.positions.size(); ++i) {
-      vertices.emplace_back(mesh.positions[i], 1.0f);
-      vertices.emplace_back(i < mesh.normals.size() ? mesh.normals[i] : glm::vec3(0.0f, 0.0f, 1.0f), 0.0f);
-      const glm::vec3 p(mesh.transform * glm::vec4(mesh.positions[i], 1.0f));
-      scene_min_ = glm::min(scene_min_, p);
-      scene_max_ = glm::max(scene_max_, p);
+      in.vertices.emplace_back(mesh.positions[i], 1.0f);
+      in.vertices.emplace_back(
+          i < mesh.normals.size() ? mesh.normals[i] : glm::vec3(0.0f, 0.0f, 1.0f), 0.0f);
+      extend(glm::vec3(mesh.transform * glm::vec4(mesh.positions[i], 1.0f)));
     }
-    mesh_draws_.push_back({static_cast<uint32_t>(indices.size()),
-                           static_cast<uint32_t>(mesh.indices.size()), mesh.color, mesh.transform});
-    for (uint32_t index : mesh.indices) indices.push_back(base + index);
+    in.meshes.push_back({static_cast<uint32_t>(in.indices.size()),
+                         static_cast<uint32_t>(mesh.indices.size()), mesh.color, mesh.transform});
+    for (uint32_t index : mesh.indices) in.indices.push_back(base + index);
   }
-  if (finest_spacing_ > 1e30f) finest_spacing_ = glm::length(scene_max_ - scene_min_) / 256.0f;
-  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  vertices_ = Buffer(ctx, at_least(vertices.size() * sizeof(glm::vec4)), storage, MemoryKind::device_local);
-  indices_ = Buffer(ctx, at_least(indices.size() * sizeof(uint32_t)), storage, MemoryKind::device_local);
-  volumes_ = Buffer(ctx, at_least(volume_info_.size() * sizeof(gpu::VolumeGpu)), storage,
-                    MemoryKind::device_local);
-  occupancy_ = Buffer(ctx, at_least(brick_ranges_.size() * sizeof(uint32_t)), storage,
-                      MemoryKind::device_local);
-  counters_readback_ = Buffer(ctx, VR_COUNTER_COUNT * sizeof(uint32_t), VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                              MemoryKind::host_readback);
-  std::memset(counters_readback_.mapped(), 0, VR_COUNTER_COUNT * sizeof(uint32_t));
-  upload(ctx, vertices_, as_bytes(vertices));
-  upload(ctx, indices_, as_bytes(indices));
-  upload(ctx, volumes_, as_bytes(volume_info_));
-  transfer_table_ = Image(ctx, {kTableFormat, {VR_TF_SIZE, std::max<uint32_t>(1, uint32_t(volume_info_.size())), 1},
-                                VK_IMAGE_TYPE_2D, VK_IMAGE_USAGE_SAMPLED_BIT});
-  upload_transfer_table();
-  upload_occupancy();
+  if (in.finest_spacing > 1e30f)
+    in.finest_spacing = glm::length(in.scene_max - in.scene_min) / 256.0f;
+  in.update_transfer();
+  return in;
 }
 
-void VolumeRenderer::upload_transfer_table() {
-  std::vector<glm::vec4> table(size_t(VR_TF_SIZE) * std::max<size_t>(1, transfer_functions_.size()),
-                               glm::vec4(0.0f));
-  for (size_t row = 0; row < transfer_functions_.size(); ++row) {
+// The transfer table samples each function at its entries' centres. A brick is occupied when
+// any entry its value range can reach (with the linear filter's neighbours) has alpha above 0.
+void RenderInputs::update_transfer() {
+  const size_t rows = std::max<size_t>(1, transfer_functions.size());
+  transfer_table.assign(VR_TF_SIZE * rows, glm::vec4(0.0f));
+  for (size_t row = 0; row < transfer_functions.size(); ++row) {
     for (uint32_t i = 0; i < VR_TF_SIZE; ++i) {
-      table[row * VR_TF_SIZE + i] = transfer_functions_[row].sample((float(i) + 0.5f) / VR_TF_SIZE);
+      transfer_table[row * VR_TF_SIZE + i] =
+          transfer_functions[row].sample((float(i) + 0.5f) / VR_TF_SIZE);
     }
   }
-  upload(ctx_, transfer_table_, as_bytes(table), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-}
-
-// A brick is occupied when any table entry its value range can reach (with the linear filter's
-// neighbours) has alpha above zero.
-void VolumeRenderer::upload_occupancy() {
-  std::vector<uint32_t> occupied(brick_ranges_.size(), 0);
-  for (size_t v = 0; v < volume_info_.size(); ++v) {
-    std::vector<float> alpha(VR_TF_SIZE);
-    for (uint32_t i = 0; i < VR_TF_SIZE; ++i) {
-      alpha[i] = transfer_functions_[v].sample((float(i) + 0.5f) / VR_TF_SIZE).a;
-    }
-    const glm::uvec4 b = volume_info_[v].bricks;
+  occupancy.assign(brick_ranges.size(), 0);
+  for (size_t v = 0; v < volumes.size(); ++v) {
+    const glm::uvec4 b = volumes[v].bricks;
     for (uint32_t n = 0; n < b.x * b.y * b.z; ++n) {
-      const glm::vec2 range = brick_ranges_[b.w + n];
+      const glm::vec2 range = brick_ranges[b.w + n];
       const int lo = std::clamp(int(std::floor(range.x * VR_TF_SIZE - 0.5f)), 0, VR_TF_SIZE - 1);
       const int hi = std::clamp(int(std::ceil(range.y * VR_TF_SIZE - 0.5f)), 0, VR_TF_SIZE - 1);
-      for (int i = lo; i <= hi && !occupied[b.w + n]; ++i) occupied[b.w + n] = alpha[i] > 0.0f;
+      for (int i = lo; i <= hi && !occupancy[b.w + n]; ++i) {
+        occupancy[b.w + n] = transfer_table[v * VR_TF_SIZE + size_t(i)].a > 0.0f;
+      }
     }
   }
-  upload(ctx_, occupancy_, as_bytes(occupied));
 }
 
-void VolumeRenderer::set_transfer_function(uint32_t volume, const TransferFunction& tf) {
-  transfer_functions_.at(volume) = tf;
-  upload_transfer_table();
-  upload_occupancy();
-}
-
-void VolumeRenderer::set_table_size(uint32_t slots) { forced_slots_ = std::max(slots, 1u); }
-
-uint32_t VolumeRenderer::slots_for(graph::Extent e) const {
-  if (forced_slots_) return forced_slots_;
-  const double wanted = double(e.width) * e.height * settings_.expected_depth_complexity / settings_.load_factor;
-  return static_cast<uint32_t>(std::min(std::ceil(wanted), 4.0e9));
-}
-
-std::vector<float> VolumeRenderer::split_depths(graph::Extent) const {
-  const uint32_t layers = settings_.layer_count;
-  if (!settings_.splits.empty()) {
-    if (settings_.splits.size() != layers - 1) {
-      throw Error("layers: " + std::to_string(layers) + " layers need " + std::to_string(layers - 1) +
-                  " split depths, " + std::to_string(settings_.splits.size()) + " given");
+std::vector<float> split_depths(const RenderInputs& in, const CameraSetup& camera,
+                                const RenderSettings& settings) {
+  const uint32_t layers = settings.layer_count;
+  if (!settings.splits.empty()) {
+    if (settings.splits.size() != layers - 1) {
+      throw Error("layers: " + std::to_string(layers) + " layers need " +
+                  std::to_string(layers - 1) + " split depths, " +
+                  std::to_string(settings.splits.size()) + " given");
     }
-    return settings_.splits;
+    return settings.splits;
   }
   // Evenly over the eye depths the scene's bounds cover, inside the near and far planes.
   float lo = 3.4e38f, hi = -3.4e38f;
   for (int c = 0; c < 8; ++c) {
-    const glm::vec3 corner((c & 1) ? scene_max_.x : scene_min_.x, (c & 2) ? scene_max_.y : scene_min_.y,
-                           (c & 4) ? scene_max_.z : scene_min_.z);
-    const float depth = -(camera_.view * glm::vec4(corner, 1.0f)).z;
+    const glm::vec3 corner((c & 1) ? in.scene_max.x : in.scene_min.x,
+                           (c & 2) ? in.scene_max.y : in.scene_min.y,
+                           (c & 4) ? in.scene_max.z : in.scene_min.z);
+    const float depth = -(camera.view * glm::vec4(corner, 1.0f)).z;
     lo = std::min(lo, depth);
     hi = std::max(hi, depth);
   }
-  lo = std::clamp(lo, camera_.near_plane, camera_.far_plane);
-  hi = std::clamp(hi, lo, camera_.far_plane);
+  lo = std::clamp(lo, camera.near_plane, camera.far_plane);
+  hi = std::clamp(hi, lo, camera.far_plane);
   std::vector<float> splits;
   for (uint32_t i = 1; i < layers; ++i) splits.push_back(lo + (hi - lo) * float(i) / float(layers));
   return splits;
 }
 
-gpu::FrameGpu VolumeRenderer::frame_data(graph::Extent e) const {
+gpu::FrameGpu frame_data(const RenderInputs& in, const CameraSetup& camera,
+                         const RenderSettings& settings, graph::Extent e, uint32_t table_size) {
+  if (settings.layer_count < 1 || settings.layer_count > VR_MAX_LAYERS) {
+    throw Error("layers: " + std::to_string(settings.layer_count) + " is not in 1.." +
+                std::to_string(VR_MAX_LAYERS));
+  }
   gpu::FrameGpu f{};
-  f.world_to_view = camera_.view;
-  f.view_to_world = glm::inverse(camera_.view);
-  glm::mat4 projection = glm::perspectiveRH_ZO(glm::radians(camera_.fov_y_degrees),
-                                               float(e.width) / float(e.height), camera_.near_plane,
-                                               camera_.far_plane);
+  f.world_to_view = camera.view;
+  f.view_to_world = glm::inverse(camera.view);
+  glm::mat4 projection =
+      glm::perspectiveRH_ZO(glm::radians(camera.fov_y_degrees), float(e.width) / float(e.height),
+                            camera.near_plane, camera.far_plane);
   projection[1][1] *= -1.0f;  // Vulkan's clip space has y down
   f.view_to_clip = projection;
   f.clip_to_view = glm::inverse(projection);
-  const std::vector<float> splits = split_depths(e);
+  const std::vector<float> splits = split_depths(in, camera, settings);
   for (size_t i = 0; i < splits.size(); ++i) f.splits[i / 4][int(i % 4)] = splits[i];
-  f.background = glm::vec4(settings_.background, 1.0f);
+  f.background = glm::vec4(settings.background, 1.0f);
   f.width = e.width;
   f.height = e.height;
-  f.layer_count = settings_.layer_count;
-  f.volume_count = static_cast<uint32_t>(volume_info_.size());
-  f.table_size = slots_for(e);
-  f.skip_empty = settings_.skip_empty ? 1u : 0u;
-  f.near_depth = camera_.near_plane;
-  f.far_depth = camera_.far_plane;
-  f.step = settings_.step > 0.0f ? settings_.step : 0.5f * finest_spacing_;
-  f.termination_alpha = settings_.termination_alpha;
-  f.depth_alpha = settings_.depth_alpha;
+  f.layer_count = settings.layer_count;
+  f.volume_count = static_cast<uint32_t>(in.volumes.size());
+  f.table_size = table_size;
+  f.skip_empty = settings.skip_empty ? 1u : 0u;
+  f.near_depth = camera.near_plane;
+  f.far_depth = camera.far_plane;
+  f.step = settings.step > 0.0f ? settings.step : 0.5f * in.finest_spacing;
+  f.termination_alpha = settings.termination_alpha;
+  f.depth_alpha = settings.depth_alpha;
   return f;
+}
+
+VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings settings)
+    : ctx_(ctx),
+      settings_(std::move(settings)),
+      camera_(camera_for(scene, "")),
+      inputs_(prepare_render_inputs(scene, ctx.properties().limits.maxImageDimension3D)),
+      build_(ctx, "habuffer_build.vert", "habuffer_build.frag", {}),
+      resolve_(ctx, "habuffer_resolve.comp") {
+  frame_data(inputs_, camera_, settings_, {1, 1}, 1);  // checks the settings early
+  const glm::uvec3 d = inputs_.atlas_dims;
+  atlas_ =
+      Image(ctx, {kAtlasFormat, {d.x, d.y, d.z}, VK_IMAGE_TYPE_3D, VK_IMAGE_USAGE_SAMPLED_BIT});
+  upload(ctx, atlas_, as_bytes(inputs_.atlas), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  const auto filled = [&](const auto& data) {
+    Buffer b(ctx, at_least(data.size() * sizeof(data[0])), storage, MemoryKind::device_local);
+    upload(ctx, b, as_bytes(data));
+    return b;
+  };
+  vertices_ = filled(inputs_.vertices);
+  indices_ = filled(inputs_.indices);
+  volumes_ = filled(inputs_.volumes);
+  occupancy_ = Buffer(ctx, at_least(inputs_.occupancy.size() * sizeof(uint32_t)), storage,
+                      MemoryKind::device_local);
+  counters_readback_ = Buffer(ctx, VR_COUNTER_COUNT * sizeof(uint32_t),
+                              VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback);
+  std::memset(counters_readback_.mapped(), 0, VR_COUNTER_COUNT * sizeof(uint32_t));
+  transfer_table_ =
+      Image(ctx, {kTableFormat,
+                  {VR_TF_SIZE, uint32_t(inputs_.transfer_table.size() / VR_TF_SIZE), 1},
+                  VK_IMAGE_TYPE_2D,
+                  VK_IMAGE_USAGE_SAMPLED_BIT});
+  upload_transfer();
+}
+
+void VolumeRenderer::upload_transfer() {
+  upload(ctx_, transfer_table_, as_bytes(inputs_.transfer_table),
+         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  if (!inputs_.occupancy.empty()) upload(ctx_, occupancy_, as_bytes(inputs_.occupancy));
+}
+
+void VolumeRenderer::set_transfer_function(uint32_t volume, const TransferFunction& tf) {
+  inputs_.transfer_functions.at(volume) = tf;
+  inputs_.update_transfer();
+  upload_transfer();
+}
+
+void VolumeRenderer::set_table_size(uint32_t slots) {
+  forced_slots_ = std::max(slots, 1u);
+}
+
+uint32_t VolumeRenderer::slots_for(graph::Extent e) const {
+  if (forced_slots_) return forced_slots_;
+  const double wanted =
+      double(e.width) * e.height * settings_.expected_depth_complexity / settings_.load_factor;
+  return static_cast<uint32_t>(std::min(std::ceil(wanted), 4.0e9));
 }
 
 VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
   const auto slots = [this](graph::Extent e) { return VkDeviceSize{slots_for(e)} * 8; };
-  const ResourceId frame = graph.add_buffer("render.frame", {[](graph::Extent) { return VkDeviceSize{sizeof(gpu::FrameGpu)}; }});
+  const ResourceId frame = graph.add_buffer(
+      "render.frame", {[](graph::Extent) { return VkDeviceSize{sizeof(gpu::FrameGpu)}; }});
   const ResourceId keys = graph.add_buffer("render.keys", {slots});
   const ResourceId payload = graph.add_buffer("render.payload", {slots});
-  const ResourceId max_age = graph.add_buffer("render.max_age", {[](graph::Extent e) {
-    return VkDeviceSize{e.width} * e.height * sizeof(uint32_t);
-  }});
-  const ResourceId counters = graph.add_buffer("render.counters", {[](graph::Extent) {
-    return VkDeviceSize{VR_COUNTER_COUNT * sizeof(uint32_t)};
-  }});
+  const ResourceId max_age = graph.add_buffer(
+      "render.max_age",
+      {[](graph::Extent e) { return VkDeviceSize{e.width} * e.height * sizeof(uint32_t); }});
+  const ResourceId counters = graph.add_buffer(
+      "render.counters",
+      {[](graph::Extent) { return VkDeviceSize{VR_COUNTER_COUNT * sizeof(uint32_t)}; }});
   Outputs out;
-  out.layers = graph.add_image("render.layers", {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count});
+  out.layers =
+      graph.add_image("render.layers", {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count});
   out.final = graph.add_image("render.final", {VK_FORMAT_R8G8B8A8_UNORM});
   out.depth = graph.add_image("render.depth", {VK_FORMAT_R32_SFLOAT});
   const graph::ImportInfo sampled_image{true, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
@@ -340,10 +365,13 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
 
   graph.add_pass({"render.clear",
                   graph::PassKind::transfer,
-                  {{frame, Use::transfer_dst}, {keys, Use::transfer_dst}, {max_age, Use::transfer_dst},
+                  {{frame, Use::transfer_dst},
+                   {keys, Use::transfer_dst},
+                   {max_age, Use::transfer_dst},
                    {counters, Use::transfer_dst}},
                   [this, frame, keys, max_age, counters](graph::PassContext& pc) {
-                    const gpu::FrameGpu data = frame_data(pc.viewport);
+                    const gpu::FrameGpu data = frame_data(inputs_, camera_, settings_, pc.viewport,
+                                                          slots_for(pc.viewport));
                     vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
                     vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
                     vkCmdFillBuffer(pc.cmd, pc.buffer(max_age), 0, VK_WHOLE_SIZE, 0);
@@ -412,19 +440,20 @@ void VolumeRenderer::record_build(graph::PassContext& pc) const {
   rendering.renderArea = {{0, 0}, {pc.viewport.width, pc.viewport.height}};
   rendering.layerCount = 1;
   vkCmdBeginRendering(pc.cmd, &rendering);
-  const VkViewport viewport{0.0f, 0.0f, float(pc.viewport.width), float(pc.viewport.height), 0.0f, 1.0f};
+  const VkViewport viewport{0.0f, 0.0f, float(pc.viewport.width), float(pc.viewport.height),
+                            0.0f, 1.0f};
   vkCmdSetViewport(pc.cmd, 0, 1, &viewport);
   vkCmdSetScissor(pc.cmd, 0, 1, &rendering.renderArea);
   pc.bind(build_);
-  for (uint32_t m = 0; m < mesh_draws_.size(); ++m) {
-    const MeshDraw& draw = mesh_draws_[m];
+  for (uint32_t m = 0; m < inputs_.meshes.size(); ++m) {
+    const RenderInputs::MeshDraw& draw = inputs_.meshes[m];
     const gpu::DrawGpu push{draw.transform, draw.color, draw.first_index, m, VR_KIND_MESH, 0};
     build_.push_constants(pc.cmd, push);
     vkCmdDraw(pc.cmd, draw.index_count, 1, 0, 0);
   }
-  for (uint32_t v = 0; v < volume_info_.size(); ++v) {
-    const gpu::DrawGpu push{volume_info_[v].texture_to_world, glm::vec4(0.0f), 0, v,
-                            VR_KIND_VOLUME_FACE, 0};
+  for (uint32_t v = 0; v < inputs_.volumes.size(); ++v) {
+    const gpu::DrawGpu push{
+        inputs_.volumes[v].texture_to_world, glm::vec4(0.0f), 0, v, VR_KIND_VOLUME_FACE, 0};
     build_.push_constants(pc.cmd, push);
     vkCmdDraw(pc.cmd, 36, 1, 0, 0);
   }
@@ -439,10 +468,12 @@ RenderStats VolumeRenderer::collect(graph::GraphRunner& runner) {
   stats.fragments = c[VR_COUNTER_FRAGMENTS];
   stats.resolve_overflow = c[VR_COUNTER_RESOLVE_OVERFLOW];
   stats.samples = c[VR_COUNTER_SAMPLES];
+  stats.shaded = c[VR_COUNTER_SHADED];
   stats.table_size = slots_for(runner.viewport());
   if (stats.overflow > 0 || stats.fragments > 0.75 * stats.table_size) {
     const double needed = (double(stats.fragments) + stats.overflow) / settings_.load_factor;
-    forced_slots_ = static_cast<uint32_t>(std::min(std::max(needed, 2.0 * stats.table_size), 4.0e9));
+    forced_slots_ =
+        static_cast<uint32_t>(std::min(std::max(needed, 2.0 * stats.table_size), 4.0e9));
     runner.reallocate();
   }
   return stats;

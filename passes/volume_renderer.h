@@ -33,7 +33,8 @@ struct RenderStats {
   uint32_t overflow = 0;          // fragments that found no slot (the table grows)
   uint32_t fragments = 0;         // fragments in the table
   uint32_t resolve_overflow = 0;  // fragments beyond the resolve's per-pixel capacity
-  uint64_t samples = 0;           // volume samples
+  uint64_t samples = 0;           // ray positions sampled
+  uint64_t shaded = 0;            // volume samples shaded (7 atlas texels + 1 table entry each)
   uint32_t table_size = 0;        // slots during that frame
   double load_factor() const { return table_size ? double(fragments) / table_size : 0.0; }
 };
@@ -47,6 +48,41 @@ struct CameraSetup {
 
 // The scene's camera, or its named position `name` (Error listing the names if there is none).
 CameraSetup camera_for(const Scene& scene, const std::string& name);
+
+// Everything the renderer derives from a scene on the CPU, once: what the GPU receives and what
+// the CPU reference renderer (volume_render_reference.h) samples.
+struct RenderInputs {
+  glm::uvec3 atlas_dims{1};
+  std::vector<uint16_t> atlas;  // normalised intensity, volumes stacked along z
+  std::vector<gpu::VolumeGpu> volumes;
+  std::vector<TransferFunction> transfer_functions;  // one per volume
+  std::vector<glm::vec4> transfer_table;             // VR_TF_SIZE x max(1, volumes)
+  std::vector<glm::vec2> brick_ranges;  // per brick: min and max normalised value (dilated)
+  std::vector<uint32_t> occupancy;      // per brick: 1 if the transfer function can show it
+  struct MeshDraw {
+    uint32_t first_index, index_count;
+    glm::vec4 color;
+    glm::mat4 transform;
+  };
+  std::vector<glm::vec4> vertices;  // model-space position, normal pairs
+  std::vector<uint32_t> indices;
+  std::vector<MeshDraw> meshes;
+  glm::vec3 scene_min{0.0f}, scene_max{0.0f};
+  float finest_spacing = 1.0f;
+
+  // Rebuilds the transfer table and the occupancy from transfer_functions.
+  void update_transfer();
+};
+
+RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d);
+
+// The layer boundaries (eye depths): settings.splits, or even over the scene's depth range.
+std::vector<float> split_depths(const RenderInputs& inputs, const CameraSetup& camera,
+                                const RenderSettings& settings);
+
+gpu::FrameGpu frame_data(const RenderInputs& inputs, const CameraSetup& camera,
+                         const RenderSettings& settings, graph::Extent viewport,
+                         uint32_t table_size);
 
 class VolumeRenderer {
  public:
@@ -76,30 +112,18 @@ class VolumeRenderer {
   // runner's transients) when fragments overflowed or it is fuller than 0.75. Returns the stats.
   RenderStats collect(graph::GraphRunner& runner);
 
-  // The layer boundaries the next frame uses (eye depths).
-  std::vector<float> split_depths(graph::Extent viewport) const;
+  const RenderInputs& inputs() const { return inputs_; }
+  const CameraSetup& camera() const { return camera_; }
 
  private:
-  gpu::FrameGpu frame_data(graph::Extent viewport) const;
   uint32_t slots_for(graph::Extent viewport) const;
-  void upload_transfer_table();
-  void upload_occupancy();
+  void upload_transfer();
   void record_build(graph::PassContext& pc) const;
 
   Context& ctx_;
   RenderSettings settings_;
   CameraSetup camera_;
-  std::vector<TransferFunction> transfer_functions_;  // one per volume (transparent if none)
-  std::vector<gpu::VolumeGpu> volume_info_;
-  std::vector<glm::vec2> brick_ranges_;  // per brick: min and max normalised value (dilated)
-  glm::vec3 scene_min_{0.0f}, scene_max_{0.0f};
-  float finest_spacing_ = 1.0f;
-  struct MeshDraw {
-    uint32_t first_index, index_count;
-    glm::vec4 color;
-    glm::mat4 transform;
-  };
-  std::vector<MeshDraw> mesh_draws_;
+  RenderInputs inputs_;
 
   Image atlas_;
   Image transfer_table_;

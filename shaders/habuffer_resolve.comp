@@ -61,10 +61,12 @@ void main() {
   const uint found = subgroupAdd(count + dropped);
   const uint lost = subgroupAdd(dropped);
   const uint samples = subgroupAdd(inside ? r.samples : 0u);
+  const uint shaded = subgroupAdd(inside ? r.shaded : 0u);
   if (subgroupElect()) {
     atomicAdd(counters[VR_COUNTER_FRAGMENTS], found);
     if (lost > 0u) atomicAdd(counters[VR_COUNTER_RESOLVE_OVERFLOW], lost);
     atomicAdd(counters[VR_COUNTER_SAMPLES], samples);
+    atomicAdd(counters[VR_COUNTER_SHADED], shaded);
   }
   if (!inside) return;
   vec4 all = vec4(0.0);

@@ -13,8 +13,11 @@
 struct PixelResult {
   vec4 layers[VR_MAX_LAYERS];  // premultiplied, each its own slab
   float depth;                 // eye depth where the total alpha first reaches depth_alpha, or 0
-  uint samples;
+  uint samples;                // ray positions sampled
+  uint shaded;                 // volume samples shaded (each fetches 7 texels and 1 table entry)
 };
+
+uint shaded_samples = 0u;
 
 uint layer_of(float z) {
   uint layer = 0u;
@@ -46,6 +49,7 @@ vec4 sample_volumes(uint live, vec3 p, vec3 to_eye, float step_world) {
     // Gradients transform with the transpose of the world-to-texture map.
     vec3 normal = transpose(mat3(vol.world_to_texture)) * (g / (2.0f * h));
     float alpha = corrected_alpha(c.a, step_world, vol.atlas_scale.w);
+    shaded_samples += 1u;
     vec4 shaded = length(normal) > 1e-6f ? shade_blinn_phong(vec4(vec3(c), 1.0f), -normal, to_eye)
                                          : vec4(vec3(c), 1.0f);
     sum += vec4(vec3(shaded) * alpha, alpha);
@@ -77,6 +81,22 @@ float skip_to(uint live, vec3 origin, vec3 direction, float z) {
   return exit_z;
 }
 
+struct Ray {
+  vec3 origin;     // the eye, world space
+  vec3 direction;  // world displacement per unit of eye depth
+};
+
+Ray pixel_ray(vec2 pixel) {
+  vec2 ndc = pixel / vec2(float(frame.width), float(frame.height)) * 2.0f - 1.0f;
+  vec4 far_point = frame.clip_to_view * vec4(ndc, 1.0f, 1.0f);
+  vec3 view_direction = vec3(far_point) / far_point.w;
+  view_direction = view_direction / -view_direction.z;
+  Ray ray;
+  ray.origin = vec3(frame.view_to_world * vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  ray.direction = mat3(frame.view_to_world) * view_direction;
+  return ray;
+}
+
 float grid_depth(float k, float dz) { return frame.near_depth + (k + 0.5f) * dz; }
 float grid_index_at_or_after(float z, float dz) {
   return max(ceil((z - frame.near_depth) / dz - 0.5f), 0.0f);
@@ -88,13 +108,11 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   for (uint l = 0u; l < VR_MAX_LAYERS; ++l) r.layers[l] = vec4(0.0f);
   r.depth = 0.0f;
   r.samples = 0u;
+  shaded_samples = 0u;
 
-  vec2 ndc = pixel / vec2(float(frame.width), float(frame.height)) * 2.0f - 1.0f;
-  vec4 far_point = frame.clip_to_view * vec4(ndc, 1.0f, 1.0f);
-  vec3 view_direction = vec3(far_point) / far_point.w;
-  view_direction = view_direction / -view_direction.z;  // one unit of eye depth
-  vec3 origin = vec3(frame.view_to_world * vec4(0.0f, 0.0f, 0.0f, 1.0f));
-  vec3 direction = mat3(frame.view_to_world) * view_direction;
+  Ray ray = pixel_ray(pixel);
+  vec3 origin = ray.origin;
+  vec3 direction = ray.direction;
   vec3 to_eye = -normalize(direction);
   float dz = frame.step / length(direction);
 
@@ -149,5 +167,6 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
     }
     z = z_end;
   }
+  r.shaded = shaded_samples;
   return r;
 }

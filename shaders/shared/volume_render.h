@@ -26,8 +26,9 @@
 #define VR_COUNTER_OVERFLOW 0           // fragments that found no free slot
 #define VR_COUNTER_FRAGMENTS 1          // fragments the resolve found
 #define VR_COUNTER_RESOLVE_OVERFLOW 2   // fragments beyond VR_MAX_FRAGMENTS in one pixel
-#define VR_COUNTER_SAMPLES 3            // volume samples taken
-#define VR_COUNTER_COUNT 4
+#define VR_COUNTER_SAMPLES 3            // ray positions sampled
+#define VR_COUNTER_SHADED 4             // volume samples shaded (alpha > 0: gradient fetched)
+#define VR_COUNTER_COUNT 5
 
 #define VR_BINDING_FRAME 0
 #define VR_BINDING_VOLUMES 1

@@ -5,6 +5,10 @@
 
 #include "volume_render.h"
 
+#ifdef __cplusplus
+#include <glm/gtc/packing.hpp>
+#endif
+
 STRATA_BEGIN
 #ifdef __cplusplus
 #define VR_INLINE inline

@@ -1,0 +1,166 @@
+#include "passes/volume_render_reference.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "shared/volume_shading.h"
+
+namespace strata {
+namespace gpu {
+namespace {
+
+// One pixel's work on the CPU. The shared resolve is included inside this struct, so its
+// functions see `frame` and the sampling functions below as members.
+struct Reference {
+  FrameGpu frame;
+  const RenderInputs& in;
+
+  VolumeGpu volume_info(uint v) const { return in.volumes[v]; }
+
+  // Linear filtering with clamp-to-edge addressing, as the GPU's sampler does.
+  float volume_sample(uint v, vec3 tc) const {
+    const VolumeGpu& vol = in.volumes[v];
+    const vec3 a = vec3(vol.atlas_offset) + tc * vec3(vol.atlas_scale);
+    const vec3 x = a * vec3(in.atlas_dims) - 0.5f;
+    const vec3 base = floor(x);
+    const vec3 f = x - base;
+    const ivec3 top = ivec3(in.atlas_dims) - 1;
+    float sum = 0.0f;
+    for (int corner = 0; corner < 8; ++corner) {
+      const ivec3 o(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+      const ivec3 p = clamp(ivec3(base) + o, ivec3(0), top);
+      const float w =
+          (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
+      sum += w * float(in.atlas[(size_t(p.z) * in.atlas_dims.y + size_t(p.y)) * in.atlas_dims.x +
+                                size_t(p.x)]);
+    }
+    return sum / 65535.0f;
+  }
+
+  vec4 transfer(uint v, float t) const {
+    const float x = t * float(VR_TF_SIZE) - 0.5f;
+    const float base = std::floor(x);
+    const float f = x - base;
+    const int i0 = std::clamp(int(base), 0, VR_TF_SIZE - 1);
+    const int i1 = std::clamp(int(base) + 1, 0, VR_TF_SIZE - 1);
+    const vec4* row = &in.transfer_table[size_t(v) * VR_TF_SIZE];
+    return mix(row[i0], row[i1], f);
+  }
+
+  bool brick_empty(uint v, vec3 tc) const {
+    const VolumeGpu& vol = in.volumes[v];
+    const uvec3 bricks(vol.bricks);
+    const uvec3 b = min(uvec3(tc / (vec3(vol.texel) * float(VR_BRICK))), bricks - 1u);
+    return in.occupancy[vol.bricks.w + (b.z * bricks.y + b.y) * bricks.x + b.x] == 0u;
+  }
+
+#include "shared/resolve_walk.h"
+};
+
+struct Fragment {
+  float depth;
+  uvec2 payload;
+};
+
+// Möller-Trumbore; t is the eye depth because the ray's direction is per unit of eye depth.
+bool intersect(const vec3& o, const vec3& d, const vec3& a, const vec3& b, const vec3& c, float& t,
+               float& u, float& v) {
+  const vec3 e1 = b - a, e2 = c - a, p = cross(d, e2);
+  const float det = dot(e1, p);
+  if (std::abs(det) < 1e-12f) return false;
+  const vec3 s = o - a, q = cross(s, e1);
+  u = dot(s, p) / det;
+  v = dot(d, q) / det;
+  t = dot(e2, q) / det;
+  return u >= 0.0f && v >= 0.0f && u + v <= 1.0f;
+}
+
+std::vector<Fragment> fragments(const RenderInputs& in, const FrameGpu& frame, const vec3& origin,
+                                const vec3& direction) {
+  std::vector<Fragment> out;
+  const auto visible = [&](float t) { return t >= frame.near_depth && t <= frame.far_depth; };
+  for (uint m = 0; m < in.meshes.size(); ++m) {
+    const RenderInputs::MeshDraw& draw = in.meshes[m];
+    const mat4 model_view = frame.world_to_view * draw.transform;
+    const mat3 normal_matrix = transpose(inverse(mat3(model_view)));
+    for (uint i = 0; i + 2 < draw.index_count; i += 3) {
+      vec3 p[3], n[3];
+      for (uint k = 0; k < 3; ++k) {
+        const uint index = in.indices[draw.first_index + i + k];
+        p[k] = vec3(draw.transform * in.vertices[2 * size_t(index)]);
+        n[k] = normal_matrix * vec3(in.vertices[2 * size_t(index) + 1]);
+      }
+      float t, u, v;
+      if (!intersect(origin, direction, p[0], p[1], p[2], t, u, v) || !visible(t)) continue;
+      const vec3 view_position = vec3(frame.world_to_view * vec4(origin + direction * t, 1.0f));
+      const vec3 normal = (1.0f - u - v) * n[0] + u * n[1] + v * n[2];
+      out.push_back({t, uvec2(mesh_payload_color(draw.color, normal, -normalize(view_position)),
+                              m | (VR_KIND_MESH << 8u))});
+    }
+  }
+  for (uint v = 0; v < in.volumes.size(); ++v) {
+    const mat4& w2t = in.volumes[v].world_to_texture;
+    const vec3 o = vec3(w2t * vec4(origin, 1.0f)), d = mat3(w2t) * direction;
+    float enter = -3.4e38f, leave = 3.4e38f;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (std::abs(d[axis]) < 1e-20f) {
+        if (o[axis] < 0.0f || o[axis] > 1.0f) enter = 3.4e38f;
+        continue;
+      }
+      const float t0 = (0.0f - o[axis]) / d[axis], t1 = (1.0f - o[axis]) / d[axis];
+      enter = std::max(enter, std::min(t0, t1));
+      leave = std::min(leave, std::max(t0, t1));
+    }
+    if (enter > leave) continue;
+    const uint face = v | (VR_KIND_VOLUME_FACE << 8u);
+    if (visible(enter)) out.push_back({enter, uvec2(0u, face | (1u << 10u))});
+    if (visible(leave)) out.push_back({leave, uvec2(0u, face)});
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Fragment& a, const Fragment& b) { return a.depth < b.depth; });
+  return out;
+}
+
+}  // namespace
+}  // namespace gpu
+
+ReferenceImage render_reference(const RenderInputs& inputs, const CameraSetup& camera,
+                                const RenderSettings& settings, graph::Extent size) {
+  gpu::Reference ref{frame_data(inputs, camera, settings, size, 1), inputs};
+  ReferenceImage image;
+  image.size = size;
+  image.layer_count = settings.layer_count;
+  const size_t pixels = size_t{size.width} * size.height;
+  image.layers.assign(pixels * settings.layer_count, glm::vec4(0.0f));
+  image.final.assign(pixels, glm::vec4(0.0f));
+  image.depth.assign(pixels, 0.0f);
+  for (uint32_t y = 0; y < size.height; ++y) {
+    for (uint32_t x = 0; x < size.width; ++x) {
+      const glm::vec2 centre(float(x) + 0.5f, float(y) + 0.5f);
+      const auto ray = ref.pixel_ray(centre);
+      const std::vector<gpu::Fragment> found =
+          gpu::fragments(inputs, ref.frame, ray.origin, ray.direction);
+      float depths[VR_MAX_FRAGMENTS];
+      glm::uvec2 payloads[VR_MAX_FRAGMENTS];
+      const uint32_t count = uint32_t(std::min<size_t>(found.size(), VR_MAX_FRAGMENTS));
+      for (uint32_t i = 0; i < count; ++i) {
+        depths[i] = found[i].depth;
+        payloads[i] = found[i].payload;
+      }
+      const auto r = ref.resolve_pixel(centre, count, depths, payloads);
+      const size_t p = size_t{y} * size.width + x;
+      glm::vec4 all(0.0f);
+      for (uint32_t l = 0; l < settings.layer_count; ++l) {
+        image.layers[l * pixels + p] = r.layers[l];
+        all = gpu::over(all, r.layers[l]);
+      }
+      image.final[p] = glm::vec4(glm::vec3(all) + (1.0f - all.a) * settings.background, 1.0f);
+      image.depth[p] = r.depth;
+      image.samples += r.samples;
+      image.shaded += r.shaded;
+    }
+  }
+  return image;
+}
+
+}  // namespace strata

@@ -1,0 +1,304 @@
+// The renderer on lavapipe against its CPU reference (passes/volume_render_reference.h), which
+// runs the same resolve code on ray-cast fragments and software-filtered samples.
+//
+// Tolerance: a channel may differ by 3/255 (hardware texture filtering uses fixed-point weights,
+// rgba8 packing of mesh colours); 1% of pixels may differ more: pixels whose centre lies on a
+// triangle or box edge, where rasterisation rules and ray-triangle tests can disagree.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/packing.hpp>
+
+#include "engine/graph_runner.h"
+#include "engine/headless_target.h"
+#include "engine/png.h"
+#include "engine/scene_loader.h"
+#include "gpu_fixture.h"
+#include "passes/volume_render_reference.h"
+#include "passes/volume_renderer.h"
+
+namespace strata {
+namespace {
+
+Mesh quad(float z, glm::vec4 color, float half = 10.0f, glm::vec2 centre = glm::vec2(0.0f)) {
+  Mesh m;
+  m.name = "quad";
+  m.positions = {{centre.x - half, centre.y - half, z},
+                 {centre.x + half, centre.y - half, z},
+                 {centre.x + half, centre.y + half, z},
+                 {centre.x - half, centre.y + half, z}};
+  m.normals.assign(4, glm::vec3(0.0f, 0.0f, 1.0f));
+  m.indices = {0, 1, 2, 0, 2, 3};
+  m.color = color;
+  return m;
+}
+
+// A ball of radius `radius` voxels whose value falls off linearly from the centre.
+Volume ball(glm::uvec3 dims, glm::vec3 origin, float radius) {
+  Volume v;
+  v.name = "ball";
+  v.type = VoxelType::uint8;
+  v.dims = dims;
+  v.origin = origin;
+  v.voxels.resize(v.voxel_count());
+  const glm::vec3 centre = glm::vec3(dims - 1u) * 0.5f;
+  for (uint32_t k = 0; k < dims.z; ++k) {
+    for (uint32_t j = 0; j < dims.y; ++j) {
+      for (uint32_t i = 0; i < dims.x; ++i) {
+        const float r = glm::length(glm::vec3(i, j, k) - centre) / radius;
+        v.voxels[(size_t(k) * dims.y + j) * dims.x + i] =
+            std::byte(uint8_t(255.0f * glm::clamp(1.0f - r, 0.0f, 1.0f)));
+      }
+    }
+  }
+  v.value_range = {0.0f, 255.0f};
+  return v;
+}
+
+TransferFunction ramp(glm::vec3 color) {
+  TransferFunction tf;
+  tf.name = "ramp";
+  tf.stops = {{0.0f, glm::vec4(color, 0.0f)},
+              {0.15f, glm::vec4(color, 0.0f)},
+              {0.5f, glm::vec4(color, 0.2f)},
+              {1.0f, glm::vec4(glm::vec3(1.0f), 0.6f)}};
+  return tf;
+}
+
+void add_volume(Scene& scene, Volume v, TransferFunction tf) {
+  v.transfer_function = int(scene.transfer_functions.size());
+  scene.transfer_functions.push_back(std::move(tf));
+  scene.volumes.push_back(std::move(v));
+}
+
+CameraSetup camera_at(glm::vec3 eye, glm::vec3 target = glm::vec3(0.0f)) {
+  return {glm::lookAt(eye, target, glm::vec3(0.0f, 1.0f, 0.0f)), 40.0f, 1.0f, 300.0f};
+}
+
+struct GpuResult {
+  std::vector<uint8_t> final;
+  std::vector<glm::vec4> layers;
+  RenderStats stats;
+};
+
+GpuResult render_gpu(Context& ctx, const Scene& scene, const CameraSetup& camera,
+                     const RenderSettings& settings, graph::Extent size, uint32_t table = 0) {
+  VolumeRenderer renderer(ctx, scene, settings);
+  renderer.set_camera(camera);
+  if (table) renderer.set_table_size(table);
+  HeadlessTarget target(ctx);
+  graph::Graph g;
+  const auto out = renderer.add_to(g);
+  target.add_output(g, out.final);
+  graph::GraphRunner runner(ctx, std::move(g));
+  runner.set_viewport(size);
+  renderer.bind(runner);
+  target.bind(runner);
+  runner.run_now();
+  GpuResult r;
+  r.stats = renderer.collect(runner);
+  r.final.assign(target.pixels().begin(), target.pixels().end());
+  const std::vector<std::byte> bytes = runner.download_image(out.layers);
+  const auto* half = reinterpret_cast<const uint16_t*>(bytes.data());
+  for (size_t i = 0; i + 3 < bytes.size() / 2; i += 4) {
+    r.layers.emplace_back(glm::unpackHalf1x16(half[i]), glm::unpackHalf1x16(half[i + 1]),
+                          glm::unpackHalf1x16(half[i + 2]), glm::unpackHalf1x16(half[i + 3]));
+  }
+  return r;
+}
+
+std::vector<uint8_t> to_rgba8(const std::vector<glm::vec4>& colors) {
+  std::vector<uint8_t> out;
+  for (const glm::vec4& c : colors) {
+    for (int ch = 0; ch < 4; ++ch)
+      out.push_back(uint8_t(std::lround(glm::clamp(c[ch], 0.0f, 1.0f) * 255.0f)));
+  }
+  return out;
+}
+
+// Checks the tolerance above; on failure writes actual, expected and difference images.
+void check_close(const std::vector<uint8_t>& actual, const std::vector<uint8_t>& expected,
+                 graph::Extent size, const std::string& name, int tolerance = 3) {
+  REQUIRE(actual.size() == expected.size());
+  size_t bad = 0;
+  std::vector<uint8_t> diff(actual.size(), 255);
+  for (size_t p = 0; p < actual.size() / 4; ++p) {
+    int worst = 0;
+    for (int ch = 0; ch < 3; ++ch) {
+      const int d = std::abs(int(actual[4 * p + ch]) - int(expected[4 * p + ch]));
+      worst = std::max(worst, d);
+      diff[4 * p + ch] = uint8_t(std::min(255, d * 8));
+    }
+    bad += worst > tolerance;
+  }
+  const size_t pixels = actual.size() / 4;
+  if (bad * 100 > pixels) {
+    const std::string base = test::output_dir() + "/" + name;
+    write_png(base + ".actual.png", size.width, size.height, actual);
+    write_png(base + ".expected.png", size.width, size.height, expected);
+    write_png(base + ".difference.png", size.width, size.height, diff);
+  }
+  CHECK_MESSAGE(bad * 100 <= pixels, name << ": " << bad << " of " << pixels
+                                          << " pixels differ by more than " << tolerance << "/255");
+}
+
+void check_against_reference(Context& ctx, const Scene& scene, const CameraSetup& camera,
+                             const std::string& name, RenderSettings settings = {},
+                             graph::Extent size = {96, 96}) {
+  const GpuResult gpu = render_gpu(ctx, scene, camera, settings, size);
+  CHECK(gpu.stats.overflow == 0);
+  const RenderInputs inputs = prepare_render_inputs(scene, 2048);
+  const ReferenceImage ref = render_reference(inputs, camera, settings, size);
+  // Guards against comparing two empty pictures: a fifth of the view shows something.
+  size_t covered = 0;
+  for (const glm::vec4& c : ref.final)
+    covered += glm::length(glm::vec3(c) - settings.background) > 0.02f;
+  CHECK_MESSAGE(covered * 5 >= ref.final.size(),
+                name << ": only " << covered << " pixels show anything");
+  check_close(gpu.final, to_rgba8(ref.final), size, name);
+  // The walk itself agrees: as many samples taken and shaded (2% for edge pixels).
+  CHECK(double(gpu.stats.samples) == doctest::Approx(double(ref.samples)).epsilon(0.02));
+  CHECK(double(gpu.stats.shaded) == doctest::Approx(double(ref.shaded)).epsilon(0.02));
+  if (std::getenv("STRATA_KEEP_IMAGES")) {
+    write_png(test::output_dir() + "/" + name + ".png", size.width, size.height, gpu.final);
+  }
+}
+
+}  // namespace
+
+TEST_SUITE("gpu") {
+  // The bundled head demo, 256x256, front camera, 4 layers, against tests/golden/head-front-256.png
+  // (rendered by lavapipe). Tolerance as above; actual and difference images are written on
+  // failure.
+  TEST_CASE_FIXTURE(test::GpuTest, "head_demo_matches_its_golden_image") {
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    const graph::Extent size{256, 256};
+    const GpuResult gpu = render_gpu(ctx, scene, camera_for(scene, "front"), {}, size);
+    CHECK(gpu.stats.overflow == 0);
+    const Rgba8Image golden = read_png(STRATA_SOURCE_DIR "/tests/golden/head-front-256.png");
+    REQUIRE(golden.width == size.width);
+    check_close(gpu.final, golden.pixels, size, "head-front-256");
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest,
+                    "two_transparent_meshes_match_the_reference_in_both_draw_orders") {
+    Scene scene;
+    scene.meshes = {quad(0.0f, {0.9f, 0.2f, 0.1f, 0.5f}, 10.0f, {-3.0f, 0.0f}),
+                    quad(8.0f, {0.1f, 0.3f, 0.9f, 0.5f}, 8.0f, {4.0f, 2.0f})};
+    const CameraSetup camera = camera_at({5.0f, 4.0f, 60.0f});
+    check_against_reference(ctx, scene, camera, "meshes-ab");
+    Scene reversed = scene;
+    std::swap(reversed.meshes[0], reversed.meshes[1]);
+    check_against_reference(ctx, reversed, camera, "meshes-ba");
+    const GpuResult a = render_gpu(ctx, scene, camera, {}, {96, 96});
+    const GpuResult b = render_gpu(ctx, reversed, camera, {}, {96, 96});
+    CHECK(a.final == b.final);  // the HA-Buffer sorts: draw order cannot matter
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "one_volume_matches_the_reference") {
+    Scene scene;
+    add_volume(scene, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.6f, 0.3f}));
+    check_against_reference(ctx, scene, camera_at({12.0f, 9.0f, 32.0f}), "one-volume");
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "two_overlapping_volumes_match_the_reference") {
+    Scene scene;
+    add_volume(scene, ball({24, 24, 24}, glm::vec3(-16.0f, -12.0f, -12.0f), 11.0f),
+               ramp({1.0f, 0.4f, 0.2f}));
+    add_volume(scene, ball({20, 28, 20}, glm::vec3(-4.0f, -14.0f, -8.0f), 9.0f),
+               ramp({0.2f, 0.5f, 1.0f}));
+    check_against_reference(ctx, scene, camera_at({6.0f, 6.0f, 38.0f}), "two-volumes");
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "a_mesh_inside_a_volume_matches_the_reference") {
+    Scene scene;
+    add_volume(scene, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.8f, 0.6f}));
+    scene.meshes = {quad(0.0f, {0.2f, 0.9f, 0.3f, 0.7f}, 6.0f)};
+    check_against_reference(ctx, scene, camera_at({5.0f, 4.0f, 32.0f}), "mesh-in-volume");
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "a_camera_inside_a_volume_starts_its_rays_at_the_near_plane") {
+    Scene scene;
+    add_volume(scene, ball({32, 32, 32}, glm::vec3(-16.0f), 15.0f), ramp({0.9f, 0.9f, 0.5f}));
+    const CameraSetup camera = camera_at({2.0f, 1.0f, 9.0f});
+    check_against_reference(ctx, scene, camera, "camera-inside");
+    const GpuResult gpu = render_gpu(ctx, scene, camera, {}, {96, 96});
+    CHECK(gpu.stats.samples > 0);  // with no front faces in view, only the near-plane start sees it
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "layer_images_composite_to_the_final_image") {
+    Scene scene;
+    add_volume(scene, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.6f, 0.3f}));
+    scene.meshes = {quad(-4.0f, {0.2f, 0.9f, 0.3f, 0.6f}, 5.0f),
+                    quad(6.0f, {0.9f, 0.2f, 0.6f, 0.4f}, 4.0f)};
+    RenderSettings settings;
+    settings.layer_count = 4;
+    const graph::Extent size{80, 80};
+    const GpuResult gpu = render_gpu(ctx, scene, camera_at({0.0f, 0.0f, 50.0f}), settings, size);
+    std::vector<glm::vec4> composite(size_t(size.width) * size.height);
+    for (size_t p = 0; p < composite.size(); ++p) {
+      glm::vec4 all(0.0f);
+      for (uint32_t l = 0; l < settings.layer_count; ++l)
+        all = all + (1.0f - all.a) * gpu.layers[l * composite.size() + p];
+      composite[p] = glm::vec4(glm::vec3(all) + (1.0f - all.a) * settings.background, 1.0f);
+    }
+    size_t non_empty_layers = 0;
+    for (uint32_t l = 0; l < settings.layer_count; ++l) {
+      float alpha = 0.0f;
+      for (size_t p = 0; p < composite.size(); ++p) alpha += gpu.layers[l * composite.size() + p].a;
+      non_empty_layers += alpha > 1.0f;
+    }
+    CHECK(non_empty_layers >= 3);
+    check_close(gpu.final, to_rgba8(composite), size, "layers-composite", 2);
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "empty_space_skipping_changes_nothing_but_the_sample_count") {
+    Scene scene;
+    add_volume(scene, ball({40, 40, 40}, glm::vec3(-20.0f), 12.0f), ramp({1.0f, 0.6f, 0.3f}));
+    RenderSettings on, off;
+    off.skip_empty = false;
+    const CameraSetup camera = camera_at({15.0f, 10.0f, 70.0f});
+    const GpuResult a = render_gpu(ctx, scene, camera, on, {64, 64});
+    const GpuResult b = render_gpu(ctx, scene, camera, off, {64, 64});
+    check_close(a.final, b.final, {64, 64}, "skipping", 1);
+    CHECK(a.stats.samples < b.stats.samples);
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest,
+                    "habuffer_overflow_is_counted_and_the_picture_is_right_by_the_second_frame") {
+    Scene scene;
+    add_volume(scene, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.6f, 0.3f}));
+    scene.meshes = {quad(0.0f, {0.2f, 0.9f, 0.3f, 0.7f}, 6.0f)};
+    const CameraSetup camera = camera_at({8.0f, 6.0f, 60.0f});
+    const graph::Extent size{64, 64};
+    VolumeRenderer renderer(ctx, scene, {});
+    renderer.set_camera(camera);
+    renderer.set_table_size(512);  // far fewer slots than fragments
+    HeadlessTarget target(ctx);
+    graph::Graph g;
+    target.add_output(g, renderer.add_to(g).final);
+    graph::GraphRunner runner(ctx, std::move(g));
+    runner.set_viewport(size);
+    const RenderInputs inputs = prepare_render_inputs(scene, 2048);
+    const std::vector<uint8_t> expected =
+        to_rgba8(render_reference(inputs, camera, {}, size).final);
+
+    std::vector<RenderStats> frames;
+    for (int frame = 0; frame < 2; ++frame) {
+      renderer.bind(runner);
+      target.bind(runner);
+      runner.run_now();
+      frames.push_back(renderer.collect(runner));
+    }
+    CHECK(frames[0].overflow > 0);
+    CHECK(frames[0].table_size == 512);
+    CHECK(frames[1].overflow == 0);
+    CHECK(frames[1].table_size > 512);
+    check_close(std::vector<uint8_t>(target.pixels().begin(), target.pixels().end()), expected,
+                size, "overflow-second-frame");
+  }
+}
+
+}  // namespace strata
