@@ -173,6 +173,7 @@ uint32_t texel_size(VkFormat format) {
     case VK_FORMAT_D32_SFLOAT:
       return 4;
     case VK_FORMAT_R16G16B16A16_SFLOAT:
+    case VK_FORMAT_R16G16B16A16_SNORM:
       return 8;
     case VK_FORMAT_R32G32B32A32_SFLOAT:
       return 16;

@@ -18,23 +18,23 @@ struct Reference {
   VolumeGpu volume_info(uint v) const { return in.volumes[v]; }
 
   // Linear filtering with clamp-to-edge addressing, as the GPU's sampler does.
-  float volume_sample(uint v, vec3 tc) const {
+  vec4 volume_sample(uint v, vec3 tc) const {
     const VolumeGpu& vol = in.volumes[v];
     const vec3 a = vec3(vol.atlas_offset) + tc * vec3(vol.atlas_scale);
     const vec3 x = a * vec3(in.atlas_dims) - 0.5f;
     const vec3 base = floor(x);
     const vec3 f = x - base;
     const ivec3 top = ivec3(in.atlas_dims) - 1;
-    float sum = 0.0f;
+    vec4 sum(0.0f);
     for (int corner = 0; corner < 8; ++corner) {
       const ivec3 o(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
       const ivec3 p = clamp(ivec3(base) + o, ivec3(0), top);
-      const float w =
-          (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
-      sum += w * float(in.atlas[(size_t(p.z) * in.atlas_dims.y + size_t(p.y)) * in.atlas_dims.x +
-                                size_t(p.x)]);
+      const float w = (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
+      const int16_t* texel =
+          &in.atlas[4 * ((size_t(p.z) * in.atlas_dims.y + size_t(p.y)) * in.atlas_dims.x + size_t(p.x))];
+      sum += w * vec4(float(texel[0]), float(texel[1]), float(texel[2]), float(texel[3]));
     }
-    return sum / 65535.0f;
+    return sum / 32767.0f;
   }
 
   vec4 transfer(uint v, float t) const {

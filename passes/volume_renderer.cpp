@@ -18,9 +18,12 @@ using graph::Use;
 
 namespace {
 
-// Volumes live in one 3D atlas, stacked along z with replicated borders, as normalised 16-bit
-// intensity: one sampler, no descriptor indexing (lavapipe lacks it), any input voxel type.
-constexpr VkFormat kAtlasFormat = VK_FORMAT_R16_UNORM;
+// Volumes live in one 3D atlas, stacked along z with replicated borders: one sampler, no
+// descriptor indexing (lavapipe lacks it), any input voxel type. Each texel holds the gradient
+// (central differences, per voxel) and the normalised intensity, so one filtered fetch gives a
+// sample and its normal instead of seven.
+constexpr VkFormat kAtlasFormat = VK_FORMAT_R16G16B16A16_SNORM;
+constexpr float kSnorm = 32767.0f;
 constexpr VkFormat kTableFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 
 glm::mat4 texture_to_world(const Volume& v) {
@@ -29,9 +32,10 @@ glm::mat4 texture_to_world(const Volume& v) {
   return v.index_to_world() * voxel_from_texture;
 }
 
-// Each voxel as normalised intensity over the volume's value range, quantised to 16 bits.
-std::vector<uint16_t> normalised(const Volume& v) {
-  std::vector<uint16_t> out(v.voxel_count());
+// Each voxel as intensity normalised over the volume's value range, quantised to 15 bits (the
+// positive half of a 16-bit SNORM channel).
+std::vector<int16_t> normalised(const Volume& v) {
+  std::vector<int16_t> out(v.voxel_count());
   const float lo = v.value_range.x;
   const float span = v.value_range.y > lo ? v.value_range.y - lo : 1.0f;
   size_t n = 0;
@@ -39,7 +43,7 @@ std::vector<uint16_t> normalised(const Volume& v) {
     for (uint32_t j = 0; j < v.dims.y; ++j) {
       for (uint32_t i = 0; i < v.dims.x; ++i) {
         const float t = std::clamp((v.value(i, j, k) - lo) / span, 0.0f, 1.0f);
-        out[n++] = static_cast<uint16_t>(std::lround(t * 65535.0f));
+        out[n++] = static_cast<int16_t>(std::lround(t * kSnorm));
       }
     }
   }
@@ -48,7 +52,7 @@ std::vector<uint16_t> normalised(const Volume& v) {
 
 // Min and max of every brick's samples, dilated by one voxel: the trilinear footprint of any
 // point inside a brick stays within it.
-void brick_ranges(const std::vector<uint16_t>& t, glm::uvec3 dims, glm::uvec3 bricks,
+void brick_ranges(const std::vector<int16_t>& t, glm::uvec3 dims, glm::uvec3 bricks,
                   std::vector<glm::vec2>& out) {
   for (uint32_t bz = 0; bz < bricks.z; ++bz) {
     for (uint32_t by = 0; by < bricks.y; ++by) {
@@ -56,17 +60,17 @@ void brick_ranges(const std::vector<uint16_t>& t, glm::uvec3 dims, glm::uvec3 br
         const glm::ivec3 lo = glm::ivec3(bx, by, bz) * VR_BRICK - 1;
         const glm::ivec3 hi = glm::min(lo + (VR_BRICK + 1), glm::ivec3(dims) - 1);
         const glm::ivec3 first = glm::max(lo, glm::ivec3(0));
-        uint16_t mn = 65535, mx = 0;
+        int16_t mn = 32767, mx = 0;
         for (int z = first.z; z <= hi.z; ++z) {
           for (int y = first.y; y <= hi.y; ++y) {
             for (int x = first.x; x <= hi.x; ++x) {
-              const uint16_t s = t[(size_t(z) * dims.y + y) * dims.x + x];
+              const int16_t s = t[(size_t(z) * dims.y + y) * dims.x + x];
               mn = std::min(mn, s);
               mx = std::max(mx, s);
             }
           }
         }
-        out.emplace_back(float(mn) / 65535.0f, float(mx) / 65535.0f);
+        out.emplace_back(float(mn) / kSnorm, float(mx) / kSnorm);
       }
     }
   }
@@ -132,20 +136,27 @@ RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimens
                 " per side");
   }
   in.atlas_dims = dims;
-  in.atlas.assign(size_t(dims.x) * dims.y * dims.z, 0);
+  in.atlas.assign(4 * size_t(dims.x) * dims.y * dims.z, 0);
   uint32_t z0 = 0, first_brick = 0;
   for (uint32_t index = 0; index < scene.volumes.size(); ++index) {
     const Volume& v = scene.volumes[index];
-    const std::vector<uint16_t> t = normalised(v);
+    const std::vector<int16_t> t = normalised(v);
     const glm::ivec3 vd(v.dims);
     for (uint32_t az = 0; az < v.dims.z + 2 * VR_ATLAS_BORDER; ++az) {
       const int k = std::clamp(int(az) - int(VR_ATLAS_BORDER), 0, vd.z - 1);
       for (uint32_t ay = 0; ay < dims.y; ++ay) {
         const int j = std::clamp(int(ay) - int(VR_ATLAS_BORDER), 0, vd.y - 1);
-        uint16_t* row = &in.atlas[(size_t(z0 + az) * dims.y + ay) * dims.x];
+        int16_t* row = &in.atlas[4 * (size_t(z0 + az) * dims.y + ay) * dims.x];
         for (uint32_t ax = 0; ax < dims.x; ++ax) {
           const int i = std::clamp(int(ax) - int(VR_ATLAS_BORDER), 0, vd.x - 1);
-          row[ax] = t[(size_t(k) * vd.y + j) * vd.x + i];
+          const auto at = [&](int x, int y, int z) {
+            return int(t[(size_t(std::clamp(z, 0, vd.z - 1)) * vd.y + size_t(std::clamp(y, 0, vd.y - 1))) * vd.x +
+                         size_t(std::clamp(x, 0, vd.x - 1))]);
+          };
+          row[4 * ax + 0] = int16_t((at(i + 1, j, k) - at(i - 1, j, k)) / 2);
+          row[4 * ax + 1] = int16_t((at(i, j + 1, k) - at(i, j - 1, k)) / 2);
+          row[4 * ax + 2] = int16_t((at(i, j, k + 1) - at(i, j, k - 1)) / 2);
+          row[4 * ax + 3] = t[(size_t(k) * vd.y + j) * vd.x + i];
         }
       }
     }
@@ -341,9 +352,6 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
       "render.frame", {[](graph::Extent) { return VkDeviceSize{sizeof(gpu::FrameGpu)}; }});
   const ResourceId keys = graph.add_buffer("render.keys", {slots});
   const ResourceId payload = graph.add_buffer("render.payload", {slots});
-  const ResourceId max_age = graph.add_buffer(
-      "render.max_age",
-      {[](graph::Extent e) { return VkDeviceSize{e.width} * e.height * sizeof(uint32_t); }});
   const ResourceId counters = graph.add_buffer(
       "render.counters",
       {[](graph::Extent) { return VkDeviceSize{VR_COUNTER_COUNT * sizeof(uint32_t)}; }});
@@ -367,14 +375,12 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                   graph::PassKind::transfer,
                   {{frame, Use::transfer_dst},
                    {keys, Use::transfer_dst},
-                   {max_age, Use::transfer_dst},
                    {counters, Use::transfer_dst}},
-                  [this, frame, keys, max_age, counters](graph::PassContext& pc) {
+                  [this, frame, keys, counters](graph::PassContext& pc) {
                     const gpu::FrameGpu data = frame_data(inputs_, camera_, settings_, pc.viewport,
                                                           slots_for(pc.viewport));
                     vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
                     vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(max_age), 0, VK_WHOLE_SIZE, 0);
                     vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
                   },
                   "render"});
@@ -385,7 +391,6 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {ids_.indices, Use::storage_read, VR_BINDING_INDICES},
                    {keys, Use::storage_read_write, VR_BINDING_KEYS},
                    {payload, Use::storage_write, VR_BINDING_PAYLOAD},
-                   {max_age, Use::storage_read_write, VR_BINDING_MAX_AGE},
                    {counters, Use::storage_read_write, VR_BINDING_COUNTERS}},
                   [this](graph::PassContext& pc) { record_build(pc); },
                   "render"});
@@ -395,7 +400,6 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {ids_.volumes, Use::storage_read, VR_BINDING_VOLUMES},
                    {keys, Use::storage_read, VR_BINDING_KEYS},
                    {payload, Use::storage_read, VR_BINDING_PAYLOAD},
-                   {max_age, Use::storage_read, VR_BINDING_MAX_AGE},
                    {counters, Use::storage_read_write, VR_BINDING_COUNTERS},
                    {ids_.atlas, Use::sampled, VR_BINDING_ATLAS},
                    {ids_.transfer, Use::sampled, VR_BINDING_TRANSFER},

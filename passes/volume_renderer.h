@@ -53,7 +53,8 @@ CameraSetup camera_for(const Scene& scene, const std::string& name);
 // the CPU reference renderer (volume_render_reference.h) samples.
 struct RenderInputs {
   glm::uvec3 atlas_dims{1};
-  std::vector<uint16_t> atlas;  // normalised intensity, volumes stacked along z
+  std::vector<int16_t> atlas;  // per texel: gradient xyz (per voxel) and normalised intensity,
+                               // 16-bit SNORM; volumes stacked along z
   std::vector<gpu::VolumeGpu> volumes;
   std::vector<TransferFunction> transfer_functions;  // one per volume
   std::vector<glm::vec4> transfer_table;             // VR_TF_SIZE x max(1, volumes)

@@ -28,7 +28,6 @@ void main() {
     const uint slot = habuffer_slot(pixel, age, frame.table_size);
     if (atomicCompSwap(keys[slot], uint64_t(0), habuffer_key(depth, age, pixel)) == uint64_t(0)) {
       payload[slot] = data;
-      atomicMax(max_age[pixel], age);
       return;
     }
   }

@@ -15,8 +15,8 @@ layout(binding = VR_BINDING_FINAL, rgba8) writeonly uniform image2D final_image;
 layout(binding = VR_BINDING_DEPTH, r32f) writeonly uniform image2D depth_image;
 
 VolumeGpu volume_info(uint v) { return volumes[v]; }
-float volume_sample(uint v, vec3 tc) {
-  return texture(atlas, volumes[v].atlas_offset.xyz + tc * volumes[v].atlas_scale.xyz).r;
+vec4 volume_sample(uint v, vec3 tc) {
+  return texture(atlas, volumes[v].atlas_offset.xyz + tc * volumes[v].atlas_scale.xyz);
 }
 vec4 transfer(uint v, float t) { return texture(transfer_table, vec2(t, volumes[v].atlas_offset.w)); }
 bool brick_empty(uint v, vec3 tc) {
@@ -34,12 +34,13 @@ void main() {
   float depths[VR_MAX_FRAGMENTS];
   uvec2 payloads[VR_MAX_FRAGMENTS];
   if (inside) {
-    // Gather this pixel's fragments (every age up to its largest), then sort them by depth.
+    // Gather this pixel's fragments along its probe sequence up to the first empty slot, then
+    // sort them by depth.
     const uint pixel = px.y * frame.width + px.x;
-    const uint ages = max_age[pixel];
-    for (uint age = 1u; age <= ages; ++age) {
+    for (uint age = 1u; age <= VR_MAX_AGE; ++age) {
       const uint slot = habuffer_slot(pixel, age, frame.table_size);
       const uint64_t key = keys[slot];
+      if (key == uint64_t(0)) break;
       if (uint(key & 0xFFFFFFul) != pixel || uint((key >> 24) & 0xFFul) != age) continue;
       if (count == VR_MAX_FRAGMENTS) {
         ++dropped;

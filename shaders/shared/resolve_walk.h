@@ -2,7 +2,8 @@
 // reference (passes/volume_render_reference.cpp). The includer provides:
 //   frame                                  FrameGpu
 //   VolumeGpu volume_info(uint v)
-//   float volume_sample(uint v, vec3 tc)   trilinear normalised intensity at tc in [0,1]^3
+//   vec4 volume_sample(uint v, vec3 tc)    trilinear at tc in [0,1]^3: xyz the gradient (per
+//                                          voxel), w the normalised intensity
 //   vec4 transfer(uint v, float t)         straight RGBA, linear between table entries
 //   bool brick_empty(uint v, vec3 tc)      transfer function is transparent in tc's brick
 // and the fragments of the pixel sorted front to back: their eye depths and payloads.
@@ -40,14 +41,12 @@ vec4 sample_volumes(uint live, vec3 p, vec3 to_eye, float step_world) {
     VolumeGpu vol = volume_info(v);
     vec3 tc = vec3(vol.world_to_texture * vec4(p, 1.0f));
     if (!inside_unit_box(tc)) continue;
-    vec4 c = transfer(v, volume_sample(v, tc));
+    vec4 s = volume_sample(v, tc);
+    vec4 c = transfer(v, s.w);
     if (c.a <= 0.0f) continue;
-    vec3 h = vec3(vol.texel);
-    vec3 g = vec3(volume_sample(v, tc + vec3(h.x, 0.0f, 0.0f)) - volume_sample(v, tc - vec3(h.x, 0.0f, 0.0f)),
-                  volume_sample(v, tc + vec3(0.0f, h.y, 0.0f)) - volume_sample(v, tc - vec3(0.0f, h.y, 0.0f)),
-                  volume_sample(v, tc + vec3(0.0f, 0.0f, h.z)) - volume_sample(v, tc - vec3(0.0f, 0.0f, h.z)));
-    // Gradients transform with the transpose of the world-to-texture map.
-    vec3 normal = transpose(mat3(vol.world_to_texture)) * (g / (2.0f * h));
+    // Per voxel to per texture unit, then world: gradients transform with the transpose of the
+    // world-to-texture map.
+    vec3 normal = transpose(mat3(vol.world_to_texture)) * (vec3(s) / vec3(vol.texel));
     float alpha = corrected_alpha(c.a, step_world, vol.atlas_scale.w);
     shaded_samples += 1u;
     vec4 shaded = length(normal) > 1e-6f ? shade_blinn_phong(vec4(vec3(c), 1.0f), -normal, to_eye)

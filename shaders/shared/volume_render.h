@@ -12,7 +12,7 @@
 
 #define VR_MAX_VOLUMES 8
 #define VR_MAX_LAYERS 8
-#define VR_MAX_FRAGMENTS 24   // per pixel in the resolve; more are counted, not drawn
+#define VR_MAX_FRAGMENTS 16   // per pixel in the resolve; more are counted, not drawn
 #define VR_MAX_AGE 255        // probes per insertion before a fragment counts as overflow
 #define VR_TF_SIZE 256        // entries per transfer-function row
 #define VR_BRICK 8            // voxels per brick edge for empty-space skipping
@@ -34,7 +34,6 @@
 #define VR_BINDING_VOLUMES 1
 #define VR_BINDING_KEYS 2
 #define VR_BINDING_PAYLOAD 3
-#define VR_BINDING_MAX_AGE 4
 #define VR_BINDING_COUNTERS 5
 #define VR_BINDING_VERTICES 6
 #define VR_BINDING_INDICES 7
