@@ -37,15 +37,7 @@ struct Reference {
     return sum / 32767.0f;
   }
 
-  vec4 transfer(uint v, float t) const {
-    const float x = t * float(VR_TF_SIZE) - 0.5f;
-    const float base = std::floor(x);
-    const float f = x - base;
-    const int i0 = std::clamp(int(base), 0, VR_TF_SIZE - 1);
-    const int i1 = std::clamp(int(base) + 1, 0, VR_TF_SIZE - 1);
-    const vec4* row = &in.transfer_table[size_t(v) * VR_TF_SIZE];
-    return mix(row[i0], row[i1], f);
-  }
+  vec4 table_entry(uint v, int i) const { return in.transfer_table[size_t(v) * VR_TF_SIZE + size_t(i)]; }
 
   bool brick_empty(uint v, vec3 tc) const {
     const VolumeGpu& vol = in.volumes[v];

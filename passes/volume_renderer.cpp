@@ -24,7 +24,6 @@ namespace {
 // sample and its normal instead of seven.
 constexpr VkFormat kAtlasFormat = VK_FORMAT_R16G16B16A16_SNORM;
 constexpr float kSnorm = 32767.0f;
-constexpr VkFormat kTableFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 
 glm::mat4 texture_to_world(const Volume& v) {
   const glm::mat4 voxel_from_texture = glm::translate(glm::mat4(1.0f), glm::vec3(-0.5f)) *
@@ -315,17 +314,13 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
   counters_readback_ = Buffer(ctx, VR_COUNTER_COUNT * sizeof(uint32_t),
                               VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback);
   std::memset(counters_readback_.mapped(), 0, VR_COUNTER_COUNT * sizeof(uint32_t));
-  transfer_table_ =
-      Image(ctx, {kTableFormat,
-                  {VR_TF_SIZE, uint32_t(inputs_.transfer_table.size() / VR_TF_SIZE), 1},
-                  VK_IMAGE_TYPE_2D,
-                  VK_IMAGE_USAGE_SAMPLED_BIT});
+  transfer_table_ = Buffer(ctx, inputs_.transfer_table.size() * sizeof(glm::vec4), storage,
+                           MemoryKind::device_local);
   upload_transfer();
 }
 
 void VolumeRenderer::upload_transfer() {
-  upload(ctx_, transfer_table_, as_bytes(inputs_.transfer_table),
-         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  upload(ctx_, transfer_table_, as_bytes(inputs_.transfer_table));
   if (!inputs_.occupancy.empty()) upload(ctx_, occupancy_, as_bytes(inputs_.occupancy));
 }
 
@@ -363,7 +358,7 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
   const graph::ImportInfo sampled_image{true, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   const graph::ImportInfo filled_buffer{false, true};
   ids_.atlas = graph.import_resource("render.atlas", sampled_image);
-  ids_.transfer = graph.import_resource("render.transfer_table", sampled_image);
+  ids_.transfer = graph.import_resource("render.transfer_table", filled_buffer);
   ids_.volumes = graph.import_resource("render.volumes", filled_buffer);
   ids_.occupancy = graph.import_resource("render.occupancy", filled_buffer);
   ids_.vertices = graph.import_resource("render.vertices", filled_buffer);
@@ -402,7 +397,7 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {payload, Use::storage_read, VR_BINDING_PAYLOAD},
                    {counters, Use::storage_read_write, VR_BINDING_COUNTERS},
                    {ids_.atlas, Use::sampled, VR_BINDING_ATLAS},
-                   {ids_.transfer, Use::sampled, VR_BINDING_TRANSFER},
+                   {ids_.transfer, Use::storage_read, VR_BINDING_TRANSFER},
                    {ids_.occupancy, Use::storage_read, VR_BINDING_OCCUPANCY},
                    {out.layers, Use::storage_write, VR_BINDING_LAYERS},
                    {out.final, Use::storage_write, VR_BINDING_FINAL},
@@ -431,7 +426,7 @@ void VolumeRenderer::bind(graph::GraphRunner& runner) {
                 " is more than the HA-Buffer's 16M pixels");
   }
   runner.bind_image(ids_.atlas, atlas_.handle(), atlas_.view(), kAtlasFormat);
-  runner.bind_image(ids_.transfer, transfer_table_.handle(), transfer_table_.view(), kTableFormat);
+  runner.bind_buffer(ids_.transfer, transfer_table_.handle());
   runner.bind_buffer(ids_.volumes, volumes_.handle());
   runner.bind_buffer(ids_.occupancy, occupancy_.handle());
   runner.bind_buffer(ids_.vertices, vertices_.handle());
@@ -473,6 +468,7 @@ RenderStats VolumeRenderer::collect(graph::GraphRunner& runner) {
   stats.resolve_overflow = c[VR_COUNTER_RESOLVE_OVERFLOW];
   stats.samples = c[VR_COUNTER_SAMPLES];
   stats.shaded = c[VR_COUNTER_SHADED];
+  stats.fetches = c[VR_COUNTER_FETCHES];
   stats.table_size = slots_for(runner.viewport());
   if (stats.overflow > 0 || stats.fragments > 0.75 * stats.table_size) {
     const double needed = (double(stats.fragments) + stats.overflow) / settings_.load_factor;

@@ -34,7 +34,8 @@ struct RenderStats {
   uint32_t fragments = 0;         // fragments in the table
   uint32_t resolve_overflow = 0;  // fragments beyond the resolve's per-pixel capacity
   uint64_t samples = 0;           // ray positions sampled
-  uint64_t shaded = 0;            // volume samples shaded (7 atlas texels + 1 table entry each)
+  uint64_t shaded = 0;            // volume samples shaded
+  uint64_t fetches = 0;           // atlas texture fetches (trilinear, 4 x 16-bit)
   uint32_t table_size = 0;        // slots during that frame
   double load_factor() const { return table_size ? double(fragments) / table_size : 0.0; }
 };
@@ -127,8 +128,7 @@ class VolumeRenderer {
   RenderInputs inputs_;
 
   Image atlas_;
-  Image transfer_table_;
-  Buffer volumes_, occupancy_, vertices_, indices_, counters_readback_;
+  Buffer transfer_table_, volumes_, occupancy_, vertices_, indices_, counters_readback_;
   uint32_t forced_slots_ = 0;  // 0: sized from the viewport
 
   GraphicsPipeline build_;

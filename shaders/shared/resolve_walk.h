@@ -4,7 +4,7 @@
 //   VolumeGpu volume_info(uint v)
 //   vec4 volume_sample(uint v, vec3 tc)    trilinear at tc in [0,1]^3: xyz the gradient (per
 //                                          voxel), w the normalised intensity
-//   vec4 transfer(uint v, float t)         straight RGBA, linear between table entries
+//   vec4 table_entry(uint v, int i)        transfer table entry i of volume v
 //   bool brick_empty(uint v, vec3 tc)      transfer function is transparent in tc's brick
 // and the fragments of the pixel sorted front to back: their eye depths and payloads.
 //
@@ -15,10 +15,12 @@ struct PixelResult {
   vec4 layers[VR_MAX_LAYERS];  // premultiplied, each its own slab
   float depth;                 // eye depth where the total alpha first reaches depth_alpha, or 0
   uint samples;                // ray positions sampled
-  uint shaded;                 // volume samples shaded (each fetches 7 texels and 1 table entry)
+  uint shaded;                 // volume samples shaded
+  uint fetches;                // atlas fetches
 };
 
 uint shaded_samples = 0u;
+uint atlas_fetches = 0u;
 
 uint layer_of(float z) {
   uint layer = 0u;
@@ -26,6 +28,16 @@ uint layer_of(float z) {
     if (z >= split_depth(frame.splits, i)) layer = i + 1u;
   }
   return layer;
+}
+
+// Straight RGBA of volume v's transfer function at normalised intensity t: linear between the
+// table's entries (centred at (i + 0.5) / VR_TF_SIZE), clamped at both ends.
+vec4 transfer(uint v, float t) {
+  float x = t * float(VR_TF_SIZE) - 0.5f;
+  float base = floor(x);
+  int i = int(base);
+  return mix(table_entry(v, clamp(i, 0, VR_TF_SIZE - 1)), table_entry(v, clamp(i + 1, 0, VR_TF_SIZE - 1)),
+             x - base);
 }
 
 bool inside_unit_box(vec3 tc) {
@@ -42,6 +54,7 @@ vec4 sample_volumes(uint live, vec3 p, vec3 to_eye, float step_world) {
     vec3 tc = vec3(vol.world_to_texture * vec4(p, 1.0f));
     if (!inside_unit_box(tc)) continue;
     vec4 s = volume_sample(v, tc);
+    atlas_fetches += 1u;
     vec4 c = transfer(v, s.w);
     if (c.a <= 0.0f) continue;
     // Per voxel to per texture unit, then world: gradients transform with the transpose of the
@@ -57,16 +70,17 @@ vec4 sample_volumes(uint live, vec3 p, vec3 to_eye, float step_world) {
   return sum;
 }
 
-// The eye depth at which the ray leaves the current brick of every live volume (the next
-// place a sample could be visible), or z itself when some live volume is not empty here.
-float skip_to(uint live, vec3 origin, vec3 direction, float z) {
+// Where the ray leaves the current brick of every live volume (x, eye depth) and whether all of
+// those bricks are empty (y = 1): the next sample that could be visible lies beyond x.
+vec2 brick_state(uint live, vec3 origin, vec3 direction, float z, float dz) {
   float exit_z = 3.4e38f;
+  bool empty = true;
   for (uint v = 0u; v < frame.volume_count; ++v) {
     if ((live & (1u << v)) == 0u) continue;
     VolumeGpu vol = volume_info(v);
     vec3 tc = vec3(vol.world_to_texture * vec4(origin + direction * z, 1.0f));
     if (!inside_unit_box(tc)) continue;
-    if (!brick_empty(v, tc)) return z;
+    empty = empty && brick_empty(v, tc);
     vec3 d = mat3(vol.world_to_texture) * direction;  // texture units per unit eye depth
     // Bricks are VR_BRICK voxels wide: brick coordinates = voxel coordinates / VR_BRICK.
     vec3 per_unit = 1.0f / (vec3(vol.texel) * float(VR_BRICK));
@@ -77,7 +91,8 @@ float skip_to(uint live, vec3 origin, vec3 direction, float z) {
     if (abs(d.z) > 1e-12f) t = min(t, ((cell.z + (d.z > 0.0f ? 1.0f : 0.0f)) / per_unit.z - tc.z) / d.z);
     exit_z = min(exit_z, z + max(t, 0.0f));
   }
-  return exit_z;
+  if (exit_z > 3.0e38f) exit_z = z + dz;  // no live volume here: nothing to see at z
+  return vec2(exit_z, empty ? 1.0f : 0.0f);
 }
 
 struct Ray {
@@ -108,6 +123,7 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   r.depth = 0.0f;
   r.samples = 0u;
   shaded_samples = 0u;
+  atlas_fetches = 0u;
 
   Ray ray = pixel_ray(pixel);
   vec3 origin = ray.origin;
@@ -124,6 +140,7 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
 
   float total = 0.0f;
   float z = frame.near_depth;
+  float checked_until = -1.0f;  // samples before this depth lie in bricks known to be occupied
   for (uint i = 0u; i <= count; ++i) {
     float z_end = i < count ? depths[i] : frame.far_depth;
     float k = grid_index_at_or_after(z, dz);
@@ -135,12 +152,14 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
         k = max(grid_index_at_or_after(split_depth(frame.splits, l), dz), k + 1.0f);
         continue;
       }
-      if (frame.skip_empty != 0u) {
-        float next = skip_to(live, origin, direction, zs);
-        if (next > zs) {
-          k = max(grid_index_at_or_after(next, dz), k + 1.0f);
+      // Occupancy is looked up once per brick, not per sample.
+      if (frame.skip_empty != 0u && zs >= checked_until) {
+        vec2 bricks = brick_state(live, origin, direction, zs, dz);
+        if (bricks.y > 0.5f) {
+          k = max(grid_index_at_or_after(bricks.x, dz), k + 1.0f);
           continue;
         }
+        checked_until = bricks.x;
       }
       vec4 c = sample_volumes(live, origin + direction * zs, to_eye, frame.step);
       r.samples += 1u;
@@ -163,9 +182,11 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
     } else {
       uint bit = 1u << (p.y & 255u);
       live = ((p.y >> 10u) & 1u) != 0u ? (live | bit) : (live & ~bit);
+      checked_until = -1.0f;
     }
     z = z_end;
   }
   r.shaded = shaded_samples;
+  r.fetches = atlas_fetches;
   return r;
 }

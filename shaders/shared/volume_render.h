@@ -16,7 +16,7 @@
 #define VR_MAX_AGE 255        // probes per insertion before a fragment counts as overflow
 #define VR_TF_SIZE 256        // entries per transfer-function row
 #define VR_BRICK 8            // voxels per brick edge for empty-space skipping
-#define VR_RESOLVE_GROUP 8    // resolve workgroup is 8 x 8 pixels
+#define VR_RESOLVE_GROUP 16   // resolve workgroup is 16 x 16 pixels
 
 // Payload kinds (bits 8..9 of payload.y); bit 10: the fragment enters its volume.
 #define VR_KIND_MESH 0u
@@ -27,8 +27,9 @@
 #define VR_COUNTER_FRAGMENTS 1          // fragments the resolve found
 #define VR_COUNTER_RESOLVE_OVERFLOW 2   // fragments beyond VR_MAX_FRAGMENTS in one pixel
 #define VR_COUNTER_SAMPLES 3            // ray positions sampled
-#define VR_COUNTER_SHADED 4             // volume samples shaded (alpha > 0: gradient fetched)
-#define VR_COUNTER_COUNT 5
+#define VR_COUNTER_SHADED 4             // volume samples shaded (alpha > 0)
+#define VR_COUNTER_FETCHES 5            // atlas fetches (one per live volume per sample)
+#define VR_COUNTER_COUNT 6
 
 #define VR_BINDING_FRAME 0
 #define VR_BINDING_VOLUMES 1
@@ -39,7 +40,7 @@
 #define VR_BINDING_INDICES 7
 #define VR_BINDING_ATLAS 8            // sampler3D: every volume, normalised, with borders
 #define VR_ATLAS_BORDER 2             // voxels of replicated edge around each volume in the atlas
-#define VR_BINDING_TRANSFER 9         // sampler2D, one row per volume
+#define VR_BINDING_TRANSFER 9         // vec4[VR_TF_SIZE] per volume, straight RGBA
 #define VR_BINDING_OCCUPANCY 10       // one uint per brick, all volumes one after the other
 #define VR_BINDING_LAYERS 11          // image2DArray rgba16f, premultiplied
 #define VR_BINDING_FINAL 12           // image2D rgba8, layers over the background
