@@ -172,9 +172,10 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
       header, sizeof header,
       "  \"benchmark\": \"render\",\n  \"scene\": \"%s\",\n  \"camera\": \"%s\",\n"
       "  \"width\": %u,\n  \"height\": %u,\n  \"layers\": %u,\n  \"empty_space_skipping\": %s,\n"
-                "  \"step\": %g,\n",
+      "  \"step\": %g,\n",
       json_escape(o.scene).c_str(), json_escape(o.camera).c_str(), size.width, size.height,
-      o.layers, o.no_skipping ? "false" : "true");
+      o.layers, o.no_skipping ? "false" : "true",
+      double(frame_data(renderer.inputs(), renderer.camera(), settings, size, 1).step));
   std::snprintf(
       tail, sizeof tail,
       ",\n  \"samples_per_ray\": %.2f,\n  \"shaded_samples_per_ray\": %.2f,\n"
@@ -214,7 +215,8 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   render_cmd->add_option("--camera", render->camera, "named camera position");
   render_cmd->add_option("--layers", render->layers, "depth layers, 1 to 8")->capture_default_str();
   render_cmd->add_flag("--no-skipping", render->no_skipping, "turn empty-space skipping off");
-  render_cmd->add_option("--step", render->step, "sampling distance in world units (0: half a voxel)");
+  render_cmd->add_option("--step", render->step,
+                         "sampling distance in world units (0: half a voxel)");
   render_cmd->add_option("--runs", options->runs, "timed runs after 3 warm-up runs")
       ->capture_default_str()
       ->check(CLI::Range(1u, 100000u));
