@@ -9,9 +9,6 @@ layout(binding = VR_BINDING_FRAME) uniform Frame { FrameGpu frame; };
 layout(binding = VR_BINDING_VOLUMES, std430) readonly buffer Volumes { VolumeGpu volumes[]; };
 layout(binding = VR_BINDING_ATLAS) uniform sampler3D atlas;
 layout(binding = VR_BINDING_TRANSFER, std430) readonly buffer Transfer { vec4 transfer_table[]; };
-
-// The transfer tables in shared memory: a lookup costs tens of cycles, not a texture fetch.
-shared vec4 tables[VR_MAX_VOLUMES * VR_TF_SIZE];
 layout(binding = VR_BINDING_OCCUPANCY, std430) readonly buffer Occupancy { uint occupancy[]; };
 layout(binding = VR_BINDING_LAYERS, rgba16f) writeonly uniform image2DArray layers;
 layout(binding = VR_BINDING_FINAL, rgba8) writeonly uniform image2D final_image;
@@ -21,7 +18,7 @@ VolumeGpu volume_info(uint v) { return volumes[v]; }
 vec4 volume_sample(uint v, vec3 tc) {
   return texture(atlas, volumes[v].atlas_offset.xyz + tc * volumes[v].atlas_scale.xyz);
 }
-vec4 table_entry(uint v, int i) { return tables[v * VR_TF_SIZE + uint(i)]; }
+vec4 table_entry(uint v, int i) { return transfer_table[v * VR_TF_SIZE + uint(i)]; }
 bool brick_empty(uint v, vec3 tc) {
   const uvec3 b = min(uvec3(tc / (volumes[v].texel.xyz * float(VR_BRICK))), volumes[v].bricks.xyz - 1u);
   const uvec4 g = volumes[v].bricks;
@@ -31,11 +28,6 @@ bool brick_empty(uint v, vec3 tc) {
 #include "shared/resolve_walk.h"
 
 void main() {
-  for (uint i = gl_LocalInvocationIndex; i < frame.volume_count * VR_TF_SIZE;
-       i += VR_RESOLVE_GROUP * VR_RESOLVE_GROUP) {
-    tables[i] = transfer_table[i];
-  }
-  barrier();
   const uvec2 px = gl_GlobalInvocationID.xy;
   const bool inside = px.x < frame.width && px.y < frame.height;
   uint count = 0u, dropped = 0u;

@@ -141,13 +141,23 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   float total = 0.0f;
   float z = frame.near_depth;
   float checked_until = -1.0f;  // samples before this depth lie in bricks known to be occupied
+  // Depth only grows along the ray, so layers are visited in order: the current layer's colour
+  // stays in registers and goes to r.layers[] when the ray moves on (a dynamically indexed array
+  // touched per sample would live in slow local memory on GPUs).
+  uint layer = 0u;
+  vec4 acc = vec4(0.0f);
   for (uint i = 0u; i <= count; ++i) {
     float z_end = i < count ? depths[i] : frame.far_depth;
     float k = grid_index_at_or_after(z, dz);
     while (live != 0u && grid_depth(k, dz) < z_end) {
       float zs = grid_depth(k, dz);
       uint l = layer_of(zs);
-      if (r.layers[l].a >= frame.termination_alpha) {  // this slab is opaque: go to the next one
+      if (l != layer) {
+        r.layers[layer] = acc;
+        layer = l;
+        acc = r.layers[layer];
+      }
+      if (acc.a >= frame.termination_alpha) {  // this slab is opaque: go to the next one
         if (l + 1u >= frame.layer_count) break;
         k = max(grid_index_at_or_after(split_depth(frame.splits, l), dz), k + 1.0f);
         continue;
@@ -163,7 +173,7 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
       }
       vec4 c = sample_volumes(live, origin + direction * zs, to_eye, frame.step);
       r.samples += 1u;
-      r.layers[l] = over(r.layers[l], c);
+      acc = over(acc, c);
       float before = total;
       total = total + (1.0f - total) * c.a;
       if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = zs;
@@ -175,7 +185,12 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
     if (kind == VR_KIND_MESH) {
       vec4 c = unpackUnorm4x8(p.x);
       uint l = layer_of(z_end);
-      r.layers[l] = over(r.layers[l], c);
+      if (l != layer) {
+        r.layers[layer] = acc;
+        layer = l;
+        acc = r.layers[layer];
+      }
+      acc = over(acc, c);
       float before = total;
       total = total + (1.0f - total) * c.a;
       if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = z_end;
@@ -186,6 +201,7 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
     }
     z = z_end;
   }
+  r.layers[layer] = acc;
   r.shaded = shaded_samples;
   r.fetches = atlas_fetches;
   return r;

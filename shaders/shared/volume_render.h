@@ -16,7 +16,7 @@
 #define VR_MAX_AGE 255        // probes per insertion before a fragment counts as overflow
 #define VR_TF_SIZE 256        // entries per transfer-function row
 #define VR_BRICK 8            // voxels per brick edge for empty-space skipping
-#define VR_RESOLVE_GROUP 16   // resolve workgroup is 16 x 16 pixels
+#define VR_RESOLVE_GROUP 8    // resolve workgroup is 8 x 8 pixels
 
 // Payload kinds (bits 8..9 of payload.y); bit 10: the fragment enters its volume.
 #define VR_KIND_MESH 0u
