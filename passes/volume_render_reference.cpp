@@ -9,23 +9,11 @@ namespace strata {
 namespace gpu {
 namespace {
 
-struct Fragment {
-  float depth;
-  uvec2 payload;
-};
-
 // One pixel's work on the CPU. The shared resolve is included inside this struct, so its
 // functions see `frame` and the sampling functions below as members.
 struct Reference {
   FrameGpu frame;
   const RenderInputs& in;
-  std::vector<Fragment> fragments;  // of the current pixel, sorted
-  std::vector<vec4>* layers = nullptr;
-  size_t current_pixel = 0, pixel_count = 0;
-
-  float fragment_depth(uint i) const { return fragments[i].depth; }
-  uvec2 fragment_payload(uint i) const { return fragments[i].payload; }
-  void store_layer(uint l, vec4 color) { (*layers)[l * pixel_count + current_pixel] = color; }
 
   VolumeGpu volume_info(uint v) const { return in.volumes[v]; }
 
@@ -41,19 +29,15 @@ struct Reference {
     for (int corner = 0; corner < 8; ++corner) {
       const ivec3 o(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
       const ivec3 p = clamp(ivec3(base) + o, ivec3(0), top);
-      const float w =
-          (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
+      const float w = (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
       const int16_t* texel =
-          &in.atlas[4 * ((size_t(p.z) * in.atlas_dims.y + size_t(p.y)) * in.atlas_dims.x +
-                         size_t(p.x))];
+          &in.atlas[4 * ((size_t(p.z) * in.atlas_dims.y + size_t(p.y)) * in.atlas_dims.x + size_t(p.x))];
       sum += w * vec4(float(texel[0]), float(texel[1]), float(texel[2]), float(texel[3]));
     }
     return sum / 32767.0f;
   }
 
-  vec4 table_entry(uint v, int i) const {
-    return in.transfer_table[size_t(v) * VR_TF_SIZE + size_t(i)];
-  }
+  vec4 table_entry(uint v, int i) const { return in.transfer_table[size_t(v) * VR_TF_SIZE + size_t(i)]; }
 
   bool brick_empty(uint v, vec3 tc) const {
     const VolumeGpu& vol = in.volumes[v];
@@ -63,6 +47,11 @@ struct Reference {
   }
 
 #include "shared/resolve_walk.h"
+};
+
+struct Fragment {
+  float depth;
+  uvec2 payload;
 };
 
 // Möller-Trumbore; t is the eye depth because the ray's direction is per unit of eye depth.
@@ -137,18 +126,26 @@ ReferenceImage render_reference(const RenderInputs& inputs, const CameraSetup& c
   image.layers.assign(pixels * settings.layer_count, glm::vec4(0.0f));
   image.final.assign(pixels, glm::vec4(0.0f));
   image.depth.assign(pixels, 0.0f);
-  ref.layers = &image.layers;
-  ref.pixel_count = pixels;
   for (uint32_t y = 0; y < size.height; ++y) {
     for (uint32_t x = 0; x < size.width; ++x) {
       const glm::vec2 centre(float(x) + 0.5f, float(y) + 0.5f);
       const auto ray = ref.pixel_ray(centre);
-      ref.fragments = gpu::fragments(inputs, ref.frame, ray.origin, ray.direction);
-      if (ref.fragments.size() > VR_MAX_FRAGMENTS) ref.fragments.resize(VR_MAX_FRAGMENTS);
+      const std::vector<gpu::Fragment> found =
+          gpu::fragments(inputs, ref.frame, ray.origin, ray.direction);
+      float depths[VR_MAX_FRAGMENTS];
+      glm::uvec2 payloads[VR_MAX_FRAGMENTS];
+      const uint32_t count = uint32_t(std::min<size_t>(found.size(), VR_MAX_FRAGMENTS));
+      for (uint32_t i = 0; i < count; ++i) {
+        depths[i] = found[i].depth;
+        payloads[i] = found[i].payload;
+      }
+      const auto r = ref.resolve_pixel(centre, count, depths, payloads);
       const size_t p = size_t{y} * size.width + x;
-      ref.current_pixel = p;
-      const auto r = ref.resolve_pixel(centre, uint32_t(ref.fragments.size()));
-      const glm::vec4 all = r.composite;
+      glm::vec4 all(0.0f);
+      for (uint32_t l = 0; l < settings.layer_count; ++l) {
+        image.layers[l * pixels + p] = r.layers[l];
+        all = gpu::over(all, r.layers[l]);
+      }
       image.final[p] = glm::vec4(glm::vec3(all) + (1.0f - all.a) * settings.background, 1.0f);
       image.depth[p] = r.depth;
       image.samples += r.samples;

@@ -149,10 +149,8 @@ RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimens
         for (uint32_t ax = 0; ax < dims.x; ++ax) {
           const int i = std::clamp(int(ax) - int(VR_ATLAS_BORDER), 0, vd.x - 1);
           const auto at = [&](int x, int y, int z) {
-            return int(
-                t[(size_t(std::clamp(z, 0, vd.z - 1)) * vd.y + size_t(std::clamp(y, 0, vd.y - 1))) *
-                      vd.x +
-                  size_t(std::clamp(x, 0, vd.x - 1))]);
+            return int(t[(size_t(std::clamp(z, 0, vd.z - 1)) * vd.y + size_t(std::clamp(y, 0, vd.y - 1))) * vd.x +
+                         size_t(std::clamp(x, 0, vd.x - 1))]);
           };
           row[4 * ax + 0] = int16_t((at(i + 1, j, k) - at(i - 1, j, k)) / 2);
           row[4 * ax + 1] = int16_t((at(i, j + 1, k) - at(i, j - 1, k)) / 2);
@@ -368,18 +366,19 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
   ids_.readback = graph.import_resource("render.counters_readback",
                                         {false, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::host_read});
 
-  graph.add_pass(
-      {"render.clear",
-       graph::PassKind::transfer,
-       {{frame, Use::transfer_dst}, {keys, Use::transfer_dst}, {counters, Use::transfer_dst}},
-       [this, frame, keys, counters](graph::PassContext& pc) {
-         const gpu::FrameGpu data =
-             frame_data(inputs_, camera_, settings_, pc.viewport, slots_for(pc.viewport));
-         vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
-         vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
-         vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
-       },
-       "render"});
+  graph.add_pass({"render.clear",
+                  graph::PassKind::transfer,
+                  {{frame, Use::transfer_dst},
+                   {keys, Use::transfer_dst},
+                   {counters, Use::transfer_dst}},
+                  [this, frame, keys, counters](graph::PassContext& pc) {
+                    const gpu::FrameGpu data = frame_data(inputs_, camera_, settings_, pc.viewport,
+                                                          slots_for(pc.viewport));
+                    vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
+                  },
+                  "render"});
   graph.add_pass({"render.habuffer_build",
                   graph::PassKind::graphics,
                   {{frame, Use::uniform, VR_BINDING_FRAME},

@@ -25,23 +25,17 @@ bool brick_empty(uint v, vec3 tc) {
   return occupancy[g.w + (b.z * g.y + b.y) * g.x + b.x] == 0u;
 }
 
-// Each pixel's fragments, sorted, in shared memory rather than in registers.
-shared float fragment_depths[VR_RESOLVE_GROUP * VR_RESOLVE_GROUP][VR_MAX_FRAGMENTS];
-shared uvec2 fragment_payloads[VR_RESOLVE_GROUP * VR_RESOLVE_GROUP][VR_MAX_FRAGMENTS];
-float fragment_depth(uint i) { return fragment_depths[gl_LocalInvocationIndex][i]; }
-uvec2 fragment_payload(uint i) { return fragment_payloads[gl_LocalInvocationIndex][i]; }
-void store_layer(uint l, vec4 color) { imageStore(layers, ivec3(gl_GlobalInvocationID.xy, l), color); }
-
 #include "shared/resolve_walk.h"
 
 void main() {
   const uvec2 px = gl_GlobalInvocationID.xy;
-  const uint me = gl_LocalInvocationIndex;
   const bool inside = px.x < frame.width && px.y < frame.height;
   uint count = 0u, dropped = 0u;
+  float depths[VR_MAX_FRAGMENTS];
+  uvec2 payloads[VR_MAX_FRAGMENTS];
   if (inside) {
-    // Gather this pixel's fragments along its probe sequence up to the first empty slot, sorting
-    // them by depth as they come.
+    // Gather this pixel's fragments along its probe sequence up to the first empty slot, then
+    // sort them by depth.
     const uint pixel = px.y * frame.width + px.x;
     for (uint age = 1u; age <= VR_MAX_AGE; ++age) {
       const uint slot = habuffer_slot(pixel, age, frame.table_size);
@@ -55,16 +49,16 @@ void main() {
       const float d = uintBitsToFloat(uint(key >> 32));
       const uvec2 p = payload[slot];
       uint j = count++;
-      for (; j > 0u && fragment_depths[me][j - 1u] > d; --j) {
-        fragment_depths[me][j] = fragment_depths[me][j - 1u];
-        fragment_payloads[me][j] = fragment_payloads[me][j - 1u];
+      for (; j > 0u && depths[j - 1u] > d; --j) {
+        depths[j] = depths[j - 1u];
+        payloads[j] = payloads[j - 1u];
       }
-      fragment_depths[me][j] = d;
-      fragment_payloads[me][j] = p;
+      depths[j] = d;
+      payloads[j] = p;
     }
   }
   PixelResult r;
-  if (inside) r = resolve_pixel(vec2(px) + 0.5, count);
+  if (inside) r = resolve_pixel(vec2(px) + 0.5, count, depths, payloads);
   const uint found = subgroupAdd(count + dropped);
   const uint lost = subgroupAdd(dropped);
   const uint samples = subgroupAdd(inside ? r.samples : 0u);
@@ -78,6 +72,11 @@ void main() {
     atomicAdd(counters[VR_COUNTER_FETCHES], fetches);
   }
   if (!inside) return;
-  imageStore(final_image, ivec2(px), vec4(r.composite.rgb + (1.0 - r.composite.a) * frame.background.rgb, 1.0));
+  vec4 all = vec4(0.0);
+  for (uint l = 0u; l < frame.layer_count; ++l) {
+    imageStore(layers, ivec3(px, l), r.layers[l]);
+    all = over(all, r.layers[l]);
+  }
+  imageStore(final_image, ivec2(px), vec4(all.rgb + (1.0 - all.a) * frame.background.rgb, 1.0));
   imageStore(depth_image, ivec2(px), vec4(r.depth));
 }

@@ -6,17 +6,13 @@
 //                                          voxel), w the normalised intensity
 //   vec4 table_entry(uint v, int i)        transfer table entry i of volume v
 //   bool brick_empty(uint v, vec3 tc)      transfer function is transparent in tc's brick
-//   float fragment_depth(uint i)           the pixel's fragments sorted front to back: eye depth
-//   uvec2 fragment_payload(uint i)         ... and payload
-//   void store_layer(uint l, vec4 color)   receives each layer's colour once, in order
-// Fragments and layer colours stay out of the walk's registers: on GPUs, register pressure is
-// what limits how many rays run at once.
+// and the fragments of the pixel sorted front to back: their eye depths and payloads.
 //
 // The ray is parametrised by eye depth z: point(z) = origin + direction * z. Samples lie on one
 // grid for the whole ray (near + (k + 0.5) * dz), so segments between fragments join seamlessly.
 
 struct PixelResult {
-  vec4 composite;              // every layer over the next, premultiplied
+  vec4 layers[VR_MAX_LAYERS];  // premultiplied, each its own slab
   float depth;                 // eye depth where the total alpha first reaches depth_alpha, or 0
   uint samples;                // ray positions sampled
   uint shaded;                 // volume samples shaded
@@ -120,9 +116,10 @@ float grid_index_at_or_after(float z, float dz) {
   return max(ceil((z - frame.near_depth) / dz - 0.5f), 0.0f);
 }
 
-PixelResult resolve_pixel(vec2 pixel, uint count) {
+PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS],
+                          uvec2 payloads[VR_MAX_FRAGMENTS]) {
   PixelResult r;
-  r.composite = vec4(0.0f);
+  for (uint l = 0u; l < VR_MAX_LAYERS; ++l) r.layers[l] = vec4(0.0f);
   r.depth = 0.0f;
   r.samples = 0u;
   shaded_samples = 0u;
@@ -145,20 +142,20 @@ PixelResult resolve_pixel(vec2 pixel, uint count) {
   float z = frame.near_depth;
   float checked_until = -1.0f;  // samples before this depth lie in bricks known to be occupied
   // Depth only grows along the ray, so layers are visited in order: the current layer's colour
-  // stays in registers and is handed to store_layer when the ray moves past it.
+  // stays in registers and goes to r.layers[] when the ray moves on (a dynamically indexed array
+  // touched per sample would live in slow local memory on GPUs).
   uint layer = 0u;
   vec4 acc = vec4(0.0f);
   for (uint i = 0u; i <= count; ++i) {
-    float z_end = i < count ? fragment_depth(i) : frame.far_depth;
+    float z_end = i < count ? depths[i] : frame.far_depth;
     float k = grid_index_at_or_after(z, dz);
     while (live != 0u && grid_depth(k, dz) < z_end) {
       float zs = grid_depth(k, dz);
       uint l = layer_of(zs);
-      while (layer < l) {
-        store_layer(layer, acc);
-        r.composite = over(r.composite, acc);
-        acc = vec4(0.0f);
-        layer += 1u;
+      if (l != layer) {
+        r.layers[layer] = acc;
+        layer = l;
+        acc = r.layers[layer];
       }
       if (acc.a >= frame.termination_alpha) {  // this slab is opaque: go to the next one
         if (l + 1u >= frame.layer_count) break;
@@ -183,16 +180,15 @@ PixelResult resolve_pixel(vec2 pixel, uint count) {
       k += 1.0f;
     }
     if (i == count) break;
-    uvec2 p = fragment_payload(i);
+    uvec2 p = payloads[i];
     uint kind = (p.y >> 8u) & 3u;
     if (kind == VR_KIND_MESH) {
       vec4 c = unpackUnorm4x8(p.x);
       uint l = layer_of(z_end);
-      while (layer < l) {
-        store_layer(layer, acc);
-        r.composite = over(r.composite, acc);
-        acc = vec4(0.0f);
-        layer += 1u;
+      if (l != layer) {
+        r.layers[layer] = acc;
+        layer = l;
+        acc = r.layers[layer];
       }
       acc = over(acc, c);
       float before = total;
@@ -205,11 +201,7 @@ PixelResult resolve_pixel(vec2 pixel, uint count) {
     }
     z = z_end;
   }
-  for (; layer < frame.layer_count; ++layer) {
-    store_layer(layer, acc);
-    r.composite = over(r.composite, acc);
-    acc = vec4(0.0f);
-  }
+  r.layers[layer] = acc;
   r.shaded = shaded_samples;
   r.fetches = atlas_fetches;
   return r;
