@@ -145,14 +145,16 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   // stays in registers and goes to r.layers[] when the ray moves on (a dynamically indexed array
   // touched per sample would live in slow local memory on GPUs).
   uint layer = 0u;
+  float next_split = frame.layer_count > 1u ? split_depth(frame.splits, 0u) : 3.4e38f;
   vec4 acc = vec4(0.0f);
   for (uint i = 0u; i <= count; ++i) {
     float z_end = i < count ? depths[i] : frame.far_depth;
     float k = grid_index_at_or_after(z, dz);
     while (live != 0u && grid_depth(k, dz) < z_end) {
       float zs = grid_depth(k, dz);
-      uint l = layer_of(zs);
+      uint l = zs >= next_split ? layer_of(zs) : layer;
       if (l != layer) {
+        next_split = l + 1u < frame.layer_count ? split_depth(frame.splits, l) : 3.4e38f;
         r.layers[layer] = acc;
         layer = l;
         acc = r.layers[layer];
@@ -184,8 +186,9 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
     uint kind = (p.y >> 8u) & 3u;
     if (kind == VR_KIND_MESH) {
       vec4 c = unpackUnorm4x8(p.x);
-      uint l = layer_of(z_end);
+      uint l = z_end >= next_split ? layer_of(z_end) : layer;
       if (l != layer) {
+        next_split = l + 1u < frame.layer_count ? split_depth(frame.splits, l) : 3.4e38f;
         r.layers[layer] = acc;
         layer = l;
         acc = r.layers[layer];
