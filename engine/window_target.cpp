@@ -163,6 +163,10 @@ void WindowTarget::create_swapchain(graph::Extent framebuffer) {
   for (VkSemaphore& s : rendered_) STRATA_VK(vkCreateSemaphore(device, &sem, nullptr, &s));
 }
 
+void WindowTarget::wait_for_last_frame() {
+  STRATA_VK(vkWaitForFences(ctx_.device(), 1, &frame_done_, VK_TRUE, UINT64_MAX));
+}
+
 bool WindowTarget::draw(graph::GraphRunner& runner) {
   const graph::Extent framebuffer = framebuffer_size(window_);
   if (framebuffer.width == 0 || framebuffer.height == 0) return false;  // minimised

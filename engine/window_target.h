@@ -37,6 +37,10 @@ class WindowTarget {
   // drawing nothing, while the window is minimised (framebuffer of zero size).
   bool draw(graph::GraphRunner& runner);
 
+  // Waits until the last submitted frame has finished (its counters can then be read, its
+  // resources reallocated): with one frame in flight, draw() waits for this anyway.
+  void wait_for_last_frame();
+
   graph::Extent extent() const { return extent_; }
   uint32_t swapchain_recreations() const { return recreations_; }
 
