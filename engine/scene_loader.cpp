@@ -12,6 +12,7 @@
 
 #include "engine/atlas.h"
 #include "engine/error.h"
+#include "engine/text_file.h"
 #include "engine/mesh_loader.h"
 #include "engine/transfer_function_loader.h"
 #include "engine/volume_loader.h"
@@ -147,16 +148,6 @@ std::optional<glm::mat4> view_matrix(const json& object, const Field& field) {
 std::string base_name(const std::filesystem::path& path) {
   const std::string name = path.filename().string();
   return name.substr(0, name.find('.'));
-}
-
-std::string read_text(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw Error(path.string() + ": no such file");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) throw Error(path.string() + ": cannot read the file");
-  return std::move(text).str();
 }
 
 class SceneReader {
@@ -437,7 +428,7 @@ Scene SceneReader::read(const json& root) {
 Scene load_scene_json(const std::filesystem::path& path) {
   json root;
   try {
-    root = json::parse(read_text(path));
+    root = json::parse(read_text_file(path));
   } catch (const json::parse_error& e) {
     // nlohmann's message starts with "[json.exception.parse_error.101] "; the rest already says
     // "parse error at line L, column C: ...".

@@ -9,6 +9,7 @@
 #include <pugixml.hpp>
 
 #include "engine/error.h"
+#include "engine/text_file.h"
 
 namespace strata {
 
@@ -27,16 +28,6 @@ std::string child(const std::string& field, const std::string& key) {
 
 std::string element(const std::string& field, size_t index) {
   return field + "[" + std::to_string(index) + "]";
-}
-
-std::string read_text(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(path.string(), "", "no such file");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) fail(path.string(), "", "cannot read the file");
-  return std::move(text).str();
 }
 
 // nlohmann's message starts with "[json.exception.parse_error.101] "; the rest already says
@@ -81,14 +72,6 @@ bool parse_double(const char* text, double& value) {
   const char* end = text + std::char_traits<char>::length(text);
   const auto [rest, error] = std::from_chars(text, end, value);
   return error == std::errc() && rest == end && rest != text;
-}
-
-std::string xml_where(const std::string& text, ptrdiff_t offset) {
-  const auto upto = text.begin() + std::clamp<ptrdiff_t>(offset, 0, ptrdiff_t(text.size()));
-  const auto line = std::count(text.begin(), upto, '\n') + 1;
-  const auto line_start = std::find(std::make_reverse_iterator(upto), text.rend(), '\n').base();
-  return "line " + std::to_string(line) + ", column " + std::to_string(upto - line_start + 1) +
-         " (offset " + std::to_string(offset) + ")";
 }
 
 // Channels are integers 0..255. One published file has a="0.01" and a="0.9": the thesis program
@@ -185,7 +168,7 @@ TransferFunction load_transfer_function_json(const std::filesystem::path& path) 
   const std::string file = path.string();
   json object;
   try {
-    object = json::parse(read_text(path));
+    object = json::parse(read_text_file(path));
   } catch (const json::parse_error& e) {
     fail(file, "", without_exception_id(e.what()));
   }
@@ -200,12 +183,12 @@ TransferFunction load_transfer_function_json(const std::filesystem::path& path) 
 
 TransferFunction load_transfer_function_gra(const std::filesystem::path& path) {
   const std::string file = path.string();
-  const std::string text = read_text(path);
+  const std::string text = read_text_file(path);
   pugi::xml_document document;
   const pugi::xml_parse_result parsed = document.load_buffer(text.data(), text.size());
   if (!parsed) {
     fail(file, "",
-         std::string("XML error at ") + xml_where(text, parsed.offset) + ": " +
+         std::string("XML error at ") + text_position(text, parsed.offset) + ": " +
              parsed.description());
   }
   const pugi::xml_node gradient = document.child("gradientData");
@@ -242,7 +225,7 @@ bool is_transfer_function_file(const std::filesystem::path& path) {
   if (path.extension() == ".gra") return true;
   if (path.extension() != ".json") return false;
   try {
-    const json object = json::parse(read_text(path));
+    const json object = json::parse(read_text_file(path));
     return object.is_object() && object.contains("strata_transfer_function");
   } catch (const std::exception&) {
     return false;  // the scene loader reports what is wrong with it

@@ -14,6 +14,7 @@
 #include <pugixml.hpp>
 
 #include "engine/error.h"
+#include "engine/text_file.h"
 #include "engine/mesh_loader.h"
 #include "engine/scene_loader.h"
 #include "engine/transfer_function_loader.h"
@@ -24,24 +25,6 @@ namespace strata {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string read_text(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(path.string() + ": no such file");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) throw Error(path.string() + ": cannot read the file");
-  return std::move(text).str();
-}
-
-std::string xml_where(const std::string& text, ptrdiff_t offset) {
-  const auto upto = text.begin() + std::clamp<ptrdiff_t>(offset, 0, ptrdiff_t(text.size()));
-  const auto line = std::count(text.begin(), upto, '\n') + 1;
-  const auto line_start = std::find(std::make_reverse_iterator(upto), text.rend(), '\n').base();
-  return "line " + std::to_string(line) + ", column " + std::to_string(upto - line_start + 1) +
-         " (offset " + std::to_string(offset) + ")";
-}
 
 // An element of the archive and where it is, for errors: "item[3] (CameraNode).viewMatrix".
 struct Node {
@@ -268,11 +251,11 @@ Scene VolyImporter::import(const pugi::xml_node& data) {
 
 Scene import_voly_scene(const fs::path& path) {
   const std::string file = path.string();
-  const std::string text = read_text(path);
+  const std::string text = read_text_file(path);
   pugi::xml_document document;
   const pugi::xml_parse_result parsed = document.load_buffer(text.data(), text.size());
   if (!parsed) {
-    throw Error(file + ": XML error at " + xml_where(text, parsed.offset) + ": " +
+    throw Error(file + ": XML error at " + text_position(text, parsed.offset) + ": " +
                 parsed.description());
   }
   const pugi::xml_node data = document.child("boost_serialization").child("data");
