@@ -8,6 +8,7 @@
 #include "engine/headless_target.h"
 #include "engine/png.h"
 #include "engine/scene_loader.h"
+#include "labeling/labelled_render.h"
 #include "passes/test_pattern.h"
 #include "passes/volume_renderer.h"
 
@@ -23,6 +24,10 @@ struct RenderOptions {
   std::string dump_layers;
   bool no_skipping = false;
   uint32_t blur = 12;
+  bool no_labels = false;
+  bool hard = false;
+  bool internal = false;
+  std::string layout;
 };
 
 // Layer images are premultiplied rgba16f; written as straight-alpha PNGs.
@@ -45,6 +50,36 @@ void dump_layers(graph::GraphRunner& runner, graph::ResourceId layers, graph::Ex
     const std::string path = folder + "/layer-" + std::to_string(l) + ".png";
     write_png(path, size.width, size.height, rgba);
     std::printf("wrote %s\n", path.c_str());
+  }
+}
+
+// strata's main job: the labelled image (labeling/labelled_render.h).
+void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
+  const graph::Extent size = parse_size(o.size, "--size");
+  const Scene scene = load_scene(o.scene);
+  for (const std::string& warning : scene.warnings)
+    std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
+  Context ctx(device.context());
+  LabellingSettings settings;
+  settings.layer_count = o.layers;
+  settings.render.skip_empty = !o.no_skipping;
+  settings.placement.weights = scene.settings.weights;
+  settings.placement.hard = o.hard;
+  settings.internal = o.internal;
+  const LabelledFrame frame =
+      render_labelled(ctx, scene, camera_for(scene, o.camera), size, settings);
+  write_png(o.output, size.width, size.height, frame.image);
+  uint32_t shown = 0;
+  for (const LabelLayout& l : frame.labels) shown += l.shown;
+  std::printf("wrote %s (%ux%u, %u layers): %u of %zu labels shown\n", o.output.c_str(), size.width,
+              size.height, frame.layering.layer_count, shown, frame.labels.size());
+  if (!o.layout.empty()) {
+    std::FILE* f = std::fopen(o.layout.c_str(), "w");
+    if (!f) throw Error(o.layout + ": cannot write the layout file");
+    const std::string json = layout_json(frame);
+    const bool ok = std::fwrite(json.data(), 1, json.size(), f) == json.size();
+    if (std::fclose(f) != 0 || !ok) throw Error(o.layout + ": cannot write the layout file");
+    std::printf("wrote %s\n", o.layout.c_str());
   }
 }
 
@@ -109,15 +144,23 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--size", o->size, "image size, N or WxH")->capture_default_str();
   cmd->add_option("--camera", o->camera, "named camera position of the scene");
   cmd->add_option("--layers", o->layers, "depth layers, 1 to 8")->capture_default_str();
-  cmd->add_option("--dump-layers", o->dump_layers, "folder to write each layer image to");
+  cmd->add_option("--dump-layers", o->dump_layers,
+                  "folder to write each (label-free) layer image to");
   cmd->add_flag("--no-skipping", o->no_skipping, "turn empty-space skipping off");
+  cmd->add_flag("--no-labels", o->no_labels, "render the scene without its labels");
+  cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
+  cmd->add_flag("--internal", o->internal, "internal labelling: labels drawn on their anchors");
+  cmd->add_option("--layout", o->layout,
+                  "JSON file to write each label's layer, anchor, box, cost");
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
       ->capture_default_str();
   cmd->callback([&device, o] {
     if (o->scene.empty()) {
       render_test_pattern(device, *o);
-    } else {
+    } else if (o->no_labels || !o->dump_layers.empty()) {
       render_scene(device, *o);
+    } else {
+      render_labelled_scene(device, *o);
     }
   });
 }

@@ -62,7 +62,7 @@ void GraphRunner::set_viewport(Extent viewport) {
                      {e.width, e.height, 1},
                      VK_IMAGE_TYPE_2D,
                      compiled_.usage[i],
-                     r.image.layers};
+                     r.image.layers, r.image.array};
       Image& image = owned_[i].emplace<Image>(ctx_, desc);
       bound_[i] = {VK_NULL_HANDLE, image.handle(), image.view(), r.image.format};
     } else {
@@ -89,6 +89,12 @@ std::vector<std::byte> GraphRunner::download_image(ResourceId id) {
     if (pass_layouts[id] != VK_IMAGE_LAYOUT_UNDEFINED) layout = pass_layouts[id];
   }
   return download(ctx_, *image, layout);
+}
+
+std::vector<std::byte> GraphRunner::download_buffer(ResourceId id) {
+  const Buffer* buffer = std::get_if<Buffer>(&owned_.at(id));
+  if (!buffer) throw Error("render graph: '" + graph_.resources()[id].name + "' is not a transient buffer");
+  return download(ctx_, *buffer);
 }
 
 void GraphRunner::bind_buffer(ResourceId id, VkBuffer buffer) {

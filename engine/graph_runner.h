@@ -69,6 +69,8 @@ class GraphRunner {
   void reallocate();
   // The texels of a transient image after the last completed run (waits; for tools and tests).
   std::vector<std::byte> download_image(ResourceId id);
+  // The bytes of a transient buffer after the last completed run (waits; tools and tests).
+  std::vector<std::byte> download_buffer(ResourceId id);
 
   // GPU time of each pass of the last completed run.
   std::vector<PassTiming> timings() const;

@@ -64,6 +64,7 @@ struct ImageInfo {
   // Size: the viewport when `fixed` is zero, else `fixed`.
   Extent fixed{};
   uint32_t layers = 1;  // more than one: a 2D array image (e.g. one layer per depth layer)
+  bool array = false;   // a 2D-array view even with one layer
 };
 
 struct BufferInfo {

@@ -44,7 +44,8 @@ struct ImageDesc {
   VkExtent3D extent{1, 1, 1};
   VkImageType type = VK_IMAGE_TYPE_2D;
   VkImageUsageFlags usage = 0;
-  uint32_t layers = 1;  // array layers (2D only); more than one gives a 2D-array view
+  uint32_t layers = 1;  // array layers (2D only)
+  bool array = false;   // a 2D-array view even with one layer (shaders declare image2DArray)
 };
 
 class Image {

@@ -10,8 +10,9 @@ using graph::Use;
 
 namespace {
 
-gpu::SatParams params_for(graph::Extent e) {
-  return {e.width, e.height, group_count(e.width, SAT_TILE), group_count(e.height, SAT_TILE)};
+gpu::SatParams params_for(graph::Extent e, uint32_t layers = 1) {
+  return {e.width, e.height, group_count(e.width, SAT_TILE), group_count(e.height, SAT_TILE), layers,
+          0, 0, 0};
 }
 
 }  // namespace
@@ -22,27 +23,27 @@ SummedAreaTable::SummedAreaTable(Context& ctx)
       scan_(ctx, "summed_area_table_scan.comp") {}
 
 void SummedAreaTable::add_to(graph::Graph& graph, ResourceId input, ResourceId output,
-                             const std::string& group) const {
+                             const std::string& group, uint32_t layers) const {
   const ResourceId carries = graph.add_buffer(
-      group + ".carries", {[](graph::Extent e) {
+      group + ".carries", {[layers](graph::Extent e) {
         const gpu::SatParams p = params_for(e);
         return (VkDeviceSize{p.tiles_x} * e.height + VkDeviceSize{p.tiles_y} * e.width) *
-               sizeof(float);
+               sizeof(float) * layers;
       }});
 
   // The three passes differ only in pipeline, resources and workgroup count.
   const auto add = [&](const char* name, const ComputePipeline& pipeline,
                        std::vector<graph::ResourceUse> uses, bool per_tile) {
     graph.add_pass({group + "." + name, graph::PassKind::compute, std::move(uses),
-                    [&pipeline, per_tile](graph::PassContext& pc) {
-                      const gpu::SatParams p = params_for(pc.viewport);
+                    [&pipeline, per_tile, layers](graph::PassContext& pc) {
+                      const gpu::SatParams p = params_for(pc.viewport, layers);
                       pc.bind(pipeline);
                       pipeline.push_constants(pc.cmd, p);
                       if (per_tile) {
-                        vkCmdDispatch(pc.cmd, p.tiles_x, p.tiles_y, 1);
+                        vkCmdDispatch(pc.cmd, p.tiles_x, p.tiles_y, layers);
                       } else {
-                        vkCmdDispatch(pc.cmd, group_count(p.width + p.height, SAT_CARRY_GROUP), 1,
-                                      1);
+                        vkCmdDispatch(pc.cmd, group_count(p.width + p.height, SAT_CARRY_GROUP),
+                                      layers, 1);
                       }
                     },
                     group});

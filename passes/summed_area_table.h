@@ -17,10 +17,10 @@ class SummedAreaTable {
  public:
   explicit SummedAreaTable(Context& ctx);
 
-  // Adds the three passes that write the table of `input` to `output` (both viewport-sized float
-  // buffers) and the two small carry buffers they share.
+  // Adds the three passes that write the tables of `input` to `output`: stacks of `layers`
+  // viewport-sized float images one after the other, each summed on its own.
   void add_to(graph::Graph& graph, graph::ResourceId input, graph::ResourceId output,
-              const std::string& group = "summed_area_table") const;
+              const std::string& group = "summed_area_table", uint32_t layers = 1) const;
 
  private:
   ComputePipeline sums_;

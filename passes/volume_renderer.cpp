@@ -352,7 +352,7 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
       {[](graph::Extent) { return VkDeviceSize{VR_COUNTER_COUNT * sizeof(uint32_t)}; }});
   Outputs out;
   out.layers =
-      graph.add_image("render.layers", {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count});
+      graph.add_image("render.layers", {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count, true});
   out.final = graph.add_image("render.final", {VK_FORMAT_R8G8B8A8_UNORM});
   out.depth = graph.add_image("render.depth", {VK_FORMAT_R32_SFLOAT});
   const graph::ImportInfo sampled_image{true, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};

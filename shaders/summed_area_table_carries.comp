@@ -31,9 +31,10 @@ void scan_line(uint first, uint stride, uint count) {
 // tiles above). Neighbouring threads scan neighbouring lines, so every access is coalesced.
 void main() {
   const uint i = gl_GlobalInvocationID.x;
+  const uint base = gl_GlobalInvocationID.y * (p.tiles_x * p.height + p.tiles_y * p.width);
   if (i < p.height) {
-    scan_line(i, p.height, p.tiles_x);
+    scan_line(base + i, p.height, p.tiles_x);
   } else if (i < p.height + p.width) {
-    scan_line(p.tiles_x * p.height + (i - p.height), p.width, p.tiles_y);
+    scan_line(base + p.tiles_x * p.height + (i - p.height), p.width, p.tiles_y);
   }
 }

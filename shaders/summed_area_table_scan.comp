@@ -66,6 +66,6 @@ void main() {
   const uint x = origin.x + gl_LocalInvocationID.x;
   for (uint r = gl_LocalInvocationID.y; r < SAT_TILE; r += SAT_GROUP_ROWS) {
     const uint y = origin.y + r;
-    if (x < p.width && y < p.height) dst.values[y * p.width + x] = tile[r][gl_LocalInvocationID.x];
+    if (x < p.width && y < p.height) dst.values[image_offset() + y * p.width + x] = tile[r][gl_LocalInvocationID.x];
   }
 }

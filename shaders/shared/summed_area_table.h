@@ -25,6 +25,10 @@ struct SatParams {
   uint height;
   uint tiles_x;
   uint tiles_y;
+  uint layers;  // a stack of images, one after the other in the buffers (workgroup z / y)
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 STRATA_END
 

@@ -1,0 +1,65 @@
+// strata's main job: a scene rendered into depth layers, its labels layered (k-means++ on anchor
+// depth), placed on the GPU layer by layer in insertion order, drawn on their layers, and the
+// layers composited into the labelled image. One frame, one command buffer, no CPU round trip
+// inside it; the placements come back after the frame.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "engine/font.h"
+#include "engine/scene.h"
+#include "labeling/layering.h"
+#include "passes/placement.h"
+#include "passes/volume_renderer.h"
+
+namespace strata {
+
+struct LabellingSettings {
+  uint32_t layer_count = 4;  // asked for; fewer when the anchors have fewer distinct depths
+  PlacementSettings placement;
+  bool internal = false;  // internal labelling: every label drawn on its anchor
+  float font_pixels = 14.0f;
+  uint64_t seed = 1;      // k-means++
+  RenderSettings render;  // its layer_count and splits come from the layering
+};
+
+// One label of the result, for --layout and for tests.
+struct LabelLayout {
+  int id = 0;
+  std::string text;
+  uint32_t layer = 0;
+  glm::vec2 anchor{0.0f};  // pixels
+  glm::vec2 box_origin{0.0f};
+  glm::vec2 box_size{0.0f};
+  bool shown = false;
+  float cost = 0.0f;
+};
+
+struct LabelledFrame {
+  graph::Extent size;
+  std::vector<uint8_t> image;  // rgba8, the labelled picture
+  std::vector<LabelLayout> labels;
+  Layering layering;
+  RenderStats render_stats;
+  std::vector<graph::PassTiming> timings;
+};
+
+// Projects each label's anchor (LABEL_ENABLED when in view and in front of the camera), and
+// returns its pixel position and eye depth.
+struct ProjectedAnchor {
+  glm::vec2 pixel{0.0f};
+  float eye_depth = 0.0f;
+  bool visible = false;
+};
+std::vector<ProjectedAnchor> project_anchors(const Scene& scene, const CameraSetup& camera,
+                                             graph::Extent size);
+
+// Renders and labels one frame offline (re-rendering while the HA-Buffer overflows).
+LabelledFrame render_labelled(Context& ctx, const Scene& scene, const CameraSetup& camera,
+                              graph::Extent size, const LabellingSettings& settings);
+
+// The layout as JSON: per label id, text, layer, anchor, box (x, y, width, height), shown, cost.
+std::string layout_json(const LabelledFrame& frame);
+
+}  // namespace strata

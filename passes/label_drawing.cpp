@@ -1,0 +1,159 @@
+#include "passes/label_drawing.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/packing.hpp>
+
+#include "engine/error.h"
+
+namespace strata {
+
+using graph::ResourceId;
+using graph::Use;
+
+namespace gpu {
+namespace {
+
+// labels.draw's pixel on the CPU: the shared loop is included inside this struct, so its
+// functions see the buffer accessors and the software sampler below as members.
+struct LabelDrawReference {
+  const LabelDrawData& data;
+  const FontAtlas& font;
+
+  uint label_count() const {
+    return static_cast<uint>(std::min(data.labels.size(), data.placements.size()));
+  }
+  LabelGpu label_at(uint i) const { return data.labels[i]; }
+  PlacementGpu placement_at(uint i) const { return data.placements[i]; }
+  GlyphGpu glyph_at(uint i) const { return data.glyphs[i]; }
+
+  float texel(ivec2 p) const {
+    const ivec2 top = ivec2(font.width, font.height) - 1;
+    const ivec2 c = clamp(p, ivec2(0), top);
+    return float(font.coverage[size_t(c.y) * font.width + size_t(c.x)]) / 255.0f;
+  }
+  // Linear filtering with clamp-to-edge addressing, as the graph's sampler does.
+  float atlas_coverage(vec2 uv) const {
+    const vec2 x = uv * vec2(font.width, font.height) - 0.5f;
+    const vec2 base = floor(x);
+    const vec2 f = x - base;
+    const ivec2 i = ivec2(base);
+    const float top = mix(texel(i), texel(i + ivec2(1, 0)), f.x);
+    const float bottom = mix(texel(i + ivec2(0, 1)), texel(i + ivec2(1, 1)), f.x);
+    return mix(top, bottom, f.y);
+  }
+
+#include "shared/label_draw_pixel.h"
+};
+
+}  // namespace
+}  // namespace gpu
+
+LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font)
+    : atlas_(ctx, {VK_FORMAT_R8_UNORM,
+                   {font.width, font.height, 1},
+                   VK_IMAGE_TYPE_2D,
+                   VK_IMAGE_USAGE_SAMPLED_BIT}),
+      draw_(ctx, "label_draw.comp"),
+      composite_(ctx, "label_composite.comp") {
+  upload(ctx, atlas_, as_bytes(font.coverage), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+}
+
+gpu::LabelDrawParams LabelDrawing::params(graph::Extent viewport) const {
+  return {viewport.width, viewport.height, layer_count_, label_count_,
+          glm::vec4(background_, 1.0f)};
+}
+
+void LabelDrawing::add_to(graph::Graph& graph, ResourceId layers, ResourceId labels_buffer,
+                          ResourceId placements_buffer, ResourceId glyphs_buffer,
+                          uint32_t layer_count, ResourceId final_out, glm::vec3 background) {
+  layer_count_ = layer_count;
+  background_ = background;
+  atlas_id_ = graph.import_resource("labels.font_atlas",
+                                    {true, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  graph.add_pass({"labels.draw",
+                  graph::PassKind::compute,
+                  {{layers, Use::storage_read_write, LABEL_DRAW_BINDING_LAYERS},
+                   {labels_buffer, Use::storage_read, LABEL_DRAW_BINDING_LABELS},
+                   {placements_buffer, Use::storage_read, LABEL_DRAW_BINDING_PLACEMENTS},
+                   {glyphs_buffer, Use::storage_read, LABEL_DRAW_BINDING_GLYPHS},
+                   {atlas_id_, Use::sampled, LABEL_DRAW_BINDING_ATLAS}},
+                  [this](graph::PassContext& pc) {
+                    pc.bind(draw_);
+                    draw_.push_constants(pc.cmd, params(pc.viewport));
+                    vkCmdDispatch(pc.cmd, group_count(pc.viewport.width, LABEL_DRAW_GROUP),
+                                  group_count(pc.viewport.height, LABEL_DRAW_GROUP), layer_count_);
+                  },
+                  "labels"});
+  graph.add_pass({"labels.composite",
+                  graph::PassKind::compute,
+                  {{layers, Use::storage_read, LABEL_DRAW_BINDING_LAYERS},
+                   {final_out, Use::storage_write, LABEL_DRAW_BINDING_FINAL}},
+                  [this](graph::PassContext& pc) {
+                    pc.bind(composite_);
+                    composite_.push_constants(pc.cmd, params(pc.viewport));
+                    vkCmdDispatch(pc.cmd, group_count(pc.viewport.width, LABEL_DRAW_GROUP),
+                                  group_count(pc.viewport.height, LABEL_DRAW_GROUP), 1);
+                  },
+                  "labels"});
+}
+
+void LabelDrawing::bind(graph::GraphRunner& runner) const {
+  runner.bind_image(atlas_id_, atlas_.handle(), atlas_.view(), VK_FORMAT_R8_UNORM);
+}
+
+namespace {
+
+glm::vec4 to_half_precision(glm::vec4 c) {
+  return glm::unpackHalf4x16(glm::packHalf4x16(c));
+}
+
+void check_layers(std::span<const glm::vec4> layers, graph::Extent size, uint32_t layer_count) {
+  if (layers.size() != size_t{size.width} * size.height * layer_count) {
+    throw Error("labels: " + std::to_string(layers.size()) + " layer pixels for " +
+                std::to_string(layer_count) + " layers of " + std::to_string(size.width) + "x" +
+                std::to_string(size.height));
+  }
+}
+
+}  // namespace
+
+std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, graph::Extent size,
+                                             uint32_t layer_count, const LabelDrawData& data,
+                                             const FontAtlas& font) {
+  check_layers(layers, size, layer_count);
+  gpu::LabelDrawReference reference{data, font};
+  std::vector<glm::vec4> out(layers.size());
+  size_t i = 0;
+  for (uint32_t l = 0; l < layer_count; ++l) {
+    for (uint32_t y = 0; y < size.height; ++y) {
+      for (uint32_t x = 0; x < size.width; ++x, ++i) {
+        const glm::vec2 p = glm::vec2(float(x), float(y)) + 0.5f;
+        out[i] = to_half_precision(reference.draw_labels_at(p, l, layers[i]));
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<uint8_t> composite_reference(std::span<const glm::vec4> layers, graph::Extent size,
+                                         uint32_t layer_count, glm::vec3 background) {
+  check_layers(layers, size, layer_count);
+  const size_t pixels = size_t{size.width} * size.height;
+  std::vector<uint8_t> out;
+  out.reserve(4 * pixels);
+  for (size_t p = 0; p < pixels; ++p) {
+    glm::vec4 accumulated(0.0f);
+    for (uint32_t l = 0; l < layer_count; ++l) {
+      accumulated = gpu::label_over(accumulated, layers[l * pixels + p]);
+    }
+    const glm::vec4 c = gpu::label_over_background(accumulated, background);
+    for (int ch = 0; ch < 4; ++ch) {
+      out.push_back(static_cast<uint8_t>(std::lround(glm::clamp(c[ch], 0.0f, 1.0f) * 255.0f)));
+    }
+  }
+  return out;
+}
+
+}  // namespace strata

@@ -1,0 +1,75 @@
+// Labels drawn into the depth layers, then the layers composited into the final image (the
+// thesis's depth cue: a label on a rear layer is partly covered by what lies in front of it).
+//   labels.draw       per pixel of each layer: its shown labels (connector, box, text, anchor
+//                     marker) over the layer's content, in place
+//   labels.composite  the layers front to back over the background into an rgba8 image
+// The shapes and the per-pixel loop are shared with the CPU reference below
+// (shaders/shared/label_drawing.h, label_draw_pixel.h).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "engine/font.h"
+#include "engine/graph_runner.h"
+#include "engine/render_graph.h"
+#include "engine/resources.h"
+#include "engine/shader_library.h"
+#include "shared/label_drawing.h"
+
+namespace strata {
+
+class LabelDrawing {
+ public:
+  // Uploads the font's atlas once.
+  LabelDrawing(Context& ctx, const FontAtlas& font);
+
+  // Adds both passes. `layers`: the renderer's rgba16f array image (layer_count >= 2 layers, so
+  // that its view is an array), read and written in place. `labels_buffer` (LabelGpu[]),
+  // `placements_buffer` (PlacementGpu[], one per label) and `glyphs_buffer` (GlyphGpu[]) must have
+  // content; `final_out` is a viewport-sized rgba8 image the composite overwrites.
+  void add_to(graph::Graph& graph, graph::ResourceId layers, graph::ResourceId labels_buffer,
+              graph::ResourceId placements_buffer, graph::ResourceId glyphs_buffer,
+              uint32_t layer_count, graph::ResourceId final_out, glm::vec3 background);
+  // Binds the font atlas imported by add_to.
+  void bind(graph::GraphRunner& runner) const;
+
+  // How many labels of the labels buffer to draw (read when the graph is recorded); the shader
+  // never reads past the end of the labels or placements buffer either way.
+  void set_label_count(uint32_t count) { label_count_ = count; }
+  void set_background(glm::vec3 background) { background_ = background; }
+
+ private:
+  gpu::LabelDrawParams params(graph::Extent viewport) const;
+
+  Image atlas_;
+  ComputePipeline draw_;
+  ComputePipeline composite_;
+  graph::ResourceId atlas_id_ = 0;
+  uint32_t layer_count_ = 0;
+  uint32_t label_count_ = LABEL_MAX;
+  glm::vec3 background_{0.0f};
+};
+
+// What the CPU reference draws: the contents of the three buffers.
+struct LabelDrawData {
+  std::span<const gpu::LabelGpu> labels;
+  std::span<const gpu::PlacementGpu> placements;
+  std::span<const gpu::GlyphGpu> glyphs;
+};
+
+// labels.draw on the CPU. `layers` holds layer_count images of `size`, layer after layer, rows
+// top to bottom (as the array image downloads); the result has the same shape, rounded to half
+// precision as the GPU's rgba16f layers store it.
+std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, graph::Extent size,
+                                             uint32_t layer_count, const LabelDrawData& data,
+                                             const FontAtlas& font);
+
+// labels.composite on the CPU: rgba8, rows top to bottom.
+std::vector<uint8_t> composite_reference(std::span<const glm::vec4> layers, graph::Extent size,
+                                         uint32_t layer_count, glm::vec3 background);
+
+}  // namespace strata

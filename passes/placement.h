@@ -1,0 +1,69 @@
+// Label placement on the GPU (thesis 3.2, 4.1), all of it inside one frame's command buffer:
+// saliency of the label-free final image, integral costs per layer (eq. 3.3/3.4) and their
+// summed-area tables, then one fused constraints + cost (eq. 3.1) + argmin dispatch per label in
+// insertion order, each reading the positions the earlier ones wrote on the GPU. The placements
+// are copied to the host after the frame; nothing waits for them inside it.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "engine/graph_runner.h"
+#include "engine/resources.h"
+#include "engine/scene.h"
+#include "engine/shader_library.h"
+#include "passes/summed_area_table.h"
+#include "shared/placement.h"
+
+namespace strata {
+
+struct PlacementSettings {
+  CostWeights weights;            // eq. 3.1 (scene settings; defaults: the thesis's final paper)
+  float margin = 6.0f;            // pixels around label boxes in the constraints
+  bool hard = false;              // forbid constraint violations (labels may end up hidden)
+  float saliency_weight = 0.5f;   // eq. 3.3: how much saliency modulates the occlusion behind
+  float occlusion_weight = 0.5f;  // eq. 3.4 (one layer)
+  float single_saliency_weight = 0.5f;  // eq. 3.4 (one layer)
+  bool write_constraints = false;       // keep each label's constraint image (tests, debugging)
+};
+
+gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent viewport,
+                                      uint32_t layer_count, uint32_t label_count, uint32_t step);
+
+class Placement {
+ public:
+  struct Resources {
+    graph::ResourceId labels, placements, saliency, costs, tables, constraints;
+  };
+
+  // `label_count` fixes the number of per-label passes; a frame may enable fewer labels.
+  Placement(Context& ctx, uint32_t label_count);
+
+  Resources add_to(graph::Graph& graph, graph::ResourceId final_image, graph::ResourceId layers,
+                   uint32_t layer_count);
+  void bind(graph::GraphRunner& runner);
+
+  // This frame's labels (label_count of them; disabled ones are skipped) and insertion order
+  // (indices of the enabled labels). Read when the frame is recorded.
+  void set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_t> order,
+                 const PlacementSettings& settings);
+
+  // The placements of the last completed frame.
+  std::span<const gpu::PlacementGpu> results() const;
+
+ private:
+  gpu::PlacementParams params(graph::Extent viewport, uint32_t step) const;
+
+  Context& ctx_;
+  uint32_t label_count_;
+  uint32_t layer_count_ = 1;
+  std::vector<gpu::LabelGpu> labels_;
+  std::vector<uint32_t> order_;
+  PlacementSettings settings_;
+  ComputePipeline saliency_, integral_costs_, place_label_, finalize_;
+  SummedAreaTable tables_;
+  Buffer readback_;
+  graph::ResourceId readback_id_ = 0;
+};
+
+}  // namespace strata

@@ -1,0 +1,29 @@
+// The CPU reference of the placement passes (passes/placement.h): the same saliency, integral
+// costs, summed-area tables, constraints, cost and argmin, in plain C++ running the shared
+// shader code (shaders/shared/saliency.h, placement_cost.h). Small images only: tests.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "passes/placement.h"
+
+namespace strata {
+
+struct ReferencePlacement {
+  std::vector<float> saliency;                // per pixel
+  std::vector<float> costs;                   // per layer, per pixel (eq. 3.3/3.4)
+  std::vector<float> tables;                  // their summed-area tables
+  std::vector<uint32_t> constraints;          // bits of the last label placed, per pixel
+  std::vector<gpu::PlacementGpu> placements;  // per label
+};
+
+// final_rgba8: the label-free final image; layers: premultiplied RGBA, layer after layer.
+ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
+                                   std::span<const glm::vec4> layers, uint32_t layer_count,
+                                   std::span<const gpu::LabelGpu> labels,
+                                   std::span<const uint32_t> order,
+                                   const PlacementSettings& settings, graph::Extent size);
+
+}  // namespace strata

@@ -1,0 +1,65 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_basic : require
+#include "shared/placement.h"
+
+// One label: constraints, eq. 3.1 and the argmin at every pixel, in one dispatch. The result
+// (cost bits << 32 | pixel) goes to results[label] with one 64-bit atomicMin per workgroup; the
+// next label's dispatch reads it there, so the greedy loop never returns to the CPU.
+layout(local_size_x = PLACEMENT_GROUP, local_size_y = PLACEMENT_GROUP) in;
+layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
+layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
+layout(binding = PLACEMENT_BINDING_ORDER, std430) readonly buffer Order { uint order[]; };
+layout(binding = PLACEMENT_BINDING_RESULTS, std430) buffer Results { uint64_t results[]; };
+layout(binding = PLACEMENT_BINDING_CONSTRAINTS, std430) writeonly buffer Constraints { uint constraints[]; };
+layout(push_constant) uniform Push { PlacementParams params; };
+
+LabelGpu label_at(uint i) { return labels[i]; }
+uint order_at(uint step) { return order[step]; }
+vec3 placed(uint j) {
+  const uint64_t r = results[j];
+  if (r == PLACEMENT_NONE) return vec3(0.0);
+  const uint pixel = uint(r & 0xFFFFFFFFul);
+  const uvec2 p = uvec2(pixel % params.width, pixel / params.width);
+  return vec3(box_origin(p, labels[j].size) + labels[j].size * 0.5, 1.0);
+}
+float table_at(uint layer, int x, int y) {
+  if (x < 0 || y < 0) return 0.0;
+  return tables[layer * params.width * params.height + uint(y) * params.width + uint(x)];
+}
+
+#include "shared/placement_cost.h"
+
+shared uint64_t group_best[PLACEMENT_GROUP * PLACEMENT_GROUP];
+
+void main() {
+  const uvec2 p = gl_GlobalInvocationID.xy;
+  const uint label = order[params.step];
+  const LabelGpu me = labels[label];
+  uint64_t key = PLACEMENT_NONE;
+  if (p.x < params.width && p.y < params.height && candidate_allowed(me, p)) {
+    const vec2 origin = box_origin(p, me.size);
+    const vec2 centre = origin + me.size * 0.5;
+    const uint bits = constraint_bits(params.step, label, centre);
+    const uint pixel = p.y * params.width + p.x;
+    if (params.write_constraints != 0u) constraints[pixel] = bits;
+    if (params.hard == 0u || bits == 0u) {
+      const float cost = candidate_cost(me, origin, centre, bits);
+      key = (uint64_t(floatBitsToUint(cost)) << 32) | uint64_t(pixel);  // costs are >= 0
+    }
+  }
+  // Lowest cost, then lowest pixel index: the subgroup's minimum cost, then the first pixel with it.
+  const uint cost_bits = uint(key >> 32);
+  const uint best_bits = subgroupMin(cost_bits);
+  const uint best_pixel = subgroupMin(cost_bits == best_bits ? uint(key) : 0xFFFFFFFFu);
+  if (subgroupElect()) group_best[gl_SubgroupID] = (uint64_t(best_bits) << 32) | uint64_t(best_pixel);
+  barrier();
+  if (gl_LocalInvocationIndex == 0u) {
+    uint64_t best = PLACEMENT_NONE;
+    for (uint s = 0u; s < gl_NumSubgroups; ++s) best = min(best, group_best[s]);
+    if (best != PLACEMENT_NONE) atomicMin(results[label], best);
+  }
+}

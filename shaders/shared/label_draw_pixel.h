@@ -1,0 +1,46 @@
+// One pixel of one depth layer with its labels drawn over it, written once for the GPU
+// (label_draw.comp) and the CPU reference (passes/label_drawing.cpp, which includes this file
+// inside a struct). The includer provides:
+//   uint label_count()                 labels to consider
+//   LabelGpu label_at(uint i)
+//   PlacementGpu placement_at(uint i)
+//   GlyphGpu glyph_at(uint i)
+//   float atlas_coverage(vec2 uv)      the font atlas, bilinear, clamped to its edge
+
+// Text coverage of a label at p. Glyph quads overlap only in their zero-coverage borders, so the
+// largest coverage is the text's.
+float text_coverage(vec2 p, vec2 top_left, LabelGpu label) {
+  vec2 q = p - top_left;
+  if (q.x < 0.0f || q.y < 0.0f || q.x > label.size.x || q.y > label.size.y) return 0.0f;
+  float coverage = 0.0f;
+  for (uint g = label.glyph_first; g < label.glyph_first + label.glyph_count; ++g) {
+    GlyphGpu glyph = glyph_at(g);
+    vec2 lo = vec2(glyph.box);
+    vec2 hi = vec2(glyph.box.z, glyph.box.w);
+    if (q.x < lo.x || q.y < lo.y || q.x >= hi.x || q.y >= hi.y) continue;
+    vec2 uv = mix(vec2(glyph.atlas), vec2(glyph.atlas.z, glyph.atlas.w), (q - lo) / (hi - lo));
+    coverage = max(coverage, atlas_coverage(uv));
+  }
+  return coverage;
+}
+
+// Every shown label of `layer` drawn over `content` (premultiplied) at pixel centre p, in label
+// order: a later label covers an earlier one. External labels: connector, box, text, then the
+// anchor marker on top. Internal labels: the box centred on the anchor, no connector or marker.
+vec4 draw_labels_at(vec2 p, uint layer, vec4 content) {
+  for (uint i = 0u; i < label_count(); ++i) {
+    LabelGpu label = label_at(i);
+    if ((label.flags & LABEL_ENABLED) == 0u || label.layer != layer) continue;
+    PlacementGpu placement = placement_at(i);
+    if (placement.shown != PLACEMENT_SHOWN) continue;
+    bool is_internal = (label.flags & LABEL_INTERNAL) != 0u;
+    vec2 centre = is_internal ? label.anchor : placement.position;
+    if (label_far_from(p, label.anchor, centre, label.size)) continue;
+    vec4 color = label_frame(p, label.anchor, centre, label.size, !is_internal);
+    float text = text_coverage(p, centre - 0.5f * label.size, label);
+    color = label_over(label_premultiplied(LABEL_TEXT_COLOR, text), color);
+    if (!is_internal) color = label_over(label_anchor_marker(p, label.anchor), color);
+    content = label_over(color, content);
+  }
+  return content;
+}

@@ -1,0 +1,118 @@
+// Drawing labels into the depth layers and compositing the layers: bindings, push constants and
+// the shapes, written once in the common subset of GLSL and GLM so that the GPU passes
+// (label_draw.comp, label_composite.comp) and their CPU reference (passes/label_drawing.cpp) run
+// the same arithmetic. Every edge is a one-pixel linear ramp of coverage, never a step: CPU and
+// GPU round differently, and a step at a pixel centre would flip between them.
+// The per-pixel loop over the labels is in label_draw_pixel.h.
+#ifndef STRATA_SHARED_LABEL_DRAWING_H
+#define STRATA_SHARED_LABEL_DRAWING_H
+
+#include "labels.h"
+
+#define LABEL_DRAW_GROUP 8
+#define LABEL_DRAW_BINDING_LAYERS 0  // rgba16f 2D array, one premultiplied layer per depth layer
+#define LABEL_DRAW_BINDING_LABELS 1  // LabelGpu[]
+#define LABEL_DRAW_BINDING_PLACEMENTS 2  // PlacementGpu[], one per label
+#define LABEL_DRAW_BINDING_GLYPHS 3      // GlyphGpu[]
+#define LABEL_DRAW_BINDING_ATLAS 4       // R8 font coverage, sampled bilinearly
+#define LABEL_DRAW_BINDING_FINAL 5       // rgba8: the layers composited over the background
+
+STRATA_BEGIN
+#ifdef __cplusplus
+#define LABEL_INLINE inline
+#else
+#define LABEL_INLINE
+#endif
+
+struct LabelDrawParams {
+  uint width;
+  uint height;
+  uint layer_count;
+  uint label_count;  // labels to consider (the shader also stops at the buffer's end)
+  vec4 background;   // rgb: what the composite shows where every layer is transparent
+};
+
+// The look of a label. Colours are straight alpha.
+const vec4 LABEL_LINE_COLOR = vec4(0.95f, 0.95f, 0.95f, 0.9f);
+const float LABEL_LINE_HALF_WIDTH = 0.75f;
+const vec4 LABEL_BOX_COLOR = vec4(0.05f, 0.06f, 0.08f, 0.7f);
+const vec4 LABEL_BORDER_COLOR = vec4(0.85f, 0.88f, 0.92f, 0.95f);
+const float LABEL_BORDER_WIDTH = 1.0f;
+const float LABEL_BOX_RADIUS = 3.0f;
+const vec4 LABEL_TEXT_COLOR = vec4(1.0f, 1.0f, 1.0f, 1.0f);
+const vec4 LABEL_MARKER_COLOR = vec4(1.0f, 1.0f, 1.0f, 1.0f);
+const vec4 LABEL_MARKER_OUTLINE_COLOR = vec4(0.05f, 0.05f, 0.05f, 1.0f);
+const float LABEL_MARKER_RADIUS = 4.0f;
+const float LABEL_MARKER_OUTLINE = 1.5f;
+
+// Eq. 3.9's "over" for premultiplied colours, front to back.
+LABEL_INLINE vec4 label_over(vec4 front, vec4 back) {
+  return front + (1.0f - front.a) * back;
+}
+
+LABEL_INLINE vec4 label_premultiplied(vec4 color, float coverage) {
+  float a = color.a * coverage;
+  return vec4(vec3(color) * a, a);
+}
+
+// Coverage of a pixel whose centre is `signed_distance` outside a shape (negative: inside).
+LABEL_INLINE float label_edge_coverage(float signed_distance) {
+  return clamp(0.5f - signed_distance, 0.0f, 1.0f);
+}
+
+LABEL_INLINE float label_segment_distance(vec2 p, vec2 a, vec2 b) {
+  vec2 ab = b - a;
+  float length2 = dot(ab, ab);
+  float t = length2 > 0.0f ? clamp(dot(p - a, ab) / length2, 0.0f, 1.0f) : 0.0f;
+  return length(p - (a + t * ab));
+}
+
+// Signed distance from p to a box with rounded corners (negative inside).
+LABEL_INLINE float label_box_distance(vec2 p, vec2 centre, vec2 half_size, float radius) {
+  vec2 q = abs(p - centre) - half_size + radius;
+  return length(max(q, vec2(0.0f))) + min(max(q.x, q.y), 0.0f) - radius;
+}
+
+// The connector (from the anchor to the nearest point of the box), the box and its border at p,
+// premultiplied: everything of a label but its text and anchor marker.
+LABEL_INLINE vec4 label_frame(vec2 p, vec2 anchor, vec2 centre, vec2 size, bool connector) {
+  vec2 half_size = 0.5f * size;
+  vec4 color = vec4(0.0f);
+  if (connector) {
+    vec2 end = clamp(anchor, centre - half_size, centre + half_size);
+    float d = label_segment_distance(p, anchor, end);
+    color = label_premultiplied(LABEL_LINE_COLOR, label_edge_coverage(d - LABEL_LINE_HALF_WIDTH));
+  }
+  float d = label_box_distance(p, centre, half_size, LABEL_BOX_RADIUS);
+  float outer = label_edge_coverage(d);
+  float inner = label_edge_coverage(d + LABEL_BORDER_WIDTH);
+  color = label_over(label_premultiplied(LABEL_BOX_COLOR, outer), color);
+  return label_over(label_premultiplied(LABEL_BORDER_COLOR, outer - inner), color);
+}
+
+// A filled disc with a dark rim on the anchor, premultiplied.
+LABEL_INLINE vec4 label_anchor_marker(vec2 p, vec2 anchor) {
+  float d = length(p - anchor);
+  vec4 rim =
+      label_premultiplied(LABEL_MARKER_OUTLINE_COLOR, label_edge_coverage(d - LABEL_MARKER_RADIUS));
+  float inner_radius = LABEL_MARKER_RADIUS - LABEL_MARKER_OUTLINE;
+  return label_over(label_premultiplied(LABEL_MARKER_COLOR, label_edge_coverage(d - inner_radius)),
+                    rim);
+}
+
+// True when p lies outside everything a label draws (box, connector, marker and their ramps), so
+// the label's shapes need not be evaluated there: they would all be exactly zero.
+LABEL_INLINE bool label_far_from(vec2 p, vec2 anchor, vec2 centre, vec2 size) {
+  float margin = LABEL_MARKER_RADIUS + 1.0f;
+  vec2 lo = min(centre - 0.5f * size, anchor) - margin;
+  vec2 hi = max(centre + 0.5f * size, anchor) + margin;
+  return p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y;
+}
+
+// The final pixel: the layers' front-to-back composite over the background, opaque.
+LABEL_INLINE vec4 label_over_background(vec4 layers, vec3 background) {
+  return vec4(vec3(layers) + (1.0f - layers.a) * background, 1.0f);
+}
+STRATA_END
+
+#endif

@@ -1,0 +1,52 @@
+// Labels on the GPU: per-frame label data (uploaded by the placement driver each frame), the
+// placement result per label, and the glyphs of their text. Written once for C++ and GLSL.
+#ifndef STRATA_SHARED_LABELS_H
+#define STRATA_SHARED_LABELS_H
+
+#include "common.h"
+
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+#endif
+
+#define LABEL_MAX 256
+
+// LabelGpu.flags
+#define LABEL_ENABLED 1u    // the anchor is in view and in front of the camera: place and draw it
+#define LABEL_INTERNAL 2u   // internal labelling: the label is drawn centred on its anchor
+
+// PlacementGpu.shown
+#define PLACEMENT_HIDDEN 0u  // not placed (disabled, or no allowed position in hard mode)
+#define PLACEMENT_SHOWN 1u
+
+STRATA_BEGIN
+#ifdef __cplusplus
+using namespace glm;
+#endif
+
+struct LabelGpu {
+  vec2 anchor;       // pixels, x right, y down (pixel centres at +0.5)
+  vec2 size;         // label box width and height in pixels
+  vec2 previous;     // the label's position in the previous frame (box centre, pixels)
+  float anchor_depth;  // eye depth of the anchor
+  uint layer;        // depth layer the label is placed and drawn on
+  uint flags;        // LABEL_*
+  uint glyph_first;  // the label's glyphs in the glyph buffer
+  uint glyph_count;
+  uint pad;
+};
+
+// The result for one label: written by the placement, read by drawing and by the host.
+struct PlacementGpu {
+  vec2 position;  // box centre, pixels
+  float cost;     // eq. 3.1 at that position
+  uint shown;     // PLACEMENT_*
+};
+
+struct GlyphGpu {
+  vec4 atlas;  // u0, v0, u1, v1 in the font atlas (normalised)
+  vec4 box;    // x0, y0, x1, y1 in pixels relative to the label box's top-left corner
+};
+STRATA_END
+
+#endif

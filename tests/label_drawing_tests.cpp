@@ -1,0 +1,372 @@
+// The font atlas, text layout, and the label drawing and compositing passes against their CPU
+// reference (passes/label_drawing.h), which runs the shaders' own shape and loop code.
+//
+// Tolerance: 2/255 per channel, in the layers and in the final image. Both sides evaluate the same
+// expressions in float, but the GPU may contract multiply-adds and has its own sqrt and division;
+// its bilinear filter weights are fixed-point (8 bits of sub-texel position on lavapipe); and it
+// rounds to half (layers) and to 8 bits (final) its own way. Every shape edge is a one-pixel
+// ramp, so none of these moves a pixel by more than a fraction of a step.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+#include <glm/gtc/packing.hpp>
+
+#include "engine/error.h"
+#include "engine/font.h"
+#include "engine/graph_runner.h"
+#include "engine/png.h"
+#include "engine/resources.h"
+#include "gpu_fixture.h"
+#include "labeling/text_layout.h"
+#include "passes/label_drawing.h"
+
+namespace strata {
+namespace {
+
+constexpr float kTolerance = 2.0f / 255.0f;
+
+const FontAtlas& test_font() {
+  static const FontAtlas font = load_font_atlas(14.0f);
+  return font;
+}
+
+// Layers, labels with their placements, and what the composite puts behind them.
+struct LabelScene {
+  graph::Extent size{112, 96};
+  uint32_t layer_count = 3;
+  std::vector<glm::vec4> layers;  // layer after layer, premultiplied, half-representable
+  std::vector<gpu::LabelGpu> labels;
+  std::vector<gpu::PlacementGpu> placements;
+  std::vector<gpu::GlyphGpu> glyphs;
+  glm::vec3 background{0.2f, 0.25f, 0.3f};
+
+  size_t pixels() const { return size_t{size.width} * size.height; }
+  glm::vec4& at(uint32_t layer, uint32_t x, uint32_t y) {
+    return layers[layer * pixels() + size_t{y} * size.width + x];
+  }
+};
+
+glm::vec4 to_half_precision(glm::vec4 c) {
+  return glm::unpackHalf4x16(glm::packHalf4x16(c));
+}
+
+gpu::LabelGpu label_on(uint32_t layer, glm::vec2 anchor, uint32_t flags = LABEL_ENABLED) {
+  gpu::LabelGpu label{};
+  label.anchor = anchor;
+  label.layer = layer;
+  label.flags = flags;
+  return label;
+}
+
+// Three layers: a semi-transparent blue rectangle in front (over the rear label's box), a soft
+// green ramp in the middle, an opaque grey ramp at the back. Four labels: an external one on each
+// of the rear and middle layers (the middle one at a half-pixel position, so its text is filtered
+// between texels), an internal one in front, and a hidden one.
+LabelScene make_scene() {
+  LabelScene s;
+  s.layers.assign(s.layer_count * s.pixels(), glm::vec4(0.0f));
+  for (uint32_t y = 0; y < s.size.height; ++y) {
+    for (uint32_t x = 0; x < s.size.width; ++x) {
+      if (x < 64 && y < 44) s.at(0, x, y) = glm::vec4(0.06f, 0.06f, 0.3f, 0.6f);
+      const float ramp = float(x) / float(s.size.width);
+      s.at(1, x, y) = glm::vec4(0.0f, 0.3f, 0.1f, 0.4f) * ramp;
+      s.at(2, x, y) = glm::vec4(glm::vec3(0.3f + 0.4f * float(y) / float(s.size.height)), 1.0f);
+    }
+  }
+  for (glm::vec4& c : s.layers) c = to_half_precision(c);
+  s.labels = {label_on(2, {22.0f, 66.0f}), label_on(1, {92.0f, 78.0f}),
+              label_on(0, {56.0f, 84.0f}, LABEL_ENABLED | LABEL_INTERNAL),
+              label_on(0, {90.0f, 12.0f})};
+  s.placements = {{{34.0f, 22.0f}, 0.0f, PLACEMENT_SHOWN},
+                  {{74.5f, 52.5f}, 0.0f, PLACEMENT_SHOWN},
+                  {{0.0f, 0.0f}, 0.0f, PLACEMENT_SHOWN},
+                  {{88.0f, 30.0f}, 0.0f, PLACEMENT_HIDDEN}};
+  const std::vector<std::string> texts = {"Cortex", "Ventricle", "Pons", "Hidden"};
+  s.glyphs = build_glyph_buffer(test_font(), texts, s.labels);
+  return s;
+}
+
+struct DrawnLabels {
+  std::vector<glm::vec4> layers;
+  std::vector<uint8_t> final;
+};
+
+Buffer storage_buffer(Context& ctx, std::span<const std::byte> bytes) {
+  // A buffer is never empty (a label list without glyphs still binds one).
+  Buffer buffer(ctx, std::max<VkDeviceSize>(bytes.size(), 16), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                MemoryKind::device_local);
+  if (!bytes.empty()) upload(ctx, buffer, bytes);
+  return buffer;
+}
+
+Image layer_image(Context& ctx, const LabelScene& s) {
+  Image image(ctx, {VK_FORMAT_R16G16B16A16_SFLOAT,
+                    {s.size.width, s.size.height, 1},
+                    VK_IMAGE_TYPE_2D,
+                    VK_IMAGE_USAGE_STORAGE_BIT,
+                    s.layer_count});
+  std::vector<uint64_t> halves;
+  for (const glm::vec4& c : s.layers) halves.push_back(glm::packHalf4x16(c));
+  upload(ctx, image, as_bytes(halves), VK_IMAGE_LAYOUT_GENERAL);
+  return image;
+}
+
+DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
+  const Image layers = layer_image(ctx, s);
+  const Buffer labels = storage_buffer(ctx, as_bytes(s.labels));
+  const Buffer placements = storage_buffer(ctx, as_bytes(s.placements));
+  const Buffer glyphs = storage_buffer(ctx, as_bytes(s.glyphs));
+  LabelDrawing drawing(ctx, test_font());
+  drawing.set_label_count(static_cast<uint32_t>(s.labels.size()));
+
+  graph::Graph g;
+  const graph::ImportInfo filled_buffer{false, true};
+  const auto layers_id =
+      g.import_resource("layers", {true, true, VK_IMAGE_LAYOUT_GENERAL, graph::Use::transfer_src});
+  const auto labels_id = g.import_resource("labels", filled_buffer);
+  const auto placements_id = g.import_resource("placements", filled_buffer);
+  const auto glyphs_id = g.import_resource("glyphs", filled_buffer);
+  const auto final_id = g.add_image("final", {VK_FORMAT_R8G8B8A8_UNORM});
+  drawing.add_to(g, layers_id, labels_id, placements_id, glyphs_id, s.layer_count, final_id,
+                 s.background);
+  graph::GraphRunner runner(ctx, std::move(g));
+  runner.set_viewport(s.size);
+  runner.bind_image(layers_id, layers.handle(), layers.view(), layers.desc().format);
+  runner.bind_buffer(labels_id, labels.handle());
+  runner.bind_buffer(placements_id, placements.handle());
+  runner.bind_buffer(glyphs_id, glyphs.handle());
+  drawing.bind(runner);
+  runner.run_now();
+
+  DrawnLabels out;
+  const std::vector<std::byte> final_bytes = runner.download_image(final_id);
+  out.final.resize(final_bytes.size());
+  std::memcpy(out.final.data(), final_bytes.data(), final_bytes.size());
+  const std::vector<std::byte> layer_bytes =
+      download(ctx, layers, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  std::vector<uint64_t> halves(layer_bytes.size() / sizeof(uint64_t));
+  std::memcpy(halves.data(), layer_bytes.data(), halves.size() * sizeof(uint64_t));
+  for (const uint64_t h : halves) out.layers.push_back(glm::unpackHalf4x16(h));
+  return out;
+}
+
+std::vector<glm::vec4> reference_layers(const LabelScene& s) {
+  return draw_labels_reference(s.layers, s.size, s.layer_count, {s.labels, s.placements, s.glyphs},
+                               test_font());
+}
+
+// The largest difference per channel, and where it is.
+float worst_difference(std::span<const glm::vec4> a, std::span<const glm::vec4> b, size_t& where) {
+  float worst = 0.0f;
+  for (size_t i = 0; i < a.size(); ++i) {
+    const glm::vec4 e = glm::abs(a[i] - b[i]);
+    const float d = std::max(std::max(e.x, e.y), std::max(e.z, e.w));
+    if (d > worst) where = i;
+    worst = std::max(worst, d);
+  }
+  return worst;
+}
+
+int worst_difference(std::span<const uint8_t> a, std::span<const uint8_t> b) {
+  int worst = 0;
+  for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(int(a[i]) - int(b[i])));
+  return worst;
+}
+
+glm::vec4 final_pixel(const LabelScene& s, const std::vector<uint8_t>& final, glm::uvec2 p) {
+  const size_t i = 4 * (size_t{p.y} * s.size.width + p.x);
+  return glm::vec4(final[i], final[i + 1], final[i + 2], final[i + 3]) / 255.0f;
+}
+
+// The pixel of `layer` inside label i's box where the drawn layer is brightest (its text).
+glm::uvec2 brightest_text_pixel(const LabelScene& s, const std::vector<glm::vec4>& drawn,
+                                size_t i) {
+  const gpu::LabelGpu& label = s.labels[i];
+  const bool inner = (label.flags & LABEL_INTERNAL) != 0;
+  const glm::vec2 centre = inner ? label.anchor : s.placements[i].position;
+  const glm::uvec2 lo(centre - 0.5f * label.size), hi(centre + 0.5f * label.size);
+  glm::uvec2 best = lo;
+  float brightest = -1.0f;
+  for (uint32_t y = lo.y; y < hi.y; ++y) {
+    for (uint32_t x = lo.x; x < hi.x; ++x) {
+      const float r = drawn[label.layer * s.pixels() + size_t{y} * s.size.width + x].r;
+      if (r > brightest) best = {x, y};
+      brightest = std::max(brightest, r);
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+TEST_SUITE("cpu") {
+  TEST_CASE("font_atlas_has_coverage_for_every_letter_and_none_for_space") {
+    const FontAtlas& font = test_font();
+    REQUIRE(font.coverage.size() == size_t{font.width} * font.height);
+    const GlyphMetrics& a = font.glyph('A');
+    REQUIRE_FALSE(a.empty());
+    const glm::uvec4 texels(
+        glm::round(a.uv * glm::vec4(font.width, font.height, font.width, font.height)));
+    int ink = 0;
+    for (uint32_t y = texels.y; y < texels.w; ++y) {
+      for (uint32_t x = texels.x; x < texels.z; ++x)
+        ink = std::max(ink, int(font.coverage[size_t{y} * font.width + x]));
+    }
+    CHECK(ink > 200);  // small glyphs rarely cover a texel fully
+    CHECK(font.glyph(' ').empty());
+    CHECK(font.glyph(' ').advance > 0.0f);
+    CHECK(font.ascent > 0.0f);
+    CHECK(font.descent < 0.0f);
+  }
+
+  TEST_CASE("font_missing_file_names_the_path_and_the_debian_package") {
+    const std::string path = "/nonexistent/fonts/NoSuchFont.ttf";
+    try {
+      (void)load_font_atlas(14.0f, path);
+      FAIL("no error for a missing font");
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      CHECK(message.find(path) != std::string::npos);
+      CHECK(message.find("fonts-dejavu-core") != std::string::npos);
+    }
+  }
+
+  TEST_CASE("text_outside_printable_ascii_becomes_one_question_mark_per_character") {
+    CHECK(printable_ascii("Gyrus") == "Gyrus");
+    CHECK(printable_ascii("N\xC3\xBC"
+                          "cleus\t\xE2\x86\x92!") ==
+          "N?cleus?"
+          "?!");                              // split: "??!" is a trigraph
+    CHECK(printable_ascii("\x80x") == "?x");  // a stray continuation byte
+    const FontAtlas& font = test_font();
+    CHECK(layout_label_text(font, "\xC3\xA9").glyphs.size() == 1);
+  }
+
+  TEST_CASE("text_layout_gives_a_longer_text_a_wider_box_of_one_line") {
+    const FontAtlas& font = test_font();
+    const LabelTextLayout short_text = layout_label_text(font, "Pons");
+    const LabelTextLayout long_text = layout_label_text(font, "Pons and medulla");
+    CHECK(long_text.size.x > short_text.size.x + 40.0f);
+    CHECK(long_text.size.y == short_text.size.y);
+    CHECK(short_text.size.y >= font.line_height());
+    CHECK(layout_label_text(font, "i").size.x == TextStyle{}.min_width);
+    CHECK(layout_label_text(font, "").glyphs.empty());
+    // A given size is kept as a minimum.
+    CHECK(layout_label_text(font, "Pons", {}, {200.0f, 40.0f}).size == glm::vec2(200.0f, 40.0f));
+  }
+
+  TEST_CASE("text_layout_glyph_boxes_lie_in_the_label_box_in_reading_order") {
+    const FontAtlas& font = test_font();
+    const LabelTextLayout layout = layout_label_text(font, "Thalamus");
+    REQUIRE(layout.glyphs.size() == 8);
+    for (size_t i = 0; i < layout.glyphs.size(); ++i) {
+      const glm::vec4 box = layout.glyphs[i].box;
+      const glm::vec4 uv = layout.glyphs[i].atlas;
+      CHECK(box.x >= 0.0f);
+      CHECK(box.y >= 0.0f);
+      CHECK(box.z <= layout.size.x);
+      CHECK(box.w <= layout.size.y);
+      // One pixel per texel: the quad is the glyph's atlas rectangle, unscaled.
+      CHECK((box.z - box.x) == doctest::Approx((uv.z - uv.x) * float(font.width)));
+      CHECK((box.w - box.y) == doctest::Approx((uv.w - uv.y) * float(font.height)));
+      if (i > 0) CHECK(box.x > layout.glyphs[i - 1].box.x);
+    }
+  }
+
+  TEST_CASE("glyph_buffer_gives_each_label_its_range_and_size") {
+    const FontAtlas& font = test_font();
+    std::vector<gpu::LabelGpu> labels(3);
+    labels[2].size = {150.0f, 0.0f};
+    const std::vector<std::string> texts = {"Insula", "a b", "Amygdala"};
+    const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, texts, labels);
+    CHECK(labels[0].glyph_first == 0);
+    CHECK(labels[0].glyph_count == 6);
+    CHECK(labels[1].glyph_first == 6);
+    CHECK(labels[1].glyph_count == 2);  // the space has no quad
+    CHECK(labels[2].glyph_first == 8);
+    CHECK(glyphs.size() == 16);
+    CHECK(labels[0].size == layout_label_text(font, "Insula").size);
+    CHECK(labels[2].size.x == 150.0f);
+    std::vector<gpu::LabelGpu> too_few(2);
+    CHECK_THROWS_AS(build_glyph_buffer(font, texts, too_few), Error);
+  }
+
+  TEST_CASE("label_reference_draws_only_enabled_shown_labels_on_their_own_layer") {
+    LabelScene s = make_scene();
+    const std::vector<glm::vec4> drawn = reference_layers(s);
+    size_t changed[3] = {0, 0, 0};
+    for (uint32_t l = 0; l < s.layer_count; ++l) {
+      for (size_t p = 0; p < s.pixels(); ++p)
+        changed[l] += drawn[l * s.pixels() + p] != s.layers[l * s.pixels() + p];
+    }
+    CHECK(changed[0] > 200);
+    CHECK(changed[1] > 500);
+    CHECK(changed[2] > 500);
+    // The hidden label's box (around 88, 30 on layer 0) is untouched.
+    CHECK(drawn[size_t{30} * s.size.width + 88] == s.at(0, 88, 30));
+    for (gpu::LabelGpu& label : s.labels) label.flags &= ~LABEL_ENABLED;
+    CHECK(reference_layers(s) == s.layers);
+  }
+}
+
+TEST_SUITE("gpu") {
+  TEST_CASE_FIXTURE(test::GpuTest, "label_drawing_and_composite_match_the_cpu_reference") {
+    const LabelScene s = make_scene();
+    const DrawnLabels gpu = draw_on_gpu(ctx, s);
+    const std::vector<glm::vec4> expected = reference_layers(s);
+    REQUIRE(gpu.layers.size() == expected.size());
+    size_t where = 0;
+    const float worst = worst_difference(gpu.layers, expected, where);
+    CHECK_MESSAGE(worst <= kTolerance,
+                  "layer pixel " << where << " differs by " << worst * 255.0f << "/255");
+    const std::vector<uint8_t> final_expected =
+        composite_reference(expected, s.size, s.layer_count, s.background);
+    CHECK(worst_difference(gpu.final, final_expected) <= 2);
+    // Guards against comparing two unlabelled pictures.
+    CHECK(gpu.layers != s.layers);
+    if (std::getenv("STRATA_KEEP_IMAGES")) {
+      write_png(test::output_dir() + "/labels.png", s.size.width, s.size.height, gpu.final);
+    }
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "label_on_a_rear_layer_is_partly_covered_by_the_front_layer") {
+    const LabelScene s = make_scene();
+    const DrawnLabels gpu = draw_on_gpu(ctx, s);
+    // Label 0 is on layer 2, under the front layer's blue rectangle (alpha 0.6) and the middle
+    // layer's faint green: its white text shows through, dimmed and tinted.
+    const glm::uvec2 rear = brightest_text_pixel(s, gpu.layers, 0);
+    const size_t pixel = size_t{rear.y} * s.size.width + rear.x;
+    const glm::vec4 text = gpu.layers[2 * s.pixels() + pixel];
+    CHECK(text.r > 0.9f);
+    const glm::vec4 front = gpu.layers[pixel], middle = gpu.layers[s.pixels() + pixel];
+    CHECK(front.a == doctest::Approx(0.6f).epsilon(0.01));
+    const glm::vec4 covered = final_pixel(s, gpu.final, rear);
+    const float expected = front.r + (1.0f - front.a) * (middle.r + (1.0f - middle.a) * text.r);
+    CHECK(covered.r == doctest::Approx(expected).epsilon(0.02));
+    CHECK(covered.r < 0.6f);  // covered ...
+    CHECK(covered.r > 0.3f);  // ... partly
+    CHECK(covered.b > covered.r);
+    // Label 2 is on the front layer: its text is at least as white in the final image as in its
+    // layer (anything behind only adds where the text's coverage is partial).
+    const glm::uvec2 nearest = brightest_text_pixel(s, gpu.layers, 2);
+    const float unobstructed = gpu.layers[size_t{nearest.y} * s.size.width + nearest.x].r;
+    CHECK(unobstructed > 0.8f);
+    CHECK(final_pixel(s, gpu.final, nearest).r >= unobstructed - kTolerance);
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "label_with_a_hidden_placement_draws_nothing") {
+    LabelScene s = make_scene();
+    for (gpu::PlacementGpu& p : s.placements) p.shown = PLACEMENT_HIDDEN;
+    const DrawnLabels gpu = draw_on_gpu(ctx, s);
+    CHECK(gpu.layers == s.layers);
+    const std::vector<uint8_t> expected =
+        composite_reference(s.layers, s.size, s.layer_count, s.background);
+    CHECK(worst_difference(gpu.final, expected) <= 2);
+  }
+}
+
+}  // namespace strata

@@ -1,0 +1,239 @@
+// Label placement on lavapipe against its CPU reference (passes/placement_reference.h), stage
+// by stage, on small hand-made inputs: a final image, layer images and labels.
+//
+// Tolerances: saliency and integral costs 1e-3 (pow and division differ in the last bits between
+// CPU and GPU), tables 1e-5 of the larger value, constraint images exactly, positions within one
+// pixel. Cost ties are broken by the lowest pixel index (row-major), on both sides.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include <glm/gtc/packing.hpp>
+
+#include "engine/graph_runner.h"
+#include "engine/resources.h"
+#include "gpu_fixture.h"
+#include "passes/placement.h"
+#include "passes/placement_reference.h"
+
+namespace strata {
+namespace {
+
+struct Inputs {
+  graph::Extent size{96, 72};
+  uint32_t layer_count = 2;
+  std::vector<uint8_t> final_rgba8;
+  std::vector<glm::vec4> layers;
+  std::vector<gpu::LabelGpu> labels;
+  std::vector<uint32_t> order;
+};
+
+gpu::LabelGpu label(glm::vec2 anchor, glm::vec2 size, uint32_t layer) {
+  gpu::LabelGpu l{};
+  l.anchor = anchor;
+  l.size = size;
+  l.previous = anchor;
+  l.layer = layer;
+  l.flags = LABEL_ENABLED;
+  return l;
+}
+
+// A bright disc (the "object") on a dark background, half of it in the front layer, half in the
+// back layer, with anchors on it.
+Inputs disc_scene(uint32_t label_count) {
+  Inputs in;
+  const size_t pixels = size_t{in.size.width} * in.size.height;
+  in.final_rgba8.resize(pixels * 4);
+  in.layers.assign(pixels * in.layer_count, glm::vec4(0.0f));
+  const glm::vec2 centre(48.0f, 36.0f);
+  for (uint32_t y = 0; y < in.size.height; ++y) {
+    for (uint32_t x = 0; x < in.size.width; ++x) {
+      const size_t p = size_t{y} * in.size.width + x;
+      const float r = glm::length(glm::vec2(x, y) + 0.5f - centre);
+      const float a = glm::clamp((22.0f - r) / 3.0f, 0.0f, 1.0f);
+      const glm::vec3 c = glm::mix(
+          glm::vec3(0.05f), glm::vec3(0.9f, 0.7f, 0.5f + 0.3f * std::sin(float(x) * 0.4f)), a);
+      for (int ch = 0; ch < 3; ++ch)
+        in.final_rgba8[4 * p + ch] = uint8_t(std::lround(c[ch] * 255.0f));
+      in.final_rgba8[4 * p + 3] = 255;
+      // Values as the rgba16f layer images hold them, so the reference sees the same inputs.
+      glm::vec4 v(c * a * 0.8f, a * 0.8f);
+      for (int ch = 0; ch < 4; ++ch) v[ch] = glm::unpackHalf1x16(glm::packHalf1x16(v[ch]));
+      in.layers[(x < 48 ? 0 : 1) * pixels + p] = v;
+    }
+  }
+  const glm::vec2 anchors[] = {{44, 30}, {55, 40}, {40, 44}, {52, 28}, {48, 36}, {60, 33}};
+  for (uint32_t i = 0; i < label_count; ++i) {
+    in.labels.push_back(label(anchors[i % 6], glm::vec2(20.0f + 2.0f * float(i), 8.0f), i % 2));
+    in.order.push_back(i);
+  }
+  return in;
+}
+
+struct GpuPlacement {
+  std::vector<float> saliency, costs, tables;
+  std::vector<uint32_t> constraints;
+  std::vector<gpu::PlacementGpu> placements;
+};
+
+template <typename T>
+std::vector<T> as(const std::vector<std::byte>& bytes) {
+  std::vector<T> out(bytes.size() / sizeof(T));
+  std::memcpy(out.data(), bytes.data(), out.size() * sizeof(T));
+  return out;
+}
+
+GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSettings& settings) {
+  Image final_image(ctx, {VK_FORMAT_R8G8B8A8_UNORM,
+                          {in.size.width, in.size.height, 1},
+                          VK_IMAGE_TYPE_2D,
+                          VK_IMAGE_USAGE_STORAGE_BIT});
+  upload(ctx, final_image, as_bytes(in.final_rgba8), VK_IMAGE_LAYOUT_GENERAL);
+  std::vector<uint16_t> halves;
+  for (const glm::vec4& c : in.layers) {
+    for (int ch = 0; ch < 4; ++ch) halves.push_back(glm::packHalf1x16(c[ch]));
+  }
+  Image layers(ctx, {VK_FORMAT_R16G16B16A16_SFLOAT,
+                     {in.size.width, in.size.height, 1},
+                     VK_IMAGE_TYPE_2D,
+                     VK_IMAGE_USAGE_STORAGE_BIT,
+                     in.layer_count,
+                     true});
+  upload(ctx, layers, as_bytes(halves), VK_IMAGE_LAYOUT_GENERAL);
+
+  Placement placement(ctx, uint32_t(in.labels.size()));
+  graph::Graph g;
+  const auto final_id = g.import_resource("final", {true, true, VK_IMAGE_LAYOUT_GENERAL});
+  const auto layers_id = g.import_resource("layers", {true, true, VK_IMAGE_LAYOUT_GENERAL});
+  const Placement::Resources r = placement.add_to(g, final_id, layers_id, in.layer_count);
+  graph::GraphRunner runner(ctx, std::move(g));
+  runner.set_viewport(in.size);
+  runner.bind_image(final_id, final_image.handle(), final_image.view(), VK_FORMAT_R8G8B8A8_UNORM);
+  runner.bind_image(layers_id, layers.handle(), layers.view(), VK_FORMAT_R16G16B16A16_SFLOAT);
+  placement.bind(runner);
+  placement.set_frame(in.labels, in.order, settings);
+  runner.run_now();
+  GpuPlacement out;
+  out.saliency = as<float>(runner.download_buffer(r.saliency));
+  out.costs = as<float>(runner.download_buffer(r.costs));
+  out.tables = as<float>(runner.download_buffer(r.tables));
+  out.constraints = as<uint32_t>(runner.download_buffer(r.constraints));
+  const auto results = placement.results();
+  out.placements.assign(results.begin(), results.end());
+  return out;
+}
+
+void check_values(const std::vector<float>& gpu, const std::vector<float>& cpu, float tolerance,
+                  bool relative, const std::string& what) {
+  REQUIRE(gpu.size() >= cpu.size());
+  size_t bad = 0;
+  for (size_t i = 0; i < cpu.size(); ++i) {
+    const float scale = relative ? std::max(1.0f, std::abs(cpu[i])) : 1.0f;
+    if (std::abs(gpu[i] - cpu[i]) > tolerance * scale && bad++ < 3) {
+      MESSAGE(what << "[" << i << "]: gpu " << gpu[i] << " cpu " << cpu[i]);
+    }
+  }
+  CHECK_MESSAGE(bad == 0, what << ": " << bad << " values differ");
+}
+
+void check_placements(const GpuPlacement& gpu, const ReferencePlacement& cpu) {
+  REQUIRE(gpu.placements.size() == cpu.placements.size());
+  for (size_t i = 0; i < cpu.placements.size(); ++i) {
+    CAPTURE(i);
+    CHECK(gpu.placements[i].shown == cpu.placements[i].shown);
+    CHECK(std::abs(gpu.placements[i].position.x - cpu.placements[i].position.x) <= 1.0f);
+    CHECK(std::abs(gpu.placements[i].position.y - cpu.placements[i].position.y) <= 1.0f);
+  }
+}
+
+}  // namespace
+
+TEST_SUITE("gpu") {
+  TEST_CASE_FIXTURE(test::GpuTest, "placement_stages_and_positions_match_the_cpu_reference") {
+    for (uint32_t count : {3u, 6u}) {
+      CAPTURE(count);
+      const Inputs in = disc_scene(count);
+      PlacementSettings settings;
+      settings.write_constraints = true;
+      const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
+      const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                     in.labels, in.order, settings, in.size);
+      check_values(gpu.saliency, cpu.saliency, 1e-3f, false, "saliency");
+      check_values(gpu.costs, cpu.costs, 1e-3f, false, "integral costs");
+      check_values(gpu.tables, cpu.tables, 1e-5f, true, "tables");
+      CHECK(gpu.constraints == cpu.constraints);
+      check_placements(gpu, cpu);
+      size_t shown = 0;
+      for (const auto& p : gpu.placements) shown += p.shown == PLACEMENT_SHOWN;
+      CHECK(shown == count);
+    }
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "one_layer_uses_eq_3_4_and_still_matches") {
+    Inputs in = disc_scene(4);
+    const size_t pixels = size_t{in.size.width} * in.size.height;
+    for (size_t p = 0; p < pixels; ++p) {
+      glm::vec4 v = in.layers[p] + (1.0f - in.layers[p].a) * in.layers[pixels + p];
+      for (int ch = 0; ch < 4; ++ch) v[ch] = glm::unpackHalf1x16(glm::packHalf1x16(v[ch]));
+      in.layers[p] = v;
+    }
+    in.layers.resize(pixels);
+    in.layer_count = 1;
+    for (auto& l : in.labels) l.layer = 0;
+    const GpuPlacement gpu = place_on_gpu(ctx, in, {});
+    const ReferencePlacement cpu =
+        place_reference(in.final_rgba8, in.layers, 1, in.labels, in.order, {}, in.size);
+    check_values(gpu.costs, cpu.costs, 1e-3f, false, "integral costs");
+    check_placements(gpu, cpu);
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest,
+                    "constraint_image_marks_the_shadow_of_a_placed_box_and_the_anchors") {
+    // Label 0 has the screen to itself; label 1's constraints then hold its shadow.
+    Inputs in = disc_scene(2);
+    in.labels[0] = label({20.0f, 36.0f}, {16.0f, 8.0f}, 0);
+    in.labels[1] = label({70.0f, 36.0f}, {10.0f, 6.0f}, 0);
+    PlacementSettings settings;
+    settings.write_constraints = true;
+    settings.margin = 0.0f;
+    const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
+    const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                   in.labels, in.order, settings, in.size);
+    CHECK(gpu.constraints == cpu.constraints);
+    const glm::vec2 placed = gpu.placements[0].position;
+    const auto bits_at = [&](glm::vec2 centre) {
+      // Candidate pixel whose box (10x6) is centred at `centre`.
+      const glm::uvec2 p(uint32_t(centre.x - 5.0f + 5.0f), uint32_t(centre.y - 3.0f + 3.0f));
+      return gpu.constraints[p.y * in.size.width + p.x];
+    };
+    // On the far side of label 0 as seen from label 1's anchor: its shadow.
+    const glm::vec2 behind = placed + glm::normalize(placed - in.labels[1].anchor) * 14.0f;
+    if (behind.x >= 5.0f && behind.y >= 3.0f) CHECK((bits_at(behind) & CONSTRAINT_LABEL) != 0u);
+    // Covering label 0's anchor, and covering its own anchor.
+    CHECK((bits_at(in.labels[0].anchor) & CONSTRAINT_ANCHOR) != 0u);
+    CHECK((bits_at(in.labels[1].anchor) & CONSTRAINT_ANCHOR) != 0u);
+    // Far from everything, on the other side of the new anchor: free.
+    CHECK(bits_at({88.0f, 10.0f}) == 0u);
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "hard_constraints_hide_a_label_that_cannot_fit") {
+    Inputs in = disc_scene(2);
+    in.size = {48, 24};
+    in.final_rgba8.assign(size_t(48) * 24 * 4, 0);
+    in.layers.assign(size_t(48) * 24 * 2, glm::vec4(0.0f));
+    // With a 6-pixel margin, label 1's box covers one of the two anchors wherever it goes.
+    in.labels[0] = label({8.0f, 12.0f}, {10.0f, 6.0f}, 0);
+    in.labels[1] = label({40.0f, 12.0f}, {30.0f, 10.0f}, 0);
+    PlacementSettings hard;
+    hard.hard = true;
+    const GpuPlacement gpu = place_on_gpu(ctx, in, hard);
+    CHECK(gpu.placements[0].shown == PLACEMENT_SHOWN);
+    CHECK(gpu.placements[1].shown == PLACEMENT_HIDDEN);
+    const GpuPlacement soft = place_on_gpu(ctx, in, {});
+    CHECK(soft.placements[1].shown == PLACEMENT_SHOWN);
+    CHECK(soft.placements[1].cost >= 100.0f);  // it violates a constraint
+  }
+}
+
+}  // namespace strata
