@@ -1,5 +1,6 @@
 // `strata bench NAME`: GPU timings of one piece of work as JSON, median and minimum of N runs.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -10,6 +11,7 @@
 #include "engine/graph_runner.h"
 #include "engine/resources.h"
 #include "engine/scene_loader.h"
+#include "labeling/labelled_render.h"
 #include "passes/summed_area_table.h"
 #include "passes/volume_renderer.h"
 
@@ -189,6 +191,102 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
   print_json(ctx, header, runs, t, tail);
 }
 
+struct PlacementBenchOptions {
+  std::string scene = "assets/scenes/head-100.json";
+  std::string size = "1024";
+  std::string camera;
+  uint32_t labels = 0;  // 0: the scene's labels
+};
+
+// The scene's labels, cut to `count` or repeated up to it (each repeat's anchor moved by 2 mm so
+// that no two coincide).
+void resize_labels(Scene& scene, uint32_t count) {
+  if (count == 0 || scene.labels.empty()) return;
+  const std::vector<Label> original = scene.labels;
+  scene.labels.clear();
+  for (uint32_t i = 0; i < count; ++i) {
+    Label l = original[i % original.size()];
+    const auto round = static_cast<float>(i / original.size());
+    l.anchor += glm::vec3(2.0f * round, -2.0f * round, 0.0f);
+    l.id = int(i) + 1;
+    scene.labels.push_back(l);
+  }
+}
+
+void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint32_t runs) {
+  const graph::Extent size = parse_size(o.size, "--size");
+  Scene scene = load_scene(o.scene);
+  resize_labels(scene, o.labels);
+  Context ctx(device.context());
+  LabellingSettings settings;
+  settings.placement.weights = scene.settings.weights;
+  LabelledRenderer frame(ctx, scene, camera_for(scene, o.camera), size, settings);
+  frame.run();  // warm up, and grow the HA-Buffer if it must
+  graph::GraphRunner& runner = frame.runner();
+  const auto is_label = [&](uint32_t pass) {
+    return pass < runner.graph().passes().size() &&
+           runner.graph().passes()[pass].name == "placement.label";
+  };
+  const Timings t = measure(runner, 1, runs, [&] { frame.bind(); });
+
+  // The thesis program's structure: back to the CPU after every label, reading its result.
+  std::vector<double> readback_ms;
+  for (uint32_t run = 0; run < std::max(1u, runs / 4); ++run) {
+    frame.bind();
+    std::chrono::steady_clock::time_point start;
+    bool started = false;
+    runner.run_split([&](uint32_t pass) { return is_label(pass) || is_label(pass + 1); },
+                     [&](uint32_t pass) {
+                       if (!started) {
+                         start = std::chrono::steady_clock::now();
+                         started = true;
+                         return;
+                       }
+                       if (!is_label(pass)) return;
+                       runner.download_buffer(frame.placement_results());
+                       if (!is_label(pass + 1)) {
+                         readback_ms.push_back(std::chrono::duration<double, std::milli>(
+                                                   std::chrono::steady_clock::now() - start)
+                                                   .count());
+                       }
+                     });
+  }
+  double placement_ms = 0.0, loop_ms = 0.0;
+  for (const auto& [name, stat] : t.groups) {
+    if (name == "placement") placement_ms = stat.median;
+  }
+  // The label loop on the GPU: from the first label pass's start to the last one's end.
+  {
+    std::vector<double> spans;
+    runner.run_now();
+    double first = 1e30, last = 0.0;
+    for (const graph::PassTiming& pt : runner.timings()) {
+      if (pt.name != "placement.label") continue;
+      first = std::min(first, pt.begin_ms);
+      last = std::max(last, pt.end_ms);
+    }
+    loop_ms = last > first ? last - first : 0.0;
+  }
+  const Stat baseline = stat_of(readback_ms.empty() ? std::vector<double>{0.0} : readback_ms);
+  const double baseline_total = placement_ms - loop_ms + baseline.median;
+  uint32_t enabled = 0;
+  for (const LabelLayout& l : frame.result().labels) enabled += l.shown;
+  char header[512], tail[512];
+  std::snprintf(
+      header, sizeof header,
+      "  \"benchmark\": \"placement\",\n  \"scene\": \"%s\",\n  \"width\": %u,\n"
+      "  \"height\": %u,\n  \"labels\": %zu,\n  \"labels_shown\": %u,\n  \"layers\": %u,\n",
+      json_escape(o.scene).c_str(), size.width, size.height, scene.labels.size(), enabled,
+      frame.result().layering.layer_count);
+  std::snprintf(tail, sizeof tail,
+                ",\n  \"placement_ms\": %.6f,\n  \"label_loop_ms\": %.6f,\n"
+                "  \"label_loop_with_readback_per_label_ms\": %.6f,\n"
+                "  \"placement_with_readback_per_label_ms\": %.6f,\n  \"speedup\": %.2f",
+                placement_ms, loop_ms, baseline.median, baseline_total,
+                placement_ms > 0.0 ? baseline_total / placement_ms : 0.0);
+  print_json(ctx, header, runs, t, tail);
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app, DeviceOptions& device) {
@@ -222,6 +320,19 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       ->check(CLI::Range(1u, 100000u));
   render_cmd->callback(
       [&device, render, options] { bench_render(device, *render, options->runs); });
+
+  auto place = std::make_shared<PlacementBenchOptions>();
+  CLI::App* place_cmd = cmd->add_subcommand(
+      "placement", "label placement per stage, against a CPU readback after every label");
+  place_cmd->add_option("--scene", place->scene, "scene file")->capture_default_str();
+  place_cmd->add_option("--size", place->size, "N or WxH")->capture_default_str();
+  place_cmd->add_option("--camera", place->camera, "named camera position");
+  place_cmd->add_option("--labels", place->labels, "label count (the scene's cut, or repeated)");
+  place_cmd->add_option("--runs", options->runs, "timed runs after 1 warm-up run")
+      ->capture_default_str()
+      ->check(CLI::Range(1u, 100000u));
+  place_cmd->callback(
+      [&device, place, options] { bench_placement(device, *place, options->runs); });
 }
 
 }  // namespace strata::app

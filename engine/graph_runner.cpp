@@ -58,11 +58,8 @@ void GraphRunner::set_viewport(Extent viewport) {
     if (r.imported) continue;
     if (r.is_image) {
       const Extent e = r.image.fixed.width ? r.image.fixed : viewport;
-      ImageDesc desc{r.image.format,
-                     {e.width, e.height, 1},
-                     VK_IMAGE_TYPE_2D,
-                     compiled_.usage[i],
-                     r.image.layers, r.image.array};
+      ImageDesc desc{r.image.format,     {e.width, e.height, 1}, VK_IMAGE_TYPE_2D,
+                     compiled_.usage[i], r.image.layers,         r.image.array};
       Image& image = owned_[i].emplace<Image>(ctx_, desc);
       bound_[i] = {VK_NULL_HANDLE, image.handle(), image.view(), r.image.format};
     } else {
@@ -93,7 +90,8 @@ std::vector<std::byte> GraphRunner::download_image(ResourceId id) {
 
 std::vector<std::byte> GraphRunner::download_buffer(ResourceId id) {
   const Buffer* buffer = std::get_if<Buffer>(&owned_.at(id));
-  if (!buffer) throw Error("render graph: '" + graph_.resources()[id].name + "' is not a transient buffer");
+  if (!buffer)
+    throw Error("render graph: '" + graph_.resources()[id].name + "' is not a transient buffer");
   return download(ctx_, *buffer);
 }
 
@@ -145,7 +143,7 @@ void GraphRunner::emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) c
   vkCmdPipelineBarrier2(cmd, &dep);
 }
 
-void GraphRunner::record(VkCommandBuffer cmd) {
+void GraphRunner::check_bound() const {
   if (viewport_.width == 0) throw Error("render graph: set_viewport() before record()");
   for (size_t i = 0; i < bound_.size(); ++i) {
     if (!bound_[i].buffer && !bound_[i].image) {
@@ -153,20 +151,46 @@ void GraphRunner::record(VkCommandBuffer cmd) {
                   "' is not bound");
     }
   }
-  const auto& passes = graph_.passes();
-  vkCmdResetQueryPool(cmd, queries_, 0, static_cast<uint32_t>(2 * passes.size()));
-  for (uint32_t p = 0; p < passes.size(); ++p) {
-    emit(cmd, compiled_.pass_barriers[p]);
-    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p);
-    PassContext pc;
-    pc.cmd = cmd;
-    pc.viewport = viewport_;
-    pc.runner_ = this;
-    pc.pass_ = p;
-    passes[p].record(pc);
-    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p + 1);
-  }
+}
+
+void GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
+  emit(cmd, compiled_.pass_barriers[p]);
+  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p);
+  PassContext pc;
+  pc.cmd = cmd;
+  pc.viewport = viewport_;
+  pc.runner_ = this;
+  pc.pass_ = p;
+  graph_.passes()[p].record(pc);
+  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p + 1);
+}
+
+void GraphRunner::record(VkCommandBuffer cmd) {
+  check_bound();
+  const auto passes = static_cast<uint32_t>(graph_.passes().size());
+  vkCmdResetQueryPool(cmd, queries_, 0, 2 * passes);
+  for (uint32_t p = 0; p < passes; ++p) record_pass(cmd, p);
   emit(cmd, compiled_.final_barriers);
+}
+
+void GraphRunner::run_split(const std::function<bool(uint32_t)>& split_after,
+                            const std::function<void(uint32_t)>& after) {
+  check_bound();
+  const auto passes = static_cast<uint32_t>(graph_.passes().size());
+  uint32_t p = 0;
+  while (p < passes) {
+    uint32_t last = p;
+    ctx_.run_now([&](VkCommandBuffer cmd) {
+      if (p == 0) vkCmdResetQueryPool(cmd, queries_, 0, 2 * passes);
+      for (last = p; last < passes; ++last) {
+        record_pass(cmd, last);
+        if (split_after(last)) break;
+      }
+      if (last >= passes - 1) emit(cmd, compiled_.final_barriers);
+    });
+    if (last < passes) after(last);
+    p = last + 1;
+  }
 }
 
 void GraphRunner::run_now() {

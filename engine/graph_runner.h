@@ -2,6 +2,7 @@
 // records every pass behind the barriers compile() derived, and wraps each pass in timestamps.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -63,6 +64,11 @@ class GraphRunner {
   void record(VkCommandBuffer cmd);
   // Records into a fresh command buffer, submits and waits (headless runs, benchmarks, tests).
   void run_now();
+  // The same work split into one submission per run of passes, waiting on the host after every
+  // pass for which `split_after` is true and calling `after` there: the structure of a program
+  // that returns to the CPU between passes (benchmark baselines).
+  void run_split(const std::function<bool(uint32_t pass)>& split_after,
+                 const std::function<void(uint32_t pass)>& after);
 
   // Re-creates the transient resources (after a size function's answer changed, e.g. a grown
   // hash table), keeping the viewport.
@@ -88,6 +94,8 @@ class GraphRunner {
     VkFormat format = VK_FORMAT_UNDEFINED;
   };
   void emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) const;
+  void check_bound() const;
+  void record_pass(VkCommandBuffer cmd, uint32_t pass);
 
   Context& ctx_;
   Graph graph_;

@@ -57,85 +57,123 @@ std::vector<ProjectedAnchor> project_anchors(const Scene& scene, const CameraSet
   return out;
 }
 
-LabelledFrame render_labelled(Context& ctx, const Scene& scene, const CameraSetup& camera,
-                              graph::Extent size, const LabellingSettings& settings) {
-  LabelledFrame frame;
-  frame.size = size;
+struct LabelledRenderer::Parts {
+  Parts(Context& ctx, const Scene& scene, const RenderSettings& render, uint32_t label_count,
+        const FontAtlas& font, size_t glyph_count)
+      : renderer(ctx, scene, render),
+        placement(ctx, label_count),
+        drawing(ctx, font),
+        target(ctx),
+        glyphs(ctx, std::max<size_t>(1, glyph_count) * sizeof(gpu::GlyphGpu),
+               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local) {}
+  VolumeRenderer renderer;
+  Placement placement;
+  LabelDrawing drawing;
+  HeadlessTarget target;
+  Buffer glyphs;
+  graph::ResourceId glyph_id = 0;
+};
+
+LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const CameraSetup& camera,
+                                   graph::Extent size, const LabellingSettings& settings)
+    : scene_(scene), size_(size) {
   // Layering on the CPU, from the camera alone: k-means++ on the visible anchors' depths.
   const std::vector<ProjectedAnchor> anchors = project_anchors(scene, camera, size);
   std::vector<float> depths;
   for (const auto& a : anchors) depths.push_back(a.visible ? a.eye_depth : std::nanf(""));
-  frame.layering = layer_labels(depths, settings.layer_count, camera.near_plane, camera.far_plane,
-                                settings.seed);
+  layering_ = layer_labels(depths, settings.layer_count, camera.near_plane, camera.far_plane,
+                           settings.seed);
   RenderSettings render = settings.render;
-  render.layer_count = frame.layering.layer_count;
-  render.splits = frame.layering.split_depths;
+  render.layer_count = layering_.layer_count;
+  render.splits = layering_.split_depths;
 
   // Labels: anchors, boxes from their texts, layers.
   const FontAtlas font = load_font_atlas(settings.font_pixels);
-  std::vector<gpu::LabelGpu> labels(scene.labels.size());
+  labels_.resize(scene.labels.size());
   std::vector<std::string> texts;
   for (size_t i = 0; i < scene.labels.size(); ++i) {
-    gpu::LabelGpu& l = labels[i];
+    gpu::LabelGpu& l = labels_[i];
     l.anchor = anchors[i].pixel;
     l.size = scene.labels[i].size;
     l.previous = anchors[i].pixel;
     l.anchor_depth = anchors[i].eye_depth;
-    l.layer = frame.layering.label_layer[i];
+    l.layer = layering_.label_layer[i];
     l.flags = (anchors[i].visible ? LABEL_ENABLED : 0u) | (settings.internal ? LABEL_INTERNAL : 0u);
     texts.push_back(scene.labels[i].text);
   }
-  const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, texts, labels);
-  const std::vector<uint32_t> order = insertion_order(labels, frame.layering);
+  const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, texts, labels_);
 
-  VolumeRenderer renderer(ctx, scene, render);
-  renderer.set_camera(camera);
-  Placement placement(ctx, uint32_t(labels.size()));
-  LabelDrawing drawing(ctx, font);
-  drawing.set_label_count(uint32_t(labels.size()));
-  HeadlessTarget target(ctx);
-  Buffer glyph_buffer(ctx, std::max<size_t>(1, glyphs.size()) * sizeof(gpu::GlyphGpu),
-                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
-  if (!glyphs.empty()) upload(ctx, glyph_buffer, as_bytes(glyphs));
+  parts_ =
+      std::make_unique<Parts>(ctx, scene, render, uint32_t(labels_.size()), font, glyphs.size());
+  Parts& p = *parts_;
+  p.renderer.set_camera(camera);
+  p.drawing.set_label_count(uint32_t(labels_.size()));
+  if (!glyphs.empty()) upload(ctx, p.glyphs, as_bytes(glyphs));
+  p.placement.set_frame(labels_, insertion_order(labels_, layering_), settings.placement);
 
   graph::Graph graph;
-  const VolumeRenderer::Outputs rendered = renderer.add_to(graph);
+  const VolumeRenderer::Outputs rendered = p.renderer.add_to(graph);
   const Placement::Resources placed =
-      placement.add_to(graph, rendered.final, rendered.layers, render.layer_count);
-  const graph::ResourceId glyph_id = graph.import_resource("labels.glyphs", {false, true});
+      p.placement.add_to(graph, rendered.final, rendered.layers, render.layer_count);
+  results_id_ = placed.results;
+  p.glyph_id = graph.import_resource("labels.glyphs", {false, true});
   const graph::ResourceId labelled = graph.add_image("labels.final", {VK_FORMAT_R8G8B8A8_UNORM});
-  drawing.add_to(graph, rendered.layers, placed.labels, placed.placements, glyph_id,
-                 render.layer_count, labelled, render.background);
-  target.add_output(graph, labelled);
-  graph::GraphRunner runner(ctx, std::move(graph));
-  runner.set_viewport(size);
-  placement.set_frame(labels, order, settings.placement);
+  p.drawing.add_to(graph, rendered.layers, placed.labels, placed.placements, p.glyph_id,
+                   render.layer_count, labelled, render.background);
+  p.target.add_output(graph, labelled);
+  runner_ = std::make_unique<graph::GraphRunner>(ctx, std::move(graph));
+  runner_->set_viewport(size);
+}
+
+LabelledRenderer::~LabelledRenderer() = default;
+
+void LabelledRenderer::bind() {
+  Parts& p = *parts_;
+  p.renderer.bind(*runner_);
+  p.placement.bind(*runner_);
+  p.drawing.bind(*runner_);
+  runner_->bind_buffer(p.glyph_id, p.glyphs.handle());
+  p.target.bind(*runner_);
+}
+
+void LabelledRenderer::run() {
   for (int attempt = 0; attempt < 4; ++attempt) {
-    renderer.bind(runner);
-    placement.bind(runner);
-    drawing.bind(runner);
-    runner.bind_buffer(glyph_id, glyph_buffer.handle());
-    target.bind(runner);
-    runner.run_now();
-    frame.render_stats = renderer.collect(runner);
-    if (frame.render_stats.overflow == 0) break;
+    bind();
+    runner_->run_now();
+    stats_ = parts_->renderer.collect(*runner_);
+    if (stats_.overflow == 0) break;
   }
-  frame.timings = runner.timings();
-  frame.image.assign(target.pixels().begin(), target.pixels().end());
-  const auto results = placement.results();
-  for (size_t i = 0; i < labels.size(); ++i) {
+}
+
+LabelledFrame LabelledRenderer::result() const {
+  LabelledFrame frame;
+  frame.size = size_;
+  frame.layering = layering_;
+  frame.render_stats = stats_;
+  frame.timings = runner_->timings();
+  const auto pixels = parts_->target.pixels();
+  frame.image.assign(pixels.begin(), pixels.end());
+  const auto results = parts_->placement.results();
+  for (size_t i = 0; i < labels_.size(); ++i) {
     LabelLayout l;
-    l.id = scene.labels[i].id;
-    l.text = scene.labels[i].text;
-    l.layer = labels[i].layer;
-    l.anchor = labels[i].anchor;
-    l.box_size = labels[i].size;
-    l.box_origin = results[i].position - labels[i].size * 0.5f;
+    l.id = scene_.labels[i].id;
+    l.text = scene_.labels[i].text;
+    l.layer = labels_[i].layer;
+    l.anchor = labels_[i].anchor;
+    l.box_size = labels_[i].size;
+    l.box_origin = results[i].position - labels_[i].size * 0.5f;
     l.shown = results[i].shown == PLACEMENT_SHOWN;
     l.cost = results[i].cost;
     frame.labels.push_back(l);
   }
   return frame;
+}
+
+LabelledFrame render_labelled(Context& ctx, const Scene& scene, const CameraSetup& camera,
+                              graph::Extent size, const LabellingSettings& settings) {
+  LabelledRenderer renderer(ctx, scene, camera, size, settings);
+  renderer.run();
+  return renderer.result();
 }
 
 std::string layout_json(const LabelledFrame& frame) {

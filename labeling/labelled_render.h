@@ -4,6 +4,7 @@
 // inside it; the placements come back after the frame.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -55,7 +56,36 @@ struct ProjectedAnchor {
 std::vector<ProjectedAnchor> project_anchors(const Scene& scene, const CameraSetup& camera,
                                              graph::Extent size);
 
-// Renders and labels one frame offline (re-rendering while the HA-Buffer overflows).
+// Everything one labelled frame needs, set up once: renderer, placement, drawing, their graph.
+class LabelledRenderer {
+ public:
+  LabelledRenderer(Context& ctx, const Scene& scene, const CameraSetup& camera, graph::Extent size,
+                   const LabellingSettings& settings);
+  ~LabelledRenderer();
+
+  // One frame, waited for; re-rendered while the HA-Buffer overflows (it grows each time).
+  void run();
+  graph::GraphRunner& runner() { return *runner_; }
+  // The placement's per-label results buffer (the baseline benchmark reads it after each label).
+  graph::ResourceId placement_results() const { return results_id_; }
+  // Binds the imported resources (after anything that reallocates the runner's transients).
+  void bind();
+  // The picture and layout of the last run.
+  LabelledFrame result() const;
+
+ private:
+  struct Parts;
+  const Scene& scene_;
+  graph::Extent size_;
+  Layering layering_;
+  std::vector<gpu::LabelGpu> labels_;
+  std::unique_ptr<Parts> parts_;
+  std::unique_ptr<graph::GraphRunner> runner_;
+  RenderStats stats_;
+  graph::ResourceId results_id_ = 0;
+};
+
+// Renders and labels one frame offline.
 LabelledFrame render_labelled(Context& ctx, const Scene& scene, const CameraSetup& camera,
                               graph::Extent size, const LabellingSettings& settings);
 

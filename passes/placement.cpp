@@ -77,6 +77,7 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
   r.labels = graph.add_buffer("placement.labels", fixed(n * sizeof(gpu::LabelGpu)));
   const ResourceId order = graph.add_buffer("placement.order", fixed(n * sizeof(uint32_t)));
   const ResourceId results = graph.add_buffer("placement.results", fixed(n * sizeof(uint64_t)));
+  r.results = results;
   r.placements = graph.add_buffer("placement.placements", fixed(n * sizeof(gpu::PlacementGpu)));
   r.saliency = graph.add_buffer("placement.saliency", per_pixel(sizeof(float)));
   r.costs = graph.add_buffer("placement.integral_costs", per_pixel(sizeof(float) * layer_count));

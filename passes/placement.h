@@ -33,7 +33,7 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
 class Placement {
  public:
   struct Resources {
-    graph::ResourceId labels, placements, saliency, costs, tables, constraints;
+    graph::ResourceId labels, placements, saliency, costs, tables, constraints, results;
   };
 
   // `label_count` fixes the number of per-label passes; a frame may enable fewer labels.
