@@ -20,7 +20,11 @@ struct Placer {
   std::vector<uint64_t> results;
 
   LabelGpu label_at(uint i) const { return labels[i]; }
-  uint order_at(uint step) const { return order[step]; }
+  // Every label placed so far, every anchor: the GPU's tile culling only skips what cannot matter.
+  uint placed_count() const { return params.step; }
+  uint placed_label(uint k) const { return order[k]; }
+  uint anchor_count() const { return params.label_count; }
+  uint anchor_label(uint k) const { return k; }
   vec3 placed(uint j) const {
     if (results[j] == PLACEMENT_NONE) return vec3(0.0f);
     const uint pixel = uint(results[j] & 0xFFFFFFFFu);
@@ -98,7 +102,7 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
         if (!placer.candidate_allowed(me, p)) continue;
         const glm::vec2 origin = gpu::box_origin(p, me.size);
         const glm::vec2 centre = origin + me.size * 0.5f;
-        const uint32_t bits = placer.constraint_bits(step, label, centre);
+        const uint32_t bits = placer.constraint_bits(label, centre);
         const uint32_t pixel = y * w + x;
         if (settings.write_constraints) out.constraints[pixel] = bits;
         if (settings.hard && bits != 0u) continue;

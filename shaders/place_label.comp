@@ -17,8 +17,17 @@ layout(binding = PLACEMENT_BINDING_RESULTS, std430) buffer Results { uint64_t re
 layout(binding = PLACEMENT_BINDING_CONSTRAINTS, std430) writeonly buffer Constraints { uint constraints[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
+// The placed labels and anchors this tile's candidates can reach (culled once per tile).
+shared uint tile_placed[LABEL_MAX];
+shared uint tile_placed_count;
+shared uint tile_anchors[LABEL_MAX];
+shared uint tile_anchor_count;
+
 LabelGpu label_at(uint i) { return labels[i]; }
-uint order_at(uint step) { return order[step]; }
+uint placed_count() { return tile_placed_count; }
+uint placed_label(uint k) { return tile_placed[k]; }
+uint anchor_count() { return tile_anchor_count; }
+uint anchor_label(uint k) { return tile_anchors[k]; }
 vec3 placed(uint j) {
   const uint64_t r = results[j];
   if (r == PLACEMENT_NONE) return vec3(0.0);
@@ -35,15 +44,44 @@ float table_at(uint layer, int x, int y) {
 
 shared uint64_t group_best[PLACEMENT_GROUP * PLACEMENT_GROUP];
 
+// The rectangle of box centres this tile's candidates have (centre and half size).
+void tile_centres(LabelGpu me, out vec2 centre, out vec2 extent) {
+  const vec2 first = box_origin(gl_WorkGroupID.xy * PLACEMENT_GROUP, me.size) + me.size * 0.5;
+  extent = vec2(0.5 * float(PLACEMENT_GROUP - 1));
+  centre = first + extent;
+}
+
+void cull(LabelGpu me) {
+  if (gl_LocalInvocationIndex == 0u) {
+    tile_placed_count = 0u;
+    tile_anchor_count = 0u;
+  }
+  barrier();
+  vec2 centre, extent;
+  tile_centres(me, centre, extent);
+  const uint threads = PLACEMENT_GROUP * PLACEMENT_GROUP;
+  for (uint s = gl_LocalInvocationIndex; s < params.step; s += threads) {
+    const uint j = order[s];
+    if (may_constrain(me, centre, extent, j)) tile_placed[atomicAdd(tile_placed_count, 1u)] = j;
+  }
+  const vec2 reach = extent + me.size * 0.5 + vec2(params.margin);
+  for (uint k = gl_LocalInvocationIndex; k < params.label_count; k += threads) {
+    const vec2 d = abs(labels[k].anchor - centre);
+    if (d.x <= reach.x && d.y <= reach.y) tile_anchors[atomicAdd(tile_anchor_count, 1u)] = k;
+  }
+  barrier();
+}
+
 void main() {
   const uvec2 p = gl_GlobalInvocationID.xy;
   const uint label = order[params.step];
   const LabelGpu me = labels[label];
+  cull(me);
   uint64_t key = PLACEMENT_NONE;
   if (p.x < params.width && p.y < params.height && candidate_allowed(me, p)) {
     const vec2 origin = box_origin(p, me.size);
     const vec2 centre = origin + me.size * 0.5;
-    const uint bits = constraint_bits(params.step, label, centre);
+    const uint bits = constraint_bits(label, centre);
     const uint pixel = p.y * params.width + p.x;
     if (params.write_constraints != 0u) constraints[pixel] = bits;
     if (params.hard == 0u || bits == 0u) {

@@ -3,7 +3,10 @@
 // The includer provides:
 //   params                         PlacementParams
 //   LabelGpu label_at(uint i)
-//   uint order_at(uint step)       the label placed at that step of the insertion order
+//   uint placed_count()            how many labels to test against (those placed so far, or the
+//   uint placed_label(uint k)      ... ones a GPU tile's candidates can reach), and which
+//   uint anchor_count()            how many anchors to test against, and which
+//   uint anchor_label(uint k)
 //   vec3 placed(uint j)            label j's box centre (xy) and 1 in z if it is shown, else 0
 //   float table_at(uint layer, int x, int y)   summed-area table of the layer's integral costs
 //
@@ -53,13 +56,13 @@ bool hull_touches(vec2 a, vec2 c, vec2 h, vec2 q0, vec2 q1, vec2 q2, vec2 q3, ve
   return true;
 }
 
-// The constraint bits of placing label i (at `step` of the order) with its box centred at c.
-uint constraint_bits(uint step, uint i, vec2 c) {
+// The constraint bits of placing label i with its box centred at c.
+uint constraint_bits(uint i, vec2 c) {
   LabelGpu me = label_at(i);
   vec2 h = me.size * 0.5f + vec2(params.margin);
   uint bits = 0u;
-  for (uint s = 0u; s < step; ++s) {
-    uint j = order_at(s);
+  for (uint k = 0u; k < placed_count(); ++k) {
+    uint j = placed_label(k);
     vec3 other = placed(j);
     if (other.z < 0.5f) continue;
     LabelGpu them = label_at(j);
@@ -73,14 +76,31 @@ uint constraint_bits(uint step, uint i, vec2 c) {
     }
   }
   if ((me.flags & LABEL_INTERNAL) == 0u) {
-    for (uint k = 0u; k < params.label_count; ++k) {
-      LabelGpu other = label_at(k);
+    for (uint k = 0u; k < anchor_count(); ++k) {
+      LabelGpu other = label_at(anchor_label(k));
       if ((other.flags & LABEL_ENABLED) == 0u) continue;
       vec2 d = abs(other.anchor - c);
       if (d.x <= h.x && d.y <= h.y) bits |= CONSTRAINT_ANCHOR;
     }
   }
   return bits;
+}
+
+// Could label j (placed) or its connector constrain any candidate whose box, half size h, is
+// centred in the rectangle around `centre` of half size `extent`? The hull of the anchor and
+// that whole region contains every candidate's hull, so "no" is exact: a GPU tile skips j.
+bool may_constrain(LabelGpu me, vec2 centre, vec2 extent, uint j) {
+  vec3 other = placed(j);
+  if (other.z < 0.5f) return false;
+  LabelGpu them = label_at(j);
+  vec2 h = extent + me.size * 0.5f + vec2(params.margin);
+  vec2 lo = vec2(other) - them.size * 0.5f, hi = vec2(other) + them.size * 0.5f;
+  if (hull_touches(me.anchor, centre, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), vec2(1.0f, 0.0f))) {
+    return true;
+  }
+  if ((them.flags & LABEL_INTERNAL) != 0u) return false;
+  vec2 p0 = them.anchor, p1 = vec2(other), d = p1 - p0;
+  return hull_touches(me.anchor, centre, h, p0, p1, p0, p1, vec2(-d.y, d.x));
 }
 
 // The sum of the layer's integral costs over the box of `size` pixels at `origin`.
