@@ -27,6 +27,8 @@ struct RenderOptions {
   bool no_labels = false;
   bool hard = false;
   bool internal = false;
+  bool decoret = false;
+  std::string order = "scene";
   std::string layout;
 };
 
@@ -66,6 +68,13 @@ void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
   settings.internal = o.internal;
+  if (o.order == "apollonius") settings.order = InsertionOrder::apollonius;
+  if (o.order == "optimized") settings.order = InsertionOrder::optimized;
+  if (o.decoret) {  // Stein & Decoret's setting, as the thesis compares against it
+    settings.layer_count = 1;
+    settings.order = InsertionOrder::apollonius;
+    settings.placement.hard = true;
+  }
   const LabelledFrame frame =
       render_labelled(ctx, scene, camera_for(scene, o.camera), size, settings);
   write_png(o.output, size.width, size.height, frame.image);
@@ -150,6 +159,13 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--no-labels", o->no_labels, "render the scene without its labels");
   cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
   cmd->add_flag("--internal", o->internal, "internal labelling: labels drawn on their anchors");
+  cmd->add_option("--order", o->order,
+                  "insertion order: scene, apollonius (Stein & Decoret, innermost first) or "
+                  "optimized (random orders, the best kept)")
+      ->check(CLI::IsMember({"scene", "apollonius", "optimized"}))
+      ->capture_default_str();
+  cmd->add_flag("--decoret", o->decoret,
+                "Stein & Decoret's setting: one layer, Apollonius order, hard constraints");
   cmd->add_option("--layout", o->layout,
                   "JSON file to write each label's layer, anchor, box, cost");
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/packing.hpp>
 
 #include "engine/error.h"
 #include "engine/graph_runner.h"
@@ -23,12 +24,14 @@ glm::mat4 projection_of(const CameraSetup& camera, graph::Extent size) {
   return p;
 }
 
-// Labels in placement order: layer by layer front to back, inside a layer in scene order.
+// Labels in placement order: layer by layer front to back, inside a layer by `within` (a
+// permutation of all label indices).
 std::vector<uint32_t> insertion_order(const std::vector<gpu::LabelGpu>& labels,
-                                      const Layering& layering) {
+                                      const Layering& layering,
+                                      const std::vector<uint32_t>& within) {
   std::vector<uint32_t> result;
   for (uint32_t layer = 0; layer < layering.layer_count; ++layer) {
-    for (uint32_t i : scene_order(uint32_t(labels.size()))) {
+    for (uint32_t i : within) {
       if ((labels[i].flags & LABEL_ENABLED) && labels[i].layer == layer) result.push_back(i);
     }
   }
@@ -109,13 +112,17 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
   p.renderer.set_camera(camera);
   p.drawing.set_label_count(uint32_t(labels_.size()));
   if (!glyphs.empty()) upload(ctx, p.glyphs, as_bytes(glyphs));
-  p.placement.set_frame(labels_, insertion_order(labels_, layering_), settings.placement);
+  settings_ = settings;
+  p.placement.set_frame(labels_,
+                        insertion_order(labels_, layering_, scene_order(uint32_t(labels_.size()))),
+                        settings.placement);
 
   graph::Graph graph;
   const VolumeRenderer::Outputs rendered = p.renderer.add_to(graph);
   const Placement::Resources placed =
       p.placement.add_to(graph, rendered.final, rendered.layers, render.layer_count);
   results_id_ = placed.results;
+  layers_id_ = rendered.layers;
   p.glyph_id = graph.import_resource("labels.glyphs", {false, true});
   const graph::ResourceId labelled = graph.add_image("labels.final", {VK_FORMAT_R8G8B8A8_UNORM});
   p.drawing.add_to(graph, rendered.layers, placed.labels, placed.placements, p.glyph_id,
@@ -136,12 +143,73 @@ void LabelledRenderer::bind() {
   p.target.bind(*runner_);
 }
 
-void LabelledRenderer::run() {
+void LabelledRenderer::run_frame() {
   for (int attempt = 0; attempt < 4; ++attempt) {
     bind();
     runner_->run_now();
     stats_ = parts_->renderer.collect(*runner_);
     if (stats_.overflow == 0) break;
+  }
+}
+
+// Stein & Decoret's order inside each layer, from the first frame's image: occupancy is the
+// alpha of all layers composited (drawn labels are only added later in the frame).
+std::vector<uint32_t> LabelledRenderer::apollonius_layers_order() {
+  const std::vector<std::byte> bytes = runner_->download_image(layers_id_);
+  const auto* half = reinterpret_cast<const uint16_t*>(bytes.data());
+  const size_t pixels = size_t{size_.width} * size_.height;
+  std::vector<float> occupancy(pixels, 0.0f);
+  for (uint32_t l = 0; l < layering_.layer_count; ++l) {
+    for (size_t p = 0; p < pixels; ++p) {
+      const float a = glm::unpackHalf1x16(half[(l * pixels + p) * 4 + 3]);
+      occupancy[p] += (1.0f - occupancy[p]) * a;
+    }
+  }
+  std::vector<glm::vec2> anchors;
+  for (const auto& l : labels_) anchors.push_back(l.anchor);
+  return apollonius_order(anchors, occupancy, size_.width, size_.height);
+}
+
+// Eq. 3.2 as the optimised order compares it: the sum of the shown labels' costs, a hidden
+// label counting as much as an anchor-constraint violation.
+double LabelledRenderer::total_cost() const {
+  double total = 0.0;
+  const auto results = parts_->placement.results();
+  for (size_t i = 0; i < labels_.size(); ++i) {
+    if ((labels_[i].flags & LABEL_ENABLED) == 0u) continue;
+    total += results[i].shown == PLACEMENT_SHOWN
+                 ? double(results[i].cost)
+                 : double(settings_.placement.weights.anchor_constraint);
+  }
+  return total;
+}
+
+void LabelledRenderer::run() {
+  Placement& placement = parts_->placement;
+  const auto set_order = [&](const std::vector<uint32_t>& within) {
+    placement.set_frame(labels_, insertion_order(labels_, layering_, within), settings_.placement);
+  };
+  set_order(scene_order(uint32_t(labels_.size())));
+  run_frame();
+  if (settings_.order == InsertionOrder::apollonius) {
+    set_order(apollonius_layers_order());
+    run_frame();
+  } else if (settings_.order == InsertionOrder::optimized) {
+    std::vector<uint32_t> best = scene_order(uint32_t(labels_.size()));
+    double best_cost = total_cost();
+    for (uint32_t t = 0; t < settings_.optimize_tries; ++t) {
+      const std::vector<uint32_t> candidate =
+          random_order(uint32_t(labels_.size()), settings_.seed + t + 1);
+      set_order(candidate);
+      run_frame();
+      const double cost = total_cost();
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = candidate;
+      }
+    }
+    set_order(best);
+    run_frame();
   }
 }
 

@@ -16,8 +16,17 @@
 
 namespace strata {
 
+// The order labels are placed in within a layer (thesis 3.2.3).
+enum class InsertionOrder {
+  scene,       // the scene's order
+  apollonius,  // Stein & Decoret: innermost first (needs the label-free image: a first frame)
+  optimized,   // random orders, each kept when its total cost is lower (offline, several frames)
+};
+
 struct LabellingSettings {
   uint32_t layer_count = 4;  // asked for; fewer when the anchors have fewer distinct depths
+  InsertionOrder order = InsertionOrder::scene;
+  uint32_t optimize_tries = 8;  // InsertionOrder::optimized: random orders tried
   PlacementSettings placement;
   bool internal = false;  // internal labelling: every label drawn on its anchor
   float font_pixels = 14.0f;
@@ -63,7 +72,9 @@ class LabelledRenderer {
                    const LabellingSettings& settings);
   ~LabelledRenderer();
 
-  // One frame, waited for; re-rendered while the HA-Buffer overflows (it grows each time).
+  // One frame, waited for; re-rendered while the HA-Buffer overflows (it grows each time). The
+  // Apollonius and optimised orders take more frames: they need a frame's image or costs, read
+  // between frames, never inside one.
   void run();
   graph::GraphRunner& runner() { return *runner_; }
   // The placement's per-label results buffer (the baseline benchmark reads it after each label).
@@ -81,8 +92,14 @@ class LabelledRenderer {
   std::vector<gpu::LabelGpu> labels_;
   std::unique_ptr<Parts> parts_;
   std::unique_ptr<graph::GraphRunner> runner_;
+  void run_frame();
+  std::vector<uint32_t> apollonius_layers_order();
+  double total_cost() const;
+
   RenderStats stats_;
   graph::ResourceId results_id_ = 0;
+  graph::ResourceId layers_id_ = 0;
+  LabellingSettings settings_;
 };
 
 // Renders and labels one frame offline.

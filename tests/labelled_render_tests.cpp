@@ -47,4 +47,52 @@ TEST_SUITE("gpu") {
   }
 }
 
+namespace {
+
+double total_cost(const LabelledFrame& frame) {
+  double total = 0.0;
+  for (const LabelLayout& l : frame.labels) total += l.shown ? double(l.cost) : 1e6;
+  return total;
+}
+
+}  // namespace
+
+TEST_SUITE("gpu") {
+  TEST_CASE_FIXTURE(test::GpuTest, "optimized_order_costs_no_more_than_the_scene_order") {
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    const CameraSetup camera = camera_for(scene, "front");
+    LabellingSettings settings;
+    const LabelledFrame scene_order = render_labelled(ctx, scene, camera, {128, 128}, settings);
+    settings.order = InsertionOrder::optimized;
+    settings.optimize_tries = 3;
+    const LabelledFrame optimized = render_labelled(ctx, scene, camera, {128, 128}, settings);
+    CHECK(total_cost(optimized) <= total_cost(scene_order) * (1.0 + 1e-6));
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "decoret_preset_places_on_one_layer_without_violations") {
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    LabellingSettings settings;
+    settings.layer_count = 1;
+    settings.order = InsertionOrder::apollonius;
+    settings.placement.hard = true;
+    const LabelledFrame frame =
+        render_labelled(ctx, scene, camera_for(scene, "front"), {192, 192}, settings);
+    CHECK(frame.layering.layer_count == 1);
+    size_t shown = 0;
+    for (const LabelLayout& a : frame.labels) {
+      if (!a.shown) continue;
+      ++shown;
+      CHECK(a.layer == 0);
+      // Hard constraints: no shown box covers an anchor (the box's own anchor included).
+      for (const LabelLayout& b : frame.labels) {
+        const bool covers =
+            b.anchor.x >= a.box_origin.x && b.anchor.x <= a.box_origin.x + a.box_size.x &&
+            b.anchor.y >= a.box_origin.y && b.anchor.y <= a.box_origin.y + a.box_size.y;
+        CHECK_MESSAGE(!covers, a.text << " covers the anchor of " << b.text);
+      }
+    }
+    CHECK(shown > 0);
+  }
+}
+
 }  // namespace strata
