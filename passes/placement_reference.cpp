@@ -102,7 +102,7 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
         if (!placer.candidate_allowed(me, p)) continue;
         const glm::vec2 origin = gpu::box_origin(p, me.size);
         const glm::vec2 centre = origin + me.size * 0.5f;
-        const uint32_t bits = placer.constraint_bits(label, centre);
+        const uint32_t bits = placer.constraint_bits(label, centre, 0u);
         const uint32_t pixel = y * w + x;
         if (settings.write_constraints) out.constraints[pixel] = bits;
         if (settings.hard && bits != 0u) continue;

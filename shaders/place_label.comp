@@ -22,6 +22,7 @@ shared uint tile_placed[LABEL_MAX];
 shared uint tile_placed_count;
 shared uint tile_anchors[LABEL_MAX];
 shared uint tile_anchor_count;
+shared uint tile_bits;  // constraints every candidate of the tile has
 
 LabelGpu label_at(uint i) { return labels[i]; }
 uint placed_count() { return tile_placed_count; }
@@ -51,10 +52,29 @@ void tile_centres(LabelGpu me, out vec2 centre, out vec2 extent) {
   centre = first + extent;
 }
 
-void cull(LabelGpu me) {
+// The bits a constraint region sets at all four corners of the tile's centre region: each
+// region (a dilated shadow, an anchor's box) is convex, so it then holds every candidate.
+uint corner_bits(uint label, vec2 centre, vec2 extent, uint j_or_anchor, bool anchor) {
+  uint all = 0xFFFFFFFFu;
+  for (int k = 0; k < 4; ++k) {
+    const vec2 c = centre + extent * vec2((k & 1) != 0 ? 1.0 : -1.0, (k & 2) != 0 ? 1.0 : -1.0);
+    if (anchor) {
+      const vec2 h = labels[label].size * 0.5 + vec2(params.margin);
+      const vec2 d = abs(labels[j_or_anchor].anchor - c);
+      all &= (d.x <= h.x && d.y <= h.y) ? CONSTRAINT_ANCHOR : 0u;
+    } else {
+      const vec2 h = labels[label].size * 0.5 + vec2(params.margin);
+      all &= placed_bits(labels[label], c, h, j_or_anchor, 0u);
+    }
+  }
+  return all;
+}
+
+void cull(LabelGpu me, uint label) {
   if (gl_LocalInvocationIndex == 0u) {
     tile_placed_count = 0u;
     tile_anchor_count = 0u;
+    tile_bits = 0u;
   }
   barrier();
   vec2 centre, extent;
@@ -62,12 +82,18 @@ void cull(LabelGpu me) {
   const uint threads = PLACEMENT_GROUP * PLACEMENT_GROUP;
   for (uint s = gl_LocalInvocationIndex; s < params.step; s += threads) {
     const uint j = order[s];
-    if (may_constrain(me, centre, extent, j)) tile_placed[atomicAdd(tile_placed_count, 1u)] = j;
+    if (!may_constrain(me, centre, extent, j)) continue;
+    const uint full = corner_bits(label, centre, extent, j, false);
+    if (full != 0u) atomicOr(tile_bits, full);
+    if (full != (CONSTRAINT_LABEL | CONSTRAINT_CONNECTOR)) tile_placed[atomicAdd(tile_placed_count, 1u)] = j;
   }
   const vec2 reach = extent + me.size * 0.5 + vec2(params.margin);
   for (uint k = gl_LocalInvocationIndex; k < params.label_count; k += threads) {
+    if ((labels[k].flags & LABEL_ENABLED) == 0u) continue;
     const vec2 d = abs(labels[k].anchor - centre);
-    if (d.x <= reach.x && d.y <= reach.y) tile_anchors[atomicAdd(tile_anchor_count, 1u)] = k;
+    if (d.x > reach.x || d.y > reach.y) continue;
+    if (corner_bits(label, centre, extent, k, true) != 0u) atomicOr(tile_bits, CONSTRAINT_ANCHOR);
+    else tile_anchors[atomicAdd(tile_anchor_count, 1u)] = k;
   }
   barrier();
 }
@@ -76,12 +102,12 @@ void main() {
   const uvec2 p = gl_GlobalInvocationID.xy;
   const uint label = order[params.step];
   const LabelGpu me = labels[label];
-  cull(me);
+  cull(me, label);
   uint64_t key = PLACEMENT_NONE;
   if (p.x < params.width && p.y < params.height && candidate_allowed(me, p)) {
     const vec2 origin = box_origin(p, me.size);
     const vec2 centre = origin + me.size * 0.5;
-    const uint bits = constraint_bits(label, centre);
+    const uint bits = constraint_bits(label, centre, tile_bits);
     const uint pixel = p.y * params.width + p.x;
     if (params.write_constraints != 0u) constraints[pixel] = bits;
     if (params.hard == 0u || bits == 0u) {

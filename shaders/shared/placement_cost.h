@@ -56,26 +56,36 @@ bool hull_touches(vec2 a, vec2 c, vec2 h, vec2 q0, vec2 q1, vec2 q2, vec2 q3, ve
   return true;
 }
 
-// The constraint bits of placing label i with its box centred at c.
-uint constraint_bits(uint i, vec2 c) {
+// The label- and connector-shadow bits placed label j gives the new label `me` at centre c
+// (its box's half size h includes the margin).
+uint placed_bits(LabelGpu me, vec2 c, vec2 h, uint j, uint known) {
+  vec3 other = placed(j);
+  if (other.z < 0.5f) return 0u;
+  LabelGpu them = label_at(j);
+  uint bits = 0u;
+  vec2 lo = vec2(other) - them.size * 0.5f, hi = vec2(other) + them.size * 0.5f;
+  if ((known & CONSTRAINT_LABEL) == 0u &&
+      hull_touches(me.anchor, c, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), vec2(1.0f, 0.0f))) {
+    bits |= CONSTRAINT_LABEL;
+  }
+  if ((known & CONSTRAINT_CONNECTOR) == 0u && (them.flags & LABEL_INTERNAL) == 0u) {
+    vec2 p0 = them.anchor, p1 = vec2(other), d = p1 - p0;
+    if (hull_touches(me.anchor, c, h, p0, p1, p0, p1, vec2(-d.y, d.x))) bits |= CONSTRAINT_CONNECTOR;
+  }
+  return bits;
+}
+
+// The constraint bits of placing label i with its box centred at c. Kinds already in `known`
+// are not tested again (a GPU tile may know them for all its candidates).
+uint constraint_bits(uint i, vec2 c, uint known) {
   LabelGpu me = label_at(i);
   vec2 h = me.size * 0.5f + vec2(params.margin);
-  uint bits = 0u;
-  for (uint k = 0u; k < placed_count(); ++k) {
-    uint j = placed_label(k);
-    vec3 other = placed(j);
-    if (other.z < 0.5f) continue;
-    LabelGpu them = label_at(j);
-    vec2 lo = vec2(other) - them.size * 0.5f, hi = vec2(other) + them.size * 0.5f;
-    if (hull_touches(me.anchor, c, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), vec2(1.0f, 0.0f))) {
-      bits |= CONSTRAINT_LABEL;
-    }
-    if ((them.flags & LABEL_INTERNAL) == 0u) {
-      vec2 p0 = them.anchor, p1 = vec2(other), d = p1 - p0;
-      if (hull_touches(me.anchor, c, h, p0, p1, p0, p1, vec2(-d.y, d.x))) bits |= CONSTRAINT_CONNECTOR;
-    }
+  const uint shadows = CONSTRAINT_LABEL | CONSTRAINT_CONNECTOR;
+  uint bits = known;
+  for (uint k = 0u; k < placed_count() && (bits & shadows) != shadows; ++k) {
+    bits |= placed_bits(me, c, h, placed_label(k), bits);
   }
-  if ((me.flags & LABEL_INTERNAL) == 0u) {
+  if ((me.flags & LABEL_INTERNAL) == 0u && (bits & CONSTRAINT_ANCHOR) == 0u) {
     for (uint k = 0u; k < anchor_count(); ++k) {
       LabelGpu other = label_at(anchor_label(k));
       if ((other.flags & LABEL_ENABLED) == 0u) continue;
