@@ -103,8 +103,24 @@ void main() {
   const uint label = order[params.step];
   const LabelGpu me = labels[label];
   cull(me, label);
+  // A lower bound of every candidate's cost in this tile: the distance term at the nearest
+  // centre, the smallest direction term (1), the constraints the whole tile has; the integral
+  // and previous-position terms are >= 0. If another workgroup already found something cheaper,
+  // no candidate here can be the argmin (strictly greater: ties cannot be lost either). The full
+  // constraint image (tests, debugging) needs every tile evaluated.
+  vec2 centre, extent;
+  tile_centres(me, centre, extent);
+  const vec2 gap = max(abs(me.anchor - centre) - extent, vec2(0.0));
+  float bound = params.weights.distance_to_anchor * length(gap) + params.weights.connector_direction;
+  if ((tile_bits & CONSTRAINT_LABEL) != 0u) bound += params.weights.label_shadow;
+  if ((tile_bits & CONSTRAINT_CONNECTOR) != 0u) bound += params.weights.connector_shadow;
+  if ((tile_bits & CONSTRAINT_ANCHOR) != 0u) bound += params.weights.anchor_constraint;
+  const uint64_t best_so_far = atomicAdd(results[label], uint64_t(0));
+  const bool hopeless = params.write_constraints == 0u && (me.flags & LABEL_INTERNAL) == 0u &&
+                        best_so_far != PLACEMENT_NONE &&
+                        bound > uintBitsToFloat(uint(best_so_far >> 32));
   uint64_t key = PLACEMENT_NONE;
-  if (p.x < params.width && p.y < params.height && candidate_allowed(me, p)) {
+  if (!hopeless && p.x < params.width && p.y < params.height && candidate_allowed(me, p)) {
     const vec2 origin = box_origin(p, me.size);
     const vec2 centre = origin + me.size * 0.5;
     const uint bits = constraint_bits(label, centre, tile_bits);
