@@ -143,7 +143,7 @@ struct RenderBenchOptions {
 
 void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t runs) {
   const graph::Extent size = parse_size(o.size, "--size");
-  const Scene scene = load_scene(o.scene);
+  const Scene scene = load_scene_reporting(o.scene);
   Context ctx(device.context());
   RenderSettings settings;
   settings.layer_count = o.layers;
@@ -215,7 +215,7 @@ void resize_labels(Scene& scene, uint32_t count) {
 
 void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint32_t runs) {
   const graph::Extent size = parse_size(o.size, "--size");
-  Scene scene = load_scene(o.scene);
+  Scene scene = load_scene_reporting(o.scene);
   resize_labels(scene, o.labels);
   Context ctx(device.context());
   LabellingSettings settings;

@@ -8,6 +8,7 @@
 #include "engine/context.h"
 #include "engine/error.h"
 #include "engine/render_graph.h"
+#include "engine/scene.h"
 
 namespace strata::app {
 
@@ -17,6 +18,9 @@ struct DeviceOptions {
   bool validate = false;  // --validate (also STRATA_VALIDATE=1; always on in debug builds)
   ContextOptions context() const;
 };
+
+// Loads a scene and prints its warnings (missing data files, ...) to stderr.
+Scene load_scene_reporting(const std::string& path);
 
 // "1024" or "1024x768"; throws Error naming the option when it is neither.
 graph::Extent parse_size(const std::string& text, const char* option);

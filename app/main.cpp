@@ -4,6 +4,7 @@
 
 #include "app/commands.h"
 #include "engine/error.h"
+#include "engine/scene_loader.h"
 
 namespace strata::app {
 
@@ -17,6 +18,13 @@ ContextOptions DeviceOptions::context() const {
   options.validation = !(env && std::string(env) == "0");
 #endif
   return options;
+}
+
+Scene load_scene_reporting(const std::string& path) {
+  Scene scene = load_scene(path);
+  for (const std::string& warning : scene.warnings)
+    std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
+  return scene;
 }
 
 graph::Extent parse_size(const std::string& text, const char* option) {

@@ -58,9 +58,7 @@ void dump_layers(graph::GraphRunner& runner, graph::ResourceId layers, graph::Ex
 // strata's main job: the labelled image (labeling/labelled_render.h).
 void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
-  const Scene scene = load_scene(o.scene);
-  for (const std::string& warning : scene.warnings)
-    std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
+  const Scene scene = load_scene_reporting(o.scene);
   Context ctx(device.context());
   LabellingSettings settings;
   settings.layer_count = o.layers;
@@ -94,9 +92,7 @@ void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
 
 void render_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
-  const Scene scene = load_scene(o.scene);
-  for (const std::string& warning : scene.warnings)
-    std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
+  const Scene scene = load_scene_reporting(o.scene);
   Context ctx(device.context());
   RenderSettings settings;
   settings.layer_count = o.layers;

@@ -59,9 +59,7 @@ void view(DeviceOptions& device, const ViewOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   std::optional<Scene> scene;
   if (!o.scene.empty()) {
-    scene = load_scene(o.scene);
-    for (const auto& warning : scene->warnings)
-      std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
+    scene = load_scene_reporting(o.scene);
   }
   Glfw glfw;
   ContextOptions context = device.context();
