@@ -2,6 +2,7 @@
 // screen, readable, and no two label boxes overlap.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstdlib>
 
 #include "engine/png.h"
@@ -67,6 +68,20 @@ TEST_SUITE("gpu") {
     settings.optimize_tries = 3;
     const LabelledFrame optimized = render_labelled(ctx, scene, camera, {128, 128}, settings);
     CHECK(total_cost(optimized) <= total_cost(scene_order) * (1.0 + 1e-6));
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "internal_labels_are_placed_on_their_anchors") {
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    LabellingSettings settings;
+    settings.internal = true;
+    const LabelledFrame frame = render_labelled(ctx, scene, camera_for(scene, "front"), {128, 128}, settings);
+    for (const LabelLayout& l : frame.labels) {
+      CAPTURE(l.text);
+      CHECK(l.shown);
+      const glm::vec2 centre = l.box_origin + l.box_size * 0.5f;
+      CHECK(std::abs(centre.x - l.anchor.x) <= 1.0f);
+      CHECK(std::abs(centre.y - l.anchor.y) <= 1.0f);
+    }
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "decoret_preset_places_on_one_layer_without_violations") {
