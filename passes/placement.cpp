@@ -27,7 +27,6 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   p.saliency_weight = s.saliency_weight;
   p.occlusion_weight = s.occlusion_weight;
   p.single_saliency_weight = s.single_saliency_weight;
-  p.stride = 1;
   return p;
 }
 
@@ -129,30 +128,22 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                   },
                   "placement"});
   tables_.add_to(graph, r.costs, r.tables, "placement.sat", layer_count);
-  // Per label: a coarse pass (every kCoarse-th pixel) finds a real candidate's cost early, so
-  // the full pass can skip every tile whose lower bound is above it; both are exact candidates
-  // of the same argmin, so the result is the full search's.
-  constexpr uint32_t kCoarse = 4;
   for (uint32_t step = 0; step < label_count_; ++step) {
-    for (const uint32_t stride : {kCoarse, 1u}) {
-      graph.add_pass({stride == 1 ? "placement.label" : "placement.coarse",
-                      graph::PassKind::compute,
-                      {{r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
-                       {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
-                       {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
-                       {results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
-                       {r.constraints, Use::storage_read_write, PLACEMENT_BINDING_CONSTRAINTS}},
-                      [this, step, stride](graph::PassContext& pc) {
-                        if (step >= order_.size()) return;  // fewer labels enabled this frame
-                        gpu::PlacementParams p = params(pc.viewport, step);
-                        p.stride = stride;
-                        pc.bind(place_label_);
-                        place_label_.push_constants(pc.cmd, p);
-                        vkCmdDispatch(pc.cmd, group_count(group_count(pc.viewport.width, stride), PLACEMENT_GROUP),
-                                      group_count(group_count(pc.viewport.height, stride), PLACEMENT_GROUP), 1);
-                      },
-                      "placement"});
-    }
+    graph.add_pass({"placement.label",
+                    graph::PassKind::compute,
+                    {{r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
+                     {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+                     {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
+                     {results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
+                     {r.constraints, Use::storage_read_write, PLACEMENT_BINDING_CONSTRAINTS}},
+                    [this, step](graph::PassContext& pc) {
+                      if (step >= order_.size()) return;  // fewer labels enabled this frame
+                      pc.bind(place_label_);
+                      place_label_.push_constants(pc.cmd, params(pc.viewport, step));
+                      vkCmdDispatch(pc.cmd, group_count(pc.viewport.width, PLACEMENT_GROUP),
+                                    group_count(pc.viewport.height, PLACEMENT_GROUP), 1);
+                    },
+                    "placement"});
   }
   graph.add_pass({"placement.finalize",
                   graph::PassKind::compute,

@@ -58,7 +58,7 @@ struct PlacementParams {
   float saliency_weight;   // eq. 3.3: beta, how much saliency modulates occlusion behind
   float occlusion_weight;  // eq. 3.4 (one layer): alpha
   float single_saliency_weight;  // eq. 3.4: beta
-  uint stride;        // place_label: candidates every `stride` pixels (a coarse first pass: > 1)
+  float pad;
 };
 
 #ifdef __cplusplus
