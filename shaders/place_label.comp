@@ -52,6 +52,16 @@ void tile_centres(LabelGpu me, out vec2 centre, out vec2 extent) {
   centre = first + extent;
 }
 
+// The integral costs every candidate box of the tile covers: the part all their boxes share
+// (integral costs are >= 0, so each box's integral is at least this).
+float shared_box_integral(LabelGpu me) {
+  const vec2 first = box_origin(gl_WorkGroupID.xy * PLACEMENT_GROUP, me.size);
+  const vec2 lo = max(first + vec2(float(PLACEMENT_GROUP - 1)), vec2(0.0));
+  const vec2 hi = min(first + me.size, vec2(params.width, params.height));
+  if (hi.x <= lo.x || hi.y <= lo.y) return 0.0;
+  return max(box_integral(me.layer, lo, hi - lo), 0.0);
+}
+
 // The bits a constraint region sets at all four corners of the tile's centre region: each
 // region (a dilated shadow, an anchor's box) is convex, so it then holds every candidate.
 uint corner_bits(uint label, vec2 centre, vec2 extent, uint j_or_anchor, bool anchor) {
@@ -104,10 +114,10 @@ void main() {
   const LabelGpu me = labels[label];
   cull(me, label);
   // A lower bound of every candidate's cost in this tile: the distance term at the nearest
-  // centre, the smallest direction term (1), the constraints the whole tile has; the integral
-  // and previous-position terms are >= 0. If another workgroup already found something cheaper,
-  // no candidate here can be the argmin (strictly greater: ties cannot be lost either). The full
-  // constraint image (tests, debugging) needs every tile evaluated.
+  // centre, the smallest direction term (1), the constraints the whole tile has, the integral
+  // over the part all its boxes share; the previous-position term is >= 0. If another workgroup
+  // already found something cheaper, no candidate here can be the argmin (strictly greater: ties
+  // cannot be lost either). The full constraint image (tests, debugging) needs every tile.
   vec2 centre, extent;
   tile_centres(me, centre, extent);
   const vec2 gap = max(abs(me.anchor - centre) - extent, vec2(0.0));
@@ -115,6 +125,8 @@ void main() {
   if ((tile_bits & CONSTRAINT_LABEL) != 0u) bound += params.weights.label_shadow;
   if ((tile_bits & CONSTRAINT_CONNECTOR) != 0u) bound += params.weights.connector_shadow;
   if ((tile_bits & CONSTRAINT_ANCHOR) != 0u) bound += params.weights.anchor_constraint;
+  // (0.999: the tables' float sums of the shared part and of a box can differ in the last bits.)
+  bound += 0.999 * params.weights.integral_costs * shared_box_integral(me);
   const uint64_t best_so_far = atomicAdd(results[label], uint64_t(0));
   const bool hopeless = params.write_constraints == 0u && (me.flags & LABEL_INTERNAL) == 0u &&
                         best_so_far != PLACEMENT_NONE &&
