@@ -13,7 +13,9 @@ layout(local_size_x = PLACEMENT_GROUP, local_size_y = PLACEMENT_GROUP) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
 layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
 layout(binding = PLACEMENT_BINDING_ORDER, std430) readonly buffer Order { uint order[]; };
-layout(binding = PLACEMENT_BINDING_RESULTS, std430) buffer Results { uint64_t results[]; };
+// coherent: the bound read below sees other workgroups' atomicMin results (a stale value is only
+// a weaker bound, never a wrong one: results only decrease).
+layout(binding = PLACEMENT_BINDING_RESULTS, std430) coherent buffer Results { uint64_t results[]; };
 layout(binding = PLACEMENT_BINDING_CONSTRAINTS, std430) writeonly buffer Constraints { uint constraints[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
@@ -127,7 +129,7 @@ void main() {
   if ((tile_bits & CONSTRAINT_ANCHOR) != 0u) bound += params.weights.anchor_constraint;
   // (0.999: the tables' float sums of the shared part and of a box can differ in the last bits.)
   bound += 0.999 * params.weights.integral_costs * shared_box_integral(me);
-  const uint64_t best_so_far = atomicAdd(results[label], uint64_t(0));
+  const uint64_t best_so_far = results[label];
   const bool hopeless = params.write_constraints == 0u && (me.flags & LABEL_INTERNAL) == 0u &&
                         best_so_far != PLACEMENT_NONE &&
                         bound > uintBitsToFloat(uint(best_so_far >> 32));
@@ -152,6 +154,7 @@ void main() {
   if (gl_LocalInvocationIndex == 0u) {
     uint64_t best = PLACEMENT_NONE;
     for (uint s = 0u; s < gl_NumSubgroups; ++s) best = min(best, group_best[s]);
-    if (best != PLACEMENT_NONE) atomicMin(results[label], best);
+    // Thousands of workgroups share one address: only those that improve on it touch it.
+    if (best < results[label]) atomicMin(results[label], best);
   }
 }
