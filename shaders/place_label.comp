@@ -19,18 +19,12 @@ layout(binding = PLACEMENT_BINDING_RESULTS, std430) coherent buffer Results { ui
 layout(binding = PLACEMENT_BINDING_CONSTRAINTS, std430) writeonly buffer Constraints { uint constraints[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
-// Per tile: the dilated shadows of placed labels that cross it (as half-planes, computed once
-// per tile), the placed labels beyond that capacity (tested per pixel the slow way), the anchors
-// within reach, and the constraints every candidate of the tile has.
-#define TILE_REGIONS 32
-shared vec3 region_planes[2 * TILE_REGIONS][REGION_PLANES];
-shared uint region_meta[2 * TILE_REGIONS];  // plane count | kind << 8
-shared uint tile_region_count;
+// The placed labels and anchors this tile's candidates can reach (culled once per tile).
 shared uint tile_placed[LABEL_MAX];
 shared uint tile_placed_count;
 shared uint tile_anchors[LABEL_MAX];
 shared uint tile_anchor_count;
-shared uint tile_bits;
+shared uint tile_bits;  // constraints every candidate of the tile has
 
 LabelGpu label_at(uint i) { return labels[i]; }
 uint placed_count() { return tile_placed_count; }
@@ -70,44 +64,26 @@ float shared_box_integral(LabelGpu me) {
   return max(box_integral(me.layer, lo, hi - lo), 0.0);
 }
 
-// How a region meets the tile's rectangle of candidate centres: 0 misses it (some plane leaves
-// all four corners outside: conservative, a miss may still be called partial), 1 partial,
-// 2 covers it (all four corners inside: regions are convex).
-uint coverage(Region r, vec2 centre, vec2 extent) {
-  if (r.kind == REGION_NOWHERE) return 0u;
-  if (r.kind == REGION_EVERYWHERE) return 2u;
-  uint inside = 0u;
+// The bits a constraint region sets at all four corners of the tile's centre region: each
+// region (a dilated shadow, an anchor's box) is convex, so it then holds every candidate.
+uint corner_bits(uint label, vec2 centre, vec2 extent, uint j_or_anchor, bool anchor) {
+  uint all = 0xFFFFFFFFu;
   for (int k = 0; k < 4; ++k) {
-    inside += in_region(r, centre + extent * vec2((k & 1) != 0 ? 1.0 : -1.0, (k & 2) != 0 ? 1.0 : -1.0)) ? 1u : 0u;
+    const vec2 c = centre + extent * vec2((k & 1) != 0 ? 1.0 : -1.0, (k & 2) != 0 ? 1.0 : -1.0);
+    if (anchor) {
+      const vec2 h = labels[label].size * 0.5 + vec2(params.margin);
+      const vec2 d = abs(labels[j_or_anchor].anchor - c);
+      all &= (d.x <= h.x && d.y <= h.y) ? CONSTRAINT_ANCHOR : 0u;
+    } else {
+      const vec2 h = labels[label].size * 0.5 + vec2(params.margin);
+      all &= placed_bits(labels[label], c, h, j_or_anchor, 0u);
+    }
   }
-  if (inside == 4u) return 2u;
-  for (uint p = 0u; p < r.count; ++p) {
-    const vec2 n = vec2(r.planes[p]);
-    const float nearest = dot(n, centre) - abs(n.x) * extent.x - abs(n.y) * extent.y;
-    if (nearest > r.planes[p].z + 1e-5 * (abs(r.planes[p].z) + 1.0)) return 0u;
-  }
-  return 1u;
-}
-
-void store_region(uint slot, Region r) {
-  region_meta[slot] = r.count | (r.kind << 8);
-  for (uint p = 0u; p < r.count; ++p) region_planes[slot][p] = r.planes[p];
-}
-
-bool in_stored_region(uint slot, vec2 c) {
-  const uint meta = region_meta[slot];
-  const uint kind = meta >> 8;
-  if (kind != REGION_PLANES_ONLY) return kind == REGION_EVERYWHERE;
-  for (uint p = 0u; p < (meta & 255u); ++p) {
-    const vec3 plane = region_planes[slot][p];
-    if (dot(vec2(plane), c) > plane.z + 1e-5 * (abs(plane.z) + 1.0)) return false;
-  }
-  return true;
+  return all;
 }
 
 void cull(LabelGpu me, uint label) {
   if (gl_LocalInvocationIndex == 0u) {
-    tile_region_count = 0u;
     tile_placed_count = 0u;
     tile_anchor_count = 0u;
     tile_bits = 0u;
@@ -115,54 +91,23 @@ void cull(LabelGpu me, uint label) {
   barrier();
   vec2 centre, extent;
   tile_centres(me, centre, extent);
-  const vec2 h = me.size * 0.5 + vec2(params.margin);
   const uint threads = PLACEMENT_GROUP * PLACEMENT_GROUP;
-  Region none;
-  none.count = 0u;
-  none.kind = REGION_NOWHERE;
   for (uint s = gl_LocalInvocationIndex; s < params.step; s += threads) {
     const uint j = order[s];
-    if (placed(j).z < 0.5) continue;
-    const Region shadow = label_shadow_region(me, h, j);
-    const Region line = connector_shadow_region(me, h, j);
-    const uint a = coverage(shadow, centre, extent), b = coverage(line, centre, extent);
-    if (a == 2u) atomicOr(tile_bits, CONSTRAINT_LABEL);
-    if (b == 2u) atomicOr(tile_bits, CONSTRAINT_CONNECTOR);
-    if (a != 1u && b != 1u) continue;
-    const uint slot = atomicAdd(tile_region_count, 1u);
-    if (slot < TILE_REGIONS) {
-      store_region(2u * slot, a == 1u ? shadow : none);
-      store_region(2u * slot + 1u, b == 1u ? line : none);
-    } else {
-      tile_placed[atomicAdd(tile_placed_count, 1u)] = j;  // beyond capacity: tested per pixel
-    }
+    if (!may_constrain(me, centre, extent, j)) continue;
+    const uint full = corner_bits(label, centre, extent, j, false);
+    if (full != 0u) atomicOr(tile_bits, full);
+    if (full != (CONSTRAINT_LABEL | CONSTRAINT_CONNECTOR)) tile_placed[atomicAdd(tile_placed_count, 1u)] = j;
   }
-  const vec2 reach = extent + h;
+  const vec2 reach = extent + me.size * 0.5 + vec2(params.margin);
   for (uint k = gl_LocalInvocationIndex; k < params.label_count; k += threads) {
     if ((labels[k].flags & LABEL_ENABLED) == 0u) continue;
     const vec2 d = abs(labels[k].anchor - centre);
     if (d.x > reach.x || d.y > reach.y) continue;
-    // The anchor's box (the new box's size + margin) is convex: all four corners inside covers it.
-    bool all = true;
-    for (int c = 0; c < 4; ++c) {
-      const vec2 e = abs(labels[k].anchor - (centre + extent * vec2((c & 1) != 0 ? 1.0 : -1.0, (c & 2) != 0 ? 1.0 : -1.0)));
-      all = all && e.x <= h.x && e.y <= h.y;
-    }
-    if (all) atomicOr(tile_bits, CONSTRAINT_ANCHOR);
+    if (corner_bits(label, centre, extent, k, true) != 0u) atomicOr(tile_bits, CONSTRAINT_ANCHOR);
     else tile_anchors[atomicAdd(tile_anchor_count, 1u)] = k;
   }
   barrier();
-}
-
-// The shadow bits of the tile's stored regions at centre c, on top of `known`.
-uint stored_bits(vec2 c, uint known) {
-  uint bits = known;
-  const uint stored = min(tile_region_count, TILE_REGIONS);
-  for (uint k = 0u; k < stored && (bits & 3u) != 3u; ++k) {
-    if ((bits & CONSTRAINT_LABEL) == 0u && in_stored_region(2u * k, c)) bits |= CONSTRAINT_LABEL;
-    if ((bits & CONSTRAINT_CONNECTOR) == 0u && in_stored_region(2u * k + 1u, c)) bits |= CONSTRAINT_CONNECTOR;
-  }
-  return bits;
 }
 
 void main() {
@@ -192,7 +137,7 @@ void main() {
   if (!hopeless && p.x < params.width && p.y < params.height && candidate_allowed(me, p)) {
     const vec2 origin = box_origin(p, me.size);
     const vec2 centre = origin + me.size * 0.5;
-    const uint bits = constraint_bits(label, centre, stored_bits(centre, tile_bits));
+    const uint bits = constraint_bits(label, centre, tile_bits);
     const uint pixel = p.y * params.width + p.x;
     if (params.write_constraints != 0u) constraints[pixel] = bits;
     if (params.hard == 0u || bits == 0u) {

@@ -14,13 +14,6 @@
 #define CONSTRAINT_CONNECTOR 2u  // ... a placed connector's shadow
 #define CONSTRAINT_ANCHOR 4u     // the new box would cover an anchor
 
-// Constraint regions as half-planes (shared/placement_cost.h): at most this many planes, and
-// their kinds.
-#define REGION_PLANES 12
-#define REGION_PLANES_ONLY 0u
-#define REGION_EVERYWHERE 1u
-#define REGION_NOWHERE 2u
-
 // A packed (cost, pixel) pair no candidate reaches: "not placed".
 #define PLACEMENT_NONE 0xFFFFFFFFFFFFFFFFul
 

@@ -13,110 +13,64 @@
 // A candidate is a pixel p; the label box then spans pixels [box_origin(p), + size) and its
 // centre is box_origin + size / 2 (box_origin: shared/placement.h).
 
-// A dilated shadow as half-planes: the candidate centres c with dot(plane.xy, c) <= plane.z for
-// every plane (kind REGION_PLANES_ONLY), or every c, or none.
-struct Region {
-  vec3 planes[REGION_PLANES];
-  uint count;
-  uint kind;
-};
-
-// The centres c at which the box of half size h, together with the anchor a, touches the convex
-// set with vertices q0..q3 (n = 4: a box, corners in order; n = 2: the segment q0-q1). That set
-// is the shadow of the convex set seen from a, dilated by the box (a Minkowski sum of two convex
-// polygons), so it is the intersection of half-planes along both polygons' edge normals: the
-// axes (the box's, and the placed box's) and the perpendiculars of the lines from a through the
-// vertices (the shadow's two tangents, and for a segment its own normal). A normal along which
-// the shadow is unbounded (some ray from a through a vertex points along it) gives no plane.
-Region shadow_region(vec2 a, vec2 q0, vec2 q1, vec2 q2, vec2 q3, uint n, vec2 h) {
-  Region r;
-  r.count = 0u;
-  r.kind = REGION_PLANES_ONLY;
-  vec2 q[4] = {q0, q1, q2, q3};
-  if (n == 4u) {
-    if (a.x >= min(q0.x, q2.x) && a.x <= max(q0.x, q2.x) && a.y >= min(q0.y, q2.y) &&
-        a.y <= max(q0.y, q2.y)) {
-      r.kind = REGION_EVERYWHERE;  // the anchor lies on the placed box
-      return r;
-    }
-  } else {
-    vec2 d = q1 - q0, e = a - q0;
-    if (abs(d.x * e.y - d.y * e.x) <= 1e-6f * dot(d, d) && dot(e, d) >= 0.0f && dot(e, d) <= dot(d, d)) {
-      r.kind = REGION_EVERYWHERE;  // the anchor lies on the placed connector
-      return r;
-    }
-  }
-  vec2 normals[REGION_PLANES];
-  uint m = 0u;
-  normals[m++] = vec2(1.0f, 0.0f);
-  normals[m++] = vec2(-1.0f, 0.0f);
-  normals[m++] = vec2(0.0f, 1.0f);
-  normals[m++] = vec2(0.0f, -1.0f);
-  for (uint k = 0u; k < n; ++k) {
-    vec2 d = q[k] - a;
-    normals[m++] = vec2(-d.y, d.x);
-    normals[m++] = vec2(d.y, -d.x);
-  }
-  if (n == 2u) {
-    vec2 d = q1 - q0;
-    normals[m++] = vec2(-d.y, d.x);
-    normals[m++] = vec2(d.y, -d.x);
-  }
-  for (uint k = 0u; k < m; ++k) {
-    vec2 nn = normals[k];
-    bool bounded = true;
-    float support = -3.4e38f;
-    for (uint v = 0u; v < n; ++v) {
-      vec2 d = q[v] - a;
-      if (dot(nn, d) > 1e-5f * length(nn) * length(d)) bounded = false;
-      support = max(support, dot(nn, q[v]));
-    }
-    if (!bounded) continue;
-    r.planes[r.count] = vec3(nn, support + h.x * abs(nn.x) + h.y * abs(nn.y));
-    r.count += 1u;
-  }
-  return r;
+// Does the hull of the new label's anchor a and its box (centre c, half size h) touch the
+// axis-aligned box [lo, hi]? The hull is what the new label and its connector cover; a placed
+// box touching it lies in the new anchor's "shadow" dilated by the new box (Stein & Decoret).
+// Separating axes: x, y and the normals of the four lines from a to the box corners (a superset
+// of the hull's edge normals, so the test is exact).
+float project_min(vec2 n, vec2 a, vec2 c, vec2 h) {
+  float m = dot(n, a);
+  m = min(m, dot(n, c + vec2(-h.x, -h.y)));
+  m = min(m, dot(n, c + vec2(h.x, -h.y)));
+  m = min(m, dot(n, c + vec2(h.x, h.y)));
+  return min(m, dot(n, c + vec2(-h.x, h.y)));
+}
+float project_max(vec2 n, vec2 a, vec2 c, vec2 h) {
+  float m = dot(n, a);
+  m = max(m, dot(n, c + vec2(-h.x, -h.y)));
+  m = max(m, dot(n, c + vec2(h.x, -h.y)));
+  m = max(m, dot(n, c + vec2(h.x, h.y)));
+  return max(m, dot(n, c + vec2(-h.x, h.y)));
 }
 
-// Touching counts (as in the separating-axis view): a centre exactly on a plane, up to float
-// rounding, is inside.
-bool in_region(Region r, vec2 c) {
-  if (r.kind != REGION_PLANES_ONLY) return r.kind == REGION_EVERYWHERE;
-  for (uint k = 0u; k < r.count; ++k) {
-    if (dot(vec2(r.planes[k]), c) > r.planes[k].z + 1e-5f * (abs(r.planes[k].z) + 1.0f)) return false;
+// True when axis n separates the hull from the segment p0-p1 (a box is handled as its two
+// diagonals' end points: its projection is the projection of its corners).
+bool separates(vec2 n, vec2 a, vec2 c, vec2 h, vec2 q0, vec2 q1, vec2 q2, vec2 q3) {
+  float lo = min(min(dot(n, q0), dot(n, q1)), min(dot(n, q2), dot(n, q3)));
+  float hi = max(max(dot(n, q0), dot(n, q1)), max(dot(n, q2), dot(n, q3)));
+  return project_max(n, a, c, h) < lo || hi < project_min(n, a, c, h);
+}
+
+// Does the hull of a and box(c, h) touch the convex set with corners q0..q3 (a box, or a segment
+// given as q0 = q2, q1 = q3)? `extra` is one more axis to try (the segment's normal).
+bool hull_touches(vec2 a, vec2 c, vec2 h, vec2 q0, vec2 q1, vec2 q2, vec2 q3, vec2 extra) {
+  if (separates(vec2(1.0f, 0.0f), a, c, h, q0, q1, q2, q3)) return false;
+  if (separates(vec2(0.0f, 1.0f), a, c, h, q0, q1, q2, q3)) return false;
+  if (separates(extra, a, c, h, q0, q1, q2, q3)) return false;
+  vec2 corners[4] = {c + vec2(-h.x, -h.y), c + vec2(h.x, -h.y), c + vec2(h.x, h.y), c + vec2(-h.x, h.y)};
+  for (int k = 0; k < 4; ++k) {
+    vec2 d = corners[k] - a;
+    if (abs(d.x) + abs(d.y) < 1e-6f) continue;
+    if (separates(vec2(-d.y, d.x), a, c, h, q0, q1, q2, q3)) return false;
   }
   return true;
 }
 
-// The dilated shadow of placed label j's box, and of its connector, for the new label `me`
-// (h: the new box's half size with the margin).
-Region label_shadow_region(LabelGpu me, vec2 h, uint j) {
-  vec3 other = placed(j);
-  LabelGpu them = label_at(j);
-  vec2 lo = vec2(other) - them.size * 0.5f, hi = vec2(other) + them.size * 0.5f;
-  return shadow_region(me.anchor, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), 4u, h);
-}
-Region connector_shadow_region(LabelGpu me, vec2 h, uint j) {
-  LabelGpu them = label_at(j);
-  if ((them.flags & LABEL_INTERNAL) != 0u) {
-    Region none;
-    none.count = 0u;
-    none.kind = REGION_NOWHERE;
-    return none;
-  }
-  vec3 other = placed(j);
-  return shadow_region(me.anchor, them.anchor, vec2(other), them.anchor, vec2(other), 2u, h);
-}
-
-// The label- and connector-shadow bits placed label j gives the new label `me` at centre c.
+// The label- and connector-shadow bits placed label j gives the new label `me` at centre c
+// (its box's half size h includes the margin).
 uint placed_bits(LabelGpu me, vec2 c, vec2 h, uint j, uint known) {
-  if (placed(j).z < 0.5f) return 0u;
+  vec3 other = placed(j);
+  if (other.z < 0.5f) return 0u;
+  LabelGpu them = label_at(j);
   uint bits = 0u;
-  if ((known & CONSTRAINT_LABEL) == 0u && in_region(label_shadow_region(me, h, j), c)) {
+  vec2 lo = vec2(other) - them.size * 0.5f, hi = vec2(other) + them.size * 0.5f;
+  if ((known & CONSTRAINT_LABEL) == 0u &&
+      hull_touches(me.anchor, c, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), vec2(1.0f, 0.0f))) {
     bits |= CONSTRAINT_LABEL;
   }
-  if ((known & CONSTRAINT_CONNECTOR) == 0u && in_region(connector_shadow_region(me, h, j), c)) {
-    bits |= CONSTRAINT_CONNECTOR;
+  if ((known & CONSTRAINT_CONNECTOR) == 0u && (them.flags & LABEL_INTERNAL) == 0u) {
+    vec2 p0 = them.anchor, p1 = vec2(other), d = p1 - p0;
+    if (hull_touches(me.anchor, c, h, p0, p1, p0, p1, vec2(-d.y, d.x))) bits |= CONSTRAINT_CONNECTOR;
   }
   return bits;
 }
@@ -140,6 +94,23 @@ uint constraint_bits(uint i, vec2 c, uint known) {
     }
   }
   return bits;
+}
+
+// Could label j (placed) or its connector constrain any candidate whose box, half size h, is
+// centred in the rectangle around `centre` of half size `extent`? The hull of the anchor and
+// that whole region contains every candidate's hull, so "no" is exact: a GPU tile skips j.
+bool may_constrain(LabelGpu me, vec2 centre, vec2 extent, uint j) {
+  vec3 other = placed(j);
+  if (other.z < 0.5f) return false;
+  LabelGpu them = label_at(j);
+  vec2 h = extent + me.size * 0.5f + vec2(params.margin);
+  vec2 lo = vec2(other) - them.size * 0.5f, hi = vec2(other) + them.size * 0.5f;
+  if (hull_touches(me.anchor, centre, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), vec2(1.0f, 0.0f))) {
+    return true;
+  }
+  if ((them.flags & LABEL_INTERNAL) != 0u) return false;
+  vec2 p0 = them.anchor, p1 = vec2(other), d = p1 - p0;
+  return hull_touches(me.anchor, centre, h, p0, p1, p0, p1, vec2(-d.y, d.x));
 }
 
 // The sum of the layer's integral costs over the box of `size` pixels at `origin`.
