@@ -55,6 +55,13 @@ void dump_layers(graph::GraphRunner& runner, graph::ResourceId layers, graph::Ex
   }
 }
 
+RenderSettings render_settings(const RenderOptions& o) {
+  RenderSettings settings;
+  settings.layer_count = o.layers;
+  settings.skip_empty = !o.no_skipping;
+  return settings;
+}
+
 // strata's main job: the labelled image (labeling/labelled_render.h).
 void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
@@ -62,7 +69,7 @@ void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
   Context ctx(device.context());
   LabellingSettings settings;
   settings.layer_count = o.layers;
-  settings.render.skip_empty = !o.no_skipping;
+  settings.render = render_settings(o);
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
   settings.internal = o.internal;
@@ -94,9 +101,7 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const Scene scene = load_scene_reporting(o.scene);
   Context ctx(device.context());
-  RenderSettings settings;
-  settings.layer_count = o.layers;
-  settings.skip_empty = !o.no_skipping;
+  const RenderSettings settings = render_settings(o);
   VolumeRenderer renderer(ctx, scene, settings);
   renderer.set_camera(camera_for(scene, o.camera));
   HeadlessTarget target(ctx);
