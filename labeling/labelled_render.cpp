@@ -122,6 +122,7 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
   const Placement::Resources placed =
       p.placement.add_to(graph, rendered.final, rendered.layers, render.layer_count);
   results_id_ = placed.results;
+  buckets_id_ = placed.buckets;
   layers_id_ = rendered.layers;
   p.glyph_id = graph.import_resource("labels.glyphs", {false, true});
   const graph::ResourceId labelled = graph.add_image("labels.final", {VK_FORMAT_R8G8B8A8_UNORM});

@@ -79,6 +79,8 @@ class LabelledRenderer {
   graph::GraphRunner& runner() { return *runner_; }
   // The placement's per-label results buffer (the baseline benchmark reads it after each label).
   graph::ResourceId placement_results() const { return results_id_; }
+  // Per label, its tiles per bucket and how many the second pass took (benchmark statistics).
+  graph::ResourceId placement_buckets() const { return buckets_id_; }
   // Binds the imported resources (after anything that reallocates the runner's transients).
   void bind();
   // The picture and layout of the last run.
@@ -98,6 +100,7 @@ class LabelledRenderer {
 
   RenderStats stats_;
   graph::ResourceId results_id_ = 0;
+  graph::ResourceId buckets_id_ = 0;
   graph::ResourceId layers_id_ = 0;
   LabellingSettings settings_;
 };

@@ -27,6 +27,7 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   p.saliency_weight = s.saliency_weight;
   p.occlusion_weight = s.occlusion_weight;
   p.single_saliency_weight = s.single_saliency_weight;
+  p.bucket_width = s.bucket_width;
   return p;
 }
 
@@ -35,7 +36,9 @@ Placement::Placement(Context& ctx, uint32_t label_count)
       label_count_(label_count),
       saliency_(ctx, "saliency.comp"),
       integral_costs_(ctx, "integral_costs.comp"),
-      place_label_(ctx, "place_label.comp"),
+      bounds_(ctx, "placement_bounds.comp"),
+      place_first_(ctx, "place_label_first.comp"),
+      place_rest_(ctx, "place_label_rest.comp"),
       finalize_(ctx, "placement_finalize.comp"),
       tables_(ctx) {
   if (label_count > LABEL_MAX) {
@@ -48,7 +51,9 @@ Placement::Placement(Context& ctx, uint32_t label_count)
 }
 
 gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) const {
-  return placement_params(settings_, viewport, layer_count_, label_count_, step);
+  gpu::PlacementParams p = placement_params(settings_, viewport, layer_count_, label_count_, step);
+  p.order_count = static_cast<uint32_t>(order_.size());
+  return p;
 }
 
 void Placement::set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_t> order,
@@ -83,6 +88,23 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
   r.costs = graph.add_buffer("placement.integral_costs", per_pixel(sizeof(float) * layer_count));
   r.tables = graph.add_buffer("placement.tables", per_pixel(sizeof(float) * layer_count));
   r.constraints = graph.add_buffer("placement.constraints", per_pixel(sizeof(uint32_t)));
+  const auto per_label_tile = [n](VkDeviceSize bytes) {
+    return graph::BufferInfo{[n, bytes](graph::Extent e) {
+      return VkDeviceSize{n} * group_count(e.width, PLACEMENT_TILE) *
+             group_count(e.height, PLACEMENT_TILE) * bytes;
+    }};
+  };
+  const ResourceId bounds = graph.add_buffer("placement.bounds", per_label_tile(sizeof(float)));
+  const ResourceId tiles = graph.add_buffer("placement.tiles", per_label_tile(sizeof(uint32_t)));
+  const ResourceId buckets =
+      graph.add_buffer("placement.buckets", fixed(n * sizeof(gpu::PlacementBucketsGpu)));
+  r.buckets = buckets;
+  const ResourceId lower = graph.add_buffer("placement.lower", fixed(n * sizeof(uint32_t)));
+  const ResourceId args = graph.add_buffer("placement.args", fixed(n * 3 * sizeof(uint32_t)));
+  const ResourceId rest_args =
+      graph.add_buffer("placement.rest_args", fixed(n * 3 * sizeof(uint32_t)));
+  const ResourceId regions =
+      graph.add_buffer("placement.regions", fixed(VkDeviceSize{n} * n * sizeof(gpu::PairRegionsGpu)));
   readback_id_ = graph.import_resource("placement.readback",
                                        {false, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::host_read});
 
@@ -91,8 +113,13 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                   {{r.labels, Use::transfer_dst},
                    {order, Use::transfer_dst},
                    {results, Use::transfer_dst},
-                   {r.constraints, Use::transfer_dst}},
-                  [this, r, order, results](graph::PassContext& pc) {
+                   {r.constraints, Use::transfer_dst},
+                   {buckets, Use::transfer_dst},
+                   {lower, Use::transfer_dst},
+                   {rest_args, Use::transfer_dst},
+                   {regions, Use::transfer_dst}},
+                  [this, r, order, results, buckets, lower, rest_args,
+                   regions](graph::PassContext& pc) {
                     if (!labels_.empty()) {
                       vkCmdUpdateBuffer(pc.cmd, pc.buffer(r.labels), 0,
                                         labels_.size() * sizeof(gpu::LabelGpu), labels_.data());
@@ -103,6 +130,13 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                     }
                     vkCmdFillBuffer(pc.cmd, pc.buffer(results), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
                     vkCmdFillBuffer(pc.cmd, pc.buffer(r.constraints), 0, VK_WHOLE_SIZE, 0);
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(buckets), 0, VK_WHOLE_SIZE, 0);
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(lower), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+                    // A label with no candidate at all has no first-pass workgroup to size the
+                    // second pass: it stays empty.
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(rest_args), 0, VK_WHOLE_SIZE, 0);
+                    // No regions: a label that is never placed constrains nobody.
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(regions), 0, VK_WHOLE_SIZE, 0);
                   },
                   "placement"});
   const auto per_pixel_dispatch = [this](const ComputePipeline& pipeline, graph::PassContext& pc) {
@@ -128,22 +162,72 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                   },
                   "placement"});
   tables_.add_to(graph, r.costs, r.tables, "placement.sat", layer_count);
-  for (uint32_t step = 0; step < label_count_; ++step) {
-    graph.add_pass({"placement.label",
+  // Tile bounds, bucket counts, tiles sorted by bucket: for every label at once.
+  for (const uint32_t phase :
+       {PLACEMENT_PHASE_BOUNDS, PLACEMENT_PHASE_COUNT, PLACEMENT_PHASE_SORT}) {
+    static constexpr const char* names[] = {"placement.bounds", "placement.buckets",
+                                            "placement.tiles"};
+    graph.add_pass({names[phase],
                     graph::PassKind::compute,
                     {{r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
                      {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
                      {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
-                     {results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
-                     {r.constraints, Use::storage_read_write, PLACEMENT_BINDING_CONSTRAINTS}},
-                    [this, step](graph::PassContext& pc) {
-                      if (step >= order_.size()) return;  // fewer labels enabled this frame
-                      pc.bind(place_label_);
-                      place_label_.push_constants(pc.cmd, params(pc.viewport, step));
-                      vkCmdDispatch(pc.cmd, group_count(pc.viewport.width, PLACEMENT_GROUP),
-                                    group_count(pc.viewport.height, PLACEMENT_GROUP), 1);
+                     // (one shader for the three phases: the bounds phase writes the bounds and
+                     // the later ones read them, but each binds them writable; the tile list and
+                     // the sizes are bound in each phase, only the last writes them)
+                     {bounds,
+                      phase == PLACEMENT_PHASE_BOUNDS ? Use::storage_write : Use::storage_read_write,
+                      PLACEMENT_BINDING_BOUNDS},
+                     {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
+                     {tiles, Use::storage_write, PLACEMENT_BINDING_TILES},
+                     {lower, Use::storage_read_write, PLACEMENT_BINDING_LOWER},
+                     {args, Use::storage_write, PLACEMENT_BINDING_ARGS}},
+                    [this, phase](graph::PassContext& pc) {
+                      if (order_.empty()) return;
+                      pc.bind(bounds_);
+                      gpu::PlacementParams p = params(pc.viewport, 0);
+                      p.phase = phase;
+                      bounds_.push_constants(pc.cmd, p);
+                      const uint32_t tile_count = group_count(pc.viewport.width, PLACEMENT_TILE) *
+                                                  group_count(pc.viewport.height, PLACEMENT_TILE);
+                      // Bounds: a workgroup of 64 per tile (its cells); then 64 tiles per group.
+                      vkCmdDispatch(pc.cmd,
+                                    phase == PLACEMENT_PHASE_BOUNDS ? tile_count
+                                                                    : group_count(tile_count, 64),
+                                    static_cast<uint32_t>(order_.size()), 1);
                     },
                     "placement"});
+  }
+  // Per label: the first pass reads its size from `args` and sizes the second in `rest_args`.
+  std::vector<graph::ResourceUse> label_uses{
+      {r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
+      {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+      {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
+      {results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
+      {r.constraints, Use::storage_read_write, PLACEMENT_BINDING_CONSTRAINTS},
+      {bounds, Use::storage_read, PLACEMENT_BINDING_BOUNDS},
+      {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
+      {tiles, Use::storage_read, PLACEMENT_BINDING_TILES},
+      {lower, Use::storage_read, PLACEMENT_BINDING_LOWER},
+      {regions, Use::storage_read_write, PLACEMENT_BINDING_REGIONS}};
+  std::vector<graph::ResourceUse> first_uses = label_uses, rest_uses = label_uses;
+  first_uses.push_back({args, Use::indirect});
+  first_uses.push_back({rest_args, Use::storage_read_write, PLACEMENT_BINDING_REST_ARGS});
+  rest_uses.push_back({rest_args, Use::indirect});
+  for (uint32_t step = 0; step < label_count_; ++step) {
+    for (const bool first : {true, false}) {
+      graph.add_pass({first ? "placement.label" : "placement.label_rest", graph::PassKind::compute,
+                      first ? first_uses : rest_uses,
+                      [this, step, first, args, rest_args](graph::PassContext& pc) {
+                        if (step >= order_.size()) return;  // fewer labels enabled this frame
+                        const ComputePipeline& pipeline = first ? place_first_ : place_rest_;
+                        pc.bind(pipeline);
+                        pipeline.push_constants(pc.cmd, params(pc.viewport, step));
+                        vkCmdDispatchIndirect(pc.cmd, pc.buffer(first ? args : rest_args),
+                                              VkDeviceSize{step} * 3 * sizeof(uint32_t));
+                      },
+                      "placement"});
+    }
   }
   graph.add_pass({"placement.finalize",
                   graph::PassKind::compute,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "passes/summed_area_table.h"
 #include "shared/saliency.h"
@@ -18,13 +19,15 @@ struct Placer {
   std::span<const uint32_t> order;
   const std::vector<float>& tables;
   std::vector<uint64_t> results;
+  std::vector<PairRegionsGpu> regions;  // the label being placed against each placed label
 
-  LabelGpu label_at(uint i) const { return labels[i]; }
+  std::vector<vec2> anchors;             // every shown label's anchor
+
   // Every label placed so far, every anchor: the GPU's tile culling only skips what cannot matter.
   uint placed_count() const { return params.step; }
-  uint placed_label(uint k) const { return order[k]; }
-  uint anchor_count() const { return params.label_count; }
-  uint anchor_label(uint k) const { return k; }
+  PairRegionsGpu placed_regions(uint k) const { return regions[order[k]]; }
+  uint anchor_count() const { return uint(anchors.size()); }
+  vec2 anchor_at(uint k) const { return anchors[k]; }
   vec3 placed(uint j) const {
     if (results[j] == PLACEMENT_NONE) return vec3(0.0f);
     const uint pixel = uint(results[j] & 0xFFFFFFFFu);
@@ -90,19 +93,28 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
   // The greedy loop: each label's argmin over every pixel (ties: the lowest pixel index).
   gpu::Placer placer{placement_params(settings, size, layer_count, uint32_t(labels.size()), 0),
                      labels, order, out.tables,
-                     std::vector<uint64_t>(labels.size(), PLACEMENT_NONE)};
+                     std::vector<uint64_t>(labels.size(), PLACEMENT_NONE),
+                     std::vector<gpu::PairRegionsGpu>(labels.size()),
+                     {}};
+  for (const gpu::LabelGpu& l : labels) {
+    if ((l.flags & LABEL_ENABLED) != 0u) placer.anchors.push_back(l.anchor);
+  }
   out.constraints.assign(pixels, 0u);
   for (uint32_t step = 0; step < order.size(); ++step) {
     placer.params.step = step;
     const uint32_t label = order[step];
     const gpu::LabelGpu& me = labels[label];
+    for (uint32_t k = 0; k < step; ++k) {
+      const uint32_t j = order[k];
+      placer.regions[j] = placer.pair_regions(me, labels[j], placer.placed(j), settings.margin);
+    }
     for (uint32_t y = 0; y < h; ++y) {
       for (uint32_t x = 0; x < w; ++x) {
         const glm::uvec2 p(x, y);
         if (!placer.candidate_allowed(me, p)) continue;
         const glm::vec2 origin = gpu::box_origin(p, me.size);
         const glm::vec2 centre = origin + me.size * 0.5f;
-        const uint32_t bits = placer.constraint_bits(label, centre, 0u);
+        const uint32_t bits = placer.constraint_bits(me, centre, 0u, std::numeric_limits<float>::infinity());
         const uint32_t pixel = y * w + x;
         if (settings.write_constraints) out.constraints[pixel] = bits;
         if (settings.hard && bits != 0u) continue;

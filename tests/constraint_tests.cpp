@@ -81,7 +81,7 @@ TEST_SUITE("cpu") {
     const graph::Extent size{48, 32};
     const size_t pixels = size_t{size.width} * size.height;
     // A mostly empty scene, so label 0 lands near its anchor; label 1 is the one whose
-    // constraints are examined. Anchors off the pixel grid: no centre lies on a region's edge.
+    // constraints are examined. Anchors off the pixel grid, so few centres lie on a region's edge.
     const std::vector<gpu::LabelGpu> labels = {label({12.3f, 16.7f}, {9.0f, 5.0f}),
                                                label({36.6f, 13.2f}, {7.0f, 3.0f})};
     const std::vector<uint32_t> order = {0, 1};
@@ -102,7 +102,7 @@ TEST_SUITE("cpu") {
     const Polygon line = hull({p0 - n, p0 + n, p1 + n, p1 - n});
     const glm::dvec2 anchor(labels[1].anchor), half = glm::dvec2(labels[1].size) * 0.5 + 1.0;
 
-    size_t label_pixels = 0, line_pixels = 0, mismatches = 0;
+    size_t label_pixels = 0, line_pixels = 0, mismatches = 0, excused = 0;
     for (uint32_t y = 0; y < size.height; ++y) {
       for (uint32_t x = 0; x < size.width; ++x) {
         const glm::vec2 origin = gpu::box_origin(glm::uvec2(x, y), labels[1].size);
@@ -116,13 +116,26 @@ TEST_SUITE("cpu") {
         const bool expect_line = touches(anchor, centre, half, line);
         label_pixels += expect_label;
         line_pixels += expect_line;
-        mismatches += ((bits & CONSTRAINT_LABEL) != 0u) != expect_label;
-        mismatches += ((bits & CONSTRAINT_CONNECTOR) != 0u) != expect_line;
+        // A centre within 1e-4 pixels of a region's slanted edge (the hull just grazing a
+        // corner) is decided by rounding: a difference there is excused, and counted.
+        const glm::dvec2 tiny(1e-4);
+        const bool label_edge = touches(anchor, centre, half - tiny, box0) != expect_label ||
+                                touches(anchor, centre, half + tiny, box0) != expect_label;
+        const bool line_edge = touches(anchor, centre, half - tiny, line) != expect_line ||
+                               touches(anchor, centre, half + tiny, line) != expect_line;
+        const bool label_differs = ((bits & CONSTRAINT_LABEL) != 0u) != expect_label;
+        const bool line_differs = ((bits & CONSTRAINT_CONNECTOR) != 0u) != expect_line;
+        excused += (label_differs && label_edge) + (line_differs && line_edge);
+        if ((label_differs && !label_edge) || (line_differs && !line_edge)) {
+          MESSAGE("pixel " << x << "," << y << ": constraint bits " << bits);
+          ++mismatches;
+        }
       }
     }
     CHECK(label_pixels > 20);  // the regions are not empty...
     CHECK(line_pixels > 20);
     CHECK(label_pixels < 900);  // ...nor everything
+    CHECK(excused <= 2);
     CHECK(mismatches == 0);
   }
 }

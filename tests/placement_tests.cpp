@@ -173,6 +173,21 @@ TEST_SUITE("gpu") {
     }
   }
 
+  TEST_CASE_FIXTURE(test::GpuTest, "bucket_width_changes_the_passes_not_the_positions") {
+    // Twelve labels in a small scene, so later ones meet constraints and their best lies far
+    // above their lowest tile bound: with a tiny width nearly every tile is left to the second
+    // pass, with a huge one the first pass takes them all. The positions stay the reference's.
+    const Inputs in = disc_scene(12);
+    const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                   in.labels, in.order, {}, in.size);
+    for (const float width : {0.01f, 1.0f, 1e9f}) {
+      CAPTURE(width);
+      PlacementSettings settings;
+      settings.bucket_width = width;
+      check_placements(place_on_gpu(ctx, in, settings), cpu);
+    }
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "one_layer_uses_eq_3_4_and_still_matches") {
     Inputs in = disc_scene(4);
     const size_t pixels = size_t{in.size.width} * in.size.height;

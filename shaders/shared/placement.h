@@ -5,7 +5,10 @@
 
 #include "labels.h"
 
-#define PLACEMENT_GROUP 16               // 16 x 16 pixels per workgroup
+#define PLACEMENT_GROUP 16               // 16 x 16 threads per workgroup
+#define PLACEMENT_TILE 32                // place_label: 32 x 32 candidates per workgroup
+#define PLACEMENT_SPAN (PLACEMENT_TILE / PLACEMENT_GROUP)  // ... SPAN x SPAN per invocation
+#define PLACEMENT_CELL 4                 // placement_bounds: 4 x 4 candidates per cell
 #define VR_MAX_LAYERS_FOR_PLACEMENT 8    // as VR_MAX_LAYERS
 #define SALIENCY_SCALE 100.0f            // |CIELAB gradient| of this size counts as saliency 1
 
@@ -13,6 +16,10 @@
 #define CONSTRAINT_LABEL 1u      // the new box or connector would touch a placed label's shadow
 #define CONSTRAINT_CONNECTOR 2u  // ... a placed connector's shadow
 #define CONSTRAINT_ANCHOR 4u     // the new box would cover an anchor
+
+// PairRegionsGpu.info.x
+#define REGION_BOX 1u        // the box region is there (the other label is shown)
+#define REGION_CONNECTOR 2u  // the connector region is there (... and not internal)
 
 // A packed (cost, pixel) pair no candidate reaches: "not placed".
 #define PLACEMENT_NONE 0xFFFFFFFFFFFFFFFFul
@@ -27,6 +34,25 @@
 #define PLACEMENT_BINDING_RESULTS 7      // uint64_t[] per label: cost bits << 32 | pixel
 #define PLACEMENT_BINDING_CONSTRAINTS 8  // uint per pixel: constraint bits of the last label placed
 #define PLACEMENT_BINDING_PLACEMENTS 9   // PlacementGpu[]
+#define PLACEMENT_BINDING_BOUNDS 10      // float per order position per tile: lower cost bound
+#define PLACEMENT_BINDING_BUCKETS 11     // PlacementBucketsGpu per order position
+#define PLACEMENT_BINDING_TILES 12       // uint per order position per tile: tiles by bucket
+#define PLACEMENT_BINDING_LOWER 13       // uint per order position: the smallest tile bound's bits
+#define PLACEMENT_BINDING_ARGS 14        // uint[3] per order position: the first pass's dispatch
+#define PLACEMENT_BINDING_REST_ARGS 15   // uint[3] per order position: the second pass's dispatch
+#define PLACEMENT_BINDING_REGIONS 16     // PairRegionsGpu per (order position, label)
+
+// Tiles are sorted per label into buckets by how far their lower cost bound lies above the
+// label's smallest one: bucket 0 below bucket_width, bucket b (1..) below bucket_width * 4^b,
+// the last one everything else. The first pass places the label in bucket 0's tiles; the second
+// takes the next buckets up to the best cost the first found.
+#define PLACEMENT_BUCKETS 8
+#define PLACEMENT_BUCKET_GROWTH 4.0f
+
+// PlacementParams.phase
+#define PLACEMENT_PHASE_BOUNDS 0u   // placement_bounds.comp: tile bounds and each label's lowest
+#define PLACEMENT_PHASE_COUNT 1u    // ... tiles per bucket
+#define PLACEMENT_PHASE_SORT 2u     // ... tiles sorted by bucket, the first pass's dispatch size
 
 STRATA_BEGIN
 #ifdef __cplusplus
@@ -58,7 +84,30 @@ struct PlacementParams {
   float saliency_weight;   // eq. 3.3: beta, how much saliency modulates occlusion behind
   float occlusion_weight;  // eq. 3.4 (one layer): alpha
   float single_saliency_weight;  // eq. 3.4: beta
-  float pad;
+  uint phase;         // placement_bounds.comp: PLACEMENT_PHASE_*
+  float bucket_width;  // cost above the label's lowest tile bound that bucket 0 holds
+  uint order_count;    // labels in the insertion order
+  uint pad1;
+};
+
+// Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,
+// after Stein & Decoret): its box or connector would touch j's box (`box`) or connector
+// (`connector`). Each region is convex, an intersection of half-planes dot(p.xy, c) <= p.z;
+// unused planes are zero. Written once per pair when j is placed; read by every tile.
+struct PairRegionsGpu {
+  vec4 box[4];
+  vec4 connector[6];
+  uvec4 info;  // x: REGION_* bits
+};
+
+// Per label (order position): its tiles per bucket, and the second pass's size.
+struct PlacementBucketsGpu {
+  uint done;       // first-pass workgroups finished (the last one sizes the second pass)
+  uint rest;       // tiles in the second pass
+  uint done_rest;  // second-pass workgroups finished
+  uint pad1;
+  uint counts[PLACEMENT_BUCKETS];
+  uint cursors[PLACEMENT_BUCKETS];
 };
 
 #ifdef __cplusplus
@@ -66,6 +115,27 @@ inline
 #endif
 // The top-left pixel of a label box of `size` whose candidate pixel is p.
 vec2 box_origin(uvec2 p, vec2 size) { return vec2(p) - floor(size * 0.5f); }
+
+#ifdef __cplusplus
+inline
+#endif
+// The workgroup counts of an indirect dispatch over `count` tiles (x is limited to 65535).
+uvec3 placement_dispatch_size(uint count) {
+  return uvec3(min(count, 65535u), (count + 65534u) / 65535u, 1u);
+}
+
+#ifdef __cplusplus
+inline
+#endif
+// The bucket of a tile whose lower cost bound lies `above` the label's lowest.
+uint placement_bucket(float above, float bucket_width) {
+  float edge = bucket_width;
+  for (uint b = 0u; b + 1u < PLACEMENT_BUCKETS; ++b) {
+    if (above < edge) return b;
+    edge *= PLACEMENT_BUCKET_GROWTH;
+  }
+  return PLACEMENT_BUCKETS - 1u;
+}
 STRATA_END
 
 #endif

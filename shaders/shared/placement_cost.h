@@ -2,115 +2,176 @@
 // once for the GPU (place_label.comp) and the CPU reference (labeling/placement_reference.cpp).
 // The includer provides:
 //   params                         PlacementParams
-//   LabelGpu label_at(uint i)
-//   uint placed_count()            how many labels to test against (those placed so far, or the
-//   uint placed_label(uint k)      ... ones a GPU tile's candidates can reach), and which
-//   uint anchor_count()            how many anchors to test against, and which
-//   uint anchor_label(uint k)
-//   vec3 placed(uint j)            label j's box centre (xy) and 1 in z if it is shown, else 0
+//   uint placed_count()            how many placed labels to test against (all placed so far,
+//                                  or the ones a GPU tile's candidates can reach) ...
+//   PairRegionsGpu placed_regions(uint k)   ... and the k-th one's regions (pair_regions below)
+//   uint anchor_count()            how many anchors to test against (shown labels'), ...
+//   vec2 anchor_at(uint k)         ... and where the k-th is
 //   float table_at(uint layer, int x, int y)   summed-area table of the layer's integral costs
 //
 // A candidate is a pixel p; the label box then spans pixels [box_origin(p), + size) and its
 // centre is box_origin + size / 2 (box_origin: shared/placement.h).
 
-// Does the hull of the new label's anchor a and its box (centre c, half size h) touch the
-// axis-aligned box [lo, hi]? The hull is what the new label and its connector cover; a placed
-// box touching it lies in the new anchor's "shadow" dilated by the new box (Stein & Decoret).
-// Separating axes: x, y and the normals of the four lines from a to the box corners (a superset
-// of the hull's edge normals, so the test is exact).
-float project_min(vec2 n, vec2 a, vec2 c, vec2 h) {
-  float m = dot(n, a);
-  m = min(m, dot(n, c + vec2(-h.x, -h.y)));
-  m = min(m, dot(n, c + vec2(h.x, -h.y)));
-  m = min(m, dot(n, c + vec2(h.x, h.y)));
-  return min(m, dot(n, c + vec2(-h.x, h.y)));
-}
-float project_max(vec2 n, vec2 a, vec2 c, vec2 h) {
-  float m = dot(n, a);
-  m = max(m, dot(n, c + vec2(-h.x, -h.y)));
-  m = max(m, dot(n, c + vec2(h.x, -h.y)));
-  m = max(m, dot(n, c + vec2(h.x, h.y)));
-  return max(m, dot(n, c + vec2(-h.x, h.y)));
+// A placed box or connector B constrains a new label whose anchor is a and whose box (half size
+// h, margin included) is centred at c when the convex hull of a and that box touches B: the new
+// box or connector would touch it. Those c form a convex region: B's "shadow" from a (B and
+// everything behind it as seen from a) dilated by the box (Stein & Decoret). Its edges are
+// parallel to the two silhouette rays from a past B, to B's edges that face a, or to the box's
+// (axis) edges, so it is the intersection of the half-planes n.c <= support of the shadow in n +
+// support of the box in n over those normals n (exact: the Minkowski sum's support function is
+// the sum). B is a box (v0..v3, counter-clockwise from lo) or a segment (v0, v1 = v2 = v3).
+struct ShadowPlanes {
+  vec4 p[6];
+};
+
+vec4 dilated_plane(vec2 n, float support, vec2 h) {
+  return vec4(n, support + abs(n.x) * h.x + abs(n.y) * h.y, 0.0f);
 }
 
-// True when axis n separates the hull from the segment p0-p1 (a box is handled as its two
-// diagonals' end points: its projection is the projection of its corners).
-bool separates(vec2 n, vec2 a, vec2 c, vec2 h, vec2 q0, vec2 q1, vec2 q2, vec2 q3) {
-  float lo = min(min(dot(n, q0), dot(n, q1)), min(dot(n, q2), dot(n, q3)));
-  float hi = max(max(dot(n, q0), dot(n, q1)), max(dot(n, q2), dot(n, q3)));
-  return project_max(n, a, c, h) < lo || hi < project_min(n, a, c, h);
-}
-
-// Does the hull of a and box(c, h) touch the convex set with corners q0..q3 (a box, or a segment
-// given as q0 = q2, q1 = q3)? `extra` is one more axis to try (the segment's normal).
-bool hull_touches(vec2 a, vec2 c, vec2 h, vec2 q0, vec2 q1, vec2 q2, vec2 q3, vec2 extra) {
-  if (separates(vec2(1.0f, 0.0f), a, c, h, q0, q1, q2, q3)) return false;
-  if (separates(vec2(0.0f, 1.0f), a, c, h, q0, q1, q2, q3)) return false;
-  if (separates(extra, a, c, h, q0, q1, q2, q3)) return false;
-  vec2 corners[4] = {c + vec2(-h.x, -h.y), c + vec2(h.x, -h.y), c + vec2(h.x, h.y), c + vec2(-h.x, h.y)};
-  for (int k = 0; k < 4; ++k) {
-    vec2 d = corners[k] - a;
-    if (abs(d.x) + abs(d.y) < 1e-6f) continue;
-    if (separates(vec2(-d.y, d.x), a, c, h, q0, q1, q2, q3)) return false;
+ShadowPlanes shadow_planes(vec2 a, vec2 h, vec2 v0, vec2 v1, vec2 v2, vec2 v3, bool segment) {
+  ShadowPlanes r;
+  for (int k = 0; k < 6; ++k) r.p[k] = vec4(0.0f);
+  vec2 v[4] = {v0, v1, v2, v3};
+  vec2 lo = min(min(v0, v1), min(v2, v3)), hi = max(max(v0, v1), max(v2, v3));
+  vec2 e = v1 - v0;
+  // a on B: the hull always touches it, every centre is constrained (all planes 0 <= 0).
+  if (segment) {
+    float t = dot(a - v0, e);
+    bool on = e.x * (a.y - v0.y) - e.y * (a.x - v0.x) == 0.0f && t >= 0.0f && t <= dot(e, e);
+    if (dot(e, e) == 0.0f) on = a == v0;
+    if (on) return r;
+  } else if (all(greaterThanEqual(a, lo)) && all(lessThanEqual(a, hi))) {
+    return r;
   }
-  return true;
+  // The silhouette: the vertices at the largest and smallest angle around the direction from a
+  // to B's middle (the shadow's opening is below 180 degrees, so angles are in (-pi, pi)).
+  vec2 m = 0.5f * (lo + hi) - a;
+  int first = 0, last = 0;
+  float most = -4.0f, least = 4.0f;
+  for (int k = 0; k < 4; ++k) {
+    vec2 d = v[k] - a;
+    float angle = atan(m.x * d.y - m.y * d.x, dot(m, d));
+    if (angle > most) {
+      most = angle;
+      first = k;
+    }
+    if (angle < least) {
+      least = angle;
+      last = k;
+    }
+  }
+  // Outward normals of the two rays (every vertex lies on the inner side).
+  vec2 d_first = v[first] - a, d_last = v[last] - a;
+  r.p[0] = dilated_plane(vec2(-d_first.y, d_first.x), dot(vec2(-d_first.y, d_first.x), a), h);
+  r.p[1] = dilated_plane(vec2(d_last.y, -d_last.x), dot(vec2(d_last.y, -d_last.x), a), h);
+  // The axes along which the shadow is bounded: B lies entirely on the near side of a.
+  if (hi.x <= a.x) r.p[2] = dilated_plane(vec2(1.0f, 0.0f), hi.x, h);
+  if (lo.x >= a.x) r.p[3] = dilated_plane(vec2(-1.0f, 0.0f), -lo.x, h);
+  if (hi.y <= a.y) r.p[4] = dilated_plane(vec2(0.0f, 1.0f), hi.y, h);
+  if (lo.y >= a.y) r.p[5] = dilated_plane(vec2(0.0f, -1.0f), -lo.y, h);
+  if (segment) {
+    // The segment's own edge, facing a (a box's facing edges are axes, above). At most two
+    // axis planes are set unless the segment has no length or lies on a line through a; the
+    // ray planes then hold the region, and an axis slot is free for this one.
+    vec2 n = vec2(-e.y, e.x);
+    if (dot(n, a - v0) < 0.0f) n = -n;
+    vec4 plane = dilated_plane(n, dot(n, v0), h);
+    if (r.p[2] == vec4(0.0f)) r.p[2] = plane;
+    else if (r.p[3] == vec4(0.0f)) r.p[3] = plane;
+    else if (r.p[4] == vec4(0.0f)) r.p[4] = plane;
+    else r.p[5] = plane;
+  }
+  return r;
 }
 
-// The label- and connector-shadow bits placed label j gives the new label `me` at centre c
-// (its box's half size h includes the margin).
-uint placed_bits(LabelGpu me, vec2 c, vec2 h, uint j, uint known) {
-  vec3 other = placed(j);
-  if (other.z < 0.5f) return 0u;
-  LabelGpu them = label_at(j);
+// Label k's regions against placed label j (its box centre and 1 in z if shown, else 0).
+PairRegionsGpu pair_regions(LabelGpu k, LabelGpu j, vec3 placed_j, float margin) {
+  PairRegionsGpu r;
+  vec2 h = k.size * 0.5f + vec2(margin);
+  r.info = uvec4(0u);
+  for (int i = 0; i < 4; ++i) r.box[i] = vec4(0.0f);
+  for (int i = 0; i < 6; ++i) r.connector[i] = vec4(0.0f);
+  if (placed_j.z < 0.5f) return r;
+  vec2 centre = vec2(placed_j);
+  vec2 lo = centre - j.size * 0.5f, hi = centre + j.size * 0.5f;
+  ShadowPlanes box = shadow_planes(k.anchor, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), false);
+  // (A box's shadow has at most two axis planes: the ray planes and those two.)
+  int used = 0;
+  for (int i = 0; i < 6; ++i) {
+    if (box.p[i] != vec4(0.0f) && used < 4) r.box[used++] = box.p[i];
+  }
+  r.info.x = REGION_BOX;
+  if ((j.flags & LABEL_INTERNAL) == 0u) {
+    ShadowPlanes c = shadow_planes(k.anchor, h, j.anchor, centre, centre, centre, true);
+    for (int i = 0; i < 6; ++i) r.connector[i] = c.p[i];
+    r.info.x |= REGION_CONNECTOR;
+  }
+  return r;
+}
+
+// The box-shadow or connector-shadow region (4 or 6 planes) holds the centre c ...
+bool region_holds(vec4 p0, vec4 p1, vec4 p2, vec4 p3, vec4 p4, vec4 p5, vec2 c) {
+  return dot(vec2(p0), c) <= p0.z && dot(vec2(p1), c) <= p1.z && dot(vec2(p2), c) <= p2.z &&
+         dot(vec2(p3), c) <= p3.z && dot(vec2(p4), c) <= p4.z && dot(vec2(p5), c) <= p5.z;
+}
+// ... touches the rectangle of centres (middle c, half size e): no plane separates them ...
+float plane_gap(vec4 p, vec2 c, vec2 e) {
+  return dot(vec2(p), c) - abs(p.x) * e.x - abs(p.y) * e.y - p.z;
+}
+bool region_touches(vec4 p0, vec4 p1, vec4 p2, vec4 p3, vec4 p4, vec4 p5, vec2 c, vec2 e) {
+  return plane_gap(p0, c, e) <= 0.0f && plane_gap(p1, c, e) <= 0.0f &&
+         plane_gap(p2, c, e) <= 0.0f && plane_gap(p3, c, e) <= 0.0f &&
+         plane_gap(p4, c, e) <= 0.0f && plane_gap(p5, c, e) <= 0.0f;
+}
+// ... or holds all of it (each of its corners).
+bool region_covers(vec4 p0, vec4 p1, vec4 p2, vec4 p3, vec4 p4, vec4 p5, vec2 c, vec2 e) {
+  return region_touches(p0, p1, p2, p3, p4, p5, c, -e);
+}
+
+// The label- and connector-shadow bits label j gives the label being placed at centre c, from
+// their regions; `known` bits are not tested again.
+uint region_bits(PairRegionsGpu r, vec2 c, uint known) {
   uint bits = 0u;
-  vec2 lo = vec2(other) - them.size * 0.5f, hi = vec2(other) + them.size * 0.5f;
-  if ((known & CONSTRAINT_LABEL) == 0u &&
-      hull_touches(me.anchor, c, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), vec2(1.0f, 0.0f))) {
+  if ((r.info.x & REGION_BOX) != 0u && (known & CONSTRAINT_LABEL) == 0u &&
+      region_holds(r.box[0], r.box[1], r.box[2], r.box[3], vec4(0.0f), vec4(0.0f), c)) {
     bits |= CONSTRAINT_LABEL;
   }
-  if ((known & CONSTRAINT_CONNECTOR) == 0u && (them.flags & LABEL_INTERNAL) == 0u) {
-    vec2 p0 = them.anchor, p1 = vec2(other), d = p1 - p0;
-    if (hull_touches(me.anchor, c, h, p0, p1, p0, p1, vec2(-d.y, d.x))) bits |= CONSTRAINT_CONNECTOR;
+  if ((r.info.x & REGION_CONNECTOR) != 0u && (known & CONSTRAINT_CONNECTOR) == 0u &&
+      region_holds(r.connector[0], r.connector[1], r.connector[2], r.connector[3],
+                   r.connector[4], r.connector[5], c)) {
+    bits |= CONSTRAINT_CONNECTOR;
   }
   return bits;
 }
 
-// The constraint bits of placing label i with its box centred at c. Kinds already in `known`
-// are not tested again (a GPU tile may know them for all its candidates).
-uint constraint_bits(uint i, vec2 c, uint known) {
-  LabelGpu me = label_at(i);
+// What eq. 3.1 adds for the constraint bits.
+float constraint_weight(uint bits) {
+  float sum = 0.0f;
+  if ((bits & CONSTRAINT_LABEL) != 0u) sum += params.weights.label_shadow;
+  if ((bits & CONSTRAINT_CONNECTOR) != 0u) sum += params.weights.connector_shadow;
+  if ((bits & CONSTRAINT_ANCHOR) != 0u) sum += params.weights.anchor_constraint;
+  return sum;
+}
+
+// The constraint bits of placing label `me` with its box centred at c. Kinds already in `known`
+// are not tested again (a GPU tile may know them for all its candidates). The search stops once
+// the bits found weigh more than `budget` (the GPU's candidates that cannot win any more; the
+// CPU reference passes infinity and always gets every bit).
+uint constraint_bits(LabelGpu me, vec2 c, uint known, float budget) {
   vec2 h = me.size * 0.5f + vec2(params.margin);
   const uint shadows = CONSTRAINT_LABEL | CONSTRAINT_CONNECTOR;
   uint bits = known;
   for (uint k = 0u; k < placed_count() && (bits & shadows) != shadows; ++k) {
-    bits |= placed_bits(me, c, h, placed_label(k), bits);
+    bits |= region_bits(placed_regions(k), c, bits);
+    if (constraint_weight(bits) > budget) return bits;
   }
   if ((me.flags & LABEL_INTERNAL) == 0u && (bits & CONSTRAINT_ANCHOR) == 0u) {
     for (uint k = 0u; k < anchor_count(); ++k) {
-      LabelGpu other = label_at(anchor_label(k));
-      if ((other.flags & LABEL_ENABLED) == 0u) continue;
-      vec2 d = abs(other.anchor - c);
-      if (d.x <= h.x && d.y <= h.y) bits |= CONSTRAINT_ANCHOR;
+      vec2 d = abs(anchor_at(k) - c);
+      if (d.x <= h.x && d.y <= h.y) return bits | CONSTRAINT_ANCHOR;
     }
   }
   return bits;
-}
-
-// Could label j (placed) or its connector constrain any candidate whose box, half size h, is
-// centred in the rectangle around `centre` of half size `extent`? The hull of the anchor and
-// that whole region contains every candidate's hull, so "no" is exact: a GPU tile skips j.
-bool may_constrain(LabelGpu me, vec2 centre, vec2 extent, uint j) {
-  vec3 other = placed(j);
-  if (other.z < 0.5f) return false;
-  LabelGpu them = label_at(j);
-  vec2 h = extent + me.size * 0.5f + vec2(params.margin);
-  vec2 lo = vec2(other) - them.size * 0.5f, hi = vec2(other) + them.size * 0.5f;
-  if (hull_touches(me.anchor, centre, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), vec2(1.0f, 0.0f))) {
-    return true;
-  }
-  if ((them.flags & LABEL_INTERNAL) != 0u) return false;
-  vec2 p0 = them.anchor, p1 = vec2(other), d = p1 - p0;
-  return hull_touches(me.anchor, centre, h, p0, p1, p0, p1, vec2(-d.y, d.x));
 }
 
 // The sum of the layer's integral costs over the box of `size` pixels at `origin`.

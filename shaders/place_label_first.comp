@@ -1,0 +1,11 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+#extension GL_EXT_shader_atomic_int64 : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_basic : require
+#include "shared/placement.h"
+
+// A label's first pass: the tiles of bucket 0; the last workgroup sizes the second pass.
+#define PLACEMENT_FIRST_PASS
+#include "place_label.glsl"

@@ -1,0 +1,129 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_basic : require
+#include "shared/placement.h"
+
+// Before the label loop, for every label at once: a lower bound of eq. 3.1 over each 32x32 tile
+// of candidates (phase BOUNDS: a workgroup per tile and label), how many tiles fall in each bucket above the label's lowest bound
+// (COUNT), and the tiles sorted by bucket with the first pass's dispatch size (SORT). None of it
+// depends on where earlier labels went, so it is one dispatch per phase, not one per label.
+layout(local_size_x = 64) in;
+layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
+layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
+layout(binding = PLACEMENT_BINDING_ORDER, std430) readonly buffer Order { uint order[]; };
+layout(binding = PLACEMENT_BINDING_BOUNDS, std430) buffer Bounds { float bounds[]; };
+layout(binding = PLACEMENT_BINDING_BUCKETS, std430) buffer Buckets { PlacementBucketsGpu buckets[]; };
+layout(binding = PLACEMENT_BINDING_TILES, std430) writeonly buffer Tiles { uint tile_list[]; };
+layout(binding = PLACEMENT_BINDING_LOWER, std430) buffer Lower { uint lower[]; };
+layout(binding = PLACEMENT_BINDING_ARGS, std430) writeonly buffer Args { uint args[]; };
+layout(push_constant) uniform Push { PlacementParams params; };
+
+const float INFINITY = 1.0 / 0.0;
+
+float table_at(uint layer, int x, int y) {
+  if (x < 0 || y < 0) return 0.0;
+  return tables[layer * params.width * params.height + uint(y) * params.width + uint(x)];
+}
+
+// Candidates p of the tile may hold the label when its box [p - floor(size / 2), + size) lies on
+// screen (internal labels: only the anchor's pixel).
+bool tile_has_candidates(LabelGpu me, uvec2 first, uvec2 last) {
+  if ((me.flags & LABEL_INTERNAL) != 0u) {
+    const uvec2 a = uvec2(me.anchor);
+    return all(greaterThanEqual(a, first)) && all(lessThanEqual(a, last));
+  }
+  const vec2 half_size = floor(me.size * 0.5);
+  const vec2 lo = max(vec2(first), half_size);
+  const vec2 hi = min(vec2(last), vec2(params.width, params.height) - me.size + half_size);
+  return all(lessThanEqual(lo, hi));
+}
+
+// Eq. 3.1 over the candidates first..last (pixels) is at least: the distance terms at their
+// nearest box centre, direction 1, no constraints, and the integral costs over the part all their
+// boxes share (costs are >= 0). The table's float sums of two boxes may differ from their true
+// order by a few ulps of the table's largest value, so that much is taken off the shared part;
+// the rest is scaled by 0.9999 against rounding in the candidates' own sums. Internal labels have
+// one candidate: 0.
+float cell_bound(LabelGpu me, uvec2 first, uvec2 last) {
+  if (!tile_has_candidates(me, first, last)) return INFINITY;
+  if ((me.flags & LABEL_INTERNAL) != 0u) return 0.0;
+  const CostWeightsGpu w = params.weights;
+  const vec2 lo_centre = box_origin(first, me.size) + me.size * 0.5;
+  const vec2 hi_centre = box_origin(last, me.size) + me.size * 0.5;
+  const vec2 to_anchor = max(max(lo_centre - me.anchor, me.anchor - hi_centre), vec2(0.0));
+  const vec2 to_previous = max(max(lo_centre - me.previous, me.previous - hi_centre), vec2(0.0));
+  float bound = 0.9999 * (w.distance_to_anchor * length(to_anchor) + w.connector_direction +
+                          w.previous_position * length(to_previous));
+  const vec2 shared_lo = max(box_origin(last, me.size), vec2(0.0));
+  const vec2 shared_hi = min(box_origin(first, me.size) + me.size, vec2(params.width, params.height));
+  if (all(lessThan(shared_lo, shared_hi))) {
+    const ivec2 a = ivec2(shared_lo), b = ivec2(shared_hi) - 1;
+    const float sum = table_at(me.layer, b.x, b.y) - table_at(me.layer, a.x - 1, b.y) -
+                      table_at(me.layer, b.x, a.y - 1) + table_at(me.layer, a.x - 1, a.y - 1);
+    const float slack = 1e-4 * table_at(me.layer, int(params.width) - 1, int(params.height) - 1);
+    bound += w.integral_costs * max(sum - slack, 0.0);
+  }
+  return bound;
+}
+
+uint tile_count() {
+  return ((params.width + PLACEMENT_TILE - 1u) / PLACEMENT_TILE) *
+         ((params.height + PLACEMENT_TILE - 1u) / PLACEMENT_TILE);
+}
+
+shared uint tile_lowest;
+
+// A tile's bound: the lowest of its cells' of 4 x 4 candidates (the integral part needs cells
+// smaller than the label boxes: what all boxes of a whole tile share is often nothing). One
+// workgroup per tile and label; each invocation takes every 64th cell.
+void tile_bound(uint tile, uint s) {
+  if (gl_LocalInvocationIndex == 0u) tile_lowest = floatBitsToUint(INFINITY);
+  barrier();
+  const uint tiles_x = (params.width + PLACEMENT_TILE - 1u) / PLACEMENT_TILE;
+  const uint cells_x = PLACEMENT_TILE / PLACEMENT_CELL;
+  const LabelGpu me = labels[order[s]];
+  float bound = INFINITY;
+  for (uint c = gl_LocalInvocationIndex; c < cells_x * cells_x; c += 64u) {
+    const uvec2 first = uvec2(tile % tiles_x, tile / tiles_x) * PLACEMENT_TILE +
+                        uvec2(c % cells_x, c / cells_x) * PLACEMENT_CELL;
+    bound = min(bound, cell_bound(me, first, first + uvec2(PLACEMENT_CELL - 1u)));
+  }
+  atomicMin(tile_lowest, floatBitsToUint(bound));  // bounds are >= 0: their bits order as they do
+  barrier();
+  if (gl_LocalInvocationIndex == 0u) {
+    bounds[s * tile_count() + tile] = uintBitsToFloat(tile_lowest);
+    atomicMin(lower[s], tile_lowest);
+  }
+}
+
+void main() {
+  if (params.phase == PLACEMENT_PHASE_BOUNDS) {
+    tile_bound(gl_WorkGroupID.x, gl_WorkGroupID.y);
+    return;
+  }
+  const uint tiles = tile_count();
+  const uint tile = gl_GlobalInvocationID.x;
+  const uint s = gl_WorkGroupID.y;  // position in the insertion order
+  const bool in_range = tile < tiles;
+  if (!in_range) return;
+  if (params.phase == PLACEMENT_PHASE_SORT && tile == 0u) {
+    const uvec3 size = placement_dispatch_size(buckets[s].counts[0]);
+    args[3u * s] = size.x;
+    args[3u * s + 1u] = size.y;
+    args[3u * s + 2u] = size.z;
+  }
+  const float bound = bounds[s * tiles + tile];
+  if (isinf(bound)) return;  // no candidate here may hold the label
+  // Everything in bucket 0 when the constraint image is kept: every candidate is evaluated.
+  const uint bucket = params.write_constraints != 0u
+                          ? 0u
+                          : placement_bucket(bound - uintBitsToFloat(lower[s]), params.bucket_width);
+  if (params.phase == PLACEMENT_PHASE_COUNT) {
+    atomicAdd(buckets[s].counts[bucket], 1u);
+    return;
+  }
+  uint offset = 0u;
+  for (uint b = 0u; b < bucket; ++b) offset += buckets[s].counts[b];
+  tile_list[s * tiles + offset + atomicAdd(buckets[s].cursors[bucket], 1u)] = tile;
+}
