@@ -14,8 +14,8 @@
 #include "engine/scene_loader.h"
 #include "labeling/labelled_render.h"
 #include "passes/summed_area_table.h"
-#include "shared/placement.h"
 #include "passes/volume_renderer.h"
+#include "shared/placement.h"
 
 namespace strata::app {
 namespace {
@@ -314,7 +314,8 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint
                 "  \"tiles_per_label_second_pass\": %.1f",
                 placement_ms, loop_ms, baseline.median, baseline_total,
                 placement_ms > 0.0 ? baseline_total / placement_ms : 0.0,
-                group_count(size.width, PLACEMENT_TILE) * group_count(size.height, PLACEMENT_TILE),
+                gpu::placement_tiles(size.width, size.height).x *
+                    gpu::placement_tiles(size.width, size.height).y,
                 first_tiles, rest_tiles);
   print_json(ctx, header, runs, t, tail);
 }

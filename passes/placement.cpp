@@ -90,8 +90,8 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
   r.constraints = graph.add_buffer("placement.constraints", per_pixel(sizeof(uint32_t)));
   const auto per_label_tile = [n](VkDeviceSize bytes) {
     return graph::BufferInfo{[n, bytes](graph::Extent e) {
-      return VkDeviceSize{n} * group_count(e.width, PLACEMENT_TILE) *
-             group_count(e.height, PLACEMENT_TILE) * bytes;
+      const glm::uvec2 tiles = gpu::placement_tiles(e.width, e.height);
+      return VkDeviceSize{n} * tiles.x * tiles.y * bytes;
     }};
   };
   const ResourceId bounds = graph.add_buffer("placement.bounds", per_label_tile(sizeof(float)));
@@ -188,8 +188,9 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                       gpu::PlacementParams p = params(pc.viewport, 0);
                       p.phase = phase;
                       bounds_.push_constants(pc.cmd, p);
-                      const uint32_t tile_count = group_count(pc.viewport.width, PLACEMENT_TILE) *
-                                                  group_count(pc.viewport.height, PLACEMENT_TILE);
+                      const glm::uvec2 across =
+                          gpu::placement_tiles(pc.viewport.width, pc.viewport.height);
+                      const uint32_t tile_count = across.x * across.y;
                       // Bounds: a workgroup of 64 per tile (its cells); then 64 tiles per group.
                       vkCmdDispatch(pc.cmd,
                                     phase == PLACEMENT_PHASE_BOUNDS ? tile_count

@@ -64,9 +64,11 @@ void tile_centres(LabelGpu me, uvec2 tile, out vec2 centre, out vec2 extent) {
 // per-candidate tests), so no plane separates them by more than that.
 bool region_may_touch(vec4 p[6], vec2 c, vec2 e) {
   for (int k = 0; k < 6; ++k) {
+    // How far the rectangle's nearest point lies beyond the plane.
+    const float gap = dot(vec2(p[k]), c) - abs(p[k].x) * e.x - abs(p[k].y) * e.y - p[k].z;
     const float scale = abs(p[k].x * c.x) + abs(p[k].y * c.y) + abs(p[k].z) +
                         abs(p[k].x) * e.x + abs(p[k].y) * e.y;
-    if (plane_gap(p[k], c, e) > 1e-4 * scale) return false;
+    if (gap > 1e-4 * scale) return false;
   }
   return true;
 }
@@ -143,11 +145,10 @@ uint size_rest_pass(uint s, uint label) {
   const float best = cost_of(atomicMin(results[label], PLACEMENT_NONE));  // an atomic read
   const float above = best - uintBitsToFloat(lower[s]);
   uint rest = 0u;
-  float edge = params.bucket_width;
   for (uint b = 1u; b < PLACEMENT_BUCKETS; ++b) {
-    if (!(above >= edge)) break;  // (infinite best: every bucket)
+    // (an infinite best: every bucket)
+    if (!(above >= placement_bucket_edge(b, params.bucket_width))) break;
     rest += buckets[s].counts[b];
-    edge *= PLACEMENT_BUCKET_GROWTH;
   }
   buckets[s].rest = rest;
   const uvec3 size = placement_dispatch_size(rest);
@@ -177,8 +178,8 @@ void main() {
   const uint s = params.step;
   const uint label = order[s];
   const LabelGpu me = labels[label];
-  const uint tiles_x = (params.width + PLACEMENT_TILE - 1u) / PLACEMENT_TILE;
-  const uint tiles = tiles_x * ((params.height + PLACEMENT_TILE - 1u) / PLACEMENT_TILE);
+  const uvec2 tiles_xy = placement_tiles(params.width, params.height);
+  const uint tiles_x = tiles_xy.x, tiles = tiles_xy.x * tiles_xy.y;
 #ifdef PLACEMENT_FIRST_PASS
   const bool first_pass = true;
 #else

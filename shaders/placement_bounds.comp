@@ -28,7 +28,7 @@ float table_at(uint layer, int x, int y) {
 
 // Candidates p of the tile may hold the label when its box [p - floor(size / 2), + size) lies on
 // screen (internal labels: only the anchor's pixel).
-bool tile_has_candidates(LabelGpu me, uvec2 first, uvec2 last) {
+bool has_candidates(LabelGpu me, uvec2 first, uvec2 last) {
   if ((me.flags & LABEL_INTERNAL) != 0u) {
     const uvec2 a = uvec2(me.anchor);
     return all(greaterThanEqual(a, first)) && all(lessThanEqual(a, last));
@@ -46,7 +46,7 @@ bool tile_has_candidates(LabelGpu me, uvec2 first, uvec2 last) {
 // the rest is scaled by 0.9999 against rounding in the candidates' own sums. Internal labels have
 // one candidate: 0.
 float cell_bound(LabelGpu me, uvec2 first, uvec2 last) {
-  if (!tile_has_candidates(me, first, last)) return INFINITY;
+  if (!has_candidates(me, first, last)) return INFINITY;
   if ((me.flags & LABEL_INTERNAL) != 0u) return 0.0;
   const CostWeightsGpu w = params.weights;
   const vec2 lo_centre = box_origin(first, me.size) + me.size * 0.5;
@@ -68,8 +68,8 @@ float cell_bound(LabelGpu me, uvec2 first, uvec2 last) {
 }
 
 uint tile_count() {
-  return ((params.width + PLACEMENT_TILE - 1u) / PLACEMENT_TILE) *
-         ((params.height + PLACEMENT_TILE - 1u) / PLACEMENT_TILE);
+  const uvec2 tiles = placement_tiles(params.width, params.height);
+  return tiles.x * tiles.y;
 }
 
 shared uint tile_lowest;
@@ -80,7 +80,7 @@ shared uint tile_lowest;
 void tile_bound(uint tile, uint s) {
   if (gl_LocalInvocationIndex == 0u) tile_lowest = floatBitsToUint(INFINITY);
   barrier();
-  const uint tiles_x = (params.width + PLACEMENT_TILE - 1u) / PLACEMENT_TILE;
+  const uint tiles_x = placement_tiles(params.width, params.height).x;
   const uint cells_x = PLACEMENT_TILE / PLACEMENT_CELL;
   const LabelGpu me = labels[order[s]];
   float bound = INFINITY;

@@ -127,14 +127,31 @@ uvec3 placement_dispatch_size(uint count) {
 #ifdef __cplusplus
 inline
 #endif
+// How many 32 x 32 tiles cover the viewport across and down.
+uvec2 placement_tiles(uint width, uint height) {
+  return uvec2((width + PLACEMENT_TILE - 1u) / PLACEMENT_TILE,
+               (height + PLACEMENT_TILE - 1u) / PLACEMENT_TILE);
+}
+
+#ifdef __cplusplus
+inline
+#endif
+// How far above the label's lowest bound bucket b starts: 0, then bucket_width * 4^(b - 1). The
+// sort and the second pass's sizing both use this, so they agree to the last bit.
+float placement_bucket_edge(uint b, float bucket_width) {
+  float edge = b == 0u ? 0.0f : bucket_width;
+  for (uint k = 1u; k < b; ++k) edge *= PLACEMENT_BUCKET_GROWTH;
+  return edge;
+}
+
+#ifdef __cplusplus
+inline
+#endif
 // The bucket of a tile whose lower cost bound lies `above` the label's lowest.
 uint placement_bucket(float above, float bucket_width) {
-  float edge = bucket_width;
-  for (uint b = 0u; b + 1u < PLACEMENT_BUCKETS; ++b) {
-    if (above < edge) return b;
-    edge *= PLACEMENT_BUCKET_GROWTH;
-  }
-  return PLACEMENT_BUCKETS - 1u;
+  uint b = 0u;
+  while (b + 1u < PLACEMENT_BUCKETS && above >= placement_bucket_edge(b + 1u, bucket_width)) ++b;
+  return b;
 }
 STRATA_END
 

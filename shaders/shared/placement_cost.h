@@ -109,23 +109,10 @@ PairRegionsGpu pair_regions(LabelGpu k, LabelGpu j, vec3 placed_j, float margin)
   return r;
 }
 
-// The box-shadow or connector-shadow region (4 or 6 planes) holds the centre c ...
+// Does the box-shadow or connector-shadow region (4 or 6 planes) hold the centre c?
 bool region_holds(vec4 p0, vec4 p1, vec4 p2, vec4 p3, vec4 p4, vec4 p5, vec2 c) {
   return dot(vec2(p0), c) <= p0.z && dot(vec2(p1), c) <= p1.z && dot(vec2(p2), c) <= p2.z &&
          dot(vec2(p3), c) <= p3.z && dot(vec2(p4), c) <= p4.z && dot(vec2(p5), c) <= p5.z;
-}
-// ... touches the rectangle of centres (middle c, half size e): no plane separates them ...
-float plane_gap(vec4 p, vec2 c, vec2 e) {
-  return dot(vec2(p), c) - abs(p.x) * e.x - abs(p.y) * e.y - p.z;
-}
-bool region_touches(vec4 p0, vec4 p1, vec4 p2, vec4 p3, vec4 p4, vec4 p5, vec2 c, vec2 e) {
-  return plane_gap(p0, c, e) <= 0.0f && plane_gap(p1, c, e) <= 0.0f &&
-         plane_gap(p2, c, e) <= 0.0f && plane_gap(p3, c, e) <= 0.0f &&
-         plane_gap(p4, c, e) <= 0.0f && plane_gap(p5, c, e) <= 0.0f;
-}
-// ... or holds all of it (each of its corners).
-bool region_covers(vec4 p0, vec4 p1, vec4 p2, vec4 p3, vec4 p4, vec4 p5, vec2 c, vec2 e) {
-  return region_touches(p0, p1, p2, p3, p4, p5, c, -e);
 }
 
 // The label- and connector-shadow bits label j gives the label being placed at centre c, from
