@@ -30,6 +30,8 @@ struct DeviceCapabilities {
   bool push_descriptor = false;
   bool subgroup_arithmetic_in_compute = false;
   bool graphics_compute_queue_with_timestamps = false;
+  // Optional: the driver reports per-pipeline statistics (registers, ...; bench output only).
+  bool pipeline_statistics = false;
 };
 
 // Names of the requirements `caps` does not meet, in a fixed order; empty when the device is
@@ -102,6 +104,8 @@ class Context {
   VkQueue queue() const { return queue_; }
   uint32_t queue_family() const { return queue_family_; }
   const DeviceReport& report() const { return report_; }
+  // Pipelines are created with their statistics captured (VK_KHR_pipeline_executable_properties).
+  bool pipeline_statistics() const { return report_.caps.pipeline_statistics; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
   double timestamp_period_ns() const { return properties_.limits.timestampPeriod; }
   ValidationLog& validation_log() { return instance_.validation_log(); }

@@ -153,16 +153,28 @@ void GraphRunner::check_bound() const {
   }
 }
 
+bool GraphRunner::stamps_begin(uint32_t p) const {
+  const auto& passes = graph_.passes();
+  return per_pass_stamps_ || p == 0 || passes[p - 1].group != passes[p].group;
+}
+
+bool GraphRunner::stamps_end(uint32_t p) const {
+  const auto& passes = graph_.passes();
+  return per_pass_stamps_ || p + 1 == passes.size() || passes[p + 1].group != passes[p].group;
+}
+
 void GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
   emit(cmd, compiled_.pass_barriers[p]);
-  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p);
+  if (stamps_begin(p)) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p);
   PassContext pc;
   pc.cmd = cmd;
   pc.viewport = viewport_;
   pc.runner_ = this;
   pc.pass_ = p;
   graph_.passes()[p].record(pc);
-  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p + 1);
+  if (stamps_end(p)) {
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p + 1);
+  }
 }
 
 void GraphRunner::record(VkCommandBuffer cmd) {
@@ -200,18 +212,40 @@ void GraphRunner::run_now() {
 std::vector<PassTiming> GraphRunner::timings() const {
   const auto& passes = graph_.passes();
   std::vector<uint64_t> stamps(2 * passes.size());
-  if (!passes.empty()) {
+  // (stamps that were not written must not be waited for: read those that were, one by one)
+  const auto read = [&](uint32_t query) {
+    STRATA_VK(vkGetQueryPoolResults(ctx_.device(), queries_, query, 1, sizeof(uint64_t),
+                                    &stamps[query], sizeof(uint64_t),
+                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+  };
+  if (per_pass_stamps_ && !passes.empty()) {
     STRATA_VK(
         vkGetQueryPoolResults(ctx_.device(), queries_, 0, static_cast<uint32_t>(stamps.size()),
                               stamps.size() * sizeof(uint64_t), stamps.data(), sizeof(uint64_t),
                               VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+  } else {
+    for (uint32_t p = 0; p < passes.size(); ++p) {
+      if (stamps_begin(p)) read(2 * p);
+      if (stamps_end(p)) read(2 * p + 1);
+    }
   }
   std::vector<PassTiming> out;
   const double to_ms = ctx_.timestamp_period_ns() * 1e-6;
-  for (size_t p = 0; p < passes.size(); ++p) {
-    const double begin = static_cast<double>(stamps[2 * p] - stamps[0]) * to_ms;
-    const double end = static_cast<double>(stamps[2 * p + 1] - stamps[0]) * to_ms;
-    out.push_back({passes[p].name, passes[p].group, end - begin, begin, end});
+  const auto since_start = [&](uint32_t query) {
+    return static_cast<double>(stamps[query] - stamps[0]) * to_ms;
+  };
+  uint32_t group_first = 0;
+  for (uint32_t p = 0; p < passes.size(); ++p) {
+    if (per_pass_stamps_) {
+      const double begin = since_start(2 * p), end = since_start(2 * p + 1);
+      out.push_back({passes[p].name, passes[p].group, end - begin, begin, end});
+      continue;
+    }
+    if (stamps_begin(p)) group_first = p;
+    if (stamps_end(p)) {
+      const double begin = since_start(2 * group_first), end = since_start(2 * p + 1);
+      out.push_back({passes[p].group, passes[p].group, end - begin, begin, end});
+    }
   }
   return out;
 }

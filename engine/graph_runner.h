@@ -78,7 +78,11 @@ class GraphRunner {
   // The bytes of a transient buffer after the last completed run (waits; tools and tests).
   std::vector<std::byte> download_buffer(ResourceId id);
 
-  // GPU time of each pass of the last completed run.
+  // Timestamps around every pass (the default), or only where a group of passes begins and
+  // ends: a group's time without the cost of stamping each of its passes (benchmarks).
+  void set_timestamps_per_pass(bool per_pass) { per_pass_stamps_ = per_pass; }
+  // GPU time of each pass of the last completed run; with group stamps only, one entry per
+  // group (named after it) instead.
   std::vector<PassTiming> timings() const;
 
   const Graph& graph() const { return graph_; }
@@ -96,8 +100,12 @@ class GraphRunner {
   void emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) const;
   void check_bound() const;
   void record_pass(VkCommandBuffer cmd, uint32_t pass);
+  // Whether pass p stamps its begin / its end (every pass, or a group's first / last).
+  bool stamps_begin(uint32_t pass) const;
+  bool stamps_end(uint32_t pass) const;
 
   Context& ctx_;
+  bool per_pass_stamps_ = true;
   Graph graph_;
   CompiledGraph compiled_;
   Extent viewport_{};

@@ -187,10 +187,55 @@ ComputePipeline::ComputePipeline(Context& ctx, std::string_view shader)
   info.stage.module = module;
   info.stage.pName = "main";
   info.layout = layout_;
+  captured_ = ctx.pipeline_statistics();
+  if (captured_) info.flags = VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR;
   const VkResult result =
       vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_);
   vkDestroyShaderModule(device_, module, nullptr);
   check_vk(result, ("vkCreateComputePipelines(" + name_ + ")").c_str());
+}
+
+std::vector<PipelineStatistic> ComputePipeline::statistics() const {
+  std::vector<PipelineStatistic> out;
+  if (!captured_) return out;
+  const auto get_executables = reinterpret_cast<PFN_vkGetPipelineExecutablePropertiesKHR>(
+      vkGetDeviceProcAddr(device_, "vkGetPipelineExecutablePropertiesKHR"));
+  const auto get_statistics = reinterpret_cast<PFN_vkGetPipelineExecutableStatisticsKHR>(
+      vkGetDeviceProcAddr(device_, "vkGetPipelineExecutableStatisticsKHR"));
+  if (!get_executables || !get_statistics) return out;
+  const VkPipelineInfoKHR pipeline{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR, nullptr, pipeline_};
+  uint32_t executables = 0;
+  STRATA_VK(get_executables(device_, &pipeline, &executables, nullptr));
+  for (uint32_t e = 0; e < executables; ++e) {
+    const VkPipelineExecutableInfoKHR executable{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR,
+                                                 nullptr, pipeline_, e};
+    uint32_t count = 0;
+    STRATA_VK(get_statistics(device_, &executable, &count, nullptr));
+    std::vector<VkPipelineExecutableStatisticKHR> stats(
+        count, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
+    STRATA_VK(get_statistics(device_, &executable, &count, stats.data()));
+    for (const VkPipelineExecutableStatisticKHR& s : stats) {
+      std::string value;
+      switch (s.format) {
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR:
+          value = s.value.b32 ? "true" : "false";
+          break;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_INT64_KHR:
+          value = std::to_string(s.value.i64);
+          break;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_UINT64_KHR:
+          value = std::to_string(s.value.u64);
+          break;
+        case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_FLOAT64_KHR:
+          value = std::to_string(s.value.f64);
+          break;
+        default:
+          continue;
+      }
+      out.push_back({s.name, value});
+    }
+  }
+  return out;
 }
 
 GraphicsPipeline::GraphicsPipeline(Context& ctx, std::string_view vertex_shader,

@@ -79,10 +79,22 @@ class Pipeline {
   PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
 };
 
+// One statistic the driver reports for a compiled pipeline (e.g. "Register Count": "64").
+struct PipelineStatistic {
+  std::string name;
+  std::string value;
+};
+
 class ComputePipeline : public Pipeline {
  public:
   ComputePipeline(Context& ctx, std::string_view shader);
   std::array<uint32_t, 3> local_size() const { return reflection_.local_size; }
+  // What the driver reports about the compiled shader; empty unless
+  // Context::pipeline_statistics().
+  std::vector<PipelineStatistic> statistics() const;
+
+ private:
+  bool captured_ = false;
 };
 
 // Rasterisation state strata's graphics passes choose from; everything else is fixed (triangle

@@ -135,6 +135,11 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
 
 LabelledRenderer::~LabelledRenderer() = default;
 
+std::vector<std::pair<std::string, std::vector<PipelineStatistic>>>
+LabelledRenderer::placement_pipelines() const {
+  return parts_->placement.pipeline_statistics();
+}
+
 void LabelledRenderer::bind() {
   Parts& p = *parts_;
   p.renderer.bind(*runner_);

@@ -8,6 +8,8 @@
 #pragma once
 
 #include <span>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/graph_runner.h"
@@ -56,6 +58,9 @@ class Placement {
 
   // The placements of the last completed frame.
   std::span<const gpu::PlacementGpu> results() const;
+
+  // The placement's compute pipelines (shader name and what the driver reports of each).
+  std::vector<std::pair<std::string, std::vector<PipelineStatistic>>> pipeline_statistics() const;
 
  private:
   gpu::PlacementParams params(graph::Extent viewport, uint32_t step) const;

@@ -5,7 +5,7 @@
 // CPU. Two passes per label (placement_bounds.comp sorted its tiles into buckets by a lower bound
 // of their cost): the FIRST takes bucket 0; its last workgroup sizes the REST pass to the buckets
 // whose bounds the best cost found so far leaves possible.
-layout(local_size_x = PLACEMENT_GROUP, local_size_y = PLACEMENT_GROUP) in;
+layout(local_size_x = PLACE_GROUP_X, local_size_y = PLACE_GROUP_Y) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
 layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
 layout(binding = PLACEMENT_BINDING_ORDER, std430) readonly buffer Order { uint order[]; };
@@ -50,7 +50,7 @@ float table_at(uint layer, int x, int y) {
 
 #include "shared/placement_cost.h"
 
-shared uint64_t group_best[PLACEMENT_GROUP * PLACEMENT_GROUP];
+shared uint64_t group_best[PLACE_GROUP_X * PLACE_GROUP_Y];  // per subgroup
 
 // The rectangle of box centres this tile's candidates have (centre and half size).
 void tile_centres(LabelGpu me, uvec2 tile, out vec2 centre, out vec2 extent) {
@@ -63,7 +63,7 @@ void tile_centres(LabelGpu me, uvec2 tile, out vec2 centre, out vec2 extent) {
 // tile's may-constrain test: it only has to be conservative (the slack covers rounding in the
 // per-candidate tests), so no plane separates them by more than that.
 bool region_may_touch(vec4 p[6], vec2 c, vec2 e) {
-  for (int k = 0; k < 6; ++k) {
+  [[unroll]] for (int k = 0; k < 6; ++k) {
     // How far the rectangle's nearest point lies beyond the plane.
     const float gap = dot(vec2(p[k]), c) - abs(p[k].x) * e.x - abs(p[k].y) * e.y - p[k].z;
     const float scale = abs(p[k].x * c.x) + abs(p[k].y * c.y) + abs(p[k].z) +
@@ -76,7 +76,7 @@ bool region_may_touch(vec4 p[6], vec2 c, vec2 e) {
 // Does the region hold every candidate of the tile? Each is convex and the rounded per-candidate
 // test is monotonic in each coordinate, so its four corner candidates decide it exactly.
 bool region_holds_corners(vec4 p[6], vec2 c, vec2 e) {
-  for (int k = 0; k < 4; ++k) {
+  [[unroll]] for (int k = 0; k < 4; ++k) {
     const vec2 corner = c + e * vec2((k & 1) != 0 ? 1.0 : -1.0, (k & 2) != 0 ? 1.0 : -1.0);
     if (!region_holds(p[0], p[1], p[2], p[3], p[4], p[5], corner)) return false;
   }
@@ -94,7 +94,7 @@ void cull(LabelGpu me, uint label, uvec2 tile) {
   barrier();
   vec2 centre, extent;
   tile_centres(me, tile, centre, extent);
-  const uint threads = PLACEMENT_GROUP * PLACEMENT_GROUP;
+  const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
   for (uint s = gl_LocalInvocationIndex; s < params.step; s += threads) {
     const uint j = order[s];
     const PairRegionsGpu r = regions_of(j);
@@ -165,7 +165,7 @@ shared uint64_t final_result;
 // The label at order position s is final: its constraint regions for every label after it.
 void write_regions(uint s, uint j) {
   const vec3 placed_j = placed_from(final_result, j);
-  const uint threads = PLACEMENT_GROUP * PLACEMENT_GROUP;
+  const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
   for (uint k_pos = s + 1u + gl_LocalInvocationIndex; k_pos < params.order_count; k_pos += threads) {
     regions[k_pos * params.label_count + j] =
         pair_regions(labels[order[k_pos]], labels[j], placed_j, params.margin);
@@ -190,8 +190,8 @@ void main() {
   if (w >= count) return;  // the whole workgroup
   const uint tile_index = tile_list[s * tiles + (first_pass ? 0u : buckets[s].counts[0]) + w];
   const uvec2 tile = uvec2(tile_index % tiles_x, tile_index / tiles_x);
-  // Each invocation has SPAN x SPAN candidates, 16 pixels apart (neighbouring invocations read
-  // neighbouring table entries).
+  // Each invocation has SPAN_X x SPAN_Y candidates, a workgroup's width or height apart
+  // (neighbouring invocations read neighbouring table entries).
   const uvec2 base = tile * PLACEMENT_TILE + gl_LocalInvocationID.xy;
 
   // A candidate can only win if its cost is not above the best another workgroup has found
@@ -208,11 +208,11 @@ void main() {
   const float best = cost_of(tile_best);
   const float bound = bounds[s * tiles + tile_index];
   bool hopeless = may_skip && bound > best;
-  float free_cost[PLACEMENT_SPAN * PLACEMENT_SPAN];
+  float free_cost[PLACE_SPAN_X * PLACE_SPAN_Y];
   uint candidates = 0u;  // bit q: candidate q is worth its constraints
   if (!hopeless) {
-    for (uint q = 0u; q < PLACEMENT_SPAN * PLACEMENT_SPAN; ++q) {
-      const uvec2 p = base + uvec2(q % PLACEMENT_SPAN, q / PLACEMENT_SPAN) * PLACEMENT_GROUP;
+    [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
+      const uvec2 p = base + uvec2(q % PLACE_SPAN_X, q / PLACE_SPAN_X) * uvec2(PLACE_GROUP_X, PLACE_GROUP_Y);
       free_cost[q] = 0.0;
       if (p.x >= params.width || p.y >= params.height || !candidate_allowed(me, p)) continue;
       const vec2 origin = box_origin(p, me.size);
@@ -229,9 +229,10 @@ void main() {
                             (params.hard != 0u && tile_bits != 0u));
   }
   uint64_t key = PLACEMENT_NONE;
-  for (uint q = 0u; q < PLACEMENT_SPAN * PLACEMENT_SPAN && !hopeless; ++q) {
+  [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
+    if (hopeless) break;
     if ((candidates & (1u << q)) == 0u) continue;
-    const uvec2 p = base + uvec2(q % PLACEMENT_SPAN, q / PLACEMENT_SPAN) * PLACEMENT_GROUP;
+    const uvec2 p = base + uvec2(q % PLACE_SPAN_X, q / PLACE_SPAN_X) * uvec2(PLACE_GROUP_X, PLACE_GROUP_Y);
     const vec2 origin = box_origin(p, me.size);
     const vec2 centre = origin + me.size * 0.5;
     // Bits weighing more than best - cost without them lose (strictly: 0.999), so the search

@@ -77,6 +77,40 @@ TEST_SUITE("gpu") {
       for (const auto& t : timings) CHECK(t.ms >= 0.0);
     }
   }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "group_timestamps_give_one_span_per_run_of_a_group") {
+    TestPattern pattern(ctx);
+    HeadlessTarget target(ctx);
+    graph::Graph g;
+    target.add_output(g, pattern.add_to(g, 3));
+    graph::GraphRunner runner(ctx, std::move(g));
+    runner.set_viewport({40, 30});
+    target.bind(runner);
+    runner.set_timestamps_per_pass(false);
+    runner.run_now();
+    // The expected spans: one per run of passes that share a group name.
+    std::vector<std::string> runs;
+    for (const auto& pass : runner.graph().passes()) {
+      if (runs.empty() || runs.back() != pass.group) runs.push_back(pass.group);
+    }
+    REQUIRE(runs.size() >= 3);  // (the table's passes form a group between ungrouped ones)
+    REQUIRE(runs.size() < runner.graph().passes().size());
+    const auto timings = runner.timings();
+    REQUIRE(timings.size() == runs.size());
+    double previous_end = 0.0;
+    for (size_t i = 0; i < runs.size(); ++i) {
+      CHECK(timings[i].name == runs[i]);
+      CHECK(timings[i].begin_ms >= previous_end);
+      CHECK(timings[i].end_ms >= timings[i].begin_ms);
+      previous_end = timings[i].end_ms;
+    }
+    // Back to a stamp per pass.
+    runner.set_timestamps_per_pass(true);
+    runner.run_now();
+    CHECK(runner.timings().size() == runner.graph().passes().size());
+    const std::vector<uint8_t> expected = test_pattern_reference(40, 30, 3);
+    CHECK(compare_images(target.pixels(), expected, {40, 30}, 2, "group-stamps") <= 2);
+  }
 }
 
 }  // namespace strata

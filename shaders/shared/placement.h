@@ -5,9 +5,12 @@
 
 #include "labels.h"
 
-#define PLACEMENT_GROUP 16               // 16 x 16 threads per workgroup
-#define PLACEMENT_TILE 32                // place_label: 32 x 32 candidates per workgroup
-#define PLACEMENT_SPAN (PLACEMENT_TILE / PLACEMENT_GROUP)  // ... SPAN x SPAN per invocation
+#define PLACEMENT_GROUP 16               // per-pixel passes: 16 x 16 threads per workgroup
+#define PLACEMENT_TILE 32                // place_label: 32 x 32 candidates per workgroup ...
+#define PLACE_GROUP_X 16                 // ... of 16 x 16 threads, 2 x 2 candidates each (on an
+#define PLACE_GROUP_Y 16                 // H200, 16 x 8 and 8 x 8 ran slower, 32 x 16 no faster)
+#define PLACE_SPAN_X (PLACEMENT_TILE / PLACE_GROUP_X)  // candidates per invocation across ...
+#define PLACE_SPAN_Y (PLACEMENT_TILE / PLACE_GROUP_Y)  // ... and down
 #define PLACEMENT_CELL 4                 // placement_bounds: 4 x 4 candidates per cell
 #define VR_MAX_LAYERS_FOR_PLACEMENT 8    // as VR_MAX_LAYERS
 #define SALIENCY_SCALE 100.0f            // |CIELAB gradient| of this size counts as saliency 1
