@@ -331,7 +331,8 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint
   std::string pipelines;  // what the driver reports per pipeline (registers, ...), if anything
   for (const auto& [name, stats] : frame.placement_pipelines()) {
     if (stats.empty()) continue;
-    pipelines += std::string(pipelines.empty() ? "" : ",") + "\n    \"" + json_escape(name) + "\": {";
+    pipelines +=
+        std::string(pipelines.empty() ? "" : ",") + "\n    \"" + json_escape(name) + "\": {";
     for (size_t i = 0; i < stats.size(); ++i) {
       pipelines += std::string(i ? ", " : "") + "\"" + json_escape(stats[i].name) + "\": \"" +
                    json_escape(stats[i].value) + "\"";

@@ -165,7 +165,9 @@ bool GraphRunner::stamps_end(uint32_t p) const {
 
 void GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
   emit(cmd, compiled_.pass_barriers[p]);
-  if (stamps_begin(p)) vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p);
+  if (stamps_begin(p)) {
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p);
+  }
   PassContext pc;
   pc.cmd = cmd;
   pc.viewport = viewport_;
