@@ -53,6 +53,7 @@ Placement::Placement(Context& ctx, uint32_t label_count)
 gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) const {
   gpu::PlacementParams p = placement_params(settings_, viewport, layer_count_, label_count_, step);
   p.order_count = static_cast<uint32_t>(order_.size());
+  p.label = step < order_.size() ? order_[step] : 0;
   return p;
 }
 

@@ -32,7 +32,8 @@ shared vec2 tile_anchors[LABEL_MAX];
 shared uint tile_anchor_count;
 shared uint tile_bits;  // constraints every candidate of the tile has
 
-PairRegionsGpu regions_of(uint j) { return regions[params.step * params.label_count + j]; }
+// The regions of the label being placed against the one placed at order position s.
+PairRegionsGpu regions_of(uint s) { return regions[params.step * params.label_count + s]; }
 uint placed_count() { return tile_placed_count; }
 PairRegionsGpu placed_regions(uint k) { return regions_of(tile_placed[k]); }
 uint anchor_count() { return tile_anchor_count; }
@@ -43,9 +44,13 @@ vec3 placed_from(uint64_t r, uint j) {
   const uvec2 p = uvec2(pixel % params.width, pixel / params.width);
   return vec3(box_origin(p, labels[j].size) + labels[j].size * 0.5, 1.0);
 }
+// (The load does not depend on the test, so a candidate's four are issued together; clamped, so
+// a candidate off screen reads inside the table.)
 float table_at(uint layer, int x, int y) {
-  if (x < 0 || y < 0) return 0.0;
-  return tables[layer * params.width * params.height + uint(y) * params.width + uint(x)];
+  const uint column = uint(clamp(x, 0, int(params.width) - 1));
+  const uint row = uint(clamp(y, 0, int(params.height) - 1));
+  const float value = tables[(layer * params.height + row) * params.width + column];
+  return x < 0 || y < 0 ? 0.0 : value;
 }
 
 #include "shared/placement_cost.h"
@@ -96,8 +101,7 @@ void cull(LabelGpu me, uint label, uvec2 tile) {
   tile_centres(me, tile, centre, extent);
   const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
   for (uint s = gl_LocalInvocationIndex; s < params.step; s += threads) {
-    const uint j = order[s];
-    const PairRegionsGpu r = regions_of(j);
+    const PairRegionsGpu r = regions_of(s);
     uint touch = 0u, full = 0u;
     if ((r.info.x & REGION_BOX) != 0u) {
       const vec4 p[6] = {r.box[0], r.box[1], r.box[2], r.box[3], vec4(0.0), vec4(0.0)};
@@ -111,7 +115,7 @@ void cull(LabelGpu me, uint label, uvec2 tile) {
       if (region_holds_corners(r.connector, centre, extent)) full |= CONSTRAINT_CONNECTOR;
     }
     if (full != 0u) atomicOr(tile_bits, full);
-    if ((touch & ~full) != 0u) tile_placed[atomicAdd(tile_placed_count, 1u)] = j;
+    if ((touch & ~full) != 0u) tile_placed[atomicAdd(tile_placed_count, 1u)] = s;
   }
   // Anchors: a candidate's box (margin included) covering one; exact at the corners as above.
   const vec2 h = me.size * 0.5 + vec2(params.margin);
@@ -167,7 +171,7 @@ void write_regions(uint s, uint j) {
   const vec3 placed_j = placed_from(final_result, j);
   const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
   for (uint k_pos = s + 1u + gl_LocalInvocationIndex; k_pos < params.order_count; k_pos += threads) {
-    regions[k_pos * params.label_count + j] =
+    regions[k_pos * params.label_count + s] =
         pair_regions(labels[order[k_pos]], labels[j], placed_j, params.margin);
   }
 }
@@ -176,7 +180,7 @@ shared uint tile_hope;  // 1: some candidate's cost without constraints is not a
 
 void main() {
   const uint s = params.step;
-  const uint label = order[s];
+  const uint label = params.label;
   const LabelGpu me = labels[label];
   const uvec2 tiles_xy = placement_tiles(params.width, params.height);
   const uint tiles_x = tiles_xy.x, tiles = tiles_xy.x * tiles_xy.y;
@@ -208,16 +212,16 @@ void main() {
   const float best = cost_of(tile_best);
   const float bound = bounds[s * tiles + tile_index];
   bool hopeless = may_skip && bound > best;
-  float free_cost[PLACE_SPAN_X * PLACE_SPAN_Y];
+  float free_costs[PLACE_SPAN_X * PLACE_SPAN_Y];
   uint candidates = 0u;  // bit q: candidate q is worth its constraints
   if (!hopeless) {
+    // (every candidate's cost is computed, allowed or not, so that nothing waits on the tests)
     [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
       const uvec2 p = base + uvec2(q % PLACE_SPAN_X, q / PLACE_SPAN_X) * uvec2(PLACE_GROUP_X, PLACE_GROUP_Y);
-      free_cost[q] = 0.0;
-      if (p.x >= params.width || p.y >= params.height || !candidate_allowed(me, p)) continue;
       const vec2 origin = box_origin(p, me.size);
-      free_cost[q] = candidate_cost(me, origin, origin + me.size * 0.5, 0u);
-      if (!may_skip || !(free_cost[q] > best)) candidates |= 1u << q;
+      free_costs[q] = free_cost(me, origin, origin + me.size * 0.5);
+      const bool allowed = p.x < params.width && p.y < params.height && candidate_allowed(me, p);
+      if (allowed && (!may_skip || !(free_costs[q] > best))) candidates |= 1u << q;
     }
     if (subgroupOr(candidates) != 0u && subgroupElect()) atomicOr(tile_hope, 1u);
   }
@@ -239,13 +243,13 @@ void main() {
     // stops there (hard mode: at the first); all of them for the constraint image.
     const float budget = !may_skip       ? 1.0 / 0.0
                          : params.hard != 0u ? 0.0
-                                             : (best - free_cost[q]) / 0.999;
+                                             : (best - free_costs[q]) / 0.999;
     const uint bits = constraint_bits(me, centre, tile_bits, budget);
     const uint pixel = p.y * params.width + p.x;
     if (params.write_constraints != 0u) constraints[pixel] = bits;
     if (constraint_weight(bits) > budget) continue;
     if (params.hard == 0u || bits == 0u) {
-      const float cost = bits == 0u ? free_cost[q] : candidate_cost(me, origin, centre, bits);
+      const float cost = free_costs[q] + constraint_weight(bits);
       key = min(key, (uint64_t(floatBitsToUint(cost)) << 32) | uint64_t(pixel));  // costs >= 0
     }
   }

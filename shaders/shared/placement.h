@@ -43,7 +43,7 @@
 #define PLACEMENT_BINDING_LOWER 13       // uint per order position: the smallest tile bound's bits
 #define PLACEMENT_BINDING_ARGS 14        // uint[3] per order position: the first pass's dispatch
 #define PLACEMENT_BINDING_REST_ARGS 15   // uint[3] per order position: the second pass's dispatch
-#define PLACEMENT_BINDING_REGIONS 16     // PairRegionsGpu per (order position, label)
+#define PLACEMENT_BINDING_REGIONS 16     // PairRegionsGpu per (order position, placed one's)
 
 // Tiles are sorted per label into buckets by how far their lower cost bound lies above the
 // label's smallest one: bucket 0 below bucket_width, bucket b (1..) below bucket_width * 4^b,
@@ -90,7 +90,7 @@ struct PlacementParams {
   uint phase;         // placement_bounds.comp: PLACEMENT_PHASE_*
   float bucket_width;  // cost above the label's lowest tile bound that bucket 0 holds
   uint order_count;    // labels in the insertion order
-  uint pad1;
+  uint label;          // place_label: the label at order position `step`
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,

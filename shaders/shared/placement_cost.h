@@ -178,17 +178,21 @@ bool candidate_allowed(LabelGpu me, uvec2 p) {
          o.y + me.size.y <= float(params.height);
 }
 
-// Eq. 3.1 at centre c with the given constraint bits.
-float candidate_cost(LabelGpu me, vec2 origin, vec2 c, uint bits) {
+// Eq. 3.1 at centre c without its constraint terms: distance, direction, integral costs,
+// previous position.
+float free_cost(LabelGpu me, vec2 origin, vec2 c) {
   CostWeightsGpu w = params.weights;
   vec2 d = c - me.anchor;
   float distance = length(d);
   float direction = distance > 0.0f ? (abs(d.x) + abs(d.y)) / distance : 1.0f;
   float cost = w.distance_to_anchor * distance + w.connector_direction * direction;
-  if ((bits & CONSTRAINT_LABEL) != 0u) cost += w.label_shadow;
-  if ((bits & CONSTRAINT_CONNECTOR) != 0u) cost += w.connector_shadow;
-  if ((bits & CONSTRAINT_ANCHOR) != 0u) cost += w.anchor_constraint;
   cost += w.integral_costs * max(box_integral(me.layer, origin, me.size), 0.0f);
   cost += w.previous_position * length(c - me.previous);
   return cost;
+}
+
+// Eq. 3.1 at centre c with the given constraint bits: the free cost plus their weight (added
+// last, so the GPU adds them to a free cost it already has and gets the same float).
+float candidate_cost(LabelGpu me, vec2 origin, vec2 c, uint bits) {
+  return free_cost(me, origin, c) + constraint_weight(bits);
 }
