@@ -96,7 +96,8 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
     }};
   };
   const ResourceId bounds = graph.add_buffer("placement.bounds", per_label_tile(sizeof(float)));
-  const ResourceId tiles = graph.add_buffer("placement.tiles", per_label_tile(sizeof(uint32_t)));
+  const ResourceId tiles =
+      graph.add_buffer("placement.tiles", per_label_tile(2 * sizeof(uint32_t)));
   const ResourceId buckets =
       graph.add_buffer("placement.buckets", fixed(n * sizeof(gpu::PlacementBucketsGpu)));
   r.buckets = buckets;
@@ -207,7 +208,6 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
       {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
       {results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
       {r.constraints, Use::storage_read_write, PLACEMENT_BINDING_CONSTRAINTS},
-      {bounds, Use::storage_read, PLACEMENT_BINDING_BOUNDS},
       {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
       {tiles, Use::storage_read, PLACEMENT_BINDING_TILES},
       {lower, Use::storage_read, PLACEMENT_BINDING_LOWER},

@@ -13,9 +13,8 @@ layout(binding = PLACEMENT_BINDING_ORDER, std430) readonly buffer Order { uint o
 // a weaker bound, never a wrong one: results only decrease).
 layout(binding = PLACEMENT_BINDING_RESULTS, std430) coherent buffer Results { uint64_t results[]; };
 layout(binding = PLACEMENT_BINDING_CONSTRAINTS, std430) writeonly buffer Constraints { uint constraints[]; };
-layout(binding = PLACEMENT_BINDING_BOUNDS, std430) readonly buffer Bounds { float bounds[]; };
 layout(binding = PLACEMENT_BINDING_BUCKETS, std430) coherent buffer Buckets { PlacementBucketsGpu buckets[]; };
-layout(binding = PLACEMENT_BINDING_TILES, std430) readonly buffer Tiles { uint tile_list[]; };
+layout(binding = PLACEMENT_BINDING_TILES, std430) readonly buffer Tiles { uvec2 tile_list[]; };
 layout(binding = PLACEMENT_BINDING_LOWER, std430) readonly buffer Lower { uint lower[]; };
 // Read for the label being placed (written by earlier labels' dispatches); written, once a label
 // is final, for every label after it.
@@ -189,10 +188,13 @@ void main() {
 #else
   const bool first_pass = false;
 #endif
-  const uint count = first_pass ? buckets[s].counts[0] : buckets[s].rest;
+  // (the tile is read before the count: neither waits for the other)
   const uint w = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
+  const uint slot = min(w, tiles - 1u);
+  const uvec2 entry = tile_list[s * tiles + (first_pass ? tiles - 1u - slot : slot)];
+  const uint count = first_pass ? buckets[s].counts[0] : buckets[s].rest;
   if (w >= count) return;  // the whole workgroup
-  const uint tile_index = tile_list[s * tiles + (first_pass ? 0u : buckets[s].counts[0]) + w];
+  const uint tile_index = entry.x;
   const uvec2 tile = uvec2(tile_index % tiles_x, tile_index / tiles_x);
   // Each invocation has SPAN_X x SPAN_Y candidates, a workgroup's width or height apart
   // (neighbouring invocations read neighbouring table entries).
@@ -210,7 +212,7 @@ void main() {
   barrier();
   const bool may_skip = params.write_constraints == 0u;
   const float best = cost_of(tile_best);
-  const float bound = bounds[s * tiles + tile_index];
+  const float bound = uintBitsToFloat(entry.y);
   bool hopeless = may_skip && bound > best;
   float free_costs[PLACE_SPAN_X * PLACE_SPAN_Y];
   uint candidates = 0u;  // bit q: candidate q is worth its constraints
@@ -263,7 +265,7 @@ void main() {
     uint64_t group = PLACEMENT_NONE;
     for (uint k = 0u; k < gl_NumSubgroups; ++k) group = min(group, group_best[k]);
     // Thousands of workgroups share one address: only those that improve on it touch it.
-    if (group < results[label]) atomicMin(results[label], group);
+    if (group != PLACEMENT_NONE && group < results[label]) atomicMin(results[label], group);
     // The last workgroup of the label's last pass (the first, if it left the second nothing)
     // finds its result final.
     memoryBarrierBuffer();

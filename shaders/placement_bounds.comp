@@ -14,7 +14,7 @@ layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { Labe
 layout(binding = PLACEMENT_BINDING_ORDER, std430) readonly buffer Order { uint order[]; };
 layout(binding = PLACEMENT_BINDING_BOUNDS, std430) buffer Bounds { float bounds[]; };
 layout(binding = PLACEMENT_BINDING_BUCKETS, std430) buffer Buckets { PlacementBucketsGpu buckets[]; };
-layout(binding = PLACEMENT_BINDING_TILES, std430) writeonly buffer Tiles { uint tile_list[]; };
+layout(binding = PLACEMENT_BINDING_TILES, std430) writeonly buffer Tiles { uvec2 tile_list[]; };
 layout(binding = PLACEMENT_BINDING_LOWER, std430) buffer Lower { uint lower[]; };
 layout(binding = PLACEMENT_BINDING_ARGS, std430) writeonly buffer Args { uint args[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
@@ -123,7 +123,13 @@ void main() {
     atomicAdd(buckets[s].counts[bucket], 1u);
     return;
   }
-  uint offset = 0u;
-  for (uint b = 0u; b < bucket; ++b) offset += buckets[s].counts[b];
-  tile_list[s * tiles + offset + atomicAdd(buckets[s].cursors[bucket], 1u)] = tile;
+  // Bucket 0 (the first pass's) from the back, the others in order from the front: each pass
+  // finds its w-th tile without reading the counts first.
+  const uint cursor = atomicAdd(buckets[s].cursors[bucket], 1u);
+  uint index = tiles - 1u - cursor;
+  if (bucket > 0u) {
+    index = cursor;
+    for (uint b = 1u; b < bucket; ++b) index += buckets[s].counts[b];
+  }
+  tile_list[s * tiles + index] = uvec2(tile, floatBitsToUint(bound));
 }

@@ -39,7 +39,8 @@
 #define PLACEMENT_BINDING_PLACEMENTS 9   // PlacementGpu[]
 #define PLACEMENT_BINDING_BOUNDS 10      // float per order position per tile: lower cost bound
 #define PLACEMENT_BINDING_BUCKETS 11     // PlacementBucketsGpu per order position
-#define PLACEMENT_BINDING_TILES 12       // uint per order position per tile: tiles by bucket
+#define PLACEMENT_BINDING_TILES 12       // uvec2 per order position per tile: (tile, bound bits)
+                                         // by bucket: 1, 2, ... from the front, 0 from the back
 #define PLACEMENT_BINDING_LOWER 13       // uint per order position: the smallest tile bound's bits
 #define PLACEMENT_BINDING_ARGS 14        // uint[3] per order position: the first pass's dispatch
 #define PLACEMENT_BINDING_REST_ARGS 15   // uint[3] per order position: the second pass's dispatch
