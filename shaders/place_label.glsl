@@ -169,9 +169,18 @@ shared uint64_t final_result;
 void write_regions(uint s, uint j) {
   const vec3 placed_j = placed_from(final_result, j);
   const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
-  for (uint k_pos = s + 1u + gl_LocalInvocationIndex; k_pos < params.order_count; k_pos += threads) {
-    regions[k_pos * params.label_count + s] =
-        pair_regions(labels[order[k_pos]], labels[j], placed_j, params.margin);
+  // Two invocations per later label: its box half and its connector half.
+  for (uint t = gl_LocalInvocationIndex; s + 1u + t / 2u < params.order_count; t += threads) {
+    const uint k_pos = s + 1u + t / 2u;
+    const uint slot = k_pos * params.label_count + s;
+    if ((t & 1u) == 0u) {
+      const PairBoxRegion r = pair_box_region(labels[order[k_pos]], labels[j], placed_j, params.margin);
+      regions[slot].box = r.box;
+      regions[slot].info = r.info;
+    } else {
+      regions[slot].connector =
+          pair_connector_region(labels[order[k_pos]], labels[j], placed_j, params.margin).p;
+    }
   }
 }
 

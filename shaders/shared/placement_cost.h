@@ -84,28 +84,49 @@ ShadowPlanes shadow_planes(vec2 a, vec2 h, vec2 v0, vec2 v1, vec2 v2, vec2 v3, b
   return r;
 }
 
-// Label k's regions against placed label j (its box centre and 1 in z if shown, else 0).
-PairRegionsGpu pair_regions(LabelGpu k, LabelGpu j, vec3 placed_j, float margin) {
-  PairRegionsGpu r;
-  vec2 h = k.size * 0.5f + vec2(margin);
-  r.info = uvec4(0u);
+// Label k's regions against placed label j (its box centre and 1 in z if shown, else 0), in two
+// halves that the GPU computes on different invocations: the box's (and the info bits) ...
+struct PairBoxRegion {
+  vec4 box[4];
+  uvec4 info;
+};
+
+PairBoxRegion pair_box_region(LabelGpu k, LabelGpu j, vec3 placed_j, float margin) {
+  PairBoxRegion r;
   for (int i = 0; i < 4; ++i) r.box[i] = vec4(0.0f);
-  for (int i = 0; i < 6; ++i) r.connector[i] = vec4(0.0f);
+  r.info = uvec4(0u);
   if (placed_j.z < 0.5f) return r;
+  vec2 h = k.size * 0.5f + vec2(margin);
   vec2 centre = vec2(placed_j);
   vec2 lo = centre - j.size * 0.5f, hi = centre + j.size * 0.5f;
-  ShadowPlanes box = shadow_planes(k.anchor, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), false);
+  ShadowPlanes planes =
+      shadow_planes(k.anchor, h, lo, vec2(hi.x, lo.y), hi, vec2(lo.x, hi.y), false);
   // (A box's shadow has at most two axis planes: the ray planes and those two.)
   int used = 0;
   for (int i = 0; i < 6; ++i) {
-    if (box.p[i] != vec4(0.0f) && used < 4) r.box[used++] = box.p[i];
+    if (planes.p[i] != vec4(0.0f) && used < 4) r.box[used++] = planes.p[i];
   }
-  r.info.x = REGION_BOX;
-  if ((j.flags & LABEL_INTERNAL) == 0u) {
-    ShadowPlanes c = shadow_planes(k.anchor, h, j.anchor, centre, centre, centre, true);
-    for (int i = 0; i < 6; ++i) r.connector[i] = c.p[i];
-    r.info.x |= REGION_CONNECTOR;
-  }
+  r.info.x = REGION_BOX | ((j.flags & LABEL_INTERNAL) == 0u ? REGION_CONNECTOR : 0u);
+  return r;
+}
+
+// ... and the connector's (zero planes when j is hidden or internal).
+ShadowPlanes pair_connector_region(LabelGpu k, LabelGpu j, vec3 placed_j, float margin) {
+  ShadowPlanes c;
+  for (int i = 0; i < 6; ++i) c.p[i] = vec4(0.0f);
+  if (placed_j.z < 0.5f || (j.flags & LABEL_INTERNAL) != 0u) return c;
+  vec2 h = k.size * 0.5f + vec2(margin);
+  vec2 centre = vec2(placed_j);
+  return shadow_planes(k.anchor, h, j.anchor, centre, centre, centre, true);
+}
+
+PairRegionsGpu pair_regions(LabelGpu k, LabelGpu j, vec3 placed_j, float margin) {
+  PairRegionsGpu r;
+  PairBoxRegion b = pair_box_region(k, j, placed_j, margin);
+  ShadowPlanes c = pair_connector_region(k, j, placed_j, margin);
+  for (int i = 0; i < 4; ++i) r.box[i] = b.box[i];
+  for (int i = 0; i < 6; ++i) r.connector[i] = c.p[i];
+  r.info = b.info;
   return r;
 }
 
