@@ -38,6 +38,20 @@ int compare_images(std::span<const uint8_t> actual, const std::vector<uint8_t>& 
   return worst;
 }
 
+// The demo's graph with its pattern pass and readback target, ready to run.
+struct PatternGraph {
+  PatternGraph(Context& ctx, uint32_t radius)
+      : pattern(ctx), target(ctx), runner(ctx, build(radius)) {}
+  graph::Graph build(uint32_t radius) {
+    graph::Graph g;
+    target.add_output(g, pattern.add_to(g, radius));
+    return g;
+  }
+  TestPattern pattern;
+  HeadlessTarget target;
+  graph::GraphRunner runner;
+};
+
 }  // namespace
 
 TEST_SUITE("gpu") {
@@ -59,11 +73,9 @@ TEST_SUITE("gpu") {
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "graph_follows_a_viewport_resize") {
-    TestPattern pattern(ctx);
-    HeadlessTarget target(ctx);
-    graph::Graph g;
-    target.add_output(g, pattern.add_to(g, 3));
-    graph::GraphRunner runner(ctx, std::move(g));
+    PatternGraph demo(ctx, 3);
+    graph::GraphRunner& runner = demo.runner;
+    HeadlessTarget& target = demo.target;
     for (const graph::Extent size : {graph::Extent{40, 30}, graph::Extent{17, 50}}) {
       CAPTURE(size.width);
       runner.set_viewport(size);
@@ -79,11 +91,9 @@ TEST_SUITE("gpu") {
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "group_timestamps_give_one_span_per_run_of_a_group") {
-    TestPattern pattern(ctx);
-    HeadlessTarget target(ctx);
-    graph::Graph g;
-    target.add_output(g, pattern.add_to(g, 3));
-    graph::GraphRunner runner(ctx, std::move(g));
+    PatternGraph demo(ctx, 3);
+    graph::GraphRunner& runner = demo.runner;
+    HeadlessTarget& target = demo.target;
     runner.set_viewport({40, 30});
     target.bind(runner);
     runner.set_timestamps_per_pass(false);
