@@ -171,7 +171,7 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
   // are in shared memory).
   const double rays = double(size.width) * size.height;
   const double fetches = double(last.fetches);
-  char header[512], tail[1024];
+  char header[512], tail[768];
   std::snprintf(
       header, sizeof header,
       "  \"benchmark\": \"render\",\n  \"scene\": \"%s\",\n  \"camera\": \"%s\",\n"

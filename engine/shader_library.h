@@ -85,6 +85,12 @@ struct PipelineStatistic {
   std::string value;
 };
 
+// A pipeline's name and its statistics (what passes hand to `strata bench`).
+struct PipelineReport {
+  std::string name;
+  std::vector<PipelineStatistic> statistics;
+};
+
 class ComputePipeline : public Pipeline {
  public:
   ComputePipeline(Context& ctx, std::string_view shader);

@@ -135,7 +135,7 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
 
 LabelledRenderer::~LabelledRenderer() = default;
 
-std::vector<std::pair<std::string, std::vector<PipelineStatistic>>>
+std::vector<PipelineReport>
 LabelledRenderer::placement_pipelines() const {
   return parts_->placement.pipeline_statistics();
 }

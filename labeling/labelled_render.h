@@ -82,7 +82,7 @@ class LabelledRenderer {
   // Per label, its tiles per bucket and how many the second pass took (benchmark statistics).
   graph::ResourceId placement_buckets() const { return buckets_id_; }
   // The placement's pipelines and what the driver reports of each (benchmark output).
-  std::vector<std::pair<std::string, std::vector<PipelineStatistic>>> placement_pipelines() const;
+  std::vector<PipelineReport> placement_pipelines() const;
   // Binds the imported resources (after anything that reallocates the runner's transients).
   void bind();
   // The picture and layout of the last run.

@@ -258,12 +258,12 @@ void Placement::bind(graph::GraphRunner& runner) {
   runner.bind_buffer(readback_id_, readback_.handle());
 }
 
-std::vector<std::pair<std::string, std::vector<PipelineStatistic>>> Placement::pipeline_statistics()
+std::vector<PipelineReport> Placement::pipeline_statistics()
     const {
-  std::vector<std::pair<std::string, std::vector<PipelineStatistic>>> out;
+  std::vector<PipelineReport> out;
   for (const ComputePipeline* p :
        {&saliency_, &integral_costs_, &bounds_, &place_first_, &place_rest_, &finalize_}) {
-    out.emplace_back(p->name(), p->statistics());
+    out.push_back({p->name(), p->statistics()});
   }
   return out;
 }

@@ -60,7 +60,7 @@ class Placement {
   std::span<const gpu::PlacementGpu> results() const;
 
   // The placement's compute pipelines (shader name and what the driver reports of each).
-  std::vector<std::pair<std::string, std::vector<PipelineStatistic>>> pipeline_statistics() const;
+  std::vector<PipelineReport> pipeline_statistics() const;
 
  private:
   gpu::PlacementParams params(graph::Extent viewport, uint32_t step) const;

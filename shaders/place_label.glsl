@@ -89,7 +89,7 @@ bool region_holds_corners(vec4 p[6], vec2 c, vec2 e) {
 
 // The tile's candidate-reaching placed labels and anchors, and the constraints all of its
 // candidates have.
-void cull(LabelGpu me, uint label, uvec2 tile) {
+void cull(LabelGpu me, uvec2 tile) {
   if (gl_LocalInvocationIndex == 0u) {
     tile_placed_count = 0u;
     tile_anchor_count = 0u;
@@ -173,18 +173,24 @@ void write_regions(uint s, uint j) {
   for (uint t = gl_LocalInvocationIndex; s + 1u + t / 2u < params.order_count; t += threads) {
     const uint k_pos = s + 1u + t / 2u;
     const uint slot = k_pos * params.label_count + s;
+    const LabelGpu k = labels[order[k_pos]];
     if ((t & 1u) == 0u) {
-      const PairBoxRegion r = pair_box_region(labels[order[k_pos]], labels[j], placed_j, params.margin);
+      const PairBoxRegion r = pair_box_region(k, labels[j], placed_j, params.margin);
       regions[slot].box = r.box;
       regions[slot].info = r.info;
     } else {
-      regions[slot].connector =
-          pair_connector_region(labels[order[k_pos]], labels[j], placed_j, params.margin).p;
+      regions[slot].connector = pair_connector_region(k, labels[j], placed_j, params.margin).p;
     }
   }
 }
 
 shared uint tile_hope;  // 1: some candidate's cost without constraints is not above the best
+
+// The pixel of an invocation's candidate q: SPAN_X x SPAN_Y of them from `base`, a workgroup's
+// width or height apart (neighbouring invocations read neighbouring table entries).
+uvec2 candidate_pixel(uvec2 base, uint q) {
+  return base + uvec2(q % PLACE_SPAN_X, q / PLACE_SPAN_X) * uvec2(PLACE_GROUP_X, PLACE_GROUP_Y);
+}
 
 void main() {
   const uint s = params.step;
@@ -205,8 +211,6 @@ void main() {
   if (w >= count) return;  // the whole workgroup
   const uint tile_index = entry.x;
   const uvec2 tile = uvec2(tile_index % tiles_x, tile_index / tiles_x);
-  // Each invocation has SPAN_X x SPAN_Y candidates, a workgroup's width or height apart
-  // (neighbouring invocations read neighbouring table entries).
   const uvec2 base = tile * PLACEMENT_TILE + gl_LocalInvocationID.xy;
 
   // A candidate can only win if its cost is not above the best another workgroup has found
@@ -228,7 +232,7 @@ void main() {
   if (!hopeless) {
     // (every candidate's cost is computed, allowed or not, so that nothing waits on the tests)
     [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
-      const uvec2 p = base + uvec2(q % PLACE_SPAN_X, q / PLACE_SPAN_X) * uvec2(PLACE_GROUP_X, PLACE_GROUP_Y);
+      const uvec2 p = candidate_pixel(base, q);
       const vec2 origin = box_origin(p, me.size);
       free_costs[q] = free_cost(me, origin, origin + me.size * 0.5);
       const bool allowed = p.x < params.width && p.y < params.height && candidate_allowed(me, p);
@@ -239,7 +243,7 @@ void main() {
   barrier();
   hopeless = tile_hope == 0u;
   if (!hopeless) {
-    cull(me, label, tile);
+    cull(me, tile);
     hopeless = may_skip && (0.9999 * (bound + constraint_weight(tile_bits)) > best ||
                             (params.hard != 0u && tile_bits != 0u));
   }
@@ -247,7 +251,7 @@ void main() {
   [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
     if (hopeless) break;
     if ((candidates & (1u << q)) == 0u) continue;
-    const uvec2 p = base + uvec2(q % PLACE_SPAN_X, q / PLACE_SPAN_X) * uvec2(PLACE_GROUP_X, PLACE_GROUP_Y);
+    const uvec2 p = candidate_pixel(base, q);
     const vec2 origin = box_origin(p, me.size);
     const vec2 centre = origin + me.size * 0.5;
     // Bits weighing more than best - cost without them lose (strictly: 0.999), so the search
