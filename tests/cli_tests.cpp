@@ -70,7 +70,7 @@ TEST_SUITE("cli") {
 
   TEST_CASE("info_imports_a_thesis_scene_and_warns_about_its_missing_volume") {
     const auto r = run_strata(std::string("info ") + STRATA_SOURCE_DIR
-                              "/../shared/data/voly-labeller/scenes/dice.xml");
+                              "/tests/data/voly-labeller/scenes/dice.xml");
     CHECK(r.exit_code == 0);
     CHECK(r.output.find("N11") != std::string::npos);
     CHECK(r.output.find("dice.mha") != std::string::npos);

@@ -17,7 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path voly_scenes = fs::path(STRATA_SHARED_DATA) / "voly-labeller/scenes";
+const fs::path voly_scenes = fs::path(STRATA_TEST_DATA) / "voly-labeller/scenes";
 
 fs::path test_folder(const std::string& name) {
   return strata::test::fresh_folder("scene_loader_tests", name);
@@ -151,7 +151,7 @@ TEST_SUITE("loaders") {
     fs::create_directories(folder / "datasets");
     strata::write_metaimage(folder / "datasets/dice.mha", dice);
     fs::create_directories(folder / "transferfunctions");
-    fs::copy_file(fs::path(STRATA_SHARED_DATA) / "voly-labeller/transferfunctions/dice4.gra",
+    fs::copy_file(fs::path(STRATA_TEST_DATA) / "voly-labeller/transferfunctions/dice4.gra",
                   folder / "transferfunctions/dice4.gra");
     const fs::path path =
         write_file(folder / "scenes/dice.xml", read_text(voly_scenes / "dice.xml"));

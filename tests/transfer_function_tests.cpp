@@ -41,7 +41,7 @@ const char* const gradient_head =
 TEST_SUITE("loaders") {
   TEST_CASE("gra_import_keeps_each_stops_position_colour_and_alpha") {
     const fs::path path =
-        fs::path(STRATA_SHARED_DATA) / "voly-labeller/transferfunctions/dice4.gra";
+        fs::path(STRATA_TEST_DATA) / "voly-labeller/transferfunctions/dice4.gra";
     const strata::TransferFunction tf = strata::load_transfer_function(path);
     CHECK(tf.name == "dice4");
     CHECK(tf.source == path);
@@ -56,7 +56,7 @@ TEST_SUITE("loaders") {
   }
 
   TEST_CASE("every_published_gra_file_imports") {
-    const fs::path folder = fs::path(STRATA_SHARED_DATA) / "voly-labeller/transferfunctions";
+    const fs::path folder = fs::path(STRATA_TEST_DATA) / "voly-labeller/transferfunctions";
     int count = 0;
     for (const auto& entry : fs::directory_iterator(folder)) {
       CAPTURE(entry.path());
