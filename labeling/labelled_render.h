@@ -79,7 +79,7 @@ class LabelledRenderer {
   graph::GraphRunner& runner() { return *runner_; }
   // The placement's per-label results buffer (the baseline benchmark reads it after each label).
   graph::ResourceId placement_results() const { return results_id_; }
-  // Per label, its tiles per bucket and how many the second pass took (benchmark statistics).
+  // Per label, its tiles per bucket and how many its main pass took (benchmark statistics).
   graph::ResourceId placement_buckets() const { return buckets_id_; }
   // The placement's pipelines and what the driver reports of each (benchmark output).
   std::vector<PipelineReport> placement_pipelines() const;

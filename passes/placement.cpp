@@ -37,8 +37,7 @@ Placement::Placement(Context& ctx, uint32_t label_count)
       saliency_(ctx, "saliency.comp"),
       integral_costs_(ctx, "integral_costs.comp"),
       bounds_(ctx, "placement_bounds.comp"),
-      place_first_(ctx, "place_label_first.comp"),
-      place_rest_(ctx, "place_label_rest.comp"),
+      place_(ctx, "place_label.comp"),
       finalize_(ctx, "placement_finalize.comp"),
       tables_(ctx) {
   if (label_count > LABEL_MAX) {
@@ -53,7 +52,9 @@ Placement::Placement(Context& ctx, uint32_t label_count)
 gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) const {
   gpu::PlacementParams p = placement_params(settings_, viewport, layer_count_, label_count_, step);
   p.order_count = static_cast<uint32_t>(order_.size());
-  p.label = step < order_.size() ? order_[step] : 0;
+  // place_label dispatch `step`: the main pass of position step - 1, the speculative one of step
+  p.label = step > 0 && step <= order_.size() ? order_[step - 1] : 0;
+  p.spec_label = step < order_.size() ? order_[step] : 0;
   return p;
 }
 
@@ -98,13 +99,16 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
   const ResourceId bounds = graph.add_buffer("placement.bounds", per_label_tile(sizeof(float)));
   const ResourceId tiles =
       graph.add_buffer("placement.tiles", per_label_tile(2 * sizeof(uint32_t)));
+  // (one more than labels: a place_label dispatch each, and the last one's main pass)
   const ResourceId buckets =
-      graph.add_buffer("placement.buckets", fixed(n * sizeof(gpu::PlacementBucketsGpu)));
+      graph.add_buffer("placement.buckets", fixed((n + 1) * sizeof(gpu::PlacementBucketsGpu)));
   r.buckets = buckets;
   const ResourceId lower = graph.add_buffer("placement.lower", fixed(n * sizeof(uint32_t)));
-  const ResourceId args = graph.add_buffer("placement.args", fixed(n * 3 * sizeof(uint32_t)));
-  const ResourceId rest_args =
-      graph.add_buffer("placement.rest_args", fixed(n * 3 * sizeof(uint32_t)));
+  const ResourceId speculative =
+      graph.add_buffer("placement.speculative", graph::BufferInfo{[](graph::Extent e) {
+                         const glm::uvec2 across = gpu::placement_tiles(e.width, e.height);
+                         return VkDeviceSize{2} * across.x * across.y * sizeof(uint64_t);
+                       }});
   const ResourceId regions =
       graph.add_buffer("placement.regions", fixed(VkDeviceSize{n} * n * sizeof(gpu::PairRegionsGpu)));
   readback_id_ = graph.import_resource("placement.readback",
@@ -118,9 +122,9 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                    {r.constraints, Use::transfer_dst},
                    {buckets, Use::transfer_dst},
                    {lower, Use::transfer_dst},
-                   {rest_args, Use::transfer_dst},
+                   {speculative, Use::transfer_dst},
                    {regions, Use::transfer_dst}},
-                  [this, r, order, results, buckets, lower, rest_args,
+                  [this, r, order, results, buckets, lower, speculative,
                    regions](graph::PassContext& pc) {
                     if (!labels_.empty()) {
                       vkCmdUpdateBuffer(pc.cmd, pc.buffer(r.labels), 0,
@@ -134,9 +138,8 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                     vkCmdFillBuffer(pc.cmd, pc.buffer(r.constraints), 0, VK_WHOLE_SIZE, 0);
                     vkCmdFillBuffer(pc.cmd, pc.buffer(buckets), 0, VK_WHOLE_SIZE, 0);
                     vkCmdFillBuffer(pc.cmd, pc.buffer(lower), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
-                    // A label with no candidate at all has no first-pass workgroup to size the
-                    // second pass: it stays empty.
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(rest_args), 0, VK_WHOLE_SIZE, 0);
+                    // (each speculative workgroup writes its tile's entry before anything reads it)
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(speculative), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
                     // No regions: a label that is never placed constrains nobody.
                     vkCmdFillBuffer(pc.cmd, pc.buffer(regions), 0, VK_WHOLE_SIZE, 0);
                   },
@@ -169,40 +172,38 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
        {PLACEMENT_PHASE_BOUNDS, PLACEMENT_PHASE_COUNT, PLACEMENT_PHASE_SORT}) {
     static constexpr const char* names[] = {"placement.bounds", "placement.buckets",
                                             "placement.tiles"};
-    graph.add_pass({names[phase],
-                    graph::PassKind::compute,
-                    {{r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
-                     {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
-                     {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
-                     // (one shader for the three phases: the bounds phase writes the bounds and
-                     // the later ones read them, but each binds them writable; the tile list and
-                     // the sizes are bound in each phase, only the last writes them)
-                     {bounds,
-                      phase == PLACEMENT_PHASE_BOUNDS ? Use::storage_write : Use::storage_read_write,
-                      PLACEMENT_BINDING_BOUNDS},
-                     {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
-                     {tiles, Use::storage_write, PLACEMENT_BINDING_TILES},
-                     {lower, Use::storage_read_write, PLACEMENT_BINDING_LOWER},
-                     {args, Use::storage_write, PLACEMENT_BINDING_ARGS}},
-                    [this, phase](graph::PassContext& pc) {
-                      if (order_.empty()) return;
-                      pc.bind(bounds_);
-                      gpu::PlacementParams p = params(pc.viewport, 0);
-                      p.phase = phase;
-                      bounds_.push_constants(pc.cmd, p);
-                      const glm::uvec2 across =
-                          gpu::placement_tiles(pc.viewport.width, pc.viewport.height);
-                      const uint32_t tile_count = across.x * across.y;
-                      // Bounds: a workgroup of 64 per tile (its cells); then 64 tiles per group.
-                      vkCmdDispatch(pc.cmd,
-                                    phase == PLACEMENT_PHASE_BOUNDS ? tile_count
-                                                                    : group_count(tile_count, 64),
-                                    static_cast<uint32_t>(order_.size()), 1);
-                    },
-                    "placement"});
+    graph.add_pass(
+        {names[phase],
+         graph::PassKind::compute,
+         {{r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
+          {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+          {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
+          // (one shader for the three phases: the bounds phase writes the bounds and
+          // the later ones read them, but each binds them writable; the tile list and
+          // the sizes are bound in each phase, only the last writes them)
+          {bounds, phase == PLACEMENT_PHASE_BOUNDS ? Use::storage_write : Use::storage_read_write,
+           PLACEMENT_BINDING_BOUNDS},
+          {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
+          {tiles, Use::storage_write, PLACEMENT_BINDING_TILES},
+          {lower, Use::storage_read_write, PLACEMENT_BINDING_LOWER}},
+         [this, phase](graph::PassContext& pc) {
+           if (order_.empty()) return;
+           pc.bind(bounds_);
+           gpu::PlacementParams p = params(pc.viewport, 0);
+           p.phase = phase;
+           bounds_.push_constants(pc.cmd, p);
+           const glm::uvec2 across = gpu::placement_tiles(pc.viewport.width, pc.viewport.height);
+           const uint32_t tile_count = across.x * across.y;
+           // Bounds: a workgroup of 64 per tile (its cells); then 64 tiles per group.
+           vkCmdDispatch(pc.cmd,
+                         phase == PLACEMENT_PHASE_BOUNDS ? tile_count : group_count(tile_count, 64),
+                         static_cast<uint32_t>(order_.size()), 1);
+         },
+         "placement"});
   }
-  // Per label: the first pass reads its size from `args` and sizes the second in `rest_args`.
-  std::vector<graph::ResourceUse> label_uses{
+  // One dispatch per label and one more (dispatch j: the main pass of order position j - 1 and
+  // the speculative pass of j); each sizes the next one's main pass.
+  const std::vector<graph::ResourceUse> label_uses{
       {r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
       {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
       {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
@@ -211,25 +212,23 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
       {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
       {tiles, Use::storage_read, PLACEMENT_BINDING_TILES},
       {lower, Use::storage_read, PLACEMENT_BINDING_LOWER},
+      {speculative, Use::storage_read_write, PLACEMENT_BINDING_SPECULATIVE},
       {regions, Use::storage_read_write, PLACEMENT_BINDING_REGIONS}};
-  std::vector<graph::ResourceUse> first_uses = label_uses, rest_uses = label_uses;
-  first_uses.push_back({args, Use::indirect});
-  first_uses.push_back({rest_args, Use::storage_read_write, PLACEMENT_BINDING_REST_ARGS});
-  rest_uses.push_back({rest_args, Use::indirect});
-  for (uint32_t step = 0; step < label_count_; ++step) {
-    for (const bool first : {true, false}) {
-      graph.add_pass({first ? "placement.label" : "placement.label_rest", graph::PassKind::compute,
-                      first ? first_uses : rest_uses,
-                      [this, step, first, args, rest_args](graph::PassContext& pc) {
-                        if (step >= order_.size()) return;  // fewer labels enabled this frame
-                        const ComputePipeline& pipeline = first ? place_first_ : place_rest_;
-                        pc.bind(pipeline);
-                        pipeline.push_constants(pc.cmd, params(pc.viewport, step));
-                        vkCmdDispatchIndirect(pc.cmd, pc.buffer(first ? args : rest_args),
-                                              VkDeviceSize{step} * 3 * sizeof(uint32_t));
-                      },
-                      "placement"});
-    }
+  for (uint32_t step = 0; step <= label_count_; ++step) {
+    graph.add_pass({"placement.label", graph::PassKind::compute, label_uses,
+                    [this, step](graph::PassContext& pc) {
+                      // (fewer labels enabled this frame, or none)
+                      if (order_.empty() || step > order_.size()) return;
+                      pc.bind(place_);
+                      place_.push_constants(pc.cmd, params(pc.viewport, step));
+                      // Twice the tiles: room for any main and speculative pass.
+                      const glm::uvec2 across =
+                          gpu::placement_tiles(pc.viewport.width, pc.viewport.height);
+                      const glm::uvec3 groups =
+                          gpu::placement_dispatch_size(2 * across.x * across.y);
+                      vkCmdDispatch(pc.cmd, groups.x, groups.y, groups.z);
+                    },
+                    "placement"});
   }
   graph.add_pass({"placement.finalize",
                   graph::PassKind::compute,
@@ -261,8 +260,7 @@ void Placement::bind(graph::GraphRunner& runner) {
 std::vector<PipelineReport> Placement::pipeline_statistics()
     const {
   std::vector<PipelineReport> out;
-  for (const ComputePipeline* p :
-       {&saliency_, &integral_costs_, &bounds_, &place_first_, &place_rest_, &finalize_}) {
+  for (const ComputePipeline* p : {&saliency_, &integral_costs_, &bounds_, &place_, &finalize_}) {
     out.push_back({p->name(), p->statistics()});
   }
   return out;

@@ -1,10 +1,10 @@
 // Label placement on the GPU (thesis 3.2, 4.1), all of it inside one frame's command buffer:
 // saliency of the label-free final image, integral costs per layer (eq. 3.3/3.4) and their
-// summed-area tables, lower cost bounds per label and 16x16 tile (tiles sorted into buckets by
-// them), then per label in insertion order two fused constraints + cost (eq. 3.1) + argmin
-// dispatches (the likeliest tiles, then those the best so far leaves possible), each reading the
-// positions the earlier labels' wrote on the GPU. The placements are copied to the host after the
-// frame; nothing waits for them inside it.
+// summed-area tables, lower cost bounds per label and 32x32 tile (tiles sorted into buckets by
+// them), then per label in insertion order one fused constraints + cost (eq. 3.1) + argmin
+// dispatch that finishes the label (its main pass) while it evaluates the next label's likeliest
+// tiles speculatively, each reading the positions the earlier labels wrote on the GPU. The
+// placements are copied to the host after the frame; nothing waits for them inside it.
 #pragma once
 
 #include <span>
@@ -29,7 +29,7 @@ struct PlacementSettings {
   float occlusion_weight = 0.5f;  // eq. 3.4 (one layer)
   float single_saliency_weight = 0.5f;  // eq. 3.4 (one layer)
   bool write_constraints = false;       // keep each label's constraint image (tests, debugging)
-  // Cost above a label's lowest tile bound that the first of its two passes covers (speed only:
+  // Cost above a label's lowest tile bound that its speculative pass covers (speed only:
   // the positions do not depend on it).
   float bucket_width = 1.0f;
 };
@@ -71,7 +71,7 @@ class Placement {
   std::vector<gpu::LabelGpu> labels_;
   std::vector<uint32_t> order_;
   PlacementSettings settings_;
-  ComputePipeline saliency_, integral_costs_, bounds_, place_first_, place_rest_, finalize_;
+  ComputePipeline saliency_, integral_costs_, bounds_, place_, finalize_;
   SummedAreaTable tables_;
   Buffer readback_;
   graph::ResourceId readback_id_ = 0;

@@ -6,7 +6,7 @@
 
 // Before the label loop, for every label at once: a lower bound of eq. 3.1 over each 32x32 tile
 // of candidates (phase BOUNDS: a workgroup per tile and label), how many tiles fall in each bucket above the label's lowest bound
-// (COUNT), and the tiles sorted by bucket with the first pass's dispatch size (SORT). None of it
+// (COUNT), and the tiles sorted by bucket (SORT). None of it
 // depends on where earlier labels went, so it is one dispatch per phase, not one per label.
 layout(local_size_x = 64) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
@@ -16,7 +16,6 @@ layout(binding = PLACEMENT_BINDING_BOUNDS, std430) buffer Bounds { float bounds[
 layout(binding = PLACEMENT_BINDING_BUCKETS, std430) buffer Buckets { PlacementBucketsGpu buckets[]; };
 layout(binding = PLACEMENT_BINDING_TILES, std430) writeonly buffer Tiles { uvec2 tile_list[]; };
 layout(binding = PLACEMENT_BINDING_LOWER, std430) buffer Lower { uint lower[]; };
-layout(binding = PLACEMENT_BINDING_ARGS, std430) writeonly buffer Args { uint args[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
 const float INFINITY = 1.0 / 0.0;
@@ -107,12 +106,6 @@ void main() {
   const uint s = gl_WorkGroupID.y;  // position in the insertion order
   const bool in_range = tile < tiles;
   if (!in_range) return;
-  if (params.phase == PLACEMENT_PHASE_SORT && tile == 0u) {
-    const uvec3 size = placement_dispatch_size(buckets[s].counts[0]);
-    args[3u * s] = size.x;
-    args[3u * s + 1u] = size.y;
-    args[3u * s + 2u] = size.z;
-  }
   const float bound = bounds[s * tiles + tile];
   if (isinf(bound)) return;  // no candidate here may hold the label
   // Everything in bucket 0 when the constraint image is kept: every candidate is evaluated.
@@ -123,13 +116,9 @@ void main() {
     atomicAdd(buckets[s].counts[bucket], 1u);
     return;
   }
-  // Bucket 0 (the first pass's) from the back, the others in order from the front: each pass
-  // finds its w-th tile without reading the counts first.
-  const uint cursor = atomicAdd(buckets[s].cursors[bucket], 1u);
-  uint index = tiles - 1u - cursor;
-  if (bucket > 0u) {
-    index = cursor;
-    for (uint b = 1u; b < bucket; ++b) index += buckets[s].counts[b];
-  }
-  tile_list[s * tiles + index] = uvec2(tile, floatBitsToUint(bound));
+  // In bucket order: the speculative pass takes the first counts[0], the main pass a prefix.
+  uint index = atomicAdd(buckets[s].cursors[bucket], 1u);
+  for (uint b = 0u; b < bucket; ++b) index += buckets[s].counts[b];
+  tile_list[s * tiles + index] =
+      uvec2(tile | (bucket == 0u ? PLACEMENT_BUCKET0_TILE : 0u), floatBitsToUint(bound));
 }

@@ -188,6 +188,28 @@ TEST_SUITE("gpu") {
     }
   }
 
+  TEST_CASE_FIXTURE(test::GpuTest, "a_speculative_winner_the_label_before_takes_is_not_kept") {
+    // Label 1 is evaluated while label 0 is still being placed, without label 0's constraints.
+    // Their anchors are neighbours, so where label 1 would go alone is where label 0 goes (or in
+    // its shadow): the main pass must move it, to where the sequential reference puts it.
+    Inputs in = disc_scene(2);
+    in.labels[0] = label({44.0f, 30.0f}, {20.0f, 8.0f}, 0);
+    in.labels[1] = label({46.0f, 31.0f}, {20.0f, 8.0f}, 0);
+    const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                   in.labels, in.order, {}, in.size);
+    const std::vector<uint32_t> only_1{1};
+    const ReferencePlacement alone =
+        place_reference(in.final_rgba8, in.layers, in.layer_count, in.labels, only_1, {}, in.size);
+    REQUIRE(alone.placements[1].shown == PLACEMENT_SHOWN);
+    CHECK(glm::length(alone.placements[1].position - cpu.placements[1].position) > 1.0f);
+    for (const float width : {1.0f, 1e9f}) {  // (1e9: bucket 0 holds every tile)
+      CAPTURE(width);
+      PlacementSettings settings;
+      settings.bucket_width = width;
+      check_placements(place_on_gpu(ctx, in, settings), cpu);
+    }
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "one_layer_uses_eq_3_4_and_still_matches") {
     Inputs in = disc_scene(4);
     const size_t pixels = size_t{in.size.width} * in.size.height;

@@ -1,5 +1,6 @@
 // Label placement on the GPU (thesis 3.2, 4.1): saliency, integral costs, and one fused
-// constraints + cost (eq. 3.1) + argmin dispatch per label. Written once for C++ and GLSL.
+// constraints + cost (eq. 3.1) + argmin dispatch per label (place_label.comp). Written once for
+// C++ and GLSL.
 #ifndef STRATA_SHARED_PLACEMENT_H
 #define STRATA_SHARED_PLACEMENT_H
 
@@ -39,24 +40,28 @@
 #define PLACEMENT_BINDING_PLACEMENTS 9   // PlacementGpu[]
 #define PLACEMENT_BINDING_BOUNDS 10      // float per order position per tile: lower cost bound
 #define PLACEMENT_BINDING_BUCKETS 11     // PlacementBucketsGpu per order position
-#define PLACEMENT_BINDING_TILES 12       // uvec2 per order position per tile: (tile, bound bits)
-                                         // by bucket: 1, 2, ... from the front, 0 from the back
+#define PLACEMENT_BINDING_TILES 12       // uvec2 (tile, bound bits) per order position per tile
 #define PLACEMENT_BINDING_LOWER 13       // uint per order position: the smallest tile bound's bits
-#define PLACEMENT_BINDING_ARGS 14        // uint[3] per order position: the first pass's dispatch
-#define PLACEMENT_BINDING_REST_ARGS 15   // uint[3] per order position: the second pass's dispatch
-#define PLACEMENT_BINDING_REGIONS 16     // PairRegionsGpu per (order position, placed one's)
+#define PLACEMENT_BINDING_SPECULATIVE 14  // uint64_t per bucket-0 tile, two labels' worth
+#define PLACEMENT_BINDING_REGIONS 15      // PairRegionsGpu per (order position, placed one's)
+
+// The tile lists are in bucket order; an entry's x has this bit when its tile is in bucket 0 (the
+// speculative pass's). The speculative minima are kept for two labels at a time (by order
+// position parity).
+#define PLACEMENT_BUCKET0_TILE 0x80000000u
 
 // Tiles are sorted per label into buckets by how far their lower cost bound lies above the
 // label's smallest one: bucket 0 below bucket_width, bucket b (1..) below bucket_width * 4^b,
-// the last one everything else. The first pass places the label in bucket 0's tiles; the second
-// takes the next buckets up to the best cost the first found.
+// the last one everything else. A speculative pass evaluates bucket 0's tiles while the label
+// before is still being placed; the main pass then takes the buckets up to the best cost that
+// leaves possible.
 #define PLACEMENT_BUCKETS 8
 #define PLACEMENT_BUCKET_GROWTH 4.0f
 
 // PlacementParams.phase
 #define PLACEMENT_PHASE_BOUNDS 0u   // placement_bounds.comp: tile bounds and each label's lowest
 #define PLACEMENT_PHASE_COUNT 1u    // ... tiles per bucket
-#define PLACEMENT_PHASE_SORT 2u     // ... tiles sorted by bucket, the first pass's dispatch size
+#define PLACEMENT_PHASE_SORT 2u     // ... tiles sorted by bucket
 
 STRATA_BEGIN
 #ifdef __cplusplus
@@ -81,7 +86,8 @@ struct PlacementParams {
   uint height;
   uint layer_count;
   uint label_count;
-  uint step;          // place_label: the position in the insertion order being placed
+  uint step;          // place_label: the dispatch (main pass of order position step - 1,
+                      // speculative pass of step)
   uint hard;          // 1: constraint violations are forbidden (the label may end up hidden)
   uint write_constraints;  // 1: store the constraint bits of every pixel (tests, debugging)
   float margin;       // pixels added around label boxes in the constraints
@@ -91,7 +97,8 @@ struct PlacementParams {
   uint phase;         // placement_bounds.comp: PLACEMENT_PHASE_*
   float bucket_width;  // cost above the label's lowest tile bound that bucket 0 holds
   uint order_count;    // labels in the insertion order
-  uint label;          // place_label: the label at order position `step`
+  uint label;          // place_label: the label at order position step - 1 (main pass) ...
+  uint spec_label;     // ... and at step (speculative pass)
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,
@@ -104,12 +111,12 @@ struct PairRegionsGpu {
   uvec4 info;  // x: REGION_* bits
 };
 
-// Per label (order position): its tiles per bucket, and the second pass's size.
+// Per label (order position s): its tiles per bucket, and its main pass.
 struct PlacementBucketsGpu {
-  uint done;       // first-pass workgroups finished (the last one sizes the second pass)
-  uint rest;       // tiles in the second pass
-  uint done_rest;  // second-pass workgroups finished
-  uint pad1;
+  uint done;    // workgroups of place_label dispatch s finished (the last one sizes the next)
+  uint rest;    // tiles of the main pass beyond bucket 0
+  uint main;    // tiles of the main pass: bucket 0 and rest
+  float bound;  // the main pass's bound on the label's best cost (its speculative winners')
   uint counts[PLACEMENT_BUCKETS];
   uint cursors[PLACEMENT_BUCKETS];
 };
@@ -140,9 +147,10 @@ uvec2 placement_tiles(uint width, uint height) {
 #ifdef __cplusplus
 inline
 #endif
-// How far above the label's lowest bound bucket b starts: 0, then bucket_width * 4^(b - 1). The
-// sort and the second pass's sizing both use this, so they agree to the last bit.
-float placement_bucket_edge(uint b, float bucket_width) {
+    // How far above the label's lowest bound bucket b starts: 0, then bucket_width * 4^(b - 1). The
+    // sort and the main pass's sizing both use this, so they agree to the last bit.
+    float
+    placement_bucket_edge(uint b, float bucket_width) {
   float edge = b == 0u ? 0.0f : bucket_width;
   for (uint k = 1u; k < b; ++k) edge *= PLACEMENT_BUCKET_GROWTH;
   return edge;
