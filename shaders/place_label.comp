@@ -164,40 +164,50 @@ shared uint finishing;  // 1: this workgroup is the dispatch's last
 shared uint64_t final_result;
 shared uint bound_bits;  // the speculative winners' smallest true cost (bits)
 
-// The label at order position s is final: its constraint regions for every label after it.
-void write_regions(uint s, uint j) {
-  const vec3 placed_j = placed_from(final_result, j);
+// The dispatch's last workgroup. Label j - 1 is final: its constraint regions for every label
+// after it (two invocations per later label: its box half and its connector half). Label j's
+// speculative pass is complete: each of its bucket-0 tiles' winners is a real candidate whose
+// true cost is at most its speculative one plus the weight of what j - 1's regions (none for
+// j = 0) add there, so the smallest of those bounds j's best; its main pass, in the next
+// dispatch, takes bucket 0 and the buckets whose lower edge that bound does not exceed. This is
+// on the loop's critical path: what it reads is loaded first, and nothing waits on a store.
+void finish(uint j) {
   const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
-  // Two invocations per later label: its box half and its connector half.
-  for (uint t = gl_LocalInvocationIndex; s + 1u + t / 2u < params.order_count; t += threads) {
-    const uint k_pos = s + 1u + t / 2u;
-    const uint slot = k_pos * params.label_count + s;
-    const LabelGpu k = labels[order[k_pos]];
-    if ((t & 1u) == 0u) {
-      const PairBoxRegion r = pair_box_region(k, labels[j], placed_j, params.margin);
-      regions[slot].box = r.box;
-      regions[slot].info = r.info;
-    } else {
-      regions[slot].connector = pair_connector_region(k, labels[j], placed_j, params.margin).p;
-    }
-  }
-}
-
-// The dispatch's last workgroup, after write_regions: label p's speculative pass is complete.
-// Each of its bucket-0 tiles' winners is a real candidate, whose true cost is at most its
-// speculative one plus the weight of what label p - 1's regions (`r`; none for p = 0) add there,
-// so the smallest of those bounds p's best. Its main pass, in the next dispatch, takes bucket 0
-// and the buckets whose lower edge that bound does not exceed.
-void size_main_pass(uint p, uint spec_label, PairRegionsGpu r) {
-  if (gl_LocalInvocationIndex == 0u) bound_bits = 0x7F800000u;
-  barrier();
   const uvec2 tiles_xy = placement_tiles(params.width, params.height);
   const uint tiles = tiles_xy.x * tiles_xy.y;
+  const uint t = gl_LocalInvocationIndex;
+  const bool sizing = j < params.order_count;
+  const uint p = min(j, params.order_count - 1u);
+  // (the speculative entry is read before its count: the buffer holds every tile's)
   const uint count0 = buckets[p].counts[0];
-  const LabelGpu me = labels[spec_label];
+  const uint64_t first_key = t < tiles ? ATOMIC_READ(speculative[(p & 1u) * tiles + t]) : PLACEMENT_NONE;
+  uint counts[PLACEMENT_BUCKETS];
+  [[unroll]] for (uint b = 0u; b < PLACEMENT_BUCKETS; ++b) counts[b] = t == 0u ? buckets[p].counts[b] : 0u;
+  const float lowest = uintBitsToFloat(lower[p]);
+  const LabelGpu placed_label = labels[params.label];
+  const LabelGpu me = labels[params.spec_label];
+  const vec3 placed = j > 0u ? placed_from(final_result, params.label) : vec3(0.0);
+
+  if (j > 0u) {
+    const uint s = j - 1u;
+    for (uint u = t; s + 1u + u / 2u < params.order_count; u += threads) {
+      const uint k_pos = s + 1u + u / 2u;
+      const uint slot = k_pos * params.label_count + s;
+      const LabelGpu k = labels[order[k_pos]];
+      if ((u & 1u) == 0u) {
+        const PairBoxRegion r = pair_box_region(k, placed_label, placed, params.margin);
+        regions[slot].box = r.box;
+        regions[slot].info = r.info;
+      } else {
+        regions[slot].connector = pair_connector_region(k, placed_label, placed, params.margin).p;
+      }
+    }
+  }
+  if (!sizing) return;
+  const PairRegionsGpu r = pair_regions(me, placed_label, placed, params.margin);
   float bound = uintBitsToFloat(0x7F800000u);
-  for (uint i = gl_LocalInvocationIndex; i < count0; i += PLACE_GROUP_X * PLACE_GROUP_Y) {
-    const uint64_t key = ATOMIC_READ(speculative[(p & 1u) * tiles + i]);
+  for (uint i = t; i < count0; i += threads) {
+    const uint64_t key = i == t ? first_key : ATOMIC_READ(speculative[(p & 1u) * tiles + i]);
     if (key == PLACEMENT_NONE) continue;
     const uint pixel = uint(key & 0xFFFFFFFFul);
     const uvec2 q = uvec2(pixel % params.width, pixel / params.width);
@@ -208,15 +218,14 @@ void size_main_pass(uint p, uint spec_label, PairRegionsGpu r) {
   bound = subgroupMin(bound);
   if (subgroupElect()) atomicMin(bound_bits, floatBitsToUint(bound));  // costs >= 0
   barrier();
-  if (gl_LocalInvocationIndex != 0u) return;
+  if (t != 0u) return;
   // (rounding: the true cost is the free cost plus the weight of all bits, summed in another
   // order; an infinite bound stays infinite)
   const float best = uintBitsToFloat(bound_bits) * 1.0001;
-  const float above = best - uintBitsToFloat(lower[p]);
+  const float above = best - lowest;
   uint rest = 0u;
-  for (uint b = 1u; b < PLACEMENT_BUCKETS; ++b) {
-    if (!(above >= placement_bucket_edge(b, params.bucket_width))) break;
-    rest += buckets[p].counts[b];
+  [[unroll]] for (uint b = 1u; b < PLACEMENT_BUCKETS; ++b) {
+    if (above >= placement_bucket_edge(b, params.bucket_width)) rest += counts[b];
   }
   buckets[p].rest = rest;
   buckets[p].bound = best;
@@ -353,19 +362,12 @@ void main() {
     if (is_spec) atomicExchange(speculative[(position & 1u) * tiles + slot], group);
     memoryBarrierBuffer();
     finishing = atomicAdd(buckets[j].done, 1u) + 1u == working ? 1u : 0u;
-    if (finishing != 0u && j > 0u) {
+    if (finishing != 0u) {
+      bound_bits = 0x7F800000u;
       memoryBarrierBuffer();
-      final_result = ATOMIC_READ(results[params.label]);
+      if (j > 0u) final_result = ATOMIC_READ(results[params.label]);
     }
   }
   barrier();
-  if (finishing == 0u) return;
-  memoryBarrierBuffer();
-  if (j > 0u) write_regions(j - 1u, params.label);
-  if (j < params.order_count) {
-    // (none before the first label)
-    const vec3 previous = j > 0u ? placed_from(final_result, params.label) : vec3(0.0);
-    size_main_pass(j, params.spec_label,
-                   pair_regions(labels[params.spec_label], labels[params.label], previous, params.margin));
-  }
+  if (finishing != 0u) finish(j);
 }
