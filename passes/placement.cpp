@@ -31,9 +31,12 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   return p;
 }
 
-Placement::Placement(Context& ctx, uint32_t label_count)
+Placement::Placement(Context& ctx, uint32_t label_count, LabelDispatch dispatch)
     : ctx_(ctx),
       label_count_(label_count),
+      indirect_(dispatch == LabelDispatch::indirect ||
+                (dispatch == LabelDispatch::automatic &&
+                 ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)),
       saliency_(ctx, "saliency.comp"),
       integral_costs_(ctx, "integral_costs.comp"),
       bounds_(ctx, "placement_bounds.comp"),
@@ -104,6 +107,7 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
       graph.add_buffer("placement.buckets", fixed((n + 1) * sizeof(gpu::PlacementBucketsGpu)));
   r.buckets = buckets;
   const ResourceId lower = graph.add_buffer("placement.lower", fixed(n * sizeof(uint32_t)));
+  const ResourceId args = graph.add_buffer("placement.args", fixed((n + 1) * 3 * sizeof(uint32_t)));
   const ResourceId speculative =
       graph.add_buffer("placement.speculative", graph::BufferInfo{[](graph::Extent e) {
                          const glm::uvec2 across = gpu::placement_tiles(e.width, e.height);
@@ -185,7 +189,8 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
            PLACEMENT_BINDING_BOUNDS},
           {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
           {tiles, Use::storage_write, PLACEMENT_BINDING_TILES},
-          {lower, Use::storage_read_write, PLACEMENT_BINDING_LOWER}},
+          {lower, Use::storage_read_write, PLACEMENT_BINDING_LOWER},
+          {args, Use::storage_write, PLACEMENT_BINDING_ARGS}},
          [this, phase](graph::PassContext& pc) {
            if (order_.empty()) return;
            pc.bind(bounds_);
@@ -202,8 +207,8 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
          "placement"});
   }
   // One dispatch per label and one more (dispatch j: the main pass of order position j - 1 and
-  // the speculative pass of j); each sizes the next one's main pass.
-  const std::vector<graph::ResourceUse> label_uses{
+  // the speculative pass of j); each sizes the next one's main pass, and the next dispatch.
+  std::vector<graph::ResourceUse> label_uses{
       {r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
       {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
       {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
@@ -212,15 +217,23 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
       {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
       {tiles, Use::storage_read, PLACEMENT_BINDING_TILES},
       {lower, Use::storage_read, PLACEMENT_BINDING_LOWER},
+      {args, Use::storage_read_write, PLACEMENT_BINDING_ARGS},
       {speculative, Use::storage_read_write, PLACEMENT_BINDING_SPECULATIVE},
       {regions, Use::storage_read_write, PLACEMENT_BINDING_REGIONS}};
+  // (direct: the sizes are still written, but no barrier waits for them)
+  if (indirect_) label_uses.push_back({args, Use::indirect});
   for (uint32_t step = 0; step <= label_count_; ++step) {
     graph.add_pass({"placement.label", graph::PassKind::compute, label_uses,
-                    [this, step](graph::PassContext& pc) {
+                    [this, step, args](graph::PassContext& pc) {
                       // (fewer labels enabled this frame, or none)
                       if (order_.empty() || step > order_.size()) return;
                       pc.bind(place_);
                       place_.push_constants(pc.cmd, params(pc.viewport, step));
+                      if (indirect_) {
+                        vkCmdDispatchIndirect(pc.cmd, pc.buffer(args),
+                                              VkDeviceSize{step} * 3 * sizeof(uint32_t));
+                        return;
+                      }
                       // Twice the tiles: room for any main and speculative pass.
                       const glm::uvec2 across =
                           gpu::placement_tiles(pc.viewport.width, pc.viewport.height);

@@ -18,9 +18,9 @@
 // Each workgroup's (cost, pixel) goes to results[label] with one 64-bit atomicMin; the dispatch's
 // last workgroup finds label j - 1 final, writes its constraint regions for the labels after it,
 // bounds label j's best by the true cost of its speculative winners (the speculative cost plus
-// what j - 1's regions add there) and sizes j's main pass. Each dispatch has a workgroup for
-// every tile twice over (the passes' sizes are only known on the GPU; an indirect dispatch costs
-// more than the workgroups that leave at once). The loop never returns to the CPU, and
+// what j - 1's regions add there) and sizes j's main pass and the next dispatch. A dispatch is
+// either indirect, of that size, or direct, of a workgroup for every tile twice over, those past
+// the passes' sizes leaving at once (Placement chooses: see LabelDispatch). The loop never returns to the CPU, and
 // a label's speculative pass is off the chain of dependent dispatches.
 layout(local_size_x = PLACE_GROUP_X, local_size_y = PLACE_GROUP_Y) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
@@ -33,6 +33,7 @@ layout(binding = PLACEMENT_BINDING_CONSTRAINTS, std430) writeonly buffer Constra
 layout(binding = PLACEMENT_BINDING_BUCKETS, std430) coherent buffer Buckets { PlacementBucketsGpu buckets[]; };
 layout(binding = PLACEMENT_BINDING_TILES, std430) readonly buffer Tiles { uvec2 tile_list[]; };
 layout(binding = PLACEMENT_BINDING_LOWER, std430) readonly buffer Lower { uint lower[]; };
+layout(binding = PLACEMENT_BINDING_ARGS, std430) writeonly buffer Args { uint args[]; };
 layout(binding = PLACEMENT_BINDING_SPECULATIVE, std430) coherent buffer Speculative { uint64_t speculative[]; };
 // Read for the label being placed (written by earlier labels' dispatches); written, once a label
 // is final, for every label after it.
@@ -184,6 +185,7 @@ void finish(uint j) {
   uint counts[PLACEMENT_BUCKETS];
   [[unroll]] for (uint b = 0u; b < PLACEMENT_BUCKETS; ++b) counts[b] = t == 0u ? buckets[p].counts[b] : 0u;
   const float lowest = uintBitsToFloat(lower[p]);
+  const uint next_count0 = t == 0u && p + 1u < params.order_count ? buckets[p + 1u].counts[0] : 0u;
   const LabelGpu placed_label = labels[params.label];
   const LabelGpu me = labels[params.spec_label];
   const vec3 placed = j > 0u ? placed_from(final_result, params.label) : vec3(0.0);
@@ -230,6 +232,11 @@ void finish(uint j) {
   buckets[p].rest = rest;
   buckets[p].bound = best;
   buckets[p].main = count0 + rest;
+  // The next dispatch's size, when indirect: this main pass and the next label's speculative one.
+  const uvec3 size = placement_dispatch_size(max(count0 + rest + next_count0, 1u));
+  args[3u * j + 3u] = size.x;
+  args[3u * j + 4u] = size.y;
+  args[3u * j + 5u] = size.z;
 }
 
 shared uint tile_hope;  // 1: some candidate's cost without constraints is not above the best

@@ -6,7 +6,7 @@
 
 // Before the label loop, for every label at once: a lower bound of eq. 3.1 over each 32x32 tile
 // of candidates (phase BOUNDS: a workgroup per tile and label), how many tiles fall in each bucket above the label's lowest bound
-// (COUNT), and the tiles sorted by bucket (SORT). None of it
+// (COUNT), and the tiles sorted by bucket with the first label dispatch's size (SORT). None of it
 // depends on where earlier labels went, so it is one dispatch per phase, not one per label.
 layout(local_size_x = 64) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
@@ -16,6 +16,7 @@ layout(binding = PLACEMENT_BINDING_BOUNDS, std430) buffer Bounds { float bounds[
 layout(binding = PLACEMENT_BINDING_BUCKETS, std430) buffer Buckets { PlacementBucketsGpu buckets[]; };
 layout(binding = PLACEMENT_BINDING_TILES, std430) writeonly buffer Tiles { uvec2 tile_list[]; };
 layout(binding = PLACEMENT_BINDING_LOWER, std430) buffer Lower { uint lower[]; };
+layout(binding = PLACEMENT_BINDING_ARGS, std430) writeonly buffer Args { uint args[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
 const float INFINITY = 1.0 / 0.0;
@@ -106,6 +107,14 @@ void main() {
   const uint s = gl_WorkGroupID.y;  // position in the insertion order
   const bool in_range = tile < tiles;
   if (!in_range) return;
+  if (params.phase == PLACEMENT_PHASE_SORT && tile == 0u && s == 0u) {
+    // The first place_label dispatch, when indirect: the first label's speculative pass (at
+    // least one workgroup, which sizes the next dispatch).
+    const uvec3 size = placement_dispatch_size(max(buckets[0].counts[0], 1u));
+    args[0] = size.x;
+    args[1] = size.y;
+    args[2] = size.z;
+  }
   const float bound = bounds[s * tiles + tile];
   if (isinf(bound)) return;  // no candidate here may hold the label
   // Everything in bucket 0 when the constraint image is kept: every candidate is evaluated.

@@ -84,7 +84,8 @@ std::vector<T> as(const std::vector<std::byte>& bytes) {
   return out;
 }
 
-GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSettings& settings) {
+GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSettings& settings,
+                          LabelDispatch dispatch = LabelDispatch::automatic) {
   Image final_image(ctx, {VK_FORMAT_R8G8B8A8_UNORM,
                           {in.size.width, in.size.height, 1},
                           VK_IMAGE_TYPE_2D,
@@ -102,7 +103,7 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
                      true});
   upload(ctx, layers, as_bytes(halves), VK_IMAGE_LAYOUT_GENERAL);
 
-  Placement placement(ctx, uint32_t(in.labels.size()));
+  Placement placement(ctx, uint32_t(in.labels.size()), dispatch);
   graph::Graph g;
   const auto final_id = g.import_resource("final", {true, true, VK_IMAGE_LAYOUT_GENERAL});
   const auto layers_id = g.import_resource("layers", {true, true, VK_IMAGE_LAYOUT_GENERAL});
@@ -175,16 +176,21 @@ TEST_SUITE("gpu") {
 
   TEST_CASE_FIXTURE(test::GpuTest, "bucket_width_changes_the_passes_not_the_positions") {
     // Twelve labels in a small scene, so later ones meet constraints and their best lies far
-    // above their lowest tile bound: with a tiny width nearly every tile is left to the second
-    // pass, with a huge one the first pass takes them all. The positions stay the reference's.
+    // above their lowest tile bound: with a tiny width nearly every tile is left to the main
+    // pass, with a huge one the speculative pass takes them all (and the main pass keeps or
+    // re-evaluates each). The positions stay the reference's, with direct and indirect
+    // dispatches.
     const Inputs in = disc_scene(12);
     const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                    in.labels, in.order, {}, in.size);
     for (const float width : {0.01f, 1.0f, 1e9f}) {
-      CAPTURE(width);
-      PlacementSettings settings;
-      settings.bucket_width = width;
-      check_placements(place_on_gpu(ctx, in, settings), cpu);
+      for (const LabelDispatch dispatch : {LabelDispatch::direct, LabelDispatch::indirect}) {
+        CAPTURE(width);
+        CAPTURE(int(dispatch));
+        PlacementSettings settings;
+        settings.bucket_width = width;
+        check_placements(place_on_gpu(ctx, in, settings, dispatch), cpu);
+      }
     }
   }
 
@@ -203,10 +209,13 @@ TEST_SUITE("gpu") {
     REQUIRE(alone.placements[1].shown == PLACEMENT_SHOWN);
     CHECK(glm::length(alone.placements[1].position - cpu.placements[1].position) > 1.0f);
     for (const float width : {1.0f, 1e9f}) {  // (1e9: bucket 0 holds every tile)
-      CAPTURE(width);
-      PlacementSettings settings;
-      settings.bucket_width = width;
-      check_placements(place_on_gpu(ctx, in, settings), cpu);
+      for (const LabelDispatch dispatch : {LabelDispatch::direct, LabelDispatch::indirect}) {
+        CAPTURE(width);
+        CAPTURE(int(dispatch));
+        PlacementSettings settings;
+        settings.bucket_width = width;
+        check_placements(place_on_gpu(ctx, in, settings, dispatch), cpu);
+      }
     }
   }
 

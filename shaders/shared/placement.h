@@ -42,8 +42,9 @@
 #define PLACEMENT_BINDING_BUCKETS 11     // PlacementBucketsGpu per order position
 #define PLACEMENT_BINDING_TILES 12       // uvec2 (tile, bound bits) per order position per tile
 #define PLACEMENT_BINDING_LOWER 13       // uint per order position: the smallest tile bound's bits
-#define PLACEMENT_BINDING_SPECULATIVE 14  // uint64_t per bucket-0 tile, two labels' worth
-#define PLACEMENT_BINDING_REGIONS 15      // PairRegionsGpu per (order position, placed one's)
+#define PLACEMENT_BINDING_ARGS 14        // uint[3] per place_label dispatch: its size (indirect)
+#define PLACEMENT_BINDING_SPECULATIVE 15  // uint64_t per bucket-0 tile, two labels' worth
+#define PLACEMENT_BINDING_REGIONS 16      // PairRegionsGpu per (order position, placed one's)
 
 // The tile lists are in bucket order; an entry's x has this bit when its tile is in bucket 0 (the
 // speculative pass's). The speculative minima are kept for two labels at a time (by order
@@ -61,7 +62,7 @@
 // PlacementParams.phase
 #define PLACEMENT_PHASE_BOUNDS 0u   // placement_bounds.comp: tile bounds and each label's lowest
 #define PLACEMENT_PHASE_COUNT 1u    // ... tiles per bucket
-#define PLACEMENT_PHASE_SORT 2u     // ... tiles sorted by bucket
+#define PLACEMENT_PHASE_SORT 2u     // ... tiles sorted by bucket, the first dispatch's size
 
 STRATA_BEGIN
 #ifdef __cplusplus
