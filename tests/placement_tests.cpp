@@ -148,6 +148,21 @@ void check_placements(const GpuPlacement& gpu, const ReferencePlacement& cpu) {
   }
 }
 
+// The GPU's positions match the reference's with each bucket width, dispatched directly and
+// indirectly.
+void check_placements_across(Context& ctx, const Inputs& in, const ReferencePlacement& cpu,
+                             std::initializer_list<float> bucket_widths) {
+  for (const float width : bucket_widths) {
+    for (const LabelDispatch dispatch : {LabelDispatch::direct, LabelDispatch::indirect}) {
+      CAPTURE(width);
+      CAPTURE(int(dispatch));
+      PlacementSettings settings;
+      settings.bucket_width = width;
+      check_placements(place_on_gpu(ctx, in, settings, dispatch), cpu);
+    }
+  }
+}
+
 }  // namespace
 
 TEST_SUITE("gpu") {
@@ -183,15 +198,7 @@ TEST_SUITE("gpu") {
     const Inputs in = disc_scene(12);
     const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                    in.labels, in.order, {}, in.size);
-    for (const float width : {0.01f, 1.0f, 1e9f}) {
-      for (const LabelDispatch dispatch : {LabelDispatch::direct, LabelDispatch::indirect}) {
-        CAPTURE(width);
-        CAPTURE(int(dispatch));
-        PlacementSettings settings;
-        settings.bucket_width = width;
-        check_placements(place_on_gpu(ctx, in, settings, dispatch), cpu);
-      }
-    }
+    check_placements_across(ctx, in, cpu, {0.01f, 1.0f, 1e9f});
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "a_speculative_winner_the_label_before_takes_is_not_kept") {
@@ -208,15 +215,7 @@ TEST_SUITE("gpu") {
         place_reference(in.final_rgba8, in.layers, in.layer_count, in.labels, only_1, {}, in.size);
     REQUIRE(alone.placements[1].shown == PLACEMENT_SHOWN);
     CHECK(glm::length(alone.placements[1].position - cpu.placements[1].position) > 1.0f);
-    for (const float width : {1.0f, 1e9f}) {  // (1e9: bucket 0 holds every tile)
-      for (const LabelDispatch dispatch : {LabelDispatch::direct, LabelDispatch::indirect}) {
-        CAPTURE(width);
-        CAPTURE(int(dispatch));
-        PlacementSettings settings;
-        settings.bucket_width = width;
-        check_placements(place_on_gpu(ctx, in, settings, dispatch), cpu);
-      }
-    }
+    check_placements_across(ctx, in, cpu, {1.0f, 1e9f});  // (1e9: bucket 0 holds every tile)
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "one_layer_uses_eq_3_4_and_still_matches") {
