@@ -43,25 +43,16 @@ ShadowPlanes shadow_planes(vec2 a, vec2 h, vec2 v0, vec2 v1, vec2 v2, vec2 v3, b
   } else if (all(greaterThanEqual(a, lo)) && all(lessThanEqual(a, hi))) {
     return r;
   }
-  // The silhouette: the vertices at the largest and smallest angle around the direction from a
-  // to B's middle (the shadow's opening is below 180 degrees, so angles are in (-pi, pi)).
-  vec2 m = 0.5f * (lo + hi) - a;
-  int first = 0, last = 0;
-  float most = -4.0f, least = 4.0f;
-  for (int k = 0; k < 4; ++k) {
+  // The silhouette: the directions from a to B's vertices span less than 180 degrees, so the
+  // sign of a cross product orders them; the most counter-clockwise and the most clockwise
+  // (the first of equals).
+  vec2 d_first = v0 - a, d_last = v0 - a;
+  for (int k = 1; k < 4; ++k) {
     vec2 d = v[k] - a;
-    float angle = atan(m.x * d.y - m.y * d.x, dot(m, d));
-    if (angle > most) {
-      most = angle;
-      first = k;
-    }
-    if (angle < least) {
-      least = angle;
-      last = k;
-    }
+    if (d_first.x * d.y - d_first.y * d.x > 0.0f) d_first = d;
+    if (d_last.x * d.y - d_last.y * d.x < 0.0f) d_last = d;
   }
   // Outward normals of the two rays (every vertex lies on the inner side).
-  vec2 d_first = v[first] - a, d_last = v[last] - a;
   r.p[0] = dilated_plane(vec2(-d_first.y, d_first.x), dot(vec2(-d_first.y, d_first.x), a), h);
   r.p[1] = dilated_plane(vec2(d_last.y, -d_last.x), dot(vec2(d_last.y, -d_last.x), a), h);
   // The axes along which the shadow is bounded: B lies entirely on the near side of a.
