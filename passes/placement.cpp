@@ -31,12 +31,14 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   return p;
 }
 
-Placement::Placement(Context& ctx, uint32_t label_count, LabelDispatch dispatch)
+Placement::Placement(Context& ctx, uint32_t label_count, LabelDispatch dispatch,
+                     uint32_t direct_groups)
     : ctx_(ctx),
       label_count_(label_count),
       indirect_(dispatch == LabelDispatch::indirect ||
                 (dispatch == LabelDispatch::automatic &&
                  ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)),
+      direct_groups_(std::max(direct_groups, 1u)),
       saliency_(ctx, "saliency.comp"),
       integral_costs_(ctx, "integral_costs.comp"),
       bounds_(ctx, "placement_bounds.comp"),
@@ -113,6 +115,11 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                          const glm::uvec2 across = gpu::placement_tiles(e.width, e.height);
                          return VkDeviceSize{2} * across.x * across.y * sizeof(uint64_t);
                        }});
+  const ResourceId samples =
+      graph.add_buffer("placement.samples", graph::BufferInfo{[](graph::Extent e) {
+                         const glm::uvec2 across = gpu::placement_tiles(e.width, e.height);
+                         return VkDeviceSize{across.x} * across.y * sizeof(uint64_t);
+                       }});
   const ResourceId regions =
       graph.add_buffer("placement.regions", fixed(VkDeviceSize{n} * n * sizeof(gpu::PairRegionsGpu)));
   readback_id_ = graph.import_resource("placement.readback",
@@ -127,8 +134,9 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                    {buckets, Use::transfer_dst},
                    {lower, Use::transfer_dst},
                    {speculative, Use::transfer_dst},
+                   {samples, Use::transfer_dst},
                    {regions, Use::transfer_dst}},
-                  [this, r, order, results, buckets, lower, speculative,
+                  [this, r, order, results, buckets, lower, speculative, samples,
                    regions](graph::PassContext& pc) {
                     if (!labels_.empty()) {
                       vkCmdUpdateBuffer(pc.cmd, pc.buffer(r.labels), 0,
@@ -144,6 +152,7 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                     vkCmdFillBuffer(pc.cmd, pc.buffer(lower), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
                     // (each speculative workgroup writes its tile's entry before anything reads it)
                     vkCmdFillBuffer(pc.cmd, pc.buffer(speculative), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(samples), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
                     // No regions: a label that is never placed constrains nobody.
                     vkCmdFillBuffer(pc.cmd, pc.buffer(regions), 0, VK_WHOLE_SIZE, 0);
                   },
@@ -215,11 +224,11 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
       {results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
       {r.constraints, Use::storage_read_write, PLACEMENT_BINDING_CONSTRAINTS},
       {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
-      {tiles, Use::storage_read, PLACEMENT_BINDING_TILES},
-      {lower, Use::storage_read, PLACEMENT_BINDING_LOWER},
+      {tiles, Use::storage_read_write, PLACEMENT_BINDING_TILES},
       {args, Use::storage_read_write, PLACEMENT_BINDING_ARGS},
       {speculative, Use::storage_read_write, PLACEMENT_BINDING_SPECULATIVE},
-      {regions, Use::storage_read_write, PLACEMENT_BINDING_REGIONS}};
+      {regions, Use::storage_read_write, PLACEMENT_BINDING_REGIONS},
+      {samples, Use::storage_read_write, PLACEMENT_BINDING_SAMPLES}};
   // (direct: the sizes are still written, but no barrier waits for them)
   if (indirect_) label_uses.push_back({args, Use::indirect});
   for (uint32_t step = 0; step <= label_count_; ++step) {
@@ -234,11 +243,14 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                                               VkDeviceSize{step} * 3 * sizeof(uint32_t));
                         return;
                       }
-                      // Twice the tiles: room for any main and speculative pass.
+                      // Room for any classification, the passes' tiles and the region
+                      // writer.
                       const glm::uvec2 across =
                           gpu::placement_tiles(pc.viewport.width, pc.viewport.height);
-                      const glm::uvec3 groups =
-                          gpu::placement_dispatch_size(2 * across.x * across.y);
+                      const uint32_t tile_count = across.x * across.y;
+                      const glm::uvec3 groups = gpu::placement_dispatch_size(
+                          gpu::placement_classify_groups(tile_count) +
+                          std::min(2 * tile_count, direct_groups_) + 1);
                       vkCmdDispatch(pc.cmd, groups.x, groups.y, groups.z);
                     },
                     "placement"});

@@ -31,14 +31,15 @@ struct PlacementSettings {
   bool write_constraints = false;       // keep each label's constraint image (tests, debugging)
   // Cost above a label's lowest tile bound that its speculative pass covers (speed only:
   // the positions do not depend on it).
-  float bucket_width = 1.0f;
+  float bucket_width = 0.0625f;
 };
 
 gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent viewport,
                                       uint32_t layer_count, uint32_t label_count, uint32_t step);
 
 // How the label loop's dispatches are sized. Their sizes are only known on the GPU: an indirect
-// dispatch reads them there; a direct one has a workgroup for every tile twice over, those past
+// dispatch reads them there; a direct one has enough workgroups for any sizes (with at most
+// `direct_groups` for the passes' tiles, each taking several when there are more), those past
 // the sizes leaving at once. On an H100 direct is faster (a chain of dependent dispatches costs
 // 2.2 us per step direct, 4.6 us indirect, and the idle workgroups about 0.5 us); on lavapipe,
 // where every workgroup runs on the CPU, idle ones cost more than the whole placement.
@@ -56,7 +57,8 @@ class Placement {
   };
 
   // `label_count` fixes the number of per-label passes; a frame may enable fewer labels.
-  Placement(Context& ctx, uint32_t label_count, LabelDispatch dispatch = LabelDispatch::automatic);
+  Placement(Context& ctx, uint32_t label_count, LabelDispatch dispatch = LabelDispatch::automatic,
+            uint32_t direct_groups = PLACEMENT_DIRECT_GROUPS);
 
   Resources add_to(graph::Graph& graph, graph::ResourceId final_image, graph::ResourceId layers,
                    uint32_t layer_count);
@@ -79,6 +81,7 @@ class Placement {
   Context& ctx_;
   uint32_t label_count_;
   bool indirect_;
+  uint32_t direct_groups_;
   uint32_t layer_count_ = 1;
   std::vector<gpu::LabelGpu> labels_;
   std::vector<uint32_t> order_;

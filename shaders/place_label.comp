@@ -5,23 +5,29 @@
 #extension GL_EXT_shader_atomic_int64 : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_ballot : require
 #include "shared/placement.h"
 
 // The greedy label loop, one dispatch per step: constraints, eq. 3.1 and the argmin over
 // lists of 32x32 tiles (placement_bounds.comp sorted each label's tiles into buckets by a lower
-// bound of their cost). Dispatch j does two things at once:
-//  - MAIN, the label at order position j - 1: every tile its best may still lie in. Bucket 0's
+// bound of their cost without constraints). Dispatch j has four kinds of workgroups:
+//  - CLASSIFY, the label at order position j: its list entries past bucket 0 against the labels
+//    placed up to j - 2 and the anchors (see classify()): the constraint bits every candidate of
+//    a tile has, and four sampled candidates' costs.
+//  - MAIN, the label at order position j - 1: the tiles its best may still lie in. Bucket 0's
 //    tiles were evaluated by the speculative pass of the dispatch before; of those, only the ones
 //    label j - 2's regions reach are evaluated again, the others hand on their minimum.
 //  - SPEC, the label at order position j: its bucket-0 tiles, with the constraints of the labels
 //    up to j - 2 (j - 1 is not final yet), a minimum per tile and no pruning.
-// Each workgroup's (cost, pixel) goes to results[label] with one 64-bit atomicMin; the dispatch's
-// last workgroup finds label j - 1 final, writes its constraint regions for the labels after it,
-// bounds label j's best by the true cost of its speculative winners (the speculative cost plus
-// what j - 1's regions add there) and sizes j's main pass and the next dispatch. A dispatch is
-// either indirect, of that size, or direct, of a workgroup for every tile twice over, those past
-// the passes' sizes leaving at once (Placement chooses: see LabelDispatch). The loop never returns to the CPU, and
-// a label's speculative pass is off the chain of dependent dispatches.
+//  - one region writer: label j - 2's constraint regions for the labels from j + 1 on.
+// The main pass's workgroups meet in results[label] with one 64-bit atomicMin each; the
+// dispatch's last workgroup finds label j - 1 final, writes its regions for labels j and j + 1,
+// bounds label j's best by the true cost of its speculative winners and samples (their cost plus
+// what j - 1's regions add there), and keeps, for j's main pass, the classified entries whose
+// bound with their bits does not exceed that (see finish()). A dispatch is either indirect, of
+// that size, or direct, of enough workgroups for any counts, those past them leaving at once
+// (Placement chooses: see LabelDispatch). The loop never returns to the CPU, and a label's
+// speculative pass and classification are off the chain of dependent dispatches.
 layout(local_size_x = PLACE_GROUP_X, local_size_y = PLACE_GROUP_Y) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
 layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
@@ -31,13 +37,15 @@ layout(binding = PLACEMENT_BINDING_ORDER, std430) readonly buffer Order { uint o
 layout(binding = PLACEMENT_BINDING_RESULTS, std430) coherent buffer Results { uint64_t results[]; };
 layout(binding = PLACEMENT_BINDING_CONSTRAINTS, std430) writeonly buffer Constraints { uint constraints[]; };
 layout(binding = PLACEMENT_BINDING_BUCKETS, std430) coherent buffer Buckets { PlacementBucketsGpu buckets[]; };
-layout(binding = PLACEMENT_BINDING_TILES, std430) readonly buffer Tiles { uvec2 tile_list[]; };
-layout(binding = PLACEMENT_BINDING_LOWER, std430) readonly buffer Lower { uint lower[]; };
+// Written past bucket 0: the classification's bits in label j's list (read in the next dispatch)
+// and, by the dispatch's last workgroup, label j's main pass moved up.
+layout(binding = PLACEMENT_BINDING_TILES, std430) coherent buffer Tiles { uvec2 tile_list[]; };
 layout(binding = PLACEMENT_BINDING_ARGS, std430) writeonly buffer Args { uint args[]; };
 layout(binding = PLACEMENT_BINDING_SPECULATIVE, std430) coherent buffer Speculative { uint64_t speculative[]; };
 // Read for the label being placed (written by earlier labels' dispatches); written, once a label
 // is final, for every label after it.
 layout(binding = PLACEMENT_BINDING_REGIONS, std430) buffer Regions { PairRegionsGpu regions[]; };
+layout(binding = PLACEMENT_BINDING_SAMPLES, std430) coherent buffer Samples { uint64_t samples[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
 // The order position this workgroup places, and the placed ones it tests against (0 .. placed - 1).
@@ -125,6 +133,17 @@ void region_reach(PairRegionsGpu r, vec2 c, vec2 e, out uint touch, out uint ful
   }
 }
 
+// Does every box (half size h, margin included) centred in the rectangle (middle c, half size e)
+// cover the anchor a? Exact at the rectangle's corners, as the candidates' own test.
+bool anchor_covers_rectangle(vec2 a, vec2 c, vec2 e, vec2 h) {
+  bool covers = true;
+  for (int k = 0; k < 4; ++k) {
+    const vec2 d = abs(a - (c + e * vec2((k & 1) != 0 ? 1.0 : -1.0, (k & 2) != 0 ? 1.0 : -1.0)));
+    covers = covers && d.x <= h.x && d.y <= h.y;
+  }
+  return covers;
+}
+
 // The tile's candidate-reaching placed labels and anchors, and the constraints all of its
 // candidates have (the shared counts start at 0; a barrier follows).
 void cull(LabelGpu me, uvec2 tile) {
@@ -137,41 +156,161 @@ void cull(LabelGpu me, uvec2 tile) {
     if (full != 0u) atomicOr(tile_bits, full);
     if ((touch & ~full) != 0u) tile_placed[atomicAdd(tile_placed_count, 1u)] = s;
   }
-  // Anchors: a candidate's box (margin included) covering one; exact at the corners as above.
+  // Anchors: a candidate's box (margin included) covering one.
   const vec2 h = me.size * 0.5 + vec2(params.margin);
   for (uint k = gl_LocalInvocationIndex; k < params.label_count; k += threads) {
     if ((labels[k].flags & LABEL_ENABLED) == 0u) continue;
     const vec2 d = abs(labels[k].anchor - centre);
     if (d.x > extent.x + h.x + 1.0 || d.y > extent.y + h.y + 1.0) continue;
-    bool covers = true;
-    for (int c = 0; c < 4; ++c) {
-      const vec2 corner = centre + extent * vec2((c & 1) != 0 ? 1.0 : -1.0, (c & 2) != 0 ? 1.0 : -1.0);
-      const vec2 dc = abs(labels[k].anchor - corner);
-      covers = covers && dc.x <= h.x && dc.y <= h.y;
-    }
-    if (covers) atomicOr(tile_bits, CONSTRAINT_ANCHOR);
+    if (anchor_covers_rectangle(labels[k].anchor, centre, extent, h)) atomicOr(tile_bits, CONSTRAINT_ANCHOR);
     else tile_anchors[atomicAdd(tile_anchor_count, 1u)] = labels[k].anchor;
   }
+}
+
+// Classification, in dispatch j, of the label at order position j: its list entries past bucket 0
+// (the main pass's, in the next dispatch) against the labels placed up to j - 2 and the anchors.
+// Per entry, the constraint bits every candidate of the tile has (into the entry: the main pass
+// adds their weight to the tile's bound and skips the tile when that exceeds the label's bound),
+// and the cheapest of four sampled candidates with their bits (into samples: the dispatch's last
+// workgroup bounds the label's best by them, as by the speculative winners). The plane tests
+// lean the safe way by a rounding margin: a bit every candidate has is never claimed wrongly, and
+// a sample is never cheaper than it is. PLACE_CLASSIFY_LANES invocations per entry, each taking
+// every so many placed labels and anchors.
+#define PLACE_CLASSIFY_LANES (PLACE_GROUP_X * PLACE_GROUP_Y / PLACEMENT_CLASSIFY_TILES)
+shared uint class_bits[PLACEMENT_CLASSIFY_TILES];  // bits 0-2: every candidate's; 3q + 3..5: sample q's
+
+// Sample q of a tile: the candidate in the middle of its quarter q.
+uvec2 sample_pixel(uvec2 tile, uint q) {
+  return tile * PLACEMENT_TILE + uvec2(PLACEMENT_TILE / 4u) * (uvec2(q & 1u, q >> 1u) * 2u + 1u);
+}
+
+// Does the box half or the connector half of a pair's regions hold every candidate centre of the
+// rectangle (middle c, half size e), bit 0, and each sample centre, bit 1 + q?
+uint classify_region(uint pair, bool connector, vec2 c, vec2 e, vec2 sample_centres[4]) {
+  bool all_in = true;
+  uint in_samples = 0xFu;
+  [[unroll]] for (uint k = 0u; k < 6u; ++k) {
+    if (!connector && k >= 4u) break;
+    const vec4 p = connector ? regions[pair].connector[k] : regions[pair].box[k];
+    const vec2 n = vec2(p);
+    const float slack = 1e-4 * (abs(n.x * c.x) + abs(n.y * c.y) + abs(p.z) + abs(n.x) * e.x + abs(n.y) * e.y);
+    // (the rectangle's corner farthest along n decides for all of it)
+    all_in = all_in && dot(n, c) + abs(n.x) * e.x + abs(n.y) * e.y <= p.z - slack;
+    [[unroll]] for (uint q = 0u; q < 4u; ++q) {
+      if (!(dot(n, sample_centres[q]) <= p.z + slack)) in_samples &= ~(1u << q);
+    }
+  }
+  return (all_in ? 1u : 0u) | (in_samples << 1u);
+}
+
+void classify(uint j, uint group, uint first, uint end) {
+  const uint t = gl_LocalInvocationIndex;
+  const uint local = t / PLACE_CLASSIFY_LANES, lane = t % PLACE_CLASSIFY_LANES;
+  const uint index = first + group * PLACEMENT_CLASSIFY_TILES + local;
+  const bool valid = index < end;
+  const uvec2 tiles_xy = placement_tiles(params.width, params.height);
+  const uint tiles = tiles_xy.x * tiles_xy.y;
+  const uint list = j * tiles + min(index, tiles - 1u);
+  const uvec2 entry = tile_list[list];
+  const LabelGpu me = labels[params.spec_label];
+  if (t < PLACEMENT_CLASSIFY_TILES) class_bits[t] = 0u;
+  barrier();
+  const uint tile_index = entry.x & PLACEMENT_TILE_INDEX_MASK;
+  const uvec2 tile = uvec2(tile_index % tiles_xy.x, tile_index / tiles_xy.x);
+  vec2 centre, extent;
+  tile_centres(me, tile, centre, extent);
+  vec2 sample_centres[4];
+  [[unroll]] for (uint q = 0u; q < 4u; ++q) {
+    sample_centres[q] = box_origin(sample_pixel(tile, q), me.size) + me.size * 0.5;
+  }
+  uint bits = 0u;
+  // (the labels placed up to j - 2, as for the speculative pass)
+  for (uint s = lane; valid && s + 2u <= j; s += PLACE_CLASSIFY_LANES) {
+    const uint pair = j * params.label_count + s;
+    // (both halves are tested before their presence is known: no load waits for another)
+    const uint info = regions[pair].info.x;
+    const uint held_halves[2] = {classify_region(pair, false, centre, extent, sample_centres),
+                                 classify_region(pair, true, centre, extent, sample_centres)};
+    [[unroll]] for (uint half_index = 0u; half_index < 2u; ++half_index) {
+      const bool connector = half_index == 1u;
+      const uint kind = connector ? CONSTRAINT_CONNECTOR : CONSTRAINT_LABEL;
+      if ((info & (connector ? REGION_CONNECTOR : REGION_BOX)) == 0u) continue;
+      const uint held = held_halves[half_index];
+      if ((held & 1u) != 0u) bits |= kind;
+      [[unroll]] for (uint q = 0u; q < 4u; ++q) {
+        if ((held & (2u << q)) != 0u) bits |= kind << (3u * q + 3u);
+      }
+    }
+  }
+  // (as cull() and constraint_bits() take the anchors)
+  const vec2 h = me.size * 0.5 + vec2(params.margin);
+  for (uint k = lane; valid && k < params.label_count; k += PLACE_CLASSIFY_LANES) {
+    if ((labels[k].flags & LABEL_ENABLED) == 0u) continue;
+    const vec2 a = labels[k].anchor;
+    if (anchor_covers_rectangle(a, centre, extent, h)) bits |= CONSTRAINT_ANCHOR;
+    if ((me.flags & LABEL_INTERNAL) != 0u) continue;
+    [[unroll]] for (uint q = 0u; q < 4u; ++q) {
+      const vec2 d = abs(a - sample_centres[q]);
+      if (d.x <= h.x && d.y <= h.y) bits |= CONSTRAINT_ANCHOR << (3u * q + 3u);
+    }
+  }
+  if (valid && bits != 0u) atomicOr(class_bits[local], bits);
+  barrier();
+  if (!valid || lane != 0u) return;
+  const uint found = class_bits[local];
+  tile_list[list].x = (entry.x & ~(7u << PLACEMENT_TILE_CLASS_SHIFT)) | ((found & 7u) << PLACEMENT_TILE_CLASS_SHIFT);
+  uint64_t best = PLACEMENT_NONE;
+  [[unroll]] for (uint q = 0u; q < 4u; ++q) {
+    const uvec2 p = sample_pixel(tile, q);
+    const uint sample_bits = (found >> (3u * q + 3u)) & 7u;
+    if (p.x >= params.width || p.y >= params.height || !candidate_allowed(me, p)) continue;
+    if (params.hard != 0u && sample_bits != 0u) continue;
+    const vec2 origin = box_origin(p, me.size);
+    const float cost = free_cost(me, origin, origin + me.size * 0.5) + constraint_weight(sample_bits);
+    best = min(best, (uint64_t(floatBitsToUint(cost)) << 32) | uint64_t(p.y * params.width + p.x));
+  }
+  atomicExchange(samples[index], best);
 }
 
 float cost_of(uint64_t key) {
   return key == PLACEMENT_NONE ? uintBitsToFloat(0x7F800000u) : uintBitsToFloat(uint(key >> 32));
 }
 
-// An atomic read of a 64-bit (cost, pixel) (atomics take no function parameters).
-#define ATOMIC_READ(value) atomicMin(value, PLACEMENT_NONE)
+// The dispatch's passes: the main pass's size and bound, the speculative pass's size, the entries
+// of the speculative pass's label's list.
+shared uint dispatch_main, dispatch_spec, dispatch_listed;
+shared float dispatch_bound;
+
+// The regions of the labels at order positions first .. last - 1 against the one at position s,
+// placed at `placed` (two invocations per label: its box half and its connector half).
+void write_regions(uint s, uint first, uint last, LabelGpu placed_label, vec3 placed) {
+  const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
+  for (uint u = gl_LocalInvocationIndex; first + u / 2u < last; u += threads) {
+    const uint k_pos = first + u / 2u;
+    const uint slot = k_pos * params.label_count + s;
+    const LabelGpu k = labels[order[k_pos]];
+    if ((u & 1u) == 0u) {
+      const PairBoxRegion r = pair_box_region(k, placed_label, placed, params.margin);
+      regions[slot].box = r.box;
+      regions[slot].info = r.info;
+    } else {
+      regions[slot].connector = pair_connector_region(k, placed_label, placed, params.margin).p;
+    }
+  }
+}
 
 shared uint finishing;  // 1: this workgroup is the dispatch's last
-shared uint64_t final_result;
-shared uint bound_bits;  // the speculative winners' smallest true cost (bits)
+shared uint bound_bits;  // the bound candidates' smallest true cost (bits)
+shared uint kept;  // entries past bucket 0 the main pass takes
 
-// The dispatch's last workgroup. Label j - 1 is final: its constraint regions for every label
-// after it (two invocations per later label: its box half and its connector half). Label j's
-// speculative pass is complete: each of its bucket-0 tiles' winners is a real candidate whose
-// true cost is at most its speculative one plus the weight of what j - 1's regions (none for
-// j = 0) add there, so the smallest of those bounds j's best; its main pass, in the next
-// dispatch, takes bucket 0 and the buckets whose lower edge that bound does not exceed. This is
-// on the loop's critical path: what it reads is loaded first, and nothing waits on a store.
+// The dispatch's last workgroup. Label j - 1 is final: its constraint regions for labels j and
+// j + 1 (the next dispatch's region writer does the rest). Label j's speculative pass and
+// classification are complete: each bucket-0 tile's winner and each entry's cheapest sample is a
+// real candidate whose true cost is at most its cost so far plus the weight of what j - 1's
+// regions (none for j = 0) add there, so the smallest of those bounds j's best. Its main pass, in
+// the next dispatch, takes bucket 0 and the other entries whose bound plus the weight of their
+// classified bits does not exceed that. This is on the loop's critical path: what it reads is
+// loaded first, and nothing waits on a store.
 void finish(uint j) {
   const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
   const uvec2 tiles_xy = placement_tiles(params.width, params.height);
@@ -179,61 +318,87 @@ void finish(uint j) {
   const uint t = gl_LocalInvocationIndex;
   const bool sizing = j < params.order_count;
   const uint p = min(j, params.order_count - 1u);
-  // (the speculative entry is read before its count: the buffer holds every tile's)
-  const uint count0 = buckets[p].counts[0];
-  const uint64_t first_key = t < tiles ? ATOMIC_READ(speculative[(p & 1u) * tiles + t]) : PLACEMENT_NONE;
-  uint counts[PLACEMENT_BUCKETS];
-  [[unroll]] for (uint b = 0u; b < PLACEMENT_BUCKETS; ++b) counts[b] = t == 0u ? buckets[p].counts[b] : 0u;
-  const float lowest = uintBitsToFloat(lower[p]);
-  const uint next_count0 = t == 0u && p + 1u < params.order_count ? buckets[p + 1u].counts[0] : 0u;
+  const uint count0 = dispatch_spec, total = dispatch_listed;
+  // Everything this reads is loaded first. The entries are taken in chunks of four per
+  // invocation: a bound candidate each (the speculative winners for bucket 0, the
+  // classification's samples for the others) and the list entry; the first chunk now.
+  // (Plain reads: every workgroup wrote its part before it counted, and this one counted last.)
+  uint64_t keys[4];
+  uvec2 entries[4];
+  const uint chunk_size = 4u * threads;
+  [[unroll]] for (uint c = 0u; c < 4u; ++c) {
+    const uint i = c * threads + t;
+    keys[c] = i >= total ? PLACEMENT_NONE : i < count0 ? speculative[(p & 1u) * tiles + i] : samples[i];
+    entries[c] = i < total ? tile_list[p * tiles + i] : uvec2(0u);
+  }
+  uint next_count0 = 0u, next_total = 0u;
+  if (t == 0u && p + 1u < params.order_count) {
+    next_count0 = buckets[p + 1u].counts[0];
+    [[unroll]] for (uint b = 0u; b < PLACEMENT_BUCKETS; ++b) next_total += buckets[p + 1u].counts[b];
+  }
   const LabelGpu placed_label = labels[params.label];
   const LabelGpu me = labels[params.spec_label];
-  const vec3 placed = j > 0u ? placed_from(final_result, params.label) : vec3(0.0);
+  const vec3 placed = j > 0u ? placed_from(results[params.label], params.label) : vec3(0.0);
 
-  if (j > 0u) {
-    const uint s = j - 1u;
-    for (uint u = t; s + 1u + u / 2u < params.order_count; u += threads) {
-      const uint k_pos = s + 1u + u / 2u;
-      const uint slot = k_pos * params.label_count + s;
-      const LabelGpu k = labels[order[k_pos]];
-      if ((u & 1u) == 0u) {
-        const PairBoxRegion r = pair_box_region(k, placed_label, placed, params.margin);
-        regions[slot].box = r.box;
-        regions[slot].info = r.info;
-      } else {
-        regions[slot].connector = pair_connector_region(k, placed_label, placed, params.margin).p;
-      }
-    }
-  }
+  // The next dispatch's passes need j - 1's regions for positions j and j + 1; its region writer
+  // does the rest.
+  if (j > 0u) write_regions(j - 1u, j, min(j + 2u, params.order_count), placed_label, placed);
   if (!sizing) return;
   const PairRegionsGpu r = pair_regions(me, placed_label, placed, params.margin);
   float bound = uintBitsToFloat(0x7F800000u);
-  for (uint i = t; i < count0; i += threads) {
-    const uint64_t key = i == t ? first_key : ATOMIC_READ(speculative[(p & 1u) * tiles + i]);
-    if (key == PLACEMENT_NONE) continue;
-    const uint pixel = uint(key & 0xFFFFFFFFul);
-    const uvec2 q = uvec2(pixel % params.width, pixel / params.width);
-    const uint bits = region_bits(r, box_origin(q, me.size) + me.size * 0.5, 0u);
-    if (params.hard != 0u && bits != 0u) continue;  // no longer allowed: bounds nothing
-    bound = min(bound, cost_of(key) + constraint_weight(bits));
+  for (uint chunk = 0u; chunk < total; chunk += chunk_size) {
+    [[unroll]] for (uint c = 0u; c < 4u; ++c) {
+      const uint i = chunk + c * threads + t;
+      const uint64_t key = chunk == 0u ? keys[c]
+                           : i >= total ? PLACEMENT_NONE
+                           : i < count0 ? speculative[(p & 1u) * tiles + i]
+                                        : samples[i];
+      if (key == PLACEMENT_NONE) continue;
+      const uint pixel = uint(key & 0xFFFFFFFFul);
+      const uvec2 q = uvec2(pixel % params.width, pixel / params.width);
+      const uint bits = region_bits(r, box_origin(q, me.size) + me.size * 0.5, 0u);
+      if (params.hard != 0u && bits != 0u) continue;  // no longer allowed: bounds nothing
+      bound = min(bound, cost_of(key) + constraint_weight(bits));
+    }
   }
   bound = subgroupMin(bound);
   if (subgroupElect()) atomicMin(bound_bits, floatBitsToUint(bound));  // costs >= 0
   barrier();
-  if (t != 0u) return;
   // (rounding: the true cost is the free cost plus the weight of all bits, summed in another
   // order; an infinite bound stays infinite)
   const float best = uintBitsToFloat(bound_bits) * 1.0001;
-  const float above = best - lowest;
-  uint rest = 0u;
-  [[unroll]] for (uint b = 1u; b < PLACEMENT_BUCKETS; ++b) {
-    if (above >= placement_bucket_edge(b, params.bucket_width)) rest += counts[b];
+  // The main pass: bucket 0, then the other entries whose bound with the bits all their
+  // candidates have is not above that, moved up in place (a chunk is read before any of it is
+  // written, and writes never pass the reads).
+  for (uint chunk = 0u; chunk < total; chunk += chunk_size) {
+    bool keep[4];
+    [[unroll]] for (uint c = 0u; c < 4u; ++c) {
+      const uint i = chunk + c * threads + t;
+      if (chunk > 0u) entries[c] = i < total ? tile_list[p * tiles + i] : uvec2(0u);
+      const uint known = (entries[c].x >> PLACEMENT_TILE_CLASS_SHIFT) & 7u;
+      keep[c] = i >= count0 && i < total &&
+                !(uintBitsToFloat(entries[c].y) + constraint_weight(known) > best) &&
+                !(params.hard != 0u && known != 0u);
+    }
+    if (chunk > 0u) barrier();
+    [[unroll]] for (uint c = 0u; c < 4u; ++c) {
+      const uvec4 ballot = subgroupBallot(keep[c]);
+      uint offset = 0u;
+      if (subgroupElect()) offset = atomicAdd(kept, subgroupBallotBitCount(ballot));
+      offset = subgroupBroadcastFirst(offset) + subgroupBallotExclusiveBitCount(ballot);
+      if (keep[c]) tile_list[p * tiles + count0 + offset] = entries[c];
+    }
   }
-  buckets[p].rest = rest;
+  barrier();
+  if (t != 0u) return;
+  buckets[p].rest = kept;
   buckets[p].bound = best;
-  buckets[p].main = count0 + rest;
-  // The next dispatch's size, when indirect: this main pass and the next label's speculative one.
-  const uvec3 size = placement_dispatch_size(max(count0 + rest + next_count0, 1u));
+  buckets[p].main = count0 + kept;
+  // The next dispatch's size, when indirect: this main pass, the next label's speculative pass and
+  // classification, and the region writer.
+  const uint next_groups =
+      count0 + kept + next_count0 + placement_classify_groups(next_total - next_count0) + 1u;
+  const uvec3 size = placement_dispatch_size(next_groups);
   args[3u * j + 3u] = size.x;
   args[3u * j + 4u] = size.y;
   args[3u * j + 5u] = size.z;
@@ -250,7 +415,8 @@ uvec2 candidate_pixel(uvec2 base, uint q) {
 
 // The tile's lowest (cost, pixel): every candidate for a speculative pass; for the main pass,
 // only those whose cost is not above the best known (`bound`: the tile's lower bound).
-uint64_t evaluate_tile(uint label, uvec2 tile, float bound, bool prune, float best_bound, bool write) {
+uint64_t evaluate_tile(uint label, uvec2 tile, uint known, float bound, bool prune, float best_bound,
+                       bool write) {
   const LabelGpu me = labels[label];
   const uvec2 base = tile * PLACEMENT_TILE + gl_LocalInvocationID.xy;
   // A candidate can only win if its cost is not above the best another workgroup has found
@@ -262,7 +428,7 @@ uint64_t evaluate_tile(uint label, uvec2 tile, float bound, bool prune, float be
     tile_hope = 0u;
     tile_placed_count = 0u;
     tile_anchor_count = 0u;
-    tile_bits = 0u;
+    tile_bits = known;
   }
   barrier();
   const float best = prune ? min(cost_of(tile_best), best_bound) : uintBitsToFloat(0x7F800000u);
@@ -323,30 +489,58 @@ void main() {
   const uvec2 tiles_xy = placement_tiles(params.width, params.height);
   const uint tiles_x = tiles_xy.x, tiles = tiles_xy.x * tiles_xy.y;
   const uint w = gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x;
-  // (the main pass's tile is read together with the counts: neither waits for the other)
-  const uint main_count = j > 0u ? buckets[j - 1u].main : 0u;
-  const uint spec_count = j < params.order_count ? buckets[j].counts[0] : 0u;
-  const uvec2 main_entry = tile_list[(j > 0u ? j - 1u : 0u) * tiles + min(w, tiles - 1u)];
-  // The dispatch covers any count; the workgroups past these leave at once. One always stays:
-  // the last to finish sizes the next dispatch.
-  const uint working = max(main_count + spec_count, 1u);
+  // (one invocation reads them: thousands of workgroups read the same few words)
+  if (gl_LocalInvocationIndex == 0u) {
+    dispatch_main = j > 0u ? buckets[j - 1u].main : 0u;
+    dispatch_bound = j > 0u ? buckets[j - 1u].bound : 0.0;
+    uint count0 = 0u, listed = 0u;
+    if (j < params.order_count) {
+      count0 = buckets[j].counts[0];
+      [[unroll]] for (uint b = 0u; b < PLACEMENT_BUCKETS; ++b) listed += buckets[j].counts[b];
+    }
+    dispatch_spec = count0;
+    dispatch_listed = listed;
+  }
+  barrier();
+  const uint main_count = dispatch_main, spec_count = dispatch_spec, listed = dispatch_listed;
+  const float best_bound = dispatch_bound;
+  const uint classify_count = placement_classify_groups(listed - spec_count);
+  // The workgroups: the classification's (first, so that they start at once), the passes', and
+  // a region writer: the label at position j - 2, final since the last dispatch, against the
+  // labels from j + 1 on (the ones up to j have them from that dispatch's last workgroup). The
+  // passes' items are the main pass's tiles, then the speculative pass's; a dispatch with fewer
+  // workgroups for them (a direct one: see LabelDispatch) has each take every so many. Those past
+  // all this leave at once. The last to finish sizes the next dispatch.
+  const uint items = main_count + spec_count;
+  const uint groups = gl_NumWorkGroups.x * gl_NumWorkGroups.y;
+  const uint stride = min(items, groups - classify_count - 1u);
+  const uint working = classify_count + stride + 1u;
   if (w >= working) return;
-  const bool is_main = w < main_count;
-  const uint slot = is_main ? w : w - main_count;
-  const bool is_spec = !is_main && slot < spec_count;
-  position = is_main ? j - 1u : j;
-  placed = is_main ? position : max(position, 1u) - 1u;
-  const uint label = is_main ? params.label : params.spec_label;
-
-  uint64_t group = PLACEMENT_NONE;
-  if (is_main || is_spec) {
-    const uvec2 entry = is_main ? main_entry : tile_list[position * tiles + slot];
-    const uint tile_index = entry.x & ~PLACEMENT_BUCKET0_TILE;
+  if (w + 1u == working && j >= 2u && j + 1u < params.order_count) {
+    const uint s = order[j - 2u];
+    write_regions(j - 2u, j + 1u, params.order_count, labels[s], placed_from(results[s], s));
+  }
+  const bool is_classify = w < classify_count;
+  if (is_classify) classify(j, w, spec_count, listed);
+  uint64_t main_group = PLACEMENT_NONE;
+  const bool has_items = !is_classify && w + 1u < working;
+  for (uint item = w - classify_count; has_items && item < items; item += stride) {
+    const bool is_main = item < main_count;
+    const uint slot = is_main ? item : item - main_count;
+    position = is_main ? j - 1u : j;
+    placed = is_main ? position : max(position, 1u) - 1u;
+    const uint label = is_main ? params.label : params.spec_label;
+    uint64_t group = PLACEMENT_NONE;
+    const uvec2 entry = tile_list[position * tiles + slot];
+    const uint tile_index = entry.x & PLACEMENT_TILE_INDEX_MASK;
     const uvec2 tile = uvec2(tile_index % tiles_x, tile_index / tiles_x);
+    const uint known = (entry.x >> PLACEMENT_TILE_CLASS_SHIFT) & 7u;
+    const float bound = uintBitsToFloat(entry.y);
+    const bool keep = params.write_constraints != 0u;
     // A bucket-0 tile of the main pass: its speculative minimum stands unless the label placed
     // last reaches its candidates (kept constraint images need every candidate evaluated).
     bool evaluate = true;
-    if (is_main && (entry.x & PLACEMENT_BUCKET0_TILE) != 0u && params.write_constraints == 0u) {
+    if (is_main && (entry.x & PLACEMENT_BUCKET0_TILE) != 0u && !keep) {
       uint touch = 0u, full;
       if (position > 0u) {
         vec2 centre, extent;
@@ -356,23 +550,32 @@ void main() {
       evaluate = touch != 0u;
       if (!evaluate) group = speculative[(position & 1u) * tiles + slot];
     }
+    // A classified tile whose bound with the bits all its candidates have is above the label's
+    // bound holds no winner (hard mode: any bit forbids every candidate).
+    if (is_main && !keep && (bound + constraint_weight(known) > best_bound ||
+                             (params.hard != 0u && known != 0u))) {
+      evaluate = false;
+    }
     if (evaluate) {
-      const float best_bound = is_main ? buckets[position].bound : 0.0;
-      const bool keep = params.write_constraints != 0u;
-      group = evaluate_tile(label, tile, uintBitsToFloat(entry.y), is_main && !keep, best_bound,
+      group = evaluate_tile(label, tile, known, bound, is_main && !keep, is_main ? best_bound : 0.0,
                             is_main && keep);
+    }
+    if (is_main) main_group = min(main_group, group);
+    if (!is_main && gl_LocalInvocationIndex == 0u) {
+      atomicExchange(speculative[(position & 1u) * tiles + slot], group);
     }
   }
   if (gl_LocalInvocationIndex == 0u) {
     // Thousands of workgroups share one address: only those that improve on it touch it.
-    if (is_main && group != PLACEMENT_NONE && group < results[label]) atomicMin(results[label], group);
-    if (is_spec) atomicExchange(speculative[(position & 1u) * tiles + slot], group);
+    if (main_group != PLACEMENT_NONE && main_group < results[params.label]) {
+      atomicMin(results[params.label], main_group);
+    }
     memoryBarrierBuffer();
     finishing = atomicAdd(buckets[j].done, 1u) + 1u == working ? 1u : 0u;
     if (finishing != 0u) {
       bound_bits = 0x7F800000u;
+      kept = 0u;
       memoryBarrierBuffer();
-      if (j > 0u) final_result = ATOMIC_READ(results[params.label]);
     }
   }
   barrier();

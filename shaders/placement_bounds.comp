@@ -108,9 +108,12 @@ void main() {
   const bool in_range = tile < tiles;
   if (!in_range) return;
   if (params.phase == PLACEMENT_PHASE_SORT && tile == 0u && s == 0u) {
-    // The first place_label dispatch, when indirect: the first label's speculative pass (at
-    // least one workgroup, which sizes the next dispatch).
-    const uvec3 size = placement_dispatch_size(max(buckets[0].counts[0], 1u));
+    // The first place_label dispatch, when indirect: the first label's speculative pass and
+    // classification, and the region writer (see place_label.comp).
+    uint listed = 0u;
+    for (uint b = 0u; b < PLACEMENT_BUCKETS; ++b) listed += buckets[0].counts[b];
+    const uint count0 = buckets[0].counts[0];
+    const uvec3 size = placement_dispatch_size(count0 + placement_classify_groups(listed - count0) + 1u);
     args[0] = size.x;
     args[1] = size.y;
     args[2] = size.z;

@@ -40,18 +40,19 @@ gpu::LabelGpu label(glm::vec2 anchor, glm::vec2 size, uint32_t layer) {
 }
 
 // A bright disc (the "object") on a dark background, half of it in the front layer, half in the
-// back layer, with anchors on it.
-Inputs disc_scene(uint32_t label_count) {
+// back layer, with anchors on it; `scale` times the size of the default (96 x 72).
+Inputs disc_scene(uint32_t label_count, float scale = 1.0f) {
   Inputs in;
+  in.size = {uint32_t(96.0f * scale), uint32_t(72.0f * scale)};
   const size_t pixels = size_t{in.size.width} * in.size.height;
   in.final_rgba8.resize(pixels * 4);
   in.layers.assign(pixels * in.layer_count, glm::vec4(0.0f));
-  const glm::vec2 centre(48.0f, 36.0f);
+  const glm::vec2 centre = glm::vec2(48.0f, 36.0f) * scale;
   for (uint32_t y = 0; y < in.size.height; ++y) {
     for (uint32_t x = 0; x < in.size.width; ++x) {
       const size_t p = size_t{y} * in.size.width + x;
       const float r = glm::length(glm::vec2(x, y) + 0.5f - centre);
-      const float a = glm::clamp((22.0f - r) / 3.0f, 0.0f, 1.0f);
+      const float a = glm::clamp((22.0f * scale - r) / 3.0f, 0.0f, 1.0f);
       const glm::vec3 c = glm::mix(
           glm::vec3(0.05f), glm::vec3(0.9f, 0.7f, 0.5f + 0.3f * std::sin(float(x) * 0.4f)), a);
       for (int ch = 0; ch < 3; ++ch)
@@ -60,12 +61,15 @@ Inputs disc_scene(uint32_t label_count) {
       // Values as the rgba16f layer images hold them, so the reference sees the same inputs.
       glm::vec4 v(c * a * 0.8f, a * 0.8f);
       for (int ch = 0; ch < 4; ++ch) v[ch] = glm::unpackHalf1x16(glm::packHalf1x16(v[ch]));
-      in.layers[(x < 48 ? 0 : 1) * pixels + p] = v;
+      in.layers[(float(x) < centre.x ? 0 : 1) * pixels + p] = v;
     }
   }
   const glm::vec2 anchors[] = {{44, 30}, {55, 40}, {40, 44}, {52, 28}, {48, 36}, {60, 33}};
   for (uint32_t i = 0; i < label_count; ++i) {
-    in.labels.push_back(label(anchors[i % 6], glm::vec2(20.0f + 2.0f * float(i), 8.0f), i % 2));
+    // (further round the disc for the labels past the first six)
+    const glm::vec2 offset = float(i / 6) * glm::vec2(7.0f, -5.0f);
+    in.labels.push_back(label(glm::floor((anchors[i % 6] + offset) * scale),
+                              glm::floor(glm::vec2(20.0f + 2.0f * float(i), 8.0f) * scale), i % 2));
     in.order.push_back(i);
   }
   return in;
@@ -75,6 +79,7 @@ struct GpuPlacement {
   std::vector<float> saliency, costs, tables;
   std::vector<uint32_t> constraints;
   std::vector<gpu::PlacementGpu> placements;
+  std::vector<gpu::PlacementBucketsGpu> buckets;  // per order position (and one more)
 };
 
 template <typename T>
@@ -85,7 +90,8 @@ std::vector<T> as(const std::vector<std::byte>& bytes) {
 }
 
 GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSettings& settings,
-                          LabelDispatch dispatch = LabelDispatch::automatic) {
+                          LabelDispatch dispatch = LabelDispatch::automatic,
+                          uint32_t direct_groups = PLACEMENT_DIRECT_GROUPS) {
   Image final_image(ctx, {VK_FORMAT_R8G8B8A8_UNORM,
                           {in.size.width, in.size.height, 1},
                           VK_IMAGE_TYPE_2D,
@@ -103,7 +109,7 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
                      true});
   upload(ctx, layers, as_bytes(halves), VK_IMAGE_LAYOUT_GENERAL);
 
-  Placement placement(ctx, uint32_t(in.labels.size()), dispatch);
+  Placement placement(ctx, uint32_t(in.labels.size()), dispatch, direct_groups);
   graph::Graph g;
   const auto final_id = g.import_resource("final", {true, true, VK_IMAGE_LAYOUT_GENERAL});
   const auto layers_id = g.import_resource("layers", {true, true, VK_IMAGE_LAYOUT_GENERAL});
@@ -120,6 +126,7 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
   out.costs = as<float>(runner.download_buffer(r.costs));
   out.tables = as<float>(runner.download_buffer(r.tables));
   out.constraints = as<uint32_t>(runner.download_buffer(r.constraints));
+  out.buckets = as<gpu::PlacementBucketsGpu>(runner.download_buffer(r.buckets));
   const auto results = placement.results();
   out.placements.assign(results.begin(), results.end());
   return out;
@@ -199,6 +206,36 @@ TEST_SUITE("gpu") {
     const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                    in.labels, in.order, {}, in.size);
     check_placements_across(ctx, in, cpu, {0.01f, 1.0f, 1e9f});
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "classified_tiles_that_cannot_hold_the_best_are_left_out") {
+    // Twelve labels crowd the disc: the later ones' lists hold tiles every candidate of which
+    // lies in an earlier label's shadow, and their main passes must leave those out, with the
+    // positions still the reference's.
+    const Inputs in = disc_scene(12, 2.5f);
+    const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                   in.labels, in.order, {}, in.size);
+    // (direct with 3 workgroups for the passes' tiles: each takes many)
+    for (const auto& [dispatch, groups] :
+         {std::pair{LabelDispatch::direct, PLACEMENT_DIRECT_GROUPS},
+          std::pair{LabelDispatch::direct, 3u}, std::pair{LabelDispatch::indirect, 0u}}) {
+      CAPTURE(int(dispatch));
+      CAPTURE(groups);
+      const GpuPlacement gpu = place_on_gpu(ctx, in, {}, dispatch, groups);
+      check_placements(gpu, cpu);
+      uint32_t listed = 0, taken = 0;
+      for (size_t s = 0; s < in.order.size(); ++s) {
+        const gpu::PlacementBucketsGpu& b = gpu.buckets[s];
+        uint32_t all = 0;
+        for (const uint32_t c : b.counts) all += c;
+        CHECK(b.main == b.counts[0] + b.rest);
+        CHECK(b.rest <= all - b.counts[0]);
+        listed += all - b.counts[0];
+        taken += b.rest;
+      }
+      MESSAGE("main pass tiles past bucket 0: " << taken << " of " << listed);
+      CHECK(taken * 2 < listed);
+    }
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "a_speculative_winner_the_label_before_takes_is_not_kept") {

@@ -45,17 +45,29 @@
 #define PLACEMENT_BINDING_ARGS 14        // uint[3] per place_label dispatch: its size (indirect)
 #define PLACEMENT_BINDING_SPECULATIVE 15  // uint64_t per bucket-0 tile, two labels' worth
 #define PLACEMENT_BINDING_REGIONS 16      // PairRegionsGpu per (order position, placed one's)
+#define PLACEMENT_BINDING_SAMPLES 17      // uint64_t per tile-list position: a sampled candidate
 
 // The tile lists are in bucket order; an entry's x has this bit when its tile is in bucket 0 (the
 // speculative pass's). The speculative minima are kept for two labels at a time (by order
 // position parity).
 #define PLACEMENT_BUCKET0_TILE 0x80000000u
+// Bits 28-30 of the x of an entry beyond bucket 0: the constraint bits every candidate of the tile
+// has from the labels placed two or more before it (place_label.comp classifies them); the tile's
+// index is in the low bits.
+#define PLACEMENT_TILE_CLASS_SHIFT 28u
+#define PLACEMENT_TILE_INDEX_MASK 0x0FFFFFFFu
+// A direct place_label dispatch has at most this many workgroups for the passes' tiles by
+// default (about what a large GPU holds at once; past that they take several each), ...
+#define PLACEMENT_DIRECT_GROUPS 512u
+// ... and classifying workgroups take this many list entries each.
+#define PLACEMENT_CLASSIFY_TILES 4u
 
 // Tiles are sorted per label into buckets by how far their lower cost bound lies above the
 // label's smallest one: bucket 0 below bucket_width, bucket b (1..) below bucket_width * 4^b,
 // the last one everything else. A speculative pass evaluates bucket 0's tiles while the label
-// before is still being placed; the main pass then takes the buckets up to the best cost that
-// leaves possible.
+// before is still being placed, and the rest of the list (in bucket order, so roughly by bound)
+// is classified against the constraints known by then; the main pass then takes bucket 0 and
+// the classified tiles that may still hold the best.
 #define PLACEMENT_BUCKETS 8
 #define PLACEMENT_BUCKET_GROWTH 4.0f
 
@@ -115,9 +127,9 @@ struct PairRegionsGpu {
 // Per label (order position s): its tiles per bucket, and its main pass.
 struct PlacementBucketsGpu {
   uint done;    // workgroups of place_label dispatch s finished (the last one sizes the next)
-  uint rest;    // tiles of the main pass beyond bucket 0
+  uint rest;    // tiles of the main pass beyond bucket 0 (moved up behind it in the list)
   uint main;    // tiles of the main pass: bucket 0 and rest
-  float bound;  // the main pass's bound on the label's best cost (its speculative winners')
+  float bound;  // the main pass's bound on the label's best cost (speculative winners', samples')
   uint counts[PLACEMENT_BUCKETS];
   uint cursors[PLACEMENT_BUCKETS];
 };
@@ -127,6 +139,15 @@ inline
 #endif
 // The top-left pixel of a label box of `size` whose candidate pixel is p.
 vec2 box_origin(uvec2 p, vec2 size) { return vec2(p) - floor(size * 0.5f); }
+
+// The classifying workgroups of a label whose tile list has `beyond` entries past bucket 0.
+#ifdef __cplusplus
+inline
+#endif
+    uint
+    placement_classify_groups(uint beyond) {
+  return (beyond + PLACEMENT_CLASSIFY_TILES - 1u) / PLACEMENT_CLASSIFY_TILES;
+}
 
 #ifdef __cplusplus
 inline
