@@ -31,14 +31,13 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   return p;
 }
 
-Placement::Placement(Context& ctx, uint32_t label_count, LabelDispatch dispatch,
-                     uint32_t direct_groups)
+Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
     : ctx_(ctx),
       label_count_(label_count),
-      indirect_(dispatch == LabelDispatch::indirect ||
-                (dispatch == LabelDispatch::automatic &&
+      indirect_(layout.dispatch == LabelDispatch::indirect ||
+                (layout.dispatch == LabelDispatch::automatic &&
                  ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)),
-      direct_groups_(std::max(direct_groups, 1u)),
+      layout_(layout),
       saliency_(ctx, "saliency.comp"),
       integral_costs_(ctx, "integral_costs.comp"),
       bounds_(ctx, "placement_bounds.comp"),
@@ -60,6 +59,7 @@ gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) co
   // place_label dispatch `step`: the main pass of position step - 1, the speculative one of step
   p.label = step > 0 && step <= order_.size() ? order_[step - 1] : 0;
   p.spec_label = step < order_.size() ? order_[step] : 0;
+  p.finish_lanes = layout_.finish_lanes;
   return p;
 }
 
@@ -250,7 +250,7 @@ Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_ima
                       const uint32_t tile_count = across.x * across.y;
                       const glm::uvec3 groups = gpu::placement_dispatch_size(
                           gpu::placement_classify_groups(tile_count) +
-                          std::min(2 * tile_count, direct_groups_) + 1);
+                          std::min(2 * tile_count, std::max(layout_.direct_groups, 1u)) + 1);
                       vkCmdDispatch(pc.cmd, groups.x, groups.y, groups.z);
                     },
                     "placement"});

@@ -39,7 +39,7 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
 
 // How the label loop's dispatches are sized. Their sizes are only known on the GPU: an indirect
 // dispatch reads them there; a direct one has enough workgroups for any sizes (with at most
-// `direct_groups` for the passes' tiles, each taking several when there are more), those past
+// PlacementLayout::direct_groups for the passes' tiles, each taking several past that), those past
 // the sizes leaving at once. On an H100 direct is faster (a chain of dependent dispatches costs
 // 2.2 us per step direct, 4.6 us indirect, and the idle workgroups about 0.5 us); on lavapipe,
 // where every workgroup runs on the CPU, idle ones cost more than the whole placement.
@@ -47,6 +47,16 @@ enum class LabelDispatch {
   automatic,  // direct, except on CPU devices
   direct,
   indirect,
+};
+
+// How the label loop is laid out on the device (speed and tests only: the positions do not
+// depend on it).
+struct PlacementLayout {
+  LabelDispatch dispatch = LabelDispatch::automatic;
+  // A direct dispatch's workgroups for the passes' tiles (at most), and the invocations of a
+  // label's last workgroup that take its tile list (0: all; fewer make more chunks).
+  uint32_t direct_groups = PLACEMENT_DIRECT_GROUPS;
+  uint32_t finish_lanes = 0;
 };
 
 class Placement {
@@ -57,8 +67,7 @@ class Placement {
   };
 
   // `label_count` fixes the number of per-label passes; a frame may enable fewer labels.
-  Placement(Context& ctx, uint32_t label_count, LabelDispatch dispatch = LabelDispatch::automatic,
-            uint32_t direct_groups = PLACEMENT_DIRECT_GROUPS);
+  Placement(Context& ctx, uint32_t label_count, PlacementLayout layout = {});
 
   Resources add_to(graph::Graph& graph, graph::ResourceId final_image, graph::ResourceId layers,
                    uint32_t layer_count);
@@ -81,7 +90,7 @@ class Placement {
   Context& ctx_;
   uint32_t label_count_;
   bool indirect_;
-  uint32_t direct_groups_;
+  PlacementLayout layout_;
   uint32_t layer_count_ = 1;
   std::vector<gpu::LabelGpu> labels_;
   std::vector<uint32_t> order_;

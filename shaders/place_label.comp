@@ -320,14 +320,15 @@ void finish(uint j) {
   const uint p = min(j, params.order_count - 1u);
   const uint count0 = dispatch_spec, total = dispatch_listed;
   // Everything this reads is loaded first. The entries are taken in chunks of four per
-  // invocation: a bound candidate each (the speculative winners for bucket 0, the
+  // invocation (per invocation of the first `lanes`): a bound candidate each (the speculative winners for bucket 0, the
   // classification's samples for the others) and the list entry; the first chunk now.
   // (Plain reads: every workgroup wrote its part before it counted, and this one counted last.)
   uint64_t keys[4];
   uvec2 entries[4];
-  const uint chunk_size = 4u * threads;
+  const uint lanes = params.finish_lanes != 0u ? min(params.finish_lanes, threads) : threads;
+  const uint chunk_size = 4u * lanes;
   [[unroll]] for (uint c = 0u; c < 4u; ++c) {
-    const uint i = c * threads + t;
+    const uint i = t < lanes ? c * lanes + t : total;
     keys[c] = i >= total ? PLACEMENT_NONE : i < count0 ? speculative[(p & 1u) * tiles + i] : samples[i];
     entries[c] = i < total ? tile_list[p * tiles + i] : uvec2(0u);
   }
@@ -348,7 +349,7 @@ void finish(uint j) {
   float bound = uintBitsToFloat(0x7F800000u);
   for (uint chunk = 0u; chunk < total; chunk += chunk_size) {
     [[unroll]] for (uint c = 0u; c < 4u; ++c) {
-      const uint i = chunk + c * threads + t;
+      const uint i = t < lanes ? chunk + c * lanes + t : total;
       const uint64_t key = chunk == 0u ? keys[c]
                            : i >= total ? PLACEMENT_NONE
                            : i < count0 ? speculative[(p & 1u) * tiles + i]
@@ -373,7 +374,7 @@ void finish(uint j) {
   for (uint chunk = 0u; chunk < total; chunk += chunk_size) {
     bool keep[4];
     [[unroll]] for (uint c = 0u; c < 4u; ++c) {
-      const uint i = chunk + c * threads + t;
+      const uint i = t < lanes ? chunk + c * lanes + t : total;
       if (chunk > 0u) entries[c] = i < total ? tile_list[p * tiles + i] : uvec2(0u);
       const uint known = (entries[c].x >> PLACEMENT_TILE_CLASS_SHIFT) & 7u;
       keep[c] = i >= count0 && i < total &&

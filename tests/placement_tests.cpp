@@ -90,8 +90,7 @@ std::vector<T> as(const std::vector<std::byte>& bytes) {
 }
 
 GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSettings& settings,
-                          LabelDispatch dispatch = LabelDispatch::automatic,
-                          uint32_t direct_groups = PLACEMENT_DIRECT_GROUPS) {
+                          const PlacementLayout& layout = {}) {
   Image final_image(ctx, {VK_FORMAT_R8G8B8A8_UNORM,
                           {in.size.width, in.size.height, 1},
                           VK_IMAGE_TYPE_2D,
@@ -109,7 +108,7 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
                      true});
   upload(ctx, layers, as_bytes(halves), VK_IMAGE_LAYOUT_GENERAL);
 
-  Placement placement(ctx, uint32_t(in.labels.size()), dispatch, direct_groups);
+  Placement placement(ctx, uint32_t(in.labels.size()), layout);
   graph::Graph g;
   const auto final_id = g.import_resource("final", {true, true, VK_IMAGE_LAYOUT_GENERAL});
   const auto layers_id = g.import_resource("layers", {true, true, VK_IMAGE_LAYOUT_GENERAL});
@@ -165,7 +164,7 @@ void check_placements_across(Context& ctx, const Inputs& in, const ReferencePlac
       CAPTURE(int(dispatch));
       PlacementSettings settings;
       settings.bucket_width = width;
-      check_placements(place_on_gpu(ctx, in, settings, dispatch), cpu);
+      check_placements(place_on_gpu(ctx, in, settings, {.dispatch = dispatch}), cpu);
     }
   }
 }
@@ -215,13 +214,17 @@ TEST_SUITE("gpu") {
     const Inputs in = disc_scene(12, 2.5f);
     const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                    in.labels, in.order, {}, in.size);
-    // (direct with 3 workgroups for the passes' tiles: each takes many)
-    for (const auto& [dispatch, groups] :
-         {std::pair{LabelDispatch::direct, PLACEMENT_DIRECT_GROUPS},
-          std::pair{LabelDispatch::direct, 3u}, std::pair{LabelDispatch::indirect, 0u}}) {
-      CAPTURE(int(dispatch));
-      CAPTURE(groups);
-      const GpuPlacement gpu = place_on_gpu(ctx, in, {}, dispatch, groups);
+    // (also direct with 3 workgroups for the passes' tiles, each taking many, and with two
+    // invocations of a label's last workgroup taking its list, in chunks of eight entries)
+    for (const PlacementLayout& layout :
+         {PlacementLayout{.dispatch = LabelDispatch::direct},
+          PlacementLayout{.dispatch = LabelDispatch::direct, .direct_groups = 3},
+          PlacementLayout{.dispatch = LabelDispatch::indirect},
+          PlacementLayout{.dispatch = LabelDispatch::indirect, .finish_lanes = 2}}) {
+      CAPTURE(int(layout.dispatch));
+      CAPTURE(layout.direct_groups);
+      CAPTURE(layout.finish_lanes);
+      const GpuPlacement gpu = place_on_gpu(ctx, in, {}, layout);
       check_placements(gpu, cpu);
       uint32_t listed = 0, taken = 0;
       for (size_t s = 0; s < in.order.size(); ++s) {

@@ -112,6 +112,8 @@ struct PlacementParams {
   uint order_count;    // labels in the insertion order
   uint label;          // place_label: the label at order position step - 1 (main pass) ...
   uint spec_label;     // ... and at step (speculative pass)
+  uint finish_lanes;   // place_label: invocations of the last workgroup taking list entries
+                       // (0: all; fewer make more chunks, for tests)
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,
