@@ -42,9 +42,10 @@ layout(binding = PLACEMENT_BINDING_BUCKETS, std430) coherent buffer Buckets { Pl
 layout(binding = PLACEMENT_BINDING_TILES, std430) coherent buffer Tiles { uvec2 tile_list[]; };
 layout(binding = PLACEMENT_BINDING_ARGS, std430) writeonly buffer Args { uint args[]; };
 layout(binding = PLACEMENT_BINDING_SPECULATIVE, std430) coherent buffer Speculative { uint64_t speculative[]; };
-// Read for the label being placed (written by earlier labels' dispatches); written, once a label
-// is final, for every label after it.
+// Read for the labels being placed and classified (written by earlier dispatches); written, once
+// a label is final, for the labels after it (rows no workgroup of the same dispatch reads).
 layout(binding = PLACEMENT_BINDING_REGIONS, std430) buffer Regions { PairRegionsGpu regions[]; };
+// The classification's cheapest sample per list entry of label j, read by the last workgroup.
 layout(binding = PLACEMENT_BINDING_SAMPLES, std430) coherent buffer Samples { uint64_t samples[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
@@ -319,9 +320,9 @@ void finish(uint j) {
   const bool sizing = j < params.order_count;
   const uint p = min(j, params.order_count - 1u);
   const uint count0 = dispatch_spec, total = dispatch_listed;
-  // Everything this reads is loaded first. The entries are taken in chunks of four per
-  // invocation (per invocation of the first `lanes`): a bound candidate each (the speculative winners for bucket 0, the
-  // classification's samples for the others) and the list entry; the first chunk now.
+  // Everything this reads is loaded first. The list is taken in chunks of four entries per
+  // invocation (of the first `lanes`): a bound candidate each (the speculative winners for
+  // bucket 0, the classification's samples for the others) and the entry; the first chunk now.
   // (Plain reads: every workgroup wrote its part before it counted, and this one counted last.)
   uint64_t keys[4];
   uvec2 entries[4];
