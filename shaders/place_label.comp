@@ -398,9 +398,8 @@ void finish(uint j) {
   buckets[p].main = count0 + kept;
   // The next dispatch's size, when indirect: this main pass, the next label's speculative pass and
   // classification, and the region writer.
-  const uint next_groups =
-      count0 + kept + next_count0 + placement_classify_groups(next_total - next_count0) + 1u;
-  const uvec3 size = placement_dispatch_size(next_groups);
+  const uvec3 size =
+      placement_dispatch_size(placement_label_groups(count0 + kept, next_count0, next_total));
   args[3u * j + 3u] = size.x;
   args[3u * j + 4u] = size.y;
   args[3u * j + 5u] = size.z;

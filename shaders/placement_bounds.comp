@@ -113,7 +113,7 @@ void main() {
     uint listed = 0u;
     for (uint b = 0u; b < PLACEMENT_BUCKETS; ++b) listed += buckets[0].counts[b];
     const uint count0 = buckets[0].counts[0];
-    const uvec3 size = placement_dispatch_size(count0 + placement_classify_groups(listed - count0) + 1u);
+    const uvec3 size = placement_dispatch_size(placement_label_groups(0u, count0, listed));
     args[0] = size.x;
     args[1] = size.y;
     args[2] = size.z;

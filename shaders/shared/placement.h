@@ -151,6 +151,17 @@ inline
   return (beyond + PLACEMENT_CLASSIFY_TILES - 1u) / PLACEMENT_CLASSIFY_TILES;
 }
 
+// The workgroups of a place_label dispatch sized to its passes: a main pass of `main_tiles`, the
+// next label's speculative pass and classification (its list: `listed` entries, `spec_tiles` of
+// them in bucket 0), and the region writer.
+#ifdef __cplusplus
+inline
+#endif
+    uint
+    placement_label_groups(uint main_tiles, uint spec_tiles, uint listed) {
+  return main_tiles + spec_tiles + placement_classify_groups(listed - spec_tiles) + 1u;
+}
+
 #ifdef __cplusplus
 inline
 #endif
