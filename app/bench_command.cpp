@@ -9,9 +9,9 @@
 #include <random>
 
 #include "app/commands.h"
-#include "engine/graph_runner.h"
-#include "engine/resources.h"
-#include "engine/scene_loader.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/gpu/resources.h"
+#include "engine/scene/io/scene_loader.h"
 #include "labeling/labelled_render.h"
 #include "passes/summed_area_table.h"
 #include "passes/volume_renderer.h"

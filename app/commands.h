@@ -5,10 +5,10 @@
 
 #include <CLI/CLI.hpp>
 
-#include "engine/context.h"
-#include "engine/error.h"
-#include "engine/render_graph.h"
-#include "engine/scene.h"
+#include "engine/gpu/context.h"
+#include "engine/core/error.h"
+#include "engine/graph/render_graph.h"
+#include "engine/scene/scene.h"
 
 namespace strata::app {
 

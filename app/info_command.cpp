@@ -6,10 +6,10 @@
 #include <string>
 
 #include "app/commands.h"
-#include "engine/mesh_loader.h"
-#include "engine/scene_loader.h"
-#include "engine/transfer_function_loader.h"
-#include "engine/volume_loader.h"
+#include "engine/scene/io/mesh_loader.h"
+#include "engine/scene/io/scene_loader.h"
+#include "engine/scene/io/transfer_function_loader.h"
+#include "engine/scene/io/volume_loader.h"
 
 namespace strata::app {
 
@@ -93,12 +93,12 @@ void describe_labels(const Scene& scene, std::string& out) {
 
 void describe_camera_and_settings(const Scene& scene, std::string& out) {
   const Camera& c = scene.camera;
-  const glm::vec3 eye = glm::vec3(glm::inverse(c.view)[3]);
+  const glm::vec3 eye = c.eye();
   out += format("camera: fov_y %g degrees, near %g, far %g, eye ", c.fov_y_degrees, c.near_plane,
                 c.far_plane) +
          vec(eye) + "\n";
-  out += format("  positions: %zu\n", c.positions.size());
-  for (const CameraPose& p : c.positions) {
+  out += format("  positions: %zu\n", scene.camera_positions.size());
+  for (const CameraPose& p : scene.camera_positions) {
     out += "    " + p.name + ": eye " + vec(glm::vec3(glm::inverse(p.view)[3])) + "\n";
   }
   const CostWeights& w = scene.settings.weights;

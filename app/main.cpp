@@ -3,8 +3,8 @@
 #include <exception>
 
 #include "app/commands.h"
-#include "engine/error.h"
-#include "engine/scene_loader.h"
+#include "engine/core/error.h"
+#include "engine/scene/io/scene_loader.h"
 
 namespace strata::app {
 

@@ -4,10 +4,10 @@
 #include <glm/gtc/packing.hpp>
 
 #include "app/commands.h"
-#include "engine/graph_runner.h"
-#include "engine/headless_target.h"
-#include "engine/png.h"
-#include "engine/scene_loader.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/graph/headless_target.h"
+#include "engine/core/png.h"
+#include "engine/scene/io/scene_loader.h"
 #include "labeling/labelled_render.h"
 #include "passes/test_pattern.h"
 #include "passes/volume_renderer.h"

@@ -6,9 +6,9 @@
 #include <GLFW/glfw3.h>
 
 #include "app/commands.h"
-#include "engine/graph_runner.h"
-#include "engine/scene_loader.h"
-#include "engine/window_target.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/scene/io/scene_loader.h"
+#include "engine/graph/window_target.h"
 #include "passes/test_pattern.h"
 #include "passes/volume_renderer.h"
 

@@ -6,23 +6,15 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 
-#include "engine/error.h"
-#include "engine/graph_runner.h"
-#include "engine/headless_target.h"
+#include "engine/core/error.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/graph/headless_target.h"
 #include "labeling/insertion_order.h"
 #include "labeling/text_layout.h"
 #include "passes/label_drawing.h"
 
 namespace strata {
 namespace {
-
-glm::mat4 projection_of(const CameraSetup& camera, graph::Extent size) {
-  glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(camera.fov_y_degrees),
-                                      float(size.width) / float(size.height), camera.near_plane,
-                                      camera.far_plane);
-  p[1][1] *= -1.0f;  // as the renderer: Vulkan's clip space has y down
-  return p;
-}
 
 // Labels in placement order: layer by layer front to back, inside a layer by `within` (a
 // permutation of all label indices).
@@ -40,22 +32,11 @@ std::vector<uint32_t> insertion_order(const std::vector<gpu::LabelGpu>& labels,
 
 }  // namespace
 
-std::vector<ProjectedAnchor> project_anchors(const Scene& scene, const CameraSetup& camera,
-                                             graph::Extent size) {
-  const glm::mat4 clip = projection_of(camera, size) * camera.view;
-  std::vector<ProjectedAnchor> out;
+std::vector<ProjectedPoint> project_anchors(const Scene& scene, const Camera& camera,
+                                            graph::Extent size) {
+  std::vector<ProjectedPoint> out;
   for (const Label& label : scene.labels) {
-    ProjectedAnchor a;
-    const glm::vec4 view = camera.view * glm::vec4(label.anchor, 1.0f);
-    a.eye_depth = -view.z;
-    const glm::vec4 c = clip * glm::vec4(label.anchor, 1.0f);
-    if (c.w > 0.0f && a.eye_depth > camera.near_plane && a.eye_depth < camera.far_plane) {
-      const glm::vec2 ndc = glm::vec2(c) / c.w;
-      a.pixel = (ndc * 0.5f + 0.5f) * glm::vec2(size.width, size.height);
-      a.visible = a.pixel.x >= 0.0f && a.pixel.y >= 0.0f && a.pixel.x < float(size.width) &&
-                  a.pixel.y < float(size.height);
-    }
-    out.push_back(a);
+    out.push_back(project(camera, label.anchor, {size.width, size.height}));
   }
   return out;
 }
@@ -77,11 +58,11 @@ struct LabelledRenderer::Parts {
   graph::ResourceId glyph_id = 0;
 };
 
-LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const CameraSetup& camera,
+LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camera& camera,
                                    graph::Extent size, const LabellingSettings& settings)
     : scene_(scene), size_(size) {
   // Layering on the CPU, from the camera alone: k-means++ on the visible anchors' depths.
-  const std::vector<ProjectedAnchor> anchors = project_anchors(scene, camera, size);
+  const std::vector<ProjectedPoint> anchors = project_anchors(scene, camera, size);
   std::vector<float> depths;
   for (const auto& a : anchors) depths.push_back(a.visible ? a.eye_depth : std::nanf(""));
   layering_ = layer_labels(depths, settings.layer_count, camera.near_plane, camera.far_plane,
@@ -243,7 +224,7 @@ LabelledFrame LabelledRenderer::result() const {
   return frame;
 }
 
-LabelledFrame render_labelled(Context& ctx, const Scene& scene, const CameraSetup& camera,
+LabelledFrame render_labelled(Context& ctx, const Scene& scene, const Camera& camera,
                               graph::Extent size, const LabellingSettings& settings) {
   LabelledRenderer renderer(ctx, scene, camera, size, settings);
   renderer.run();

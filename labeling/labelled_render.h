@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/font.h"
-#include "engine/scene.h"
+#include "engine/core/font.h"
+#include "engine/scene/scene.h"
 #include "labeling/layering.h"
 #include "passes/placement.h"
 #include "passes/volume_renderer.h"
@@ -55,20 +55,14 @@ struct LabelledFrame {
   std::vector<graph::PassTiming> timings;
 };
 
-// Projects each label's anchor (LABEL_ENABLED when in view and in front of the camera), and
-// returns its pixel position and eye depth.
-struct ProjectedAnchor {
-  glm::vec2 pixel{0.0f};
-  float eye_depth = 0.0f;
-  bool visible = false;
-};
-std::vector<ProjectedAnchor> project_anchors(const Scene& scene, const CameraSetup& camera,
-                                             graph::Extent size);
+// Each label's anchor in the image (a label is enabled when its anchor is visible).
+std::vector<ProjectedPoint> project_anchors(const Scene& scene, const Camera& camera,
+                                            graph::Extent size);
 
 // Everything one labelled frame needs, set up once: renderer, placement, drawing, their graph.
 class LabelledRenderer {
  public:
-  LabelledRenderer(Context& ctx, const Scene& scene, const CameraSetup& camera, graph::Extent size,
+  LabelledRenderer(Context& ctx, const Scene& scene, const Camera& camera, graph::Extent size,
                    const LabellingSettings& settings);
   ~LabelledRenderer();
 
@@ -108,7 +102,7 @@ class LabelledRenderer {
 };
 
 // Renders and labels one frame offline.
-LabelledFrame render_labelled(Context& ctx, const Scene& scene, const CameraSetup& camera,
+LabelledFrame render_labelled(Context& ctx, const Scene& scene, const Camera& camera,
                               graph::Extent size, const LabellingSettings& settings);
 
 // The layout as JSON: per label id, text, layer, anchor, box (x, y, width, height), shown, cost.

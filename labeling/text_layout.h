@@ -10,7 +10,7 @@
 
 #include <glm/glm.hpp>
 
-#include "engine/font.h"
+#include "engine/core/font.h"
 #include "shared/labels.h"
 
 namespace strata {

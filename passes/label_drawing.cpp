@@ -5,7 +5,7 @@
 
 #include <glm/gtc/packing.hpp>
 
-#include "engine/error.h"
+#include "engine/core/error.h"
 
 namespace strata {
 

@@ -13,11 +13,11 @@
 
 #include <glm/glm.hpp>
 
-#include "engine/font.h"
-#include "engine/graph_runner.h"
-#include "engine/render_graph.h"
-#include "engine/resources.h"
-#include "engine/shader_library.h"
+#include "engine/core/font.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/graph/render_graph.h"
+#include "engine/gpu/resources.h"
+#include "engine/gpu/shader_library.h"
 #include "shared/label_drawing.h"
 
 namespace strata {

@@ -2,8 +2,8 @@
 
 #include <cstring>
 
-#include "engine/context.h"
-#include "engine/error.h"
+#include "engine/gpu/context.h"
+#include "engine/core/error.h"
 
 namespace strata {
 

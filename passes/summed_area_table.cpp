@@ -1,6 +1,6 @@
 #include "passes/summed_area_table.h"
 
-#include "engine/graph_runner.h"
+#include "engine/graph/graph_runner.h"
 #include "shared/summed_area_table.h"
 
 namespace strata {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "engine/graph_runner.h"
+#include "engine/graph/graph_runner.h"
 #include "shared/test_pattern.h"
 
 namespace strata {

@@ -116,7 +116,7 @@ std::vector<Fragment> fragments(const RenderInputs& in, const FrameGpu& frame, c
 }  // namespace
 }  // namespace gpu
 
-ReferenceImage render_reference(const RenderInputs& inputs, const CameraSetup& camera,
+ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera,
                                 const RenderSettings& settings, graph::Extent size) {
   gpu::Reference ref{frame_data(inputs, camera, settings, size, 1), inputs};
   ReferenceImage image;

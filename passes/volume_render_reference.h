@@ -19,7 +19,7 @@ struct ReferenceImage {
   uint64_t shaded = 0;
 };
 
-ReferenceImage render_reference(const RenderInputs& inputs, const CameraSetup& camera,
+ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera,
                                 const RenderSettings& settings, graph::Extent size);
 
 }  // namespace strata

@@ -6,9 +6,9 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "engine/context.h"
-#include "engine/error.h"
-#include "engine/graph_runner.h"
+#include "engine/gpu/context.h"
+#include "engine/core/error.h"
+#include "engine/graph/graph_runner.h"
 #include "shared/volume_render.h"
 
 namespace strata {
@@ -88,22 +88,6 @@ VkDeviceSize at_least(VkDeviceSize bytes) {
 }
 
 }  // namespace
-
-CameraSetup camera_for(const Scene& scene, const std::string& name) {
-  CameraSetup setup{scene.camera.view, scene.camera.fov_y_degrees, scene.camera.near_plane,
-                    scene.camera.far_plane};
-  if (name.empty()) return setup;
-  std::string names;
-  for (const CameraPose& pose : scene.camera.positions) {
-    if (pose.name == name) {
-      setup.view = pose.view;
-      return setup;
-    }
-    names += (names.empty() ? "" : ", ") + pose.name;
-  }
-  throw Error(scene.source.string() + ": no camera position named '" + name +
-              "' (the scene has: " + (names.empty() ? "none" : names) + ")");
-}
 
 RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d) {
   if (scene.volumes.size() > VR_MAX_VOLUMES) {
@@ -228,7 +212,7 @@ void RenderInputs::update_transfer() {
   }
 }
 
-std::vector<float> split_depths(const RenderInputs& in, const CameraSetup& camera,
+std::vector<float> split_depths(const RenderInputs& in, const Camera& camera,
                                 const RenderSettings& settings) {
   const uint32_t layers = settings.layer_count;
   if (!settings.splits.empty()) {
@@ -256,7 +240,7 @@ std::vector<float> split_depths(const RenderInputs& in, const CameraSetup& camer
   return splits;
 }
 
-gpu::FrameGpu frame_data(const RenderInputs& in, const CameraSetup& camera,
+gpu::FrameGpu frame_data(const RenderInputs& in, const Camera& camera,
                          const RenderSettings& settings, graph::Extent e, uint32_t table_size) {
   if (settings.layer_count < 1 || settings.layer_count > VR_MAX_LAYERS) {
     throw Error("layers: " + std::to_string(settings.layer_count) + " is not in 1.." +
@@ -265,10 +249,7 @@ gpu::FrameGpu frame_data(const RenderInputs& in, const CameraSetup& camera,
   gpu::FrameGpu f{};
   f.world_to_view = camera.view;
   f.view_to_world = glm::inverse(camera.view);
-  glm::mat4 projection =
-      glm::perspectiveRH_ZO(glm::radians(camera.fov_y_degrees), float(e.width) / float(e.height),
-                            camera.near_plane, camera.far_plane);
-  projection[1][1] *= -1.0f;  // Vulkan's clip space has y down
+  const glm::mat4 projection = camera.projection(float(e.width) / float(e.height));
   f.view_to_clip = projection;
   f.clip_to_view = glm::inverse(projection);
   const std::vector<float> splits = split_depths(in, camera, settings);

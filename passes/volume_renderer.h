@@ -7,11 +7,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "engine/graph_runner.h"
-#include "engine/render_graph.h"
-#include "engine/resources.h"
-#include "engine/scene.h"
-#include "engine/shader_library.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/graph/render_graph.h"
+#include "engine/gpu/resources.h"
+#include "engine/scene/scene.h"
+#include "engine/gpu/shader_library.h"
 #include "shared/volume_render.h"
 
 namespace strata {
@@ -39,16 +39,6 @@ struct RenderStats {
   uint32_t table_size = 0;        // slots during that frame
   double load_factor() const { return table_size ? double(fragments) / table_size : 0.0; }
 };
-
-struct CameraSetup {
-  glm::mat4 view{1.0f};
-  float fov_y_degrees = 45.0f;
-  float near_plane = 0.1f;
-  float far_plane = 100.0f;
-};
-
-// The scene's camera, or its named position `name` (Error listing the names if there is none).
-CameraSetup camera_for(const Scene& scene, const std::string& name);
 
 // Everything the renderer derives from a scene on the CPU, once: what the GPU receives and what
 // the CPU reference renderer (volume_render_reference.h) samples.
@@ -79,10 +69,10 @@ struct RenderInputs {
 RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d);
 
 // The layer boundaries (eye depths): settings.splits, or even over the scene's depth range.
-std::vector<float> split_depths(const RenderInputs& inputs, const CameraSetup& camera,
+std::vector<float> split_depths(const RenderInputs& inputs, const Camera& camera,
                                 const RenderSettings& settings);
 
-gpu::FrameGpu frame_data(const RenderInputs& inputs, const CameraSetup& camera,
+gpu::FrameGpu frame_data(const RenderInputs& inputs, const Camera& camera,
                          const RenderSettings& settings, graph::Extent viewport,
                          uint32_t table_size);
 
@@ -102,7 +92,7 @@ class VolumeRenderer {
   // Binds the uploaded scene and the counter readback; call after the runner has its viewport.
   void bind(graph::GraphRunner& runner);
 
-  void set_camera(const CameraSetup& camera) { camera_ = camera; }
+  void set_camera(const Camera& camera) { camera_ = camera; }
   RenderSettings& settings() { return settings_; }
   // Rebuilds volume v's empty-space grid and its transfer-function row.
   void set_transfer_function(uint32_t volume, const TransferFunction& tf);
@@ -115,7 +105,7 @@ class VolumeRenderer {
   RenderStats collect(graph::GraphRunner& runner);
 
   const RenderInputs& inputs() const { return inputs_; }
-  const CameraSetup& camera() const { return camera_; }
+  const Camera& camera() const { return camera_; }
 
  private:
   uint32_t slots_for(graph::Extent viewport) const;
@@ -124,7 +114,7 @@ class VolumeRenderer {
 
   Context& ctx_;
   RenderSettings settings_;
-  CameraSetup camera_;
+  Camera camera_;
   RenderInputs inputs_;
 
   Image atlas_;

@@ -5,9 +5,9 @@
 #include <fstream>
 #include <map>
 
-#include "engine/atlas.h"
-#include "engine/error.h"
-#include "engine/volume_loader.h"
+#include "engine/scene/atlas.h"
+#include "engine/core/error.h"
+#include "engine/scene/io/volume_loader.h"
 
 namespace strata {
 namespace {

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "engine/png.h"
+#include "engine/core/png.h"
 #include "gpu_fixture.h"
 
 namespace strata {

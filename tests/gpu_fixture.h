@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "engine/context.h"
+#include "engine/gpu/context.h"
 
 namespace strata::test {
 

@@ -15,11 +15,11 @@
 
 #include <glm/gtc/packing.hpp>
 
-#include "engine/error.h"
-#include "engine/font.h"
-#include "engine/graph_runner.h"
-#include "engine/png.h"
-#include "engine/resources.h"
+#include "engine/core/error.h"
+#include "engine/core/font.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/core/png.h"
+#include "engine/gpu/resources.h"
 #include "gpu_fixture.h"
 #include "labeling/text_layout.h"
 #include "passes/label_drawing.h"

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "engine/png.h"
-#include "engine/scene_loader.h"
+#include "engine/core/png.h"
+#include "engine/scene/io/scene_loader.h"
 #include "gpu_fixture.h"
 #include "labeling/labelled_render.h"
 
@@ -61,7 +61,7 @@ double total_cost(const LabelledFrame& frame) {
 TEST_SUITE("gpu") {
   TEST_CASE_FIXTURE(test::GpuTest, "optimized_order_costs_no_more_than_the_scene_order") {
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
-    const CameraSetup camera = camera_for(scene, "front");
+    const Camera camera = camera_for(scene, "front");
     LabellingSettings settings;
     const LabelledFrame scene_order = render_labelled(ctx, scene, camera, {128, 128}, settings);
     settings.order = InsertionOrder::optimized;

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/error.h"
-#include "engine/mesh_loader.h"
+#include "engine/core/error.h"
+#include "engine/scene/io/mesh_loader.h"
 #include "test_files.h"
 
 namespace {

@@ -11,8 +11,8 @@
 
 #include <glm/gtc/packing.hpp>
 
-#include "engine/graph_runner.h"
-#include "engine/resources.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/gpu/resources.h"
 #include "gpu_fixture.h"
 #include "passes/placement.h"
 #include "passes/placement_reference.h"

@@ -1,7 +1,7 @@
 // The render graph's compile step, from declarations alone: no device.
 #include <doctest/doctest.h>
 
-#include "engine/render_graph.h"
+#include "engine/graph/render_graph.h"
 
 namespace strata::graph {
 namespace {

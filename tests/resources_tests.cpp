@@ -3,8 +3,8 @@
 
 #include <numeric>
 
-#include "engine/error.h"
-#include "engine/resources.h"
+#include "engine/core/error.h"
+#include "engine/gpu/resources.h"
 #include "gpu_fixture.h"
 
 namespace strata {

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "engine/error.h"
-#include "engine/scene_loader.h"
-#include "engine/transfer_function_loader.h"
-#include "engine/volume_loader.h"
+#include "engine/core/error.h"
+#include "engine/scene/io/scene_loader.h"
+#include "engine/scene/io/transfer_function_loader.h"
+#include "engine/scene/io/volume_loader.h"
 #include "test_files.h"
 
 namespace {
@@ -81,9 +81,9 @@ TEST_SUITE("loaders") {
     CHECK(camera.fov_y_degrees == doctest::Approx(45.0).epsilon(1e-6));
     CHECK(camera.near_plane == doctest::Approx(-1.434267998 / (-1.513750076 - 1.0)));
     CHECK(camera.far_plane == doctest::Approx(-1.434267998 / (-1.513750076 + 1.0)));
-    REQUIRE(camera.positions.size() == 6);
-    for (size_t i = 0; i < 6; ++i) CHECK(camera.positions[i].name == "S" + std::to_string(i));
-    const glm::mat4& s5 = camera.positions[5].view;
+    REQUIRE(scene.camera_positions.size() == 6);
+    for (size_t i = 0; i < 6; ++i) CHECK(scene.camera_positions[i].name == "S" + std::to_string(i));
+    const glm::mat4& s5 = scene.camera_positions[5].view;
     CHECK(s5[0][0] == float(-9.615108371e-01));
     CHECK(s5[3][0] == float(1.172330454e-01));   // r0c3
     CHECK(s5[1][2] == float(-8.041925430e-01));  // r2c1
@@ -118,7 +118,7 @@ TEST_SUITE("loaders") {
       const fs::path path = voly_scenes / e.file;
       const strata::Scene scene = strata::load_scene(path);
       CHECK(scene.labels.size() == e.labels);
-      CHECK(scene.camera.positions.size() == e.positions);
+      CHECK(scene.camera_positions.size() == e.positions);
       CHECK(scene.meshes.empty());
       REQUIRE(scene.warnings.size() == 1);
       CHECK(scene.warnings[0] == path.string() + ": mesh '" + e.mesh + "' not found; skipped");
@@ -234,11 +234,11 @@ TEST_SUITE("loaders") {
     CHECK(scene.camera.near_plane == 0.5f);
     CHECK(scene.camera.far_plane == 50.0f);
     CHECK(scene.camera.view[3] == glm::vec4(0.0f, 0.0f, -10.0f, 1.0f));
-    REQUIRE(scene.camera.positions.size() == 2);
-    CHECK(scene.camera.positions[0].name == "side");
-    const glm::vec4 side_eye = glm::inverse(scene.camera.positions[0].view)[3];
+    REQUIRE(scene.camera_positions.size() == 2);
+    CHECK(scene.camera_positions[0].name == "side");
+    const glm::vec4 side_eye = glm::inverse(scene.camera_positions[0].view)[3];
     CHECK(side_eye.x == doctest::Approx(10.0));
-    CHECK(scene.camera.positions[1].view[3][2] == -3.0f);
+    CHECK(scene.camera_positions[1].view[3][2] == -3.0f);
     CHECK(scene.settings.layer_count == 3);
     CHECK(scene.settings.weights.label_shadow == 2.0f);
     CHECK(scene.settings.weights.previous_position == 0.5f);
@@ -401,9 +401,9 @@ TEST_SUITE("loaders") {
     CHECK(back.camera.fov_y_degrees == scene.camera.fov_y_degrees);
     CHECK(back.camera.near_plane == scene.camera.near_plane);
     CHECK(back.camera.far_plane == scene.camera.far_plane);
-    REQUIRE(back.camera.positions.size() == 6);
-    CHECK(back.camera.positions[5].name == "S5");
-    CHECK(back.camera.positions[5].view == scene.camera.positions[5].view);
+    REQUIRE(back.camera_positions.size() == 6);
+    CHECK(back.camera_positions[5].name == "S5");
+    CHECK(back.camera_positions[5].view == scene.camera_positions[5].view);
     REQUIRE(back.meshes.size() == 1);
     CHECK(back.meshes[0].color == glm::vec4(0.0f, 0.0f, 1.0f, 1.0f));
     CHECK(back.meshes[0].transform == scene.meshes[0].transform);

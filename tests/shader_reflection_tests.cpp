@@ -1,8 +1,8 @@
 // Descriptor layouts come from SPIR-V reflection of the embedded shaders.
 #include <doctest/doctest.h>
 
-#include "engine/error.h"
-#include "engine/shader_library.h"
+#include "engine/core/error.h"
+#include "engine/gpu/shader_library.h"
 #include "shared/summed_area_table.h"
 #include "shared/test_pattern.h"
 

@@ -2,8 +2,8 @@
 // validation, and the same graph with its derived barriers is clean.
 #include <doctest/doctest.h>
 
-#include "engine/graph_runner.h"
-#include "engine/headless_target.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/graph/headless_target.h"
 #include "gpu_fixture.h"
 #include "passes/test_pattern.h"
 

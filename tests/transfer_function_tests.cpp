@@ -4,8 +4,8 @@
 #include <fstream>
 #include <string>
 
-#include "engine/error.h"
-#include "engine/transfer_function_loader.h"
+#include "engine/core/error.h"
+#include "engine/scene/io/transfer_function_loader.h"
 #include "test_files.h"
 
 namespace {

@@ -21,8 +21,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "engine/error.h"
-#include "engine/volume_loader.h"
+#include "engine/core/error.h"
+#include "engine/scene/io/volume_loader.h"
 
 // ---- heap accounting
 // Global operator new/delete are replaced (for the whole strata_scene_tests binary) to count the

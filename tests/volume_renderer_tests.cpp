@@ -11,10 +11,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 
-#include "engine/graph_runner.h"
-#include "engine/headless_target.h"
-#include "engine/png.h"
-#include "engine/scene_loader.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/graph/headless_target.h"
+#include "engine/core/png.h"
+#include "engine/scene/io/scene_loader.h"
 #include "gpu_fixture.h"
 #include "passes/volume_render_reference.h"
 #include "passes/volume_renderer.h"
@@ -73,7 +73,7 @@ void add_volume(Scene& scene, Volume v, TransferFunction tf) {
   scene.volumes.push_back(std::move(v));
 }
 
-CameraSetup camera_at(glm::vec3 eye, glm::vec3 target = glm::vec3(0.0f)) {
+Camera camera_at(glm::vec3 eye, glm::vec3 target = glm::vec3(0.0f)) {
   return {glm::lookAt(eye, target, glm::vec3(0.0f, 1.0f, 0.0f)), 40.0f, 1.0f, 300.0f};
 }
 
@@ -83,7 +83,7 @@ struct GpuResult {
   RenderStats stats;
 };
 
-GpuResult render_gpu(Context& ctx, const Scene& scene, const CameraSetup& camera,
+GpuResult render_gpu(Context& ctx, const Scene& scene, const Camera& camera,
                      const RenderSettings& settings, graph::Extent size, uint32_t table = 0) {
   VolumeRenderer renderer(ctx, scene, settings);
   renderer.set_camera(camera);
@@ -144,7 +144,7 @@ void check_close(const std::vector<uint8_t>& actual, const std::vector<uint8_t>&
                                           << " pixels differ by more than " << tolerance << "/255");
 }
 
-void check_against_reference(Context& ctx, const Scene& scene, const CameraSetup& camera,
+void check_against_reference(Context& ctx, const Scene& scene, const Camera& camera,
                              const std::string& name, RenderSettings settings = {},
                              graph::Extent size = {96, 96}) {
   const GpuResult gpu = render_gpu(ctx, scene, camera, settings, size);
@@ -187,7 +187,7 @@ TEST_SUITE("gpu") {
     Scene scene;
     scene.meshes = {quad(0.0f, {0.9f, 0.2f, 0.1f, 0.5f}, 10.0f, {-3.0f, 0.0f}),
                     quad(8.0f, {0.1f, 0.3f, 0.9f, 0.5f}, 8.0f, {4.0f, 2.0f})};
-    const CameraSetup camera = camera_at({5.0f, 4.0f, 60.0f});
+    const Camera camera = camera_at({5.0f, 4.0f, 60.0f});
     check_against_reference(ctx, scene, camera, "meshes-ab");
     Scene reversed = scene;
     std::swap(reversed.meshes[0], reversed.meshes[1]);
@@ -222,7 +222,7 @@ TEST_SUITE("gpu") {
   TEST_CASE_FIXTURE(test::GpuTest, "a_camera_inside_a_volume_starts_its_rays_at_the_near_plane") {
     Scene scene;
     add_volume(scene, ball({32, 32, 32}, glm::vec3(-16.0f), 15.0f), ramp({0.9f, 0.9f, 0.5f}));
-    const CameraSetup camera = camera_at({2.0f, 1.0f, 9.0f});
+    const Camera camera = camera_at({2.0f, 1.0f, 9.0f});
     check_against_reference(ctx, scene, camera, "camera-inside");
     const GpuResult gpu = render_gpu(ctx, scene, camera, {}, {96, 96});
     CHECK(gpu.stats.samples > 0);  // with no front faces in view, only the near-plane start sees it
@@ -259,7 +259,7 @@ TEST_SUITE("gpu") {
     add_volume(scene, ball({40, 40, 40}, glm::vec3(-20.0f), 12.0f), ramp({1.0f, 0.6f, 0.3f}));
     RenderSettings on, off;
     off.skip_empty = false;
-    const CameraSetup camera = camera_at({15.0f, 10.0f, 70.0f});
+    const Camera camera = camera_at({15.0f, 10.0f, 70.0f});
     const GpuResult a = render_gpu(ctx, scene, camera, on, {64, 64});
     const GpuResult b = render_gpu(ctx, scene, camera, off, {64, 64});
     check_close(a.final, b.final, {64, 64}, "skipping", 1);
@@ -271,7 +271,7 @@ TEST_SUITE("gpu") {
     Scene scene;
     add_volume(scene, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.6f, 0.3f}));
     scene.meshes = {quad(0.0f, {0.2f, 0.9f, 0.3f, 0.7f}, 6.0f)};
-    const CameraSetup camera = camera_at({8.0f, 6.0f, 60.0f});
+    const Camera camera = camera_at({8.0f, 6.0f, 60.0f});
     const graph::Extent size{64, 64};
     VolumeRenderer renderer(ctx, scene, {});
     renderer.set_camera(camera);

@@ -5,8 +5,8 @@
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
 
-#include "engine/graph_runner.h"
-#include "engine/window_target.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/graph/window_target.h"
 #include "gpu_fixture.h"
 #include "passes/test_pattern.h"
 

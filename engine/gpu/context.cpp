@@ -1,0 +1,396 @@
+#include "engine/gpu/context.h"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <utility>
+
+#include "engine/gpu/vulkan_check.h"
+
+namespace strata {
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+VKAPI_ATTR VkBool32 VKAPI_CALL
+on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  std::string message = data->pMessage ? data->pMessage : "(no message)";
+  std::fprintf(stderr, "strata: validation: %s\n", message.c_str());
+  static_cast<ValidationLog*>(user)->add(std::move(message));
+  return VK_FALSE;
+}
+
+bool has_layer(const char* name) {
+  uint32_t count = 0;
+  vkEnumerateInstanceLayerProperties(&count, nullptr);
+  std::vector<VkLayerProperties> layers(count);
+  vkEnumerateInstanceLayerProperties(&count, layers.data());
+  return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) {
+    return std::strcmp(l.layerName, name) == 0;
+  });
+}
+
+bool has_device_extension(VkPhysicalDevice device, const char* name) {
+  uint32_t count = 0;
+  vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr);
+  std::vector<VkExtensionProperties> extensions(count);
+  vkEnumerateDeviceExtensionProperties(device, nullptr, &count, extensions.data());
+  return std::any_of(extensions.begin(), extensions.end(), [&](const VkExtensionProperties& e) {
+    return std::strcmp(e.extensionName, name) == 0;
+  });
+}
+
+// The first queue family that does graphics and compute and writes timestamps; -1 if none.
+int graphics_compute_family(VkPhysicalDevice device) {
+  uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
+  for (uint32_t i = 0; i < count; ++i) {
+    const VkQueueFlags need = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
+    if ((families[i].queueFlags & need) == need && families[i].timestampValidBits > 0) {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+DeviceReport describe(VkPhysicalDevice device, uint32_t index) {
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
+  VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES,
+                                              &driver};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &subgroup};
+  vkGetPhysicalDeviceProperties2(device, &props);
+  const bool is13 = props.properties.apiVersion >= VK_API_VERSION_1_3;
+  if (is13) vkGetPhysicalDeviceFeatures2(device, &features);
+
+  DeviceReport report;
+  report.index = index;
+  report.name = props.properties.deviceName;
+  report.type = props.properties.deviceType;
+  report.driver = std::string(driver.driverName) + " " + driver.driverInfo;
+  DeviceCapabilities& caps = report.caps;
+  caps.api_version = props.properties.apiVersion;
+  caps.shader_int64 = features.features.shaderInt64;
+  caps.buffer_int64_atomics = f12.shaderBufferInt64Atomics;
+  caps.fragment_stores_and_atomics = features.features.fragmentStoresAndAtomics;
+  caps.timeline_semaphore = f12.timelineSemaphore;
+  caps.synchronization2 = f13.synchronization2;
+  caps.dynamic_rendering = f13.dynamicRendering;
+  caps.maintenance4 = f13.maintenance4;
+  caps.push_descriptor = has_device_extension(device, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME);
+  caps.subgroup_arithmetic_in_compute =
+      (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+      (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT);
+  caps.graphics_compute_queue_with_timestamps = graphics_compute_family(device) >= 0;
+  if (is13 && has_device_extension(device, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME)) {
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executables{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+    VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &executables};
+    vkGetPhysicalDeviceFeatures2(device, &query);
+    caps.pipeline_statistics = executables.pipelineExecutableInfo;
+  }
+  report.missing = missing_requirements(caps);
+  return report;
+}
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return out;
+}
+
+int type_rank(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return 3;
+    default:
+      return 4;
+  }
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& item : items) out += (out.empty() ? "" : ", ") + item;
+  return out;
+}
+
+std::string unusable(const DeviceReport& d) {
+  return "device " + std::to_string(d.index) + " '" + d.name +
+         "' lacks what strata needs: " + join(d.missing);
+}
+
+}  // namespace
+
+std::vector<std::string> missing_requirements(const DeviceCapabilities& caps) {
+  std::vector<std::string> missing;
+  auto need = [&](bool ok, const char* what) {
+    if (!ok) missing.emplace_back(what);
+  };
+  need(caps.api_version >= VK_API_VERSION_1_3, "Vulkan 1.3");
+  need(caps.shader_int64, "shaderInt64");
+  need(caps.buffer_int64_atomics, "shaderBufferInt64Atomics (64-bit buffer atomics)");
+  need(caps.fragment_stores_and_atomics, "fragmentStoresAndAtomics");
+  need(caps.synchronization2, "synchronization2");
+  need(caps.dynamic_rendering, "dynamicRendering");
+  need(caps.maintenance4, "maintenance4");
+  need(caps.timeline_semaphore, "timelineSemaphore");
+  need(caps.push_descriptor, "VK_KHR_push_descriptor");
+  need(caps.subgroup_arithmetic_in_compute, "subgroup arithmetic in compute shaders");
+  need(caps.graphics_compute_queue_with_timestamps,
+       "a graphics+compute queue with timestamp queries");
+  return missing;
+}
+
+const char* to_string(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return "CPU";
+    default:
+      return "other";
+  }
+}
+
+uint32_t choose_device(const std::vector<DeviceReport>& devices, std::string_view selector) {
+  if (devices.empty()) {
+    throw Error(
+        "no Vulkan device found (is a Vulkan driver installed? on Debian: mesa-vulkan-drivers)");
+  }
+  if (!selector.empty()) {
+    uint32_t index = 0;
+    const auto [end, ec] =
+        std::from_chars(selector.data(), selector.data() + selector.size(), index);
+    const bool numeric = ec == std::errc() && end == selector.data() + selector.size();
+    const DeviceReport* match = nullptr;
+    for (const auto& d : devices) {
+      if (numeric ? d.index == index : lower(d.name).find(lower(selector)) != std::string::npos) {
+        match = &d;
+        break;
+      }
+    }
+    if (!match) {
+      throw Error("no Vulkan device matches '" + std::string(selector) + "' (" +
+                  std::to_string(devices.size()) + " found; 'strata devices' lists them)");
+    }
+    if (!match->missing.empty()) throw Error(unusable(*match));
+    return match->index;
+  }
+  const DeviceReport* best = nullptr;
+  for (const auto& d : devices) {
+    if (d.missing.empty() && (!best || type_rank(d.type) < type_rank(best->type))) best = &d;
+  }
+  if (!best) {
+    std::string why;
+    for (const auto& d : devices) why += "\n  " + unusable(d);
+    throw Error("no usable Vulkan device:" + why);
+  }
+  return best->index;
+}
+
+void ValidationLog::add(std::string message) {
+  std::lock_guard lock(mutex_);
+  messages_.push_back(std::move(message));
+}
+
+std::vector<std::string> ValidationLog::take() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(messages_, {});
+}
+
+size_t ValidationLog::count() const {
+  std::lock_guard lock(mutex_);
+  return messages_.size();
+}
+
+Instance::Instance(bool validation, const std::vector<const char*>& extensions) {
+  if (validation && !has_layer(kValidationLayer)) {
+    throw Error(std::string("validation was asked for but ") + kValidationLayer +
+                " is not installed (Debian: vulkan-validationlayers)");
+  }
+  std::vector<const char*> exts = extensions;
+  if (validation) exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "strata";
+  app.apiVersion = VK_API_VERSION_1_3;
+
+  VkDebugUtilsMessengerCreateInfoEXT messenger{
+      VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  messenger.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                              VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  messenger.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;  // not performance hints
+  messenger.pfnUserCallback = on_validation_message;
+  messenger.pUserData = &log_;
+
+  const VkValidationFeatureEnableEXT enables[] = {
+      VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT, &messenger};
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = enables;
+
+  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  info.pNext = validation ? &features : nullptr;
+  info.pApplicationInfo = &app;
+  info.enabledExtensionCount = static_cast<uint32_t>(exts.size());
+  info.ppEnabledExtensionNames = exts.data();
+  info.enabledLayerCount = validation ? 1 : 0;
+  info.ppEnabledLayerNames = &kValidationLayer;
+  const VkResult result = vkCreateInstance(&info, nullptr, &instance_);
+  if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
+    throw Error("no Vulkan 1.3 driver found (on Debian: mesa-vulkan-drivers)");
+  }
+  check_vk(result, "vkCreateInstance");
+  if (validation) {
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+    check_vk(create(instance_, &messenger, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+  }
+}
+
+Instance::~Instance() {
+  if (messenger_) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+    destroy(instance_, messenger_, nullptr);
+  }
+  vkDestroyInstance(instance_, nullptr);
+}
+
+std::vector<DeviceReport> Instance::devices() const {
+  uint32_t count = 0;
+  vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+  std::vector<VkPhysicalDevice> handles(count);
+  vkEnumeratePhysicalDevices(instance_, &count, handles.data());
+  std::vector<DeviceReport> reports;
+  for (uint32_t i = 0; i < count; ++i) reports.push_back(describe(handles[i], i));
+  return reports;
+}
+
+Context::Context(const ContextOptions& options)
+    : instance_(options.validation, options.instance_extensions) {
+  std::string selector = options.device_selector;
+  if (selector.empty()) {
+    if (const char* env = std::getenv("STRATA_DEVICE")) selector = env;
+  }
+  const std::vector<DeviceReport> reports = instance_.devices();
+  const uint32_t index = choose_device(reports, selector);
+  report_ = reports[index];
+  uint32_t count = 0;
+  vkEnumeratePhysicalDevices(instance_.handle(), &count, nullptr);
+  std::vector<VkPhysicalDevice> handles(count);
+  vkEnumeratePhysicalDevices(instance_.handle(), &count, handles.data());
+  physical_ = handles[index];
+  vkGetPhysicalDeviceProperties(physical_, &properties_);
+  vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+  queue_family_ = static_cast<uint32_t>(graphics_compute_family(physical_));
+  if (!options.quiet) {
+    std::fprintf(stderr, "strata: device %u: %s (%s)\n", index, report_.name.c_str(),
+                 to_string(report_.type));
+  }
+
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  f13.synchronization2 = VK_TRUE;
+  f13.dynamicRendering = VK_TRUE;
+  f13.maintenance4 = VK_TRUE;  // core in 1.3; SPIR-V 1.6 declares workgroup sizes with LocalSizeId
+  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
+  f12.shaderBufferInt64Atomics = VK_TRUE;
+  f12.timelineSemaphore = VK_TRUE;
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
+  features.features.shaderInt64 = VK_TRUE;
+  features.features.fragmentStoresAndAtomics = VK_TRUE;
+
+  std::vector<const char*> extensions = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+  if (options.presentation) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executables{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+  if (report_.caps.pipeline_statistics) {
+    extensions.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
+    executables.pipelineExecutableInfo = VK_TRUE;
+    f13.pNext = &executables;
+  }
+
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queue.queueFamilyIndex = queue_family_;
+  queue.queueCount = 1;
+  queue.pQueuePriorities = &priority;
+  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features};
+  info.queueCreateInfoCount = 1;
+  info.pQueueCreateInfos = &queue;
+  info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
+  STRATA_VK(vkCreateDevice(physical_, &info, nullptr, &device_));
+  vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+
+  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+  pool.queueFamilyIndex = queue_family_;
+  STRATA_VK(vkCreateCommandPool(device_, &pool, nullptr, &pool_));
+}
+
+Context::~Context() {
+  if (device_) {
+    vkDeviceWaitIdle(device_);
+    vkDestroyCommandPool(device_, pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+  }
+}
+
+uint32_t Context::memory_type(uint32_t allowed_types, VkMemoryPropertyFlags wanted) const {
+  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
+    if ((allowed_types & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & wanted) == wanted) {
+      return i;
+    }
+  }
+  throw Error("device '" + report_.name + "' has no memory type with the properties needed");
+}
+
+void Context::run_now(const std::function<void(VkCommandBuffer)>& record) {
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  STRATA_VK(vkAllocateCommandBuffers(device_, &alloc, &cmd));
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  STRATA_VK(vkBeginCommandBuffer(cmd, &begin));
+  record(cmd);
+  STRATA_VK(vkEndCommandBuffer(cmd));
+
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence = VK_NULL_HANDLE;
+  STRATA_VK(vkCreateFence(device_, &fence_info, nullptr, &fence));
+  VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  cmd_info.commandBuffer = cmd;
+  VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  submit.commandBufferInfoCount = 1;
+  submit.pCommandBufferInfos = &cmd_info;
+  const VkResult result = vkQueueSubmit2(queue_, 1, &submit, fence);
+  if (result == VK_SUCCESS) STRATA_VK(vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX));
+  vkDestroyFence(device_, fence, nullptr);
+  vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+  check_vk(result, "vkQueueSubmit2");
+}
+
+}  // namespace strata

@@ -1,0 +1,274 @@
+#include "engine/gpu/resources.h"
+
+#include <utility>
+
+#include "engine/gpu/context.h"
+#include "engine/gpu/vulkan_check.h"
+
+namespace strata {
+namespace {
+
+VkMemoryPropertyFlags properties_for(MemoryKind kind) {
+  switch (kind) {
+    case MemoryKind::device_local:
+      return VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+    case MemoryKind::host_upload:
+      return VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    case MemoryKind::host_readback:
+      return VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  }
+  return 0;
+}
+
+VkDeviceMemory allocate(Context& ctx, const VkMemoryRequirements& req,
+                        VkMemoryPropertyFlags props) {
+  VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  info.allocationSize = req.size;
+  info.memoryTypeIndex = ctx.memory_type(req.memoryTypeBits, props);
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  const VkResult result = vkAllocateMemory(ctx.device(), &info, nullptr, &memory);
+  if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) {
+    throw Error("out of memory allocating " + std::to_string(req.size) + " bytes on '" +
+                ctx.report().name + "'");
+  }
+  check_vk(result, "vkAllocateMemory");
+  return memory;
+}
+
+VkImageAspectFlags aspect_of(VkFormat format) {
+  return format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+}
+
+VkDeviceSize image_bytes(const ImageDesc& d) {
+  return VkDeviceSize{d.extent.width} * d.extent.height * d.extent.depth * d.layers *
+         texel_size(d.format);
+}
+
+// Makes a copy's writes visible to the host that reads the staging buffer after the fence.
+void copy_to_host_barrier(VkCommandBuffer cmd) {
+  VkMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+  to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+  to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.memoryBarrierCount = 1;
+  dep.pMemoryBarriers = &to_host;
+  vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+}  // namespace
+
+Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind)
+    : device_(ctx.device()), size_(size) {
+  if (kind == MemoryKind::device_local) {
+    usage |= VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  }
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = size;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  STRATA_VK(vkCreateBuffer(device_, &info, nullptr, &buffer_));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device_, buffer_, &req);
+  memory_ = allocate(ctx, req, properties_for(kind));
+  STRATA_VK(vkBindBufferMemory(device_, buffer_, memory_, 0));
+  if (kind != MemoryKind::device_local) {
+    void* ptr = nullptr;
+    STRATA_VK(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &ptr));
+    mapped_ = static_cast<std::byte*>(ptr);
+  }
+}
+
+Buffer::~Buffer() {
+  release();
+}
+
+Buffer::Buffer(Buffer&& other) noexcept {
+  *this = std::move(other);
+}
+
+Buffer& Buffer::operator=(Buffer&& other) noexcept {
+  if (this != &other) {
+    release();
+    device_ = std::exchange(other.device_, VK_NULL_HANDLE);
+    buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
+    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    size_ = std::exchange(other.size_, 0);
+    mapped_ = std::exchange(other.mapped_, nullptr);
+  }
+  return *this;
+}
+
+void Buffer::release() {
+  if (!device_) return;
+  vkDestroyBuffer(device_, buffer_, nullptr);
+  vkFreeMemory(device_, memory_, nullptr);
+  device_ = VK_NULL_HANDLE;
+}
+
+Image::Image(Context& ctx, const ImageDesc& desc) : device_(ctx.device()), desc_(desc) {
+  VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  info.imageType = desc.type;
+  info.format = desc.format;
+  info.extent = desc.extent;
+  info.mipLevels = 1;
+  info.arrayLayers = desc.layers;
+  info.samples = VK_SAMPLE_COUNT_1_BIT;
+  info.tiling = VK_IMAGE_TILING_OPTIMAL;
+  info.usage = desc.usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  STRATA_VK(vkCreateImage(device_, &info, nullptr, &image_));
+  VkMemoryRequirements req;
+  vkGetImageMemoryRequirements(device_, image_, &req);
+  memory_ = allocate(ctx, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  STRATA_VK(vkBindImageMemory(device_, image_, memory_, 0));
+
+  VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+  view.image = image_;
+  view.viewType = desc.type == VK_IMAGE_TYPE_3D ? VK_IMAGE_VIEW_TYPE_3D
+                  : desc.layers > 1 || desc.array ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
+                                                : VK_IMAGE_VIEW_TYPE_2D;
+  view.format = desc.format;
+  view.subresourceRange = {aspect_of(desc.format), 0, 1, 0, desc.layers};
+  STRATA_VK(vkCreateImageView(device_, &view, nullptr, &view_));
+}
+
+Image::~Image() {
+  release();
+}
+
+Image::Image(Image&& other) noexcept {
+  *this = std::move(other);
+}
+
+Image& Image::operator=(Image&& other) noexcept {
+  if (this != &other) {
+    release();
+    device_ = std::exchange(other.device_, VK_NULL_HANDLE);
+    image_ = std::exchange(other.image_, VK_NULL_HANDLE);
+    view_ = std::exchange(other.view_, VK_NULL_HANDLE);
+    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    desc_ = other.desc_;
+  }
+  return *this;
+}
+
+void Image::release() {
+  if (!device_) return;
+  vkDestroyImageView(device_, view_, nullptr);
+  vkDestroyImage(device_, image_, nullptr);
+  vkFreeMemory(device_, memory_, nullptr);
+  device_ = VK_NULL_HANDLE;
+}
+
+uint32_t texel_size(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R8G8B8A8_UNORM:
+    case VK_FORMAT_R8G8B8A8_SRGB:
+    case VK_FORMAT_B8G8R8A8_UNORM:
+    case VK_FORMAT_B8G8R8A8_SRGB:
+    case VK_FORMAT_R32_SFLOAT:
+    case VK_FORMAT_R32_UINT:
+    case VK_FORMAT_D32_SFLOAT:
+      return 4;
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+    case VK_FORMAT_R16G16B16A16_SNORM:
+      return 8;
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+      return 16;
+    case VK_FORMAT_R8_UNORM:
+      return 1;
+    case VK_FORMAT_R16_UNORM:
+    case VK_FORMAT_R16_SFLOAT:
+      return 2;
+    default:
+      throw Error("texel_size: format " + std::to_string(format) + " is not one strata uses");
+  }
+}
+
+void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data) {
+  if (data.size() > dst.size()) throw Error("upload: data larger than the buffer");
+  if (data.empty()) return;
+  Buffer staging(ctx, data.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::host_upload);
+  std::memcpy(staging.mapped(), data.data(), data.size());
+  ctx.run_now([&](VkCommandBuffer cmd) {
+    const VkBufferCopy region{0, 0, data.size()};
+    vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), 1, &region);
+  });
+}
+
+namespace {
+
+void transition(VkCommandBuffer cmd, const Image& image, VkImageLayout from, VkImageLayout to,
+                VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) {
+  VkImageMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+  barrier.srcStageMask = src_stage;
+  barrier.srcAccessMask = src_access;
+  barrier.dstStageMask = dst_stage;
+  barrier.dstAccessMask = dst_access;
+  barrier.oldLayout = from;
+  barrier.newLayout = to;
+  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.image = image.handle();
+  barrier.subresourceRange = {aspect_of(image.desc().format), 0, 1, 0, image.desc().layers};
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.imageMemoryBarrierCount = 1;
+  dep.pImageMemoryBarriers = &barrier;
+  vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+}  // namespace
+
+void upload(Context& ctx, const Image& dst, std::span<const std::byte> data,
+            VkImageLayout final_layout) {
+  const VkDeviceSize size = image_bytes(dst.desc());
+  if (data.size() != size) {
+    throw Error("upload: " + std::to_string(data.size()) + " bytes for an image of " +
+                std::to_string(size));
+  }
+  Buffer staging(ctx, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::host_upload);
+  std::memcpy(staging.mapped(), data.data(), size);
+  ctx.run_now([&](VkCommandBuffer cmd) {
+    // Setup code outside any graph: the image is new, so it starts undefined and is then handed
+    // to every later stage (the graph imports it with content in `final_layout`).
+    transition(cmd, dst, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+               VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT,
+               VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {aspect_of(dst.desc().format), 0, 0, dst.desc().layers};
+    region.imageExtent = dst.desc().extent;
+    vkCmdCopyBufferToImage(cmd, staging.handle(), dst.handle(),
+                           VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    transition(cmd, dst, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout,
+               VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+               VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+  });
+}
+
+std::vector<std::byte> download(Context& ctx, const Buffer& src) {
+  Buffer staging(ctx, src.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback);
+  ctx.run_now([&](VkCommandBuffer cmd) {
+    const VkBufferCopy region{0, 0, src.size()};
+    vkCmdCopyBuffer(cmd, src.handle(), staging.handle(), 1, &region);
+    copy_to_host_barrier(cmd);
+  });
+  return {staging.mapped(), staging.mapped() + src.size()};
+}
+
+std::vector<std::byte> download(Context& ctx, const Image& src, VkImageLayout layout) {
+  const ImageDesc& d = src.desc();
+  const VkDeviceSize size = image_bytes(d);
+  Buffer staging(ctx, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback);
+  ctx.run_now([&](VkCommandBuffer cmd) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {aspect_of(d.format), 0, 0, d.layers};
+    region.imageExtent = d.extent;
+    vkCmdCopyImageToBuffer(cmd, src.handle(), layout, staging.handle(), 1, &region);
+    copy_to_host_barrier(cmd);
+  });
+  return {staging.mapped(), staging.mapped() + size};
+}
+
+}  // namespace strata

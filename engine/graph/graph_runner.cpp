@@ -1,0 +1,255 @@
+#include "engine/graph/graph_runner.h"
+
+#include "engine/gpu/context.h"
+#include "engine/gpu/vulkan_check.h"
+
+namespace strata::graph {
+
+VkBuffer PassContext::buffer(ResourceId id) const {
+  return runner_->bound_.at(id).buffer;
+}
+VkImage PassContext::image(ResourceId id) const {
+  return runner_->bound_.at(id).image;
+}
+VkImageView PassContext::view(ResourceId id) const {
+  return runner_->bound_.at(id).view;
+}
+
+void PassContext::bind(const Pipeline& pipeline) const {
+  std::vector<DescriptorResource> resources;
+  const PassInfo& pass = runner_->graph_.passes()[pass_];
+  for (const ResourceUse& u : pass.uses) {
+    if (!u.binding) continue;
+    const GraphRunner::Bound& b = runner_->bound_.at(u.resource);
+    const VkSampler sampler = u.use == Use::sampled ? runner_->linear_sampler_ : VK_NULL_HANDLE;
+    resources.push_back({*u.binding, u.array_element, b.buffer, b.view,
+                         runner_->compiled_.layout[pass_][u.resource], sampler});
+  }
+  pipeline.bind(cmd, resources);
+}
+
+GraphRunner::GraphRunner(Context& ctx, Graph graph)
+    : ctx_(ctx), graph_(std::move(graph)), compiled_(compile(graph_)) {
+  bound_.resize(graph_.resources().size());
+  owned_.resize(graph_.resources().size());
+  VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  info.queryCount = static_cast<uint32_t>(2 * std::max<size_t>(1, graph_.passes().size()));
+  STRATA_VK(vkCreateQueryPool(ctx_.device(), &info, nullptr, &queries_));
+  VkSamplerCreateInfo sampler{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  sampler.magFilter = sampler.minFilter = VK_FILTER_LINEAR;
+  sampler.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  sampler.addressModeU = sampler.addressModeV = sampler.addressModeW =
+      VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  STRATA_VK(vkCreateSampler(ctx_.device(), &sampler, nullptr, &linear_sampler_));
+}
+
+GraphRunner::~GraphRunner() {
+  vkDestroySampler(ctx_.device(), linear_sampler_, nullptr);
+  vkDestroyQueryPool(ctx_.device(), queries_, nullptr);
+}
+
+void GraphRunner::set_viewport(Extent viewport) {
+  if (viewport == viewport_) return;
+  if (viewport.width == 0 || viewport.height == 0) throw Error("render graph: empty viewport");
+  viewport_ = viewport;
+  for (size_t i = 0; i < graph_.resources().size(); ++i) {
+    const ResourceInfo& r = graph_.resources()[i];
+    if (r.imported) continue;
+    if (r.is_image) {
+      const Extent e = r.image.fixed.width ? r.image.fixed : viewport;
+      ImageDesc desc{r.image.format,     {e.width, e.height, 1}, VK_IMAGE_TYPE_2D,
+                     compiled_.usage[i], r.image.layers,         r.image.array};
+      Image& image = owned_[i].emplace<Image>(ctx_, desc);
+      bound_[i] = {VK_NULL_HANDLE, image.handle(), image.view(), r.image.format};
+    } else {
+      const VkDeviceSize size = std::max<VkDeviceSize>(4, r.buffer.size(viewport));
+      Buffer& buffer =
+          owned_[i].emplace<Buffer>(ctx_, size, compiled_.usage[i], MemoryKind::device_local);
+      bound_[i] = {buffer.handle()};
+    }
+  }
+}
+
+void GraphRunner::reallocate() {
+  const Extent viewport = viewport_;
+  viewport_ = {};
+  set_viewport(viewport);
+}
+
+std::vector<std::byte> GraphRunner::download_image(ResourceId id) {
+  const Image* image = std::get_if<Image>(&owned_.at(id));
+  if (!image)
+    throw Error("render graph: '" + graph_.resources()[id].name + "' is not a transient image");
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  for (const auto& pass_layouts : compiled_.layout) {
+    if (pass_layouts[id] != VK_IMAGE_LAYOUT_UNDEFINED) layout = pass_layouts[id];
+  }
+  return download(ctx_, *image, layout);
+}
+
+std::vector<std::byte> GraphRunner::download_buffer(ResourceId id) {
+  const Buffer* buffer = std::get_if<Buffer>(&owned_.at(id));
+  if (!buffer)
+    throw Error("render graph: '" + graph_.resources()[id].name + "' is not a transient buffer");
+  return download(ctx_, *buffer);
+}
+
+void GraphRunner::bind_buffer(ResourceId id, VkBuffer buffer) {
+  bound_.at(id) = {buffer};
+}
+
+void GraphRunner::bind_image(ResourceId id, VkImage image, VkImageView view, VkFormat format) {
+  bound_.at(id) = {VK_NULL_HANDLE, image, view, format};
+}
+
+void GraphRunner::emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) const {
+  if (barriers.empty()) return;
+  std::vector<VkBufferMemoryBarrier2> buffers;
+  std::vector<VkImageMemoryBarrier2> images;
+  for (const Barrier& b : barriers) {
+    const Bound& r = bound_[b.resource];
+    if (b.is_image) {
+      VkImageMemoryBarrier2 ib{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+      ib.srcStageMask = b.src_stage;
+      ib.srcAccessMask = b.src_access;
+      ib.dstStageMask = b.dst_stage;
+      ib.dstAccessMask = b.dst_access;
+      ib.oldLayout = b.old_layout;
+      ib.newLayout = b.new_layout;
+      ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      ib.image = r.image;
+      const VkImageAspectFlags aspect =
+          r.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+      ib.subresourceRange = {aspect, 0, 1, 0, VK_REMAINING_ARRAY_LAYERS};
+      images.push_back(ib);
+    } else {
+      VkBufferMemoryBarrier2 bb{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+      bb.srcStageMask = b.src_stage;
+      bb.srcAccessMask = b.src_access;
+      bb.dstStageMask = b.dst_stage;
+      bb.dstAccessMask = b.dst_access;
+      bb.srcQueueFamilyIndex = bb.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+      bb.buffer = r.buffer;
+      bb.size = VK_WHOLE_SIZE;
+      buffers.push_back(bb);
+    }
+  }
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.bufferMemoryBarrierCount = static_cast<uint32_t>(buffers.size());
+  dep.pBufferMemoryBarriers = buffers.data();
+  dep.imageMemoryBarrierCount = static_cast<uint32_t>(images.size());
+  dep.pImageMemoryBarriers = images.data();
+  vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+void GraphRunner::check_bound() const {
+  if (viewport_.width == 0) throw Error("render graph: set_viewport() before record()");
+  for (size_t i = 0; i < bound_.size(); ++i) {
+    if (!bound_[i].buffer && !bound_[i].image) {
+      throw Error("render graph: imported resource '" + graph_.resources()[i].name +
+                  "' is not bound");
+    }
+  }
+}
+
+bool GraphRunner::stamps_begin(uint32_t p) const {
+  const auto& passes = graph_.passes();
+  return per_pass_stamps_ || p == 0 || passes[p - 1].group != passes[p].group;
+}
+
+bool GraphRunner::stamps_end(uint32_t p) const {
+  const auto& passes = graph_.passes();
+  return per_pass_stamps_ || p + 1 == passes.size() || passes[p + 1].group != passes[p].group;
+}
+
+void GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
+  emit(cmd, compiled_.pass_barriers[p]);
+  if (stamps_begin(p)) {
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p);
+  }
+  PassContext pc;
+  pc.cmd = cmd;
+  pc.viewport = viewport_;
+  pc.runner_ = this;
+  pc.pass_ = p;
+  graph_.passes()[p].record(pc);
+  if (stamps_end(p)) {
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p + 1);
+  }
+}
+
+void GraphRunner::record(VkCommandBuffer cmd) {
+  check_bound();
+  const auto passes = static_cast<uint32_t>(graph_.passes().size());
+  vkCmdResetQueryPool(cmd, queries_, 0, 2 * passes);
+  for (uint32_t p = 0; p < passes; ++p) record_pass(cmd, p);
+  emit(cmd, compiled_.final_barriers);
+}
+
+void GraphRunner::run_split(const std::function<bool(uint32_t)>& split_after,
+                            const std::function<void(uint32_t)>& after) {
+  check_bound();
+  const auto passes = static_cast<uint32_t>(graph_.passes().size());
+  uint32_t p = 0;
+  while (p < passes) {
+    uint32_t last = p;
+    ctx_.run_now([&](VkCommandBuffer cmd) {
+      if (p == 0) vkCmdResetQueryPool(cmd, queries_, 0, 2 * passes);
+      for (last = p; last < passes; ++last) {
+        record_pass(cmd, last);
+        if (split_after(last)) break;
+      }
+      if (last >= passes - 1) emit(cmd, compiled_.final_barriers);
+    });
+    if (last < passes) after(last);
+    p = last + 1;
+  }
+}
+
+void GraphRunner::run_now() {
+  ctx_.run_now([&](VkCommandBuffer cmd) { record(cmd); });
+}
+
+std::vector<PassTiming> GraphRunner::timings() const {
+  const auto& passes = graph_.passes();
+  std::vector<uint64_t> stamps(2 * passes.size());
+  // (stamps that were not written must not be waited for: read those that were, one by one)
+  const auto read = [&](uint32_t query) {
+    STRATA_VK(vkGetQueryPoolResults(ctx_.device(), queries_, query, 1, sizeof(uint64_t),
+                                    &stamps[query], sizeof(uint64_t),
+                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+  };
+  if (per_pass_stamps_ && !passes.empty()) {
+    STRATA_VK(
+        vkGetQueryPoolResults(ctx_.device(), queries_, 0, static_cast<uint32_t>(stamps.size()),
+                              stamps.size() * sizeof(uint64_t), stamps.data(), sizeof(uint64_t),
+                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+  } else {
+    for (uint32_t p = 0; p < passes.size(); ++p) {
+      if (stamps_begin(p)) read(2 * p);
+      if (stamps_end(p)) read(2 * p + 1);
+    }
+  }
+  std::vector<PassTiming> out;
+  const double to_ms = ctx_.timestamp_period_ns() * 1e-6;
+  const auto since_start = [&](uint32_t query) {
+    return static_cast<double>(stamps[query] - stamps[0]) * to_ms;
+  };
+  uint32_t group_first = 0;
+  for (uint32_t p = 0; p < passes.size(); ++p) {
+    if (per_pass_stamps_) {
+      const double begin = since_start(2 * p), end = since_start(2 * p + 1);
+      out.push_back({passes[p].name, passes[p].group, end - begin, begin, end});
+      continue;
+    }
+    if (stamps_begin(p)) group_first = p;
+    if (stamps_end(p)) {
+      const double begin = since_start(2 * group_first), end = since_start(2 * p + 1);
+      out.push_back({passes[p].group, passes[p].group, end - begin, begin, end});
+    }
+  }
+  return out;
+}
+
+}  // namespace strata::graph

@@ -1,0 +1,228 @@
+#include "engine/graph/window_target.h"
+
+#include <algorithm>
+
+#define GLFW_INCLUDE_VULKAN
+#include <GLFW/glfw3.h>
+
+#include "engine/gpu/context.h"
+#include "engine/gpu/vulkan_check.h"
+
+namespace strata {
+namespace {
+
+graph::Extent framebuffer_size(GLFWwindow* window) {
+  int w = 0, h = 0;
+  glfwGetFramebufferSize(window, &w, &h);
+  return {static_cast<uint32_t>(std::max(w, 0)), static_cast<uint32_t>(std::max(h, 0))};
+}
+
+VkSurfaceFormatKHR choose_format(VkPhysicalDevice device, VkSurfaceKHR surface) {
+  uint32_t count = 0;
+  vkGetPhysicalDeviceSurfaceFormatsKHR(device, surface, &count, nullptr);
+  std::vector<VkSurfaceFormatKHR> formats(count);
+  vkGetPhysicalDeviceSurfaceFormatsKHR(device, surface, &count, formats.data());
+  if (formats.empty()) throw Error("the window surface offers no formats");
+  // strata's frames hold display-ready values: prefer a UNORM swapchain (no second sRGB encode).
+  for (const auto& f : formats) {
+    if (f.format == VK_FORMAT_B8G8R8A8_UNORM || f.format == VK_FORMAT_R8G8B8A8_UNORM) return f;
+  }
+  return formats[0];
+}
+
+}  // namespace
+
+Glfw::Glfw() {
+  if (!glfwInit()) {
+    const char* why = nullptr;
+    glfwGetError(&why);
+    throw Error(std::string("cannot open a window: ") + (why ? why : "GLFW failed to initialise") +
+                " (is DISPLAY set? without a display use 'strata render')");
+  }
+  if (!glfwVulkanSupported()) {
+    glfwTerminate();
+    throw Error("cannot open a window: GLFW finds no Vulkan loader");
+  }
+}
+
+Glfw::~Glfw() {
+  glfwTerminate();
+}
+
+std::vector<const char*> Glfw::instance_extensions() const {
+  uint32_t count = 0;
+  const char** names = glfwGetRequiredInstanceExtensions(&count);
+  return {names, names + count};
+}
+
+WindowTarget::WindowTarget(Context& ctx, GLFWwindow* window) : ctx_(ctx), window_(window) {
+  STRATA_VK(glfwCreateWindowSurface(ctx.instance(), window, nullptr, &surface_));
+  VkBool32 supported = VK_FALSE;
+  vkGetPhysicalDeviceSurfaceSupportKHR(ctx.physical_device(), ctx.queue_family(), surface_,
+                                       &supported);
+  if (!supported) throw Error("device '" + ctx.report().name + "' cannot present to this window");
+
+  VkSemaphoreCreateInfo sem{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+  STRATA_VK(vkCreateSemaphore(ctx.device(), &sem, nullptr, &acquired_));
+  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  fence.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+  STRATA_VK(vkCreateFence(ctx.device(), &fence, nullptr, &frame_done_));
+  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pool.queueFamilyIndex = ctx.queue_family();
+  STRATA_VK(vkCreateCommandPool(ctx.device(), &pool, nullptr, &pool_));
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool_;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  STRATA_VK(vkAllocateCommandBuffers(ctx.device(), &alloc, &cmd_));
+}
+
+WindowTarget::~WindowTarget() {
+  VkDevice device = ctx_.device();
+  vkDeviceWaitIdle(device);
+  destroy_swapchain_images();
+  vkDestroySwapchainKHR(device, swapchain_, nullptr);
+  vkDestroyCommandPool(device, pool_, nullptr);
+  vkDestroyFence(device, frame_done_, nullptr);
+  vkDestroySemaphore(device, acquired_, nullptr);
+  vkDestroySurfaceKHR(ctx_.instance(), surface_, nullptr);
+}
+
+void WindowTarget::add_output(graph::Graph& graph, graph::ResourceId frame) {
+  swapchain_id_ = graph.import_resource(
+      "swapchain", {true, false, VK_IMAGE_LAYOUT_UNDEFINED, graph::Use::present,
+                    VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT});
+  const graph::ResourceId target = swapchain_id_;
+  graph.add_pass({"present.blit",
+                  graph::PassKind::transfer,
+                  {{frame, graph::Use::transfer_src}, {target, graph::Use::transfer_dst}},
+                  [frame, target](graph::PassContext& pc) {
+                    const auto w = static_cast<int32_t>(pc.viewport.width);
+                    const auto h = static_cast<int32_t>(pc.viewport.height);
+                    VkImageBlit region{};
+                    region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                    region.srcOffsets[1] = {w, h, 1};
+                    region.dstSubresource = region.srcSubresource;
+                    region.dstOffsets[1] = {w, h, 1};
+                    vkCmdBlitImage(pc.cmd, pc.image(frame), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                   pc.image(target), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                                   &region, VK_FILTER_NEAREST);
+                  }});
+}
+
+void WindowTarget::destroy_swapchain_images() {
+  for (VkSemaphore s : rendered_) vkDestroySemaphore(ctx_.device(), s, nullptr);
+  rendered_.clear();
+  images_.clear();
+}
+
+void WindowTarget::create_swapchain(graph::Extent framebuffer) {
+  VkDevice device = ctx_.device();
+  vkDeviceWaitIdle(device);
+  VkSurfaceCapabilitiesKHR caps;
+  STRATA_VK(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(ctx_.physical_device(), surface_, &caps));
+  const VkSurfaceFormatKHR format = choose_format(ctx_.physical_device(), surface_);
+  graph::Extent extent = framebuffer;
+  if (caps.currentExtent.width != UINT32_MAX)
+    extent = {caps.currentExtent.width, caps.currentExtent.height};
+  extent.width = std::clamp(extent.width, caps.minImageExtent.width, caps.maxImageExtent.width);
+  extent.height = std::clamp(extent.height, caps.minImageExtent.height, caps.maxImageExtent.height);
+
+  VkSwapchainCreateInfoKHR info{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
+  info.surface = surface_;
+  info.minImageCount = caps.maxImageCount ? std::min(caps.minImageCount + 1, caps.maxImageCount)
+                                          : caps.minImageCount + 1;
+  info.imageFormat = format.format;
+  info.imageColorSpace = format.colorSpace;
+  info.imageExtent = {extent.width, extent.height};
+  info.imageArrayLayers = 1;
+  info.imageUsage = VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  info.preTransform = caps.currentTransform;
+  info.compositeAlpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
+  info.presentMode = VK_PRESENT_MODE_FIFO_KHR;
+  info.clipped = VK_TRUE;
+  info.oldSwapchain = swapchain_;
+  VkSwapchainKHR created = VK_NULL_HANDLE;
+  STRATA_VK(vkCreateSwapchainKHR(device, &info, nullptr, &created));
+  destroy_swapchain_images();
+  vkDestroySwapchainKHR(device, swapchain_, nullptr);
+  swapchain_ = created;
+  format_ = format.format;
+  extent_ = extent;
+  out_of_date_ = false;
+  ++recreations_;
+
+  uint32_t count = 0;
+  vkGetSwapchainImagesKHR(device, swapchain_, &count, nullptr);
+  images_.resize(count);
+  vkGetSwapchainImagesKHR(device, swapchain_, &count, images_.data());
+  rendered_.resize(count);
+  VkSemaphoreCreateInfo sem{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+  for (VkSemaphore& s : rendered_) STRATA_VK(vkCreateSemaphore(device, &sem, nullptr, &s));
+}
+
+void WindowTarget::wait_for_last_frame() {
+  STRATA_VK(vkWaitForFences(ctx_.device(), 1, &frame_done_, VK_TRUE, UINT64_MAX));
+}
+
+bool WindowTarget::draw(graph::GraphRunner& runner) {
+  const graph::Extent framebuffer = framebuffer_size(window_);
+  if (framebuffer.width == 0 || framebuffer.height == 0) return false;  // minimised
+  if (!swapchain_ || out_of_date_ || !(framebuffer == extent_)) create_swapchain(framebuffer);
+  runner.set_viewport(extent_);
+
+  VkDevice device = ctx_.device();
+  STRATA_VK(vkWaitForFences(device, 1, &frame_done_, VK_TRUE, UINT64_MAX));
+  uint32_t index = 0;
+  const VkResult acquired =
+      vkAcquireNextImageKHR(device, swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
+  if (acquired == VK_ERROR_OUT_OF_DATE_KHR) {
+    out_of_date_ = true;
+    return false;
+  }
+  if (acquired != VK_SUBOPTIMAL_KHR) check_vk(acquired, "vkAcquireNextImageKHR");
+  STRATA_VK(vkResetFences(device, 1, &frame_done_));
+
+  runner.bind_image(swapchain_id_, images_[index], VK_NULL_HANDLE, format_);
+  STRATA_VK(vkResetCommandBuffer(cmd_, 0));
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  STRATA_VK(vkBeginCommandBuffer(cmd_, &begin));
+  runner.record(cmd_);
+  STRATA_VK(vkEndCommandBuffer(cmd_));
+
+  VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  wait.semaphore = acquired_;
+  wait.stageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;  // the blit; matches initial_stage
+  VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  signal.semaphore = rendered_[index];
+  signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+  VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+  cmd_info.commandBuffer = cmd_;
+  VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+  submit.waitSemaphoreInfoCount = 1;
+  submit.pWaitSemaphoreInfos = &wait;
+  submit.commandBufferInfoCount = 1;
+  submit.pCommandBufferInfos = &cmd_info;
+  submit.signalSemaphoreInfoCount = 1;
+  submit.pSignalSemaphoreInfos = &signal;
+  STRATA_VK(vkQueueSubmit2(ctx_.queue(), 1, &submit, frame_done_));
+
+  VkPresentInfoKHR present{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+  present.waitSemaphoreCount = 1;
+  present.pWaitSemaphores = &rendered_[index];
+  present.swapchainCount = 1;
+  present.pSwapchains = &swapchain_;
+  present.pImageIndices = &index;
+  const VkResult presented = vkQueuePresentKHR(ctx_.queue(), &present);
+  if (presented == VK_ERROR_OUT_OF_DATE_KHR || presented == VK_SUBOPTIMAL_KHR) {
+    out_of_date_ = true;
+  } else {
+    check_vk(presented, "vkQueuePresentKHR");
+  }
+  return true;
+}
+
+}  // namespace strata

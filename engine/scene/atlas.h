@@ -1,0 +1,34 @@
+// Anatomical atlases: a label volume (each voxel holds a region index) and a names file in AAL's
+// format ("index name colour" per line, e.g. "2001 Precentral_L 1"). From them: each region's
+// centroid in world space as a label, a region as a mask volume (for multi-volume rendering) and
+// as a smoothed surface mesh (for the transparent-mesh path).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "engine/scene/scene.h"
+
+namespace strata {
+
+struct AtlasRegion {
+  int index = 0;       // the value of its voxels in the label volume
+  std::string name;    // as in the names file, e.g. "Precentral_L"
+  int colour = 0;      // the names file's third column
+};
+
+std::vector<AtlasRegion> load_atlas_names(const std::filesystem::path& path);
+
+// One label per region that has voxels, at its centroid (world space), text = region name with
+// '_' as ' '; ids are region indices. Regions without voxels are skipped.
+std::vector<Label> atlas_labels(const Volume& labels, const std::vector<AtlasRegion>& regions);
+
+// A uint8 volume on the label volume's grid: 255 inside the region, 0 outside.
+Volume atlas_mask(const Volume& labels, const AtlasRegion& region);
+
+// The region's boundary as a triangle mesh (marching cubes on the mask, then Taubin smoothing),
+// in world space, with per-vertex normals.
+Mesh atlas_surface(const Volume& labels, const AtlasRegion& region, int smoothing_iterations = 10);
+
+}  // namespace strata

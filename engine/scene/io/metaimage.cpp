@@ -1,0 +1,280 @@
+// MetaImage (ITK's MetaIO): a text header of "Key = Value" lines whose last line,
+// ElementDataFile, names the raw data file or says LOCAL (.mha: the data follows the header).
+// Geometry is taken as ITK writes it: LPS+ patient space, TransformMatrix holding the direction
+// of i, then j, then k.
+#include <bit>
+#include <charconv>
+#include <cmath>
+
+#include <zlib.h>
+
+#include "engine/scene/io/volume_io.h"
+#include "engine/scene/io/volume_loader.h"
+
+namespace strata {
+namespace {
+
+using namespace volume_io;
+namespace fs = std::filesystem;
+
+// Headers are a few hundred bytes; a megabyte without ElementDataFile is not a header.
+constexpr size_t max_header_bytes = 1 << 20;
+
+struct MetaHeader {
+  fs::path path;
+  std::vector<std::pair<std::string, std::string>> fields;  // lowercase key, value
+  uint64_t data_offset = 0;  // where LOCAL data starts: after the ElementDataFile line
+
+  // The value of the first of the given keys (MetaIO's synonyms) that is present.
+  std::optional<std::string_view> get(std::initializer_list<std::string_view> keys) const {
+    for (std::string_view key : keys)
+      for (const auto& [name, value] : fields)
+        if (name == lowercase(key)) return value;
+    return std::nullopt;
+  }
+  std::string_view require(std::string_view key) const {
+    const auto value = get({key});
+    if (!value) fail(path, concat("no ", key, " field"));
+    return *value;
+  }
+};
+
+MetaHeader parse_header(const fs::path& path) {
+  MetaHeader header{.path = path};
+  const std::string text = read_prefix(path, max_header_bytes);
+  size_t pos = 0;
+  for (int line_number = 1; pos < text.size(); ++line_number) {
+    size_t end = text.find('\n', pos);
+    const bool complete = end != std::string::npos;
+    if (!complete) end = text.size();
+    const std::string_view line = trim(std::string_view(text).substr(pos, end - pos));
+    pos = complete ? end + 1 : end;
+    for (char c : line)
+      if ((static_cast<unsigned char>(c) < 32 && c != '\t') || c == 127)
+        fail(path, concat("not a MetaImage header: line ", line_number, " holds binary data"));
+    if (line.empty()) continue;
+    const size_t equals = line.find('=');
+    if (equals == std::string_view::npos) {
+      if (!complete) break;  // the header was cut inside this line
+      if (header.fields.empty())
+        fail(path, concat("not a MetaImage header: line ", line_number, " is not 'Key = Value'"));
+      fail(path,
+           concat("line ", line_number, ": expected 'Key = Value', got '", printable(line), "'"));
+    }
+    header.fields.emplace_back(lowercase(trim(line.substr(0, equals))),
+                               std::string(trim(line.substr(equals + 1))));
+    if (header.fields.back().first == "elementdatafile") {
+      header.data_offset = pos;
+      return header;
+    }
+  }
+  fail(path, "header is truncated: no ElementDataFile line");
+}
+
+bool parse_bool(const fs::path& path, std::string_view field, std::string_view value) {
+  const std::string v = lowercase(value);
+  if (v == "true" || v == "1") return true;
+  if (v == "false" || v == "0") return false;
+  fail(path, concat(field, " = ", value, ": expected True or False"));
+}
+
+void check_image_kind(const MetaHeader& header) {
+  const fs::path& path = header.path;
+  if (const auto type = header.get({"ObjectType"}); type && lowercase(*type) != "image")
+    fail(path, concat("ObjectType = ", *type, ": only Image is supported"));
+  const std::string_view ndims = header.require("NDims");
+  if (trim(ndims) != "3") fail(path, concat("NDims = ", ndims, ": only 3D images are supported"));
+  if (const auto channels = header.get({"ElementNumberOfChannels"}); channels && *channels != "1")
+    fail(path, concat("ElementNumberOfChannels = ", *channels, ": only 1 is supported"));
+  if (const auto binary = header.get({"BinaryData"});
+      binary && !parse_bool(path, "BinaryData", *binary))
+    fail(path, "BinaryData = False: ASCII data is not supported");
+}
+
+StoredType element_type(const MetaHeader& header) {
+  const std::string_view name = header.require("ElementType");
+  if (name == "MET_UCHAR") return StoredType::uint8;
+  if (name == "MET_SHORT") return StoredType::int16;
+  if (name == "MET_USHORT") return StoredType::uint16;
+  if (name == "MET_FLOAT") return StoredType::float32;
+  fail(header.path, concat("ElementType = ", name,
+                           " is not supported (strata reads MET_UCHAR, MET_SHORT, MET_USHORT, "
+                           "MET_FLOAT)"));
+}
+
+void set_geometry(Volume& volume, const MetaHeader& header) {
+  const fs::path& path = header.path;
+  if (const auto text = header.get({"ElementSpacing", "ElementSize"})) {
+    const auto s = parse_exactly<float, 3>(path, "ElementSpacing", *text);
+    check_spacing(path, "ElementSpacing", {s[0], s[1], s[2]});
+    volume.spacing = glm::vec3(s[0], s[1], s[2]);
+  }
+  if (const auto text = header.get({"Offset", "Position", "Origin"})) {
+    const auto o = parse_exactly<float, 3>(path, "Offset", *text);
+    volume.origin = glm::vec3(o[0], o[1], o[2]);
+  }
+  if (const auto text = header.get({"TransformMatrix", "Rotation", "Orientation"})) {
+    const auto m = parse_exactly<float, 9>(path, "TransformMatrix", *text);
+    for (int axis = 0; axis < 3; ++axis)
+      volume.direction[axis] = glm::vec3(m[3 * axis], m[3 * axis + 1], m[3 * axis + 2]);
+  }
+}
+
+InputFile::Source data_source(const MetaHeader& header, size_t bytes) {
+  const fs::path& path = header.path;
+  InputFile::Source source{.file = path, .report_as = path};
+  if (const auto text = header.get({"CompressedData"}))
+    source.compressed = parse_bool(path, "CompressedData", *text);
+  if (const auto text = header.get({"CompressedDataSize"}); text && source.compressed)
+    source.compressed_size = parse_exactly<uint64_t, 1>(path, "CompressedDataSize", *text)[0];
+
+  const std::string name(header.require("ElementDataFile"));
+  if (lowercase(name) == "local") {
+    source.what = "the LOCAL data after the header";
+    source.offset = header.data_offset;
+    return source;
+  }
+  if (lowercase(name) == "list" || name.find('%') != std::string::npos)
+    fail(path, concat("ElementDataFile = ", name, ": file lists and patterns are not supported"));
+  source.file = path.parent_path() / name;
+  source.what = concat("ElementDataFile '", name, "'");
+  std::error_code error;
+  const uint64_t size = fs::file_size(source.file, error);
+  if (error) fail(path, concat(source.what, ": no such file (", source.file.string(), ")"));
+  if (const auto text = header.get({"HeaderSize"})) {
+    const int64_t skip = parse_exactly<int64_t, 1>(path, "HeaderSize", *text)[0];
+    // -1 means "the data is at the end of the file, after a header of unknown size".
+    if (skip == -1 && !source.compressed) source.offset = size >= bytes ? size - bytes : 0;
+    if (skip > 0) source.offset = static_cast<uint64_t>(skip);
+  }
+  return source;
+}
+
+// ---- writing
+
+std::string numbers(std::initializer_list<float> values) {
+  std::string text;
+  for (float v : values) {
+    char buffer[32];
+    // Shortest round-trip form: reading it back with from_chars gives the same float.
+    const auto end = std::to_chars(buffer, buffer + sizeof buffer, v).ptr;
+    if (!text.empty()) text += ' ';
+    text.append(buffer, end);
+  }
+  return text;
+}
+
+const char* met_type(VoxelType type) {
+  switch (type) {
+    case VoxelType::uint8:
+      return "MET_UCHAR";
+    case VoxelType::int16:
+      return "MET_SHORT";
+    case VoxelType::uint16:
+      return "MET_USHORT";
+    case VoxelType::float32:
+      return "MET_FLOAT";
+  }
+  return "MET_UCHAR";
+}
+
+std::string header_text(const Volume& v, bool compress, const std::string& data_file) {
+  const glm::mat3& d = v.direction;
+  const bool msb = std::endian::native == std::endian::big;
+  return concat(
+      "ObjectType = Image\nNDims = 3\nBinaryData = True\n",
+      "BinaryDataByteOrderMSB = ", msb ? "True" : "False", "\n",
+      "CompressedData = ", compress ? "True" : "False", "\n", "TransformMatrix = ",
+      numbers({d[0][0], d[0][1], d[0][2], d[1][0], d[1][1], d[1][2], d[2][0], d[2][1], d[2][2]}),
+      "\nOffset = ", numbers({v.origin.x, v.origin.y, v.origin.z}),
+      "\nElementSpacing = ", numbers({v.spacing.x, v.spacing.y, v.spacing.z}),
+      "\nDimSize = ", v.dims.x, " ", v.dims.y, " ", v.dims.z, "\nElementType = ", met_type(v.type),
+      "\nElementDataFile = ", data_file, "\n");
+}
+
+// Streams the voxels through deflate (zlib format, as MetaIO writes) in 64 KiB pieces, so writing
+// needs no second copy of the volume.
+void write_deflated(std::ofstream& out, const std::vector<std::byte>& data, const fs::path& path) {
+  z_stream z{};
+  if (deflateInit(&z, Z_DEFAULT_COMPRESSION) != Z_OK) fail(path, "cannot start zlib");
+  std::vector<unsigned char> buffer(1 << 16);
+  size_t offset = 0;
+  int flush = Z_NO_FLUSH;
+  do {
+    const size_t chunk = std::min<size_t>(data.size() - offset, size_t{1} << 30);
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(data.data() + offset));
+    z.avail_in = static_cast<uInt>(chunk);
+    offset += chunk;
+    flush = offset == data.size() ? Z_FINISH : Z_NO_FLUSH;
+    do {
+      z.next_out = buffer.data();
+      z.avail_out = static_cast<uInt>(buffer.size());
+      deflate(&z, flush);
+      out.write(reinterpret_cast<const char*>(buffer.data()),
+                static_cast<std::streamsize>(buffer.size() - z.avail_out));
+    } while (z.avail_out == 0);
+  } while (flush != Z_FINISH);
+  deflateEnd(&z);
+}
+
+void write_data(const fs::path& file, std::ios::openmode mode, const Volume& volume, bool compress,
+                const fs::path& path) {
+  std::ofstream out(file, std::ios::binary | mode);
+  if (!out) fail(path, concat("cannot open ", file.string(), " for writing"));
+  if (compress) {
+    write_deflated(out, volume.voxels, path);
+  } else {
+    out.write(reinterpret_cast<const char*>(volume.voxels.data()),
+              static_cast<std::streamsize>(volume.voxels.size()));
+  }
+  out.close();
+  if (!out) fail(path, concat("writing ", file.string(), " failed"));
+}
+
+}  // namespace
+
+Volume load_metaimage(const std::filesystem::path& path) {
+  existing_file_size(path);
+  const MetaHeader header = parse_header(path);
+  check_image_kind(header);
+  const StoredType stored = element_type(header);
+  const auto dims = parse_exactly<int64_t, 3>(path, "DimSize", header.require("DimSize"));
+  const size_t bytes = checked_voxel_bytes(path, "DimSize", dims, stored_size(stored));
+
+  Volume volume;
+  volume.name = volume_name(path);
+  volume.source = path;
+  volume.dims = to_dims(dims);
+  set_geometry(volume, header);
+  bool big_endian = false;
+  if (const auto msb = header.get({"BinaryDataByteOrderMSB", "ElementByteOrderMSB"}))
+    big_endian = parse_bool(path, "BinaryDataByteOrderMSB", *msb);
+
+  InputFile in(data_source(header, bytes));
+  read_voxels(in, bytes, volume);
+  finish_voxels(volume, {.stored = stored, .big_endian = big_endian, .per_slice = {Rescale{}}});
+  return volume;
+}
+
+void write_metaimage(const std::filesystem::path& path, const Volume& volume, bool compress) {
+  const std::string extension = lowercase(path.extension().string());
+  if (extension != ".mha" && extension != ".mhd")
+    fail(path, "write_metaimage: the extension must be .mha or .mhd");
+  const size_t expected = volume.voxel_count() * voxel_size(volume.type);
+  if (volume.voxels.size() != expected)
+    fail(path, concat("write_metaimage: the volume holds ", volume.voxels.size(),
+                      " bytes, its dims and type need ", expected));
+
+  const bool local = extension == ".mha";
+  const fs::path data_file =
+      local ? path : path.parent_path() / (path.stem().string() + (compress ? ".zraw" : ".raw"));
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (!out) fail(path, "cannot open for writing");
+    out << header_text(volume, compress, local ? "LOCAL" : data_file.filename().string());
+    if (!out) fail(path, "writing the header failed");
+  }
+  write_data(data_file, local ? std::ios::app : std::ios::trunc, volume, compress, path);
+}
+
+}  // namespace strata

@@ -1,0 +1,249 @@
+// NRRD (teem's "nearly raw raster data"): a "NRRD000N" magic line, "field: value" lines, then
+// either a blank line and the data (.nrrd, attached) or a "data file:" field (.nhdr, detached).
+// strata reads 3D scalar volumes with raw or gzip encoding. Positions in "space directions" and
+// "space origin" are converted to strata's LPS+ patient space according to the "space" field.
+#include <bit>
+
+#include "engine/scene/io/volume_io.h"
+#include "engine/scene/io/volume_loader.h"
+
+namespace strata {
+namespace {
+
+using namespace volume_io;
+namespace fs = std::filesystem;
+
+constexpr size_t max_header_bytes = 1 << 20;
+
+struct NrrdHeader {
+  fs::path path;
+  std::vector<std::pair<std::string, std::string>> fields;  // lowercase field name, value
+  bool attached = false;     // a blank line ended the header: the data follows it
+  uint64_t data_offset = 0;  // just after that blank line
+
+  std::optional<std::string_view> get(std::string_view field) const {
+    for (const auto& [name, value] : fields)
+      if (name == field) return value;
+    return std::nullopt;
+  }
+  std::string_view require(std::string_view field) const {
+    const auto value = get(field);
+    if (!value) fail(path, concat("no '", field, "' field"));
+    return *value;
+  }
+  std::optional<std::string_view> data_file() const {
+    if (auto name = get("data file")) return name;
+    return get("datafile");
+  }
+};
+
+void check_magic(const fs::path& path, const std::string& text) {
+  const std::string_view first = std::string_view(text).substr(0, text.find('\n'));
+  const bool ok =
+      first.size() >= 8 && first.starts_with("NRRD000") && first[7] >= '1' && first[7] <= '5';
+  if (!ok)
+    fail(path, concat("not a NRRD file: wrong magic '", printable(first.substr(0, 8)),
+                      "' (expected NRRD0001 to NRRD0005)"));
+}
+
+NrrdHeader parse_header(const fs::path& path) {
+  NrrdHeader header{.path = path};
+  const std::string text = read_prefix(path, max_header_bytes);
+  check_magic(path, text);
+  size_t pos = text.find('\n') + 1;
+  std::string bad_last_line;  // an unfinished last line that is not a field: cut off?
+  for (int line_number = 2; pos < text.size(); ++line_number) {
+    size_t end = text.find('\n', pos);
+    const bool complete = end != std::string::npos;
+    if (!complete) end = text.size();
+    std::string_view line = std::string_view(text).substr(pos, end - pos);
+    if (line.ends_with('\r')) line.remove_suffix(1);
+    pos = complete ? end + 1 : end;
+    if (line.empty()) {
+      header.attached = true;
+      header.data_offset = pos;
+      break;
+    }
+    if (line.starts_with('#') || line.find(":=") != std::string_view::npos) continue;  // key/value
+    const size_t colon = line.find(": ");
+    if (colon == std::string_view::npos) {
+      const std::string message =
+          concat("line ", line_number, ": expected 'field: value', got '", printable(line), "'");
+      if (complete) fail(path, message);
+      bad_last_line = message;
+      break;
+    }
+    header.fields.emplace_back(lowercase(trim(line.substr(0, colon))),
+                               std::string(trim(line.substr(colon + 2))));
+  }
+  if (!header.attached && !header.data_file()) {
+    if (text.size() == max_header_bytes) fail(path, "no blank line ends the header in its 1 MiB");
+    fail(path, "header is truncated: no blank line ends it and it names no data file");
+  }
+  if (!bad_last_line.empty()) fail(path, bad_last_line);
+  return header;
+}
+
+StoredType element_type(const NrrdHeader& header) {
+  const std::string type = lowercase(header.require("type"));
+  for (const char* name : {"uchar", "unsigned char", "uint8", "uint8_t"})
+    if (type == name) return StoredType::uint8;
+  for (const char* name :
+       {"short", "short int", "signed short", "signed short int", "int16", "int16_t"})
+    if (type == name) return StoredType::int16;
+  for (const char* name : {"ushort", "unsigned short", "unsigned short int", "uint16", "uint16_t"})
+    if (type == name) return StoredType::uint16;
+  if (type == "float") return StoredType::float32;
+  fail(header.path,
+       concat("type '", type, "' is not supported (strata reads uchar, short, ushort, float)"));
+}
+
+// "(x,y,z) (x,y,z) ..." as the texts between the parentheses.
+std::vector<std::string_view> vectors(const fs::path& path, std::string_view field,
+                                      std::string_view text) {
+  std::vector<std::string_view> result;
+  std::string_view rest = trim(text);
+  while (!rest.empty()) {
+    if (rest.starts_with("none"))
+      fail(path, concat(field, ": 'none' (a non-spatial axis) is not supported"));
+    const size_t close = rest.find(')');
+    if (rest.front() != '(' || close == std::string_view::npos)
+      fail(path, concat(field, ": '", printable(text), "' is not a list of (x,y,z) vectors"));
+    result.push_back(rest.substr(1, close - 1));
+    rest = trim(rest.substr(close + 1));
+  }
+  return result;
+}
+
+glm::dvec3 vector3(const fs::path& path, std::string_view field, std::string_view inside) {
+  const auto v = parse_exactly<double, 3>(path, field, inside);
+  return glm::dvec3(v[0], v[1], v[2]);
+}
+
+// Signs that take coordinates of the header's "space" to LPS+.
+glm::dvec3 to_lps(const NrrdHeader& header) {
+  const auto space = header.get("space");
+  if (!space) return glm::dvec3(1.0);
+  const std::string name = lowercase(*space);
+  if (name == "right-anterior-superior" || name == "ras") return {-1.0, -1.0, 1.0};
+  if (name == "left-anterior-superior" || name == "las") return {1.0, -1.0, 1.0};
+  if (name == "left-posterior-superior" || name == "lps" || name == "scanner-xyz" ||
+      name == "3d-right-handed" || name == "3d-left-handed")
+    return glm::dvec3(1.0);
+  fail(header.path, concat("space '", *space, "' is not a 3D space strata knows"));
+}
+
+void set_geometry(Volume& volume, const NrrdHeader& header) {
+  const fs::path& path = header.path;
+  const glm::dvec3 signs = to_lps(header);
+  if (const auto text = header.get("space directions")) {
+    const auto axes = vectors(path, "space directions", *text);
+    if (axes.size() != 3)
+      fail(path, concat("space directions: expected 3 vectors, got ", axes.size()));
+    for (int axis = 0; axis < 3; ++axis) {
+      const glm::dvec3 v = signs * vector3(path, "space directions", axes[size_t(axis)]);
+      const double length = glm::length(v);
+      if (!(length > 0.0) || !std::isfinite(length))
+        fail(path,
+             concat("space directions: axis ", axis, " has zero length: spacing must be positive"));
+      volume.spacing[axis] = static_cast<float>(length);
+      volume.direction[axis] = glm::vec3(v / length);
+    }
+  } else if (const auto spacings = header.get("spacings")) {
+    const auto s = parse_exactly<double, 3>(path, "spacings", *spacings);
+    check_spacing(path, "spacings", s);
+    volume.spacing = glm::vec3(glm::dvec3(s[0], s[1], s[2]));
+  }
+  if (const auto text = header.get("space origin")) {
+    const auto origin = vectors(path, "space origin", *text);
+    if (origin.size() != 1) fail(path, "space origin: expected one (x,y,z) vector");
+    volume.origin = glm::vec3(signs * vector3(path, "space origin", origin[0]));
+  }
+}
+
+bool is_gzip_encoding(const NrrdHeader& header) {
+  const std::string encoding = lowercase(header.require("encoding"));
+  if (encoding == "raw") return false;
+  if (encoding == "gzip" || encoding == "gz") return true;
+  fail(header.path, concat("encoding '", encoding, "' is not supported (raw, gzip)"));
+}
+
+bool is_big_endian(const NrrdHeader& header) {
+  const auto endian = header.get("endian");
+  if (!endian || lowercase(*endian) == "little") return false;
+  if (lowercase(*endian) == "big") return true;
+  fail(header.path, concat("endian '", *endian, "': expected little or big"));
+}
+
+int64_t skip_field(const NrrdHeader& header, std::string_view field) {
+  const auto text = header.get(field);
+  return text ? parse_exactly<int64_t, 1>(header.path, field, *text)[0] : 0;
+}
+
+// Where the data starts in its file, before "byte skip" (which, for gzip, counts inflated bytes).
+InputFile::Source data_source(const NrrdHeader& header, bool gzip) {
+  const fs::path& path = header.path;
+  InputFile::Source source{.file = path, .report_as = path, .compressed = gzip};
+  if (const auto name = header.data_file()) {
+    if (name->starts_with("LIST") || name->find_first_of("% ") != std::string_view::npos)
+      fail(path, concat("data file: '", *name, "': file lists and patterns are not supported"));
+    source.file = path.parent_path() / *name;
+    source.what = concat("data file '", *name, "'");
+    std::error_code error;
+    if (!fs::is_regular_file(source.file, error))
+      fail(path, concat(source.what, ": no such file (", source.file.string(), ")"));
+  } else {
+    source.what = "the data after the header";
+    source.offset = header.data_offset;
+  }
+  const int64_t lines = skip_field(header, "line skip");
+  if (lines < 0) fail(path, concat("line skip = ", lines, ": must not be negative"));
+  if (lines > 0) {
+    std::ifstream in(source.file, std::ios::binary);
+    in.seekg(static_cast<std::streamoff>(source.offset));
+    for (int64_t i = 0; i < lines && in; ++i)
+      in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
+    source.offset = in ? static_cast<uint64_t>(in.tellg()) : fs::file_size(source.file);
+  }
+  return source;
+}
+
+}  // namespace
+
+Volume load_nrrd(const std::filesystem::path& path) {
+  existing_file_size(path);
+  const NrrdHeader header = parse_header(path);
+  if (trim(header.require("dimension")) != "3")
+    fail(path,
+         concat("dimension = ", header.require("dimension"), ": only 3D volumes are supported"));
+  const StoredType stored = element_type(header);
+  const auto dims = parse_exactly<int64_t, 3>(path, "sizes", header.require("sizes"));
+  const size_t bytes = checked_voxel_bytes(path, "sizes", dims, stored_size(stored));
+  const bool gzip = is_gzip_encoding(header);
+
+  Volume volume;
+  volume.name = volume_name(path);
+  volume.source = path;
+  volume.dims = to_dims(dims);
+  set_geometry(volume, header);
+
+  InputFile::Source source = data_source(header, gzip);
+  const int64_t byte_skip = skip_field(header, "byte skip");
+  if (byte_skip < -1 || (byte_skip == -1 && gzip))
+    fail(path, concat("byte skip = ", byte_skip, ": expected >= 0 (or -1 for raw data)"));
+  if (byte_skip == -1) {  // the data is the last `bytes` of the file
+    const uint64_t size = fs::file_size(source.file);
+    source.offset = size >= bytes ? size - bytes : 0;
+  } else if (!gzip) {
+    source.offset += static_cast<uint64_t>(byte_skip);
+  }
+  InputFile in(std::move(source));
+  if (gzip && !in.skip(static_cast<uint64_t>(byte_skip)))
+    fail(path, concat("byte skip = ", byte_skip, ": past the end of the data"));
+  read_voxels(in, bytes, volume);
+  finish_voxels(volume,
+                {.stored = stored, .big_endian = is_big_endian(header), .per_slice = {Rescale{}}});
+  return volume;
+}
+
+}  // namespace strata

@@ -1,0 +1,450 @@
+#include "engine/scene/io/scene_loader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#include "engine/scene/atlas.h"
+#include "engine/core/error.h"
+#include "engine/core/text_file.h"
+#include "engine/scene/io/mesh_loader.h"
+#include "engine/scene/io/transfer_function_loader.h"
+#include "engine/scene/io/volume_loader.h"
+
+namespace strata {
+
+namespace {
+
+using nlohmann::json;
+
+// Where a JSON value is, for error messages: "scene.json: volumes[0].transform: ...".
+struct Field {
+  const std::string& file;
+  std::string path;
+
+  Field operator/(const std::string& key) const {
+    return {file, path.empty() ? key : path + "." + key};
+  }
+  Field operator[](size_t index) const { return {file, path + "[" + std::to_string(index) + "]"}; }
+  [[noreturn]] void fail(const std::string& reason) const {
+    throw Error(file + ": " + (path.empty() ? "" : path + ": ") + reason);
+  }
+  // Runs a loader for the file this field names and puts the field before its error.
+  template <typename F>
+  auto wrap(F&& load) const {
+    try {
+      return load();
+    } catch (const Error& e) {
+      fail(e.what());
+    }
+  }
+};
+
+void check_keys(const json& object, const Field& field, std::initializer_list<const char*> keys) {
+  if (!object.is_object()) field.fail("expected an object");
+  for (const auto& [key, value] : object.items()) {
+    if (std::find(keys.begin(), keys.end(), key) != keys.end()) continue;
+    std::string expected;
+    for (const char* k : keys) expected += (expected.empty() ? "" : ", ") + std::string(k);
+    field.fail("unknown key '" + key + "' (expected " + expected + ")");
+  }
+}
+
+const json* optional(const json& object, const char* key) {
+  const auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+const json& required(const json& object, const Field& field, const char* key) {
+  const json* value = optional(object, key);
+  if (!value) field.fail(std::string("missing key '") + key + "'");
+  return *value;
+}
+
+float number(const json& value, const Field& field) {
+  if (!value.is_number() || !std::isfinite(value.get<double>())) field.fail("expected a number");
+  return value.get<float>();
+}
+
+float non_negative(const json& value, const Field& field) {
+  const float v = number(value, field);
+  if (v < 0.0f) field.fail("expected a number >= 0, got " + value.dump());
+  return v;
+}
+
+int integer(const json& value, const Field& field) {
+  if (!value.is_number_integer()) field.fail("expected an integer");
+  return value.get<int>();
+}
+
+std::string string(const json& value, const Field& field) {
+  if (!value.is_string()) field.fail("expected a string");
+  return value.get<std::string>();
+}
+
+std::vector<float> numbers(const json& value, const Field& field, size_t count) {
+  const std::string expected = "expected " + std::to_string(count) + " numbers";
+  if (!value.is_array() || value.size() != count) field.fail(expected);
+  std::vector<float> result;
+  for (const json& v : value) {
+    if (!v.is_number() || !std::isfinite(v.get<double>())) field.fail(expected);
+    result.push_back(v.get<float>());
+  }
+  return result;
+}
+
+glm::vec3 vec3(const json& value, const Field& field) {
+  const auto v = numbers(value, field, 3);
+  return {v[0], v[1], v[2]};
+}
+
+glm::vec4 color(const json& value, const Field& field) {
+  const auto v = numbers(value, field, 4);
+  for (float c : v) {
+    if (c < 0.0f || c > 1.0f) field.fail("expected 4 numbers [r, g, b, a] in [0, 1]");
+  }
+  return {v[0], v[1], v[2], v[3]};
+}
+
+// Scene files write matrices row by row, as one reads them; glm indexes [column][row].
+glm::mat4 matrix(const json& value, const Field& field) {
+  const auto v = numbers(value, field, 16);
+  glm::mat4 m(1.0f);
+  for (int row = 0; row < 4; ++row) {
+    for (int col = 0; col < 4; ++col) m[col][row] = v[size_t(row * 4 + col)];
+  }
+  return m;
+}
+
+// "view": [16 numbers] or "eye"/"target"/"up"; nullopt when the object gives neither.
+std::optional<glm::mat4> view_matrix(const json& object, const Field& field) {
+  const json* view = optional(object, "view");
+  const json* eye = optional(object, "eye");
+  if (view && (eye || optional(object, "target") || optional(object, "up"))) {
+    field.fail("give either 'view' or 'eye'/'target'/'up', not both");
+  }
+  if (view) return matrix(*view, field / "view");
+  if (!eye) {
+    if (optional(object, "target") || optional(object, "up")) field.fail("missing key 'eye'");
+    return std::nullopt;
+  }
+  const glm::vec3 from = vec3(*eye, field / "eye");
+  const glm::vec3 to = vec3(required(object, field, "target"), field / "target");
+  const json* up_json = optional(object, "up");
+  const glm::vec3 up = up_json ? vec3(*up_json, field / "up") : glm::vec3(0.0f, 1.0f, 0.0f);
+  if (glm::length(glm::cross(to - from, up)) <= 0.0f) {
+    field.fail("eye and target coincide, or 'up' is parallel to the view direction");
+  }
+  return glm::lookAt(from, to, up);
+}
+
+// The name before the first dot: "ch2.nii.gz" is "ch2".
+std::string base_name(const std::filesystem::path& path) {
+  const std::string name = path.filename().string();
+  return name.substr(0, name.find('.'));
+}
+
+class SceneReader {
+ public:
+  explicit SceneReader(const std::filesystem::path& path)
+      : file_(path.string()), folder_(path.parent_path()) {
+    scene_.source = path;
+  }
+
+  Scene read(const json& root);
+
+ private:
+  std::filesystem::path resolve(const json& value, const Field& field) const {
+    const std::filesystem::path relative(string(value, field));
+    return (relative.is_absolute() ? relative : folder_ / relative).lexically_normal();
+  }
+  int transfer_function(const json& value, const Field& field);
+  void volume(const json& object, const Field& field);
+  void mesh(const json& object, const Field& field);
+  void atlas(const json& object, const Field& field);
+  std::vector<AtlasRegion> atlas_regions(const json& object, const Field& field);
+  void label(const json& object, const Field& field);
+  void camera(const json& object, const Field& field);
+  void settings(const json& object, const Field& field);
+
+  std::string file_;
+  std::filesystem::path folder_;
+  Scene scene_;
+  std::map<std::filesystem::path, int> transfer_function_by_file_;
+};
+
+// A path (loaded once however many volumes share it) or an inline transfer-function object.
+int SceneReader::transfer_function(const json& value, const Field& field) {
+  if (value.is_object()) {
+    TransferFunction tf = transfer_function_from_json(value, file_, field.path);
+    if (tf.name.empty()) tf.name = field.path;
+    scene_.transfer_functions.push_back(std::move(tf));
+    return int(scene_.transfer_functions.size()) - 1;
+  }
+  if (!value.is_string()) field.fail("expected a file name or a transfer-function object");
+  const std::filesystem::path path = resolve(value, field).lexically_normal();
+  const auto known = transfer_function_by_file_.find(path);
+  if (known != transfer_function_by_file_.end()) return known->second;
+  scene_.transfer_functions.push_back(field.wrap([&] { return load_transfer_function(path); }));
+  const int index = int(scene_.transfer_functions.size()) - 1;
+  transfer_function_by_file_[path] = index;
+  return index;
+}
+
+// Every field is checked before the (slow) file is read, so a typo is reported at once.
+void SceneReader::volume(const json& object, const Field& field) {
+  check_keys(object, field, {"name", "file", "transfer_function", "transform"});
+  const std::filesystem::path path = resolve(required(object, field, "file"), field / "file");
+  const json* name = optional(object, "name");
+  const std::string volume_name = name ? string(*name, field / "name") : base_name(path);
+  const json* transform = optional(object, "transform");
+  const glm::mat4 placement = transform ? matrix(*transform, field / "transform") : glm::mat4(1.0f);
+  const json* tf = optional(object, "transfer_function");
+  const int tf_index = tf ? transfer_function(*tf, field / "transfer_function") : -1;
+  Volume volume = (field / "file").wrap([&] { return load_volume(path); });
+  volume.name = volume_name;
+  volume.transform = placement;
+  volume.transfer_function = tf_index;
+  scene_.volumes.push_back(std::move(volume));
+}
+
+void SceneReader::mesh(const json& object, const Field& field) {
+  check_keys(object, field, {"file", "color", "transform"});
+  const std::filesystem::path path = resolve(required(object, field, "file"), field / "file");
+  const json* color_json = optional(object, "color");
+  const json* transform_json = optional(object, "transform");
+  const glm::vec4 override_color = color_json ? color(*color_json, field / "color") : glm::vec4(0);
+  const glm::mat4 transform =
+      transform_json ? matrix(*transform_json, field / "transform") : glm::mat4(1.0f);
+  std::vector<Mesh> meshes = (field / "file").wrap([&] { return load_meshes(path); });
+  for (Mesh& mesh : meshes) {
+    if (color_json) mesh.color = override_color;
+    mesh.transform = transform;
+    scene_.meshes.push_back(std::move(mesh));
+  }
+}
+
+// "all" (the names file's order) or a list of names, each of which must be in the names file.
+std::vector<AtlasRegion> SceneReader::atlas_regions(const json& object, const Field& field) {
+  const std::filesystem::path names_path =
+      resolve(required(object, field, "names"), field / "names");
+  std::vector<AtlasRegion> all =
+      (field / "names").wrap([&] { return load_atlas_names(names_path); });
+  const json& wanted = required(object, field, "regions");
+  const Field regions_field = field / "regions";
+  if (wanted == "all") return all;
+  if (!wanted.is_array()) regions_field.fail("expected \"all\" or an array of region names");
+  std::vector<AtlasRegion> chosen;
+  for (size_t i = 0; i < wanted.size(); ++i) {
+    const std::string name = string(wanted[i], regions_field[i]);
+    const auto it =
+        std::find_if(all.begin(), all.end(), [&](const auto& r) { return r.name == name; });
+    if (it == all.end())
+      regions_field[i].fail("no region '" + name + "' in " + names_path.string());
+    chosen.push_back(*it);
+  }
+  return chosen;
+}
+
+// "make": any of "labels", "masks", "surfaces"; ["labels"] when absent.
+std::set<std::string> atlas_products(const json& object, const Field& field) {
+  const json* make = optional(object, "make");
+  if (!make) return {"labels"};
+  if (!make->is_array()) field.fail("expected an array of \"labels\", \"masks\", \"surfaces\"");
+  std::set<std::string> products;
+  for (size_t i = 0; i < make->size(); ++i) {
+    const std::string what = string((*make)[i], field[i]);
+    if (what != "labels" && what != "masks" && what != "surfaces") {
+      field[i].fail("'" + what + "' is not one of labels, masks, surfaces");
+    }
+    products.insert(what);
+  }
+  return products;
+}
+
+void SceneReader::atlas(const json& object, const Field& field) {
+  check_keys(
+      object, field,
+      {"labels", "names", "regions", "limit", "make", "surface_color", "mask_transfer_function"});
+  const std::set<std::string> make = atlas_products(object, field / "make");
+  const json* limit_json = optional(object, "limit");
+  const int limit = limit_json ? integer(*limit_json, field / "limit") : -1;
+  if (limit_json && limit < 1) (field / "limit").fail("expected an integer >= 1");
+  const json* surface_color = optional(object, "surface_color");
+  const glm::vec4 surface = surface_color ? color(*surface_color, field / "surface_color")
+                                          : glm::vec4(0.9f, 0.75f, 0.6f, 0.5f);
+  const json* mask_tf_json = optional(object, "mask_transfer_function");
+  int mask_tf =
+      mask_tf_json ? transfer_function(*mask_tf_json, field / "mask_transfer_function") : -1;
+  if (make.count("masks") && mask_tf < 0) {
+    // Masks hold 0 and 255: transparent outside, the surface colour inside.
+    scene_.transfer_functions.push_back(
+        {"atlas mask", {}, {{0.0f, glm::vec4(glm::vec3(surface), 0.0f)}, {1.0f, surface}}});
+    mask_tf = int(scene_.transfer_functions.size()) - 1;
+  }
+
+  const std::vector<AtlasRegion> regions = atlas_regions(object, field);
+  const std::filesystem::path labels_path =
+      resolve(required(object, field, "labels"), field / "labels");
+  const Volume labels = (field / "labels").wrap([&] { return load_volume(labels_path); });
+  // atlas_labels skips regions without voxels, so its result says which regions "limit" counts.
+  const std::vector<Label> centroids = atlas_labels(labels, regions);
+  int kept = 0;
+  for (const AtlasRegion& region : regions) {
+    if (kept == limit) break;
+    const auto it = std::find_if(centroids.begin(), centroids.end(),
+                                 [&](const Label& l) { return l.id == region.index; });
+    if (it == centroids.end()) continue;
+    ++kept;
+    if (make.count("labels")) scene_.labels.push_back(*it);
+    if (make.count("masks")) {
+      scene_.volumes.push_back(atlas_mask(labels, region));
+      scene_.volumes.back().name = region.name;
+      scene_.volumes.back().transfer_function = mask_tf;
+    }
+    if (make.count("surfaces")) {
+      scene_.meshes.push_back(atlas_surface(labels, region));
+      scene_.meshes.back().name = region.name;
+      scene_.meshes.back().color = surface;
+    }
+  }
+}
+
+void SceneReader::label(const json& object, const Field& field) {
+  check_keys(object, field, {"id", "text", "anchor", "size"});
+  Label label;
+  label.id = integer(required(object, field, "id"), field / "id");
+  label.text = string(required(object, field, "text"), field / "text");
+  label.anchor = vec3(required(object, field, "anchor"), field / "anchor");
+  if (const json* size = optional(object, "size")) {
+    const auto v = numbers(*size, field / "size", 2);
+    if (v[0] < 0.0f || v[1] < 0.0f)
+      (field / "size").fail("expected 2 numbers >= 0 (0 = from the text)");
+    label.size = {v[0], v[1]};
+  }
+  scene_.labels.push_back(std::move(label));
+}
+
+void SceneReader::camera(const json& object, const Field& field) {
+  check_keys(object, field, {"fov_y", "near", "far", "eye", "target", "up", "view", "positions"});
+  Camera& camera = scene_.camera;
+  if (const json* fov = optional(object, "fov_y"))
+    camera.fov_y_degrees = number(*fov, field / "fov_y");
+  if (!(camera.fov_y_degrees > 0.0f && camera.fov_y_degrees < 180.0f)) {
+    (field / "fov_y").fail("expected degrees between 0 and 180");
+  }
+  if (const json* n = optional(object, "near")) camera.near_plane = number(*n, field / "near");
+  if (const json* f = optional(object, "far")) camera.far_plane = number(*f, field / "far");
+  if (!(camera.near_plane > 0.0f)) (field / "near").fail("expected a number > 0");
+  if (!(camera.far_plane > camera.near_plane)) (field / "far").fail("expected a number > near");
+  if (const auto view = view_matrix(object, field)) camera.view = *view;
+  const json* positions = optional(object, "positions");
+  if (!positions) return;
+  if (!positions->is_array()) (field / "positions").fail("expected an array");
+  for (size_t i = 0; i < positions->size(); ++i) {
+    const Field position_field = (field / "positions")[i];
+    const json& position = (*positions)[i];
+    check_keys(position, position_field, {"name", "eye", "target", "up", "view"});
+    CameraPose pose;
+    pose.name = string(required(position, position_field, "name"), position_field / "name");
+    const auto view = view_matrix(position, position_field);
+    if (!view) position_field.fail("missing 'view' or 'eye'/'target'");
+    pose.view = *view;
+    scene_.camera_positions.push_back(std::move(pose));
+  }
+}
+
+void SceneReader::settings(const json& object, const Field& field) {
+  check_keys(object, field, {"layers", "weights"});
+  if (const json* layers = optional(object, "layers")) {
+    scene_.settings.layer_count = integer(*layers, field / "layers");
+    if (scene_.settings.layer_count < 1) (field / "layers").fail("expected an integer >= 1");
+  }
+  const json* weights = optional(object, "weights");
+  if (!weights) return;
+  const Field weights_field = field / "weights";
+  CostWeights& w = scene_.settings.weights;
+  const std::pair<const char*, float*> all[] = {{"label_shadow", &w.label_shadow},
+                                                {"anchor_constraint", &w.anchor_constraint},
+                                                {"connector_shadow", &w.connector_shadow},
+                                                {"integral_costs", &w.integral_costs},
+                                                {"distance_to_anchor", &w.distance_to_anchor},
+                                                {"connector_direction", &w.connector_direction},
+                                                {"previous_position", &w.previous_position}};
+  check_keys(*weights, weights_field,
+             {"label_shadow", "anchor_constraint", "connector_shadow", "integral_costs",
+              "distance_to_anchor", "connector_direction", "previous_position"});
+  for (const auto& [key, target] : all) {
+    if (const json* value = optional(*weights, key))
+      *target = non_negative(*value, weights_field / key);
+  }
+}
+
+template <typename F>
+void each(const json& root, const Field& root_field, const char* key, F&& read) {
+  const json* array = optional(root, key);
+  if (!array) return;
+  const Field field = root_field / key;
+  if (!array->is_array()) field.fail("expected an array");
+  for (size_t i = 0; i < array->size(); ++i) read((*array)[i], field[i]);
+}
+
+Scene SceneReader::read(const json& root) {
+  const Field field{file_, ""};
+  if (!root.is_object() || !root.contains("strata_scene")) {
+    field.fail("not a strata scene (no \"strata_scene\": 1)");
+  }
+  if (root["strata_scene"] != 1) {
+    (field / "strata_scene")
+        .fail("version " + root["strata_scene"].dump() +
+              " is not supported (this strata reads version 1)");
+  }
+  check_keys(root, field,
+             {"strata_scene", "volumes", "meshes", "atlas", "labels", "camera", "settings"});
+  each(root, field, "volumes", [&](const json& v, const Field& f) { volume(v, f); });
+  each(root, field, "meshes", [&](const json& v, const Field& f) { mesh(v, f); });
+  each(root, field, "atlas", [&](const json& v, const Field& f) { atlas(v, f); });
+  each(root, field, "labels", [&](const json& v, const Field& f) { label(v, f); });
+  if (const json* c = optional(root, "camera")) camera(*c, field / "camera");
+  if (const json* s = optional(root, "settings")) settings(*s, field / "settings");
+  // Placement keys its state by label id; two labels with one id would silently share it.
+  std::set<int> ids;
+  for (const Label& l : scene_.labels) {
+    if (!ids.insert(l.id).second) {
+      (field / "labels").fail("id " + std::to_string(l.id) + " is used by two labels");
+    }
+  }
+  return std::move(scene_);
+}
+
+}  // namespace
+
+Scene load_scene_json(const std::filesystem::path& path) {
+  json root;
+  try {
+    root = json::parse(read_text_file(path));
+  } catch (const json::parse_error& e) {
+    // nlohmann's message starts with "[json.exception.parse_error.101] "; the rest already says
+    // "parse error at line L, column C: ...".
+    const std::string what = e.what();
+    const size_t end = what.find("] ");
+    throw Error(path.string() + ": " + (end == std::string::npos ? what : what.substr(end + 2)));
+  }
+  return SceneReader(path).read(root);
+}
+
+Scene load_scene(const std::filesystem::path& path) {
+  const std::string extension = path.extension().string();
+  if (extension == ".json") return load_scene_json(path);
+  if (extension == ".xml") return import_voly_scene(path);
+  throw Error(path.string() + ": unknown scene format '" + extension +
+              "' (expected .json, or .xml from the thesis program)");
+}
+
+}  // namespace strata

@@ -1,0 +1,452 @@
+// load_volume's dispatch by extension, and the helpers every volume reader shares (volume_io.h):
+// size checks, reading straight into the voxel buffer with on-the-fly inflate, byte order, type
+// conversion, rescale and value range.
+#include "engine/scene/io/volume_loader.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <system_error>
+
+#include <zlib.h>
+
+#include "engine/scene/io/volume_io.h"
+
+namespace strata {
+
+Volume load_volume(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::exists(path, error)) volume_io::fail(path, "no such file");
+  if (fs::is_directory(path, error)) return load_dicom_series(path);
+
+  const std::string name = volume_io::lowercase(path.filename().string());
+  const auto ends_with = [&](std::string_view suffix) { return name.ends_with(suffix); };
+  if (ends_with(".nii") || ends_with(".nii.gz")) return load_nifti(path);
+  if (ends_with(".mhd") || ends_with(".mha")) return load_metaimage(path);
+  if (ends_with(".nrrd") || ends_with(".nhdr")) return load_nrrd(path);
+  volume_io::fail(path, "unknown volume extension '" + path.extension().string() +
+                            "' (strata reads .nii, .nii.gz, .mhd, .mha, .nrrd, .nhdr and DICOM "
+                            "folders)");
+}
+
+}  // namespace strata
+
+namespace strata::volume_io {
+
+void fail(const std::filesystem::path& file, const std::string& what) {
+  throw Error(file.string() + ": " + what);
+}
+
+// ---- element types and sizes
+
+size_t stored_size(StoredType type) {
+  switch (type) {
+    case StoredType::uint8:
+    case StoredType::int8:
+      return 1;
+    case StoredType::int16:
+    case StoredType::uint16:
+      return 2;
+    case StoredType::int32:
+    case StoredType::uint32:
+    case StoredType::float32:
+      return 4;
+    case StoredType::float64:
+      return 8;
+  }
+  return 1;
+}
+
+const char* to_string(StoredType type) {
+  constexpr const char* names[] = {"uint8", "int8",   "int16",   "uint16",
+                                   "int32", "uint32", "float32", "float64"};
+  return names[static_cast<int>(type)];
+}
+
+size_t checked_voxel_bytes(const std::filesystem::path& file, std::string_view field,
+                           const std::array<int64_t, 3>& dims, size_t element_size) {
+  const std::string shown = concat(field, " = ", dims[0], "x", dims[1], "x", dims[2]);
+  for (int64_t d : dims)
+    if (d < 1) fail(file, shown + ": dimensions must be positive");
+  uint64_t bytes = element_size;
+  bool overflow = false;
+  for (int64_t d : dims)
+    overflow |= __builtin_mul_overflow(bytes, static_cast<uint64_t>(d), &bytes);
+  if (overflow || bytes > std::numeric_limits<size_t>::max())
+    fail(file, shown + ": voxel count overflows");
+  for (int64_t d : dims)
+    if (d > int64_t{std::numeric_limits<uint32_t>::max()})
+      fail(file, shown + ": a dimension exceeds 4294967295");
+  if (bytes > max_voxel_bytes)
+    fail(file, concat(shown, ": ", bytes, " bytes of voxels, more than the 16 GiB strata accepts"));
+  return static_cast<size_t>(bytes);
+}
+
+void check_spacing(const std::filesystem::path& file, std::string_view field,
+                   const std::array<double, 3>& spacing) {
+  for (double s : spacing)
+    if (!std::isfinite(s) || s <= 0.0)
+      fail(file, concat(field, " = ", spacing[0], " ", spacing[1], " ", spacing[2],
+                        ": spacing must be positive"));
+}
+
+// ---- reading
+
+// zlib's state plus its input buffer; kept out of the header's way.
+struct InputFile::Inflater {
+  z_stream stream{};
+  std::vector<unsigned char> input = std::vector<unsigned char>(1 << 16);
+  bool gzip = false;      // gzip streams may be concatenated members; zlib streams end once
+  bool finished = false;  // the stream's end was reached
+  ~Inflater() { inflateEnd(&stream); }
+};
+
+InputFile::InputFile(Source source) : source_(std::move(source)) {
+  std::error_code error;
+  const uint64_t size = std::filesystem::file_size(source_.file, error);
+  in_.open(source_.file, std::ios::binary);
+  if (error || !in_) fail(source_.report_as, concat(source_.what, ": cannot open ", source_.file));
+  file_bytes_left_ = source_.offset < size ? size - source_.offset : 0;
+  in_.seekg(static_cast<std::streamoff>(std::min(source_.offset, size)));
+  if (!source_.compressed) return;
+  if (source_.compressed_size)
+    file_bytes_left_ = std::min(file_bytes_left_, *source_.compressed_size);
+  compressed_total_ = file_bytes_left_;
+  inflater_ = std::make_unique<Inflater>();
+  // 15 + 32: the largest window, and accept either a zlib or a gzip header.
+  if (inflateInit2(&inflater_->stream, 15 + 32) != Z_OK)
+    fail(source_.report_as, concat(source_.what, ": cannot start zlib"));
+}
+
+InputFile::~InputFile() = default;
+
+bool InputFile::refill() {
+  if (file_bytes_left_ == 0) return false;
+  Inflater& z = *inflater_;
+  const uint64_t want = std::min<uint64_t>(z.input.size(), file_bytes_left_);
+  in_.read(reinterpret_cast<char*>(z.input.data()), static_cast<std::streamsize>(want));
+  const auto got = static_cast<uint64_t>(in_.gcount());
+  file_bytes_left_ = got == want ? file_bytes_left_ - got : 0;
+  if (produced_ == 0 && z.stream.total_in == 0 && got > 0) z.gzip = z.input[0] == 0x1f;
+  z.stream.next_in = z.input.data();
+  z.stream.avail_in = static_cast<uInt>(got);
+  return got > 0;
+}
+
+size_t InputFile::read_compressed(std::byte* destination, size_t n) {
+  Inflater& z = *inflater_;
+  size_t done = 0;
+  while (done < n && !z.finished) {
+    if (z.stream.avail_in == 0 && !refill()) break;  // the compressed data ends early
+    const size_t chunk = std::min<size_t>(n - done, size_t{1} << 30);
+    z.stream.next_out = reinterpret_cast<Bytef*>(destination + done);
+    z.stream.avail_out = static_cast<uInt>(chunk);
+    const int result = inflate(&z.stream, Z_NO_FLUSH);
+    done += chunk - z.stream.avail_out;
+    if (result == Z_STREAM_END) {
+      // A gzip file may hold several members one after another (what `cat a.gz b.gz` makes).
+      if (z.stream.avail_in == 0) refill();
+      const bool next_member = z.gzip && z.stream.avail_in > 0 && z.stream.next_in[0] == 0x1f;
+      if (next_member) {
+        inflateReset(&z.stream);
+      } else {
+        z.finished = true;
+      }
+    } else if (result != Z_OK && !(result == Z_BUF_ERROR && z.stream.avail_in == 0)) {
+      fail(source_.report_as, concat(source_.what, ": compressed data is corrupt (zlib: ",
+                                     z.stream.msg ? z.stream.msg : "error", ")"));
+    }
+  }
+  produced_ += done;
+  return done;
+}
+
+size_t InputFile::read(std::byte* destination, size_t n) {
+  if (source_.compressed) return read_compressed(destination, n);
+  const uint64_t want = std::min<uint64_t>(n, file_bytes_left_);
+  in_.read(reinterpret_cast<char*>(destination), static_cast<std::streamsize>(want));
+  const auto got = static_cast<uint64_t>(in_.gcount());
+  file_bytes_left_ = got == want ? file_bytes_left_ - got : 0;
+  produced_ += got;
+  return static_cast<size_t>(got);
+}
+
+bool InputFile::skip(uint64_t n) {
+  if (!source_.compressed) {
+    if (n > file_bytes_left_) return false;
+    in_.seekg(static_cast<std::streamoff>(n), std::ios::cur);
+    file_bytes_left_ -= n;
+    return true;
+  }
+  std::vector<std::byte> scratch(std::min<uint64_t>(n, 1 << 16));
+  while (n > 0) {
+    const size_t chunk = static_cast<size_t>(std::min<uint64_t>(n, scratch.size()));
+    if (read(scratch.data(), chunk) != chunk) return false;
+    n -= chunk;
+  }
+  return true;
+}
+
+uint64_t InputFile::max_remaining() const {
+  if (!source_.compressed) return file_bytes_left_;
+  // Deflate cannot expand data by more than 1032:1; the slack covers stream headers.
+  const uint64_t bound = compressed_total_ * 1032 + (uint64_t{1} << 20);
+  return bound > produced_ ? bound - produced_ : 0;
+}
+
+bool is_gzip_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  unsigned char magic[2] = {0, 0};
+  in.read(reinterpret_cast<char*>(magic), 2);
+  return in.gcount() == 2 && magic[0] == 0x1f && magic[1] == 0x8b;
+}
+
+void read_voxels(InputFile& in, size_t bytes, Volume& volume) {
+  const InputFile::Source& source = in.source();
+  const uint64_t available = in.max_remaining();
+  if (bytes > available) {
+    if (!in.compressed())
+      fail(source.report_as,
+           concat(source.what, " has ", available, " bytes, the header needs ", bytes));
+    fail(source.report_as, concat(source.what, " is too short: its compressed bytes inflate to at ",
+                                  "most ", available, " bytes, the header needs ", bytes));
+  }
+  volume.voxels.resize(bytes);
+  const size_t got = in.read(volume.voxels.data(), bytes);
+  if (got < bytes)
+    fail(source.report_as,
+         concat(source.what, " ends after ", got, " of the ", bytes, " bytes the header needs"));
+}
+
+std::string read_prefix(const std::filesystem::path& file, size_t max_bytes) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) fail(file, "cannot open");
+  std::string text(max_bytes, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(max_bytes));
+  text.resize(static_cast<size_t>(in.gcount()));
+  return text;
+}
+
+uint64_t existing_file_size(const std::filesystem::path& file) {
+  std::error_code error;
+  if (!std::filesystem::exists(file, error)) fail(file, "no such file");
+  if (!std::filesystem::is_regular_file(file, error)) fail(file, "not a file");
+  return std::filesystem::file_size(file, error);
+}
+
+// ---- voxel conversion
+
+void swap_bytes(std::span<std::byte> data, size_t element_size) {
+  if (element_size < 2) return;
+  for (size_t i = 0; i + element_size <= data.size(); i += element_size)
+    std::reverse(data.begin() + static_cast<std::ptrdiff_t>(i),
+                 data.begin() + static_cast<std::ptrdiff_t>(i + element_size));
+}
+
+bool Rescale::applies() const {
+  return std::isfinite(slope) && std::isfinite(intercept) && slope != 0.0 &&
+         !(slope == 1.0 && intercept == 0.0);
+}
+
+namespace {
+
+template <class T>
+T load(const std::byte* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  return value;
+}
+
+// Calls fn with a value of the C++ type a StoredType names (the value itself is unused).
+template <class Fn>
+void with_type(StoredType type, Fn&& fn) {
+  switch (type) {
+    case StoredType::uint8:
+      return fn(uint8_t{});
+    case StoredType::int8:
+      return fn(int8_t{});
+    case StoredType::int16:
+      return fn(int16_t{});
+    case StoredType::uint16:
+      return fn(uint16_t{});
+    case StoredType::int32:
+      return fn(int32_t{});
+    case StoredType::uint32:
+      return fn(uint32_t{});
+    case StoredType::float32:
+      return fn(float{});
+    case StoredType::float64:
+      return fn(double{});
+  }
+}
+
+StoredType stored_type_of(VoxelType type) {
+  switch (type) {
+    case VoxelType::uint8:
+      return StoredType::uint8;
+    case VoxelType::int16:
+      return StoredType::int16;
+    case VoxelType::uint16:
+      return StoredType::uint16;
+    case VoxelType::float32:
+      return StoredType::float32;
+  }
+  return StoredType::uint8;
+}
+
+std::optional<VoxelType> held_as_is(StoredType type) {
+  switch (type) {
+    case StoredType::uint8:
+      return VoxelType::uint8;
+    case StoredType::int16:
+      return VoxelType::int16;
+    case StoredType::uint16:
+      return VoxelType::uint16;
+    case StoredType::float32:
+      return VoxelType::float32;
+    default:
+      return std::nullopt;
+  }
+}
+
+// Rewrites every element as Dst = op(Src, index). In place when Dst is not larger than Src
+// (element i is read before it is written, and its write ends where element i + 1 starts);
+// otherwise through the one extra buffer the loaders are allowed.
+template <class Src, class Dst, class Op>
+void convert_elements(Volume& volume, VoxelType to, Op op) {
+  const size_t count = volume.voxels.size() / sizeof(Src);
+  constexpr bool in_place = sizeof(Dst) <= sizeof(Src);
+  std::vector<std::byte> grown(in_place ? 0 : count * sizeof(Dst));
+  std::byte* out = in_place ? volume.voxels.data() : grown.data();
+  const std::byte* in = volume.voxels.data();
+  for (size_t i = 0; i < count; ++i) {
+    const Dst value = op(load<Src>(in + i * sizeof(Src)), i);
+    std::memcpy(out + i * sizeof(Dst), &value, sizeof(Dst));
+  }
+  if (in_place) {
+    volume.voxels.resize(count * sizeof(Dst));
+  } else {
+    volume.voxels = std::move(grown);
+  }
+  volume.type = to;
+}
+
+bool is_integer(double v) {
+  return std::nearbyint(v) == v && std::fabs(v) < 1e9;
+}
+
+// DICOM CT keeps int16 when the rescale maps the stored range onto integers that fit int16.
+bool rescale_fits_int16(const Volume& volume, const std::vector<Rescale>& per_slice) {
+  if (volume.type == VoxelType::float32) return false;
+  const glm::vec2 range = compute_value_range(volume);
+  for (const Rescale& r : per_slice) {
+    if (!is_integer(r.slope) || !is_integer(r.intercept)) return false;
+    for (float v : {range.x, range.y}) {
+      const double result = r.slope * v + r.intercept;
+      if (result < -32768.0 || result > 32767.0) return false;
+    }
+  }
+  return true;
+}
+
+void apply_rescale(Volume& volume, const std::vector<Rescale>& per_slice, bool int16_when_exact) {
+  if (std::none_of(per_slice.begin(), per_slice.end(), [](auto& r) { return r.applies(); })) return;
+  const size_t slice_voxels = size_t{volume.dims.x} * volume.dims.y;
+  const auto rescale_of = [&](size_t index) {
+    const Rescale& r = per_slice.size() == 1 ? per_slice[0] : per_slice[index / slice_voxels];
+    return r.applies() ? r : Rescale{};
+  };
+  const bool to_int16 = int16_when_exact && rescale_fits_int16(volume, per_slice);
+  with_type(stored_type_of(volume.type), [&](auto source) {
+    using Src = decltype(source);
+    if (to_int16) {
+      convert_elements<Src, int16_t>(volume, VoxelType::int16, [&](Src v, size_t i) {
+        const Rescale r = rescale_of(i);
+        return static_cast<int16_t>(std::lround(r.slope * v + r.intercept));
+      });
+    } else {
+      convert_elements<Src, float>(volume, VoxelType::float32, [&](Src v, size_t i) {
+        const Rescale r = rescale_of(i);
+        return static_cast<float>(r.slope * v + r.intercept);
+      });
+    }
+  });
+}
+
+}  // namespace
+
+void finish_voxels(Volume& volume, const Conversion& conversion) {
+  const size_t size = stored_size(conversion.stored);
+  if (conversion.big_endian != (std::endian::native == std::endian::big))
+    swap_bytes(volume.voxels, size);
+  if (const auto type = held_as_is(conversion.stored)) {
+    volume.type = *type;
+  } else {
+    with_type(conversion.stored, [&](auto source) {
+      using Src = decltype(source);
+      convert_elements<Src, float>(volume, VoxelType::float32,
+                                   [](Src v, size_t) { return static_cast<float>(v); });
+    });
+  }
+  apply_rescale(volume, conversion.per_slice, conversion.int16_when_exact);
+  volume.value_range = compute_value_range(volume);
+}
+
+glm::vec2 compute_value_range(const Volume& volume) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  with_type(stored_type_of(volume.type), [&](auto tag) {
+    using T = decltype(tag);
+    T min_value = std::numeric_limits<T>::max(), max_value = std::numeric_limits<T>::lowest();
+    const size_t count = volume.voxels.size() / sizeof(T);
+    for (size_t i = 0; i < count; ++i) {
+      const T v = load<T>(volume.voxels.data() + i * sizeof(T));
+      if constexpr (std::is_floating_point_v<T>)
+        if (!std::isfinite(v)) continue;
+      min_value = std::min(min_value, v);
+      max_value = std::max(max_value, v);
+    }
+    if (min_value <= max_value) {
+      lo = static_cast<double>(min_value);
+      hi = static_cast<double>(max_value);
+    }
+  });
+  if (lo > hi) return glm::vec2(0.0f);
+  return glm::vec2(static_cast<float>(lo), static_cast<float>(hi));
+}
+
+std::string volume_name(const std::filesystem::path& path) {
+  std::filesystem::path name = path.filename();
+  if (name.empty()) name = path.parent_path().filename();  // "folder/"
+  if (lowercase(name.extension().string()) == ".gz") name = name.stem();
+  const std::string extension = lowercase(name.extension().string());
+  for (const char* known : {".nii", ".mhd", ".mha", ".nrrd", ".nhdr"})
+    if (extension == known) return name.stem().string();
+  return name.string();
+}
+
+// ---- text headers
+
+std::string_view trim(std::string_view text) {
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+  while (!text.empty() && space(text.front())) text.remove_prefix(1);
+  while (!text.empty() && space(text.back())) text.remove_suffix(1);
+  return text;
+}
+
+std::string lowercase(std::string_view text) {
+  std::string result(text);
+  for (char& c : result)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return result;
+}
+
+std::string printable(std::string_view text, size_t max_length) {
+  std::string shown(text.substr(0, max_length));
+  for (char& c : shown)
+    if (c < 32 || c > 126) c = '?';
+  return shown;
+}
+
+}  // namespace strata::volume_io

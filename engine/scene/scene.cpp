@@ -1,0 +1,112 @@
+#include "engine/scene/scene.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "engine/core/error.h"
+
+namespace strata {
+
+const char* to_string(VoxelType type) {
+  switch (type) {
+    case VoxelType::uint8:
+      return "uint8";
+    case VoxelType::int16:
+      return "int16";
+    case VoxelType::uint16:
+      return "uint16";
+    case VoxelType::float32:
+      return "float32";
+  }
+  return "?";
+}
+
+size_t voxel_size(VoxelType type) {
+  switch (type) {
+    case VoxelType::uint8:
+      return 1;
+    case VoxelType::int16:
+    case VoxelType::uint16:
+      return 2;
+    case VoxelType::float32:
+      return 4;
+  }
+  return 0;
+}
+
+glm::mat4 Volume::index_to_patient() const {
+  glm::mat4 m(1.0f);
+  for (int axis = 0; axis < 3; ++axis) m[axis] = glm::vec4(direction[axis] * spacing[axis], 0.0f);
+  m[3] = glm::vec4(origin, 1.0f);
+  return m;
+}
+
+std::pair<glm::vec3, glm::vec3> Volume::world_bounds() const {
+  const glm::mat4 m = index_to_world();
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::vec3 ijk((corner & 1) ? float(dims.x - 1) : 0.0f, (corner & 2) ? float(dims.y - 1) : 0.0f,
+                        (corner & 4) ? float(dims.z - 1) : 0.0f);
+    const glm::vec3 p = glm::vec3(m * glm::vec4(ijk, 1.0f));
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  return {lo, hi};
+}
+
+float Volume::value(uint32_t i, uint32_t j, uint32_t k) const {
+  const size_t index = (size_t{k} * dims.y + j) * dims.x + i;
+  const std::byte* p = voxels.data() + index * voxel_size(type);
+  switch (type) {
+    case VoxelType::uint8:
+      return static_cast<float>(std::to_integer<uint8_t>(*p));
+    case VoxelType::int16: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    case VoxelType::uint16: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    case VoxelType::float32: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+  return 0.0f;
+}
+
+glm::vec4 TransferFunction::sample(float t) const {
+  if (stops.empty()) return glm::vec4(0.0f);
+  if (t <= stops.front().position) return stops.front().color;
+  if (t >= stops.back().position) return stops.back().color;
+  const auto upper = std::upper_bound(stops.begin(), stops.end(), t,
+                                      [](float v, const Stop& s) { return v < s.position; });
+  const Stop& b = *upper;
+  const Stop& a = *(upper - 1);
+  const float span = b.position - a.position;
+  return span > 0.0f ? glm::mix(a.color, b.color, (t - a.position) / span) : b.color;
+}
+
+Camera camera_for(const Scene& scene, const std::string& name) {
+  Camera camera = scene.camera;
+  if (name.empty()) return camera;
+  std::string names;
+  for (const CameraPose& pose : scene.camera_positions) {
+    if (pose.name == name) {
+      camera.view = pose.view;
+      return camera;
+    }
+    names += (names.empty() ? "" : ", ") + pose.name;
+  }
+  throw Error(scene.source.string() + ": no camera position named '" + name +
+              "' (the scene has: " + (names.empty() ? "none" : names) + ")");
+}
+
+}  // namespace strata

@@ -1,0 +1,110 @@
+// The scene model: what strata renders and labels. Plain data; loaders fill it (scene_loader.h),
+// the renderer and placement read it. Units: world space is millimetres for medical data (the
+// thesis's own scenes use their own unit), label sizes are pixels.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "engine/scene/camera.h"
+
+namespace strata {
+
+enum class VoxelType { uint8, int16, uint16, float32 };
+
+const char* to_string(VoxelType type);
+size_t voxel_size(VoxelType type);
+
+struct Volume {
+  std::string name;
+  std::filesystem::path source;
+  VoxelType type = VoxelType::uint8;
+  glm::uvec3 dims{0};
+  glm::vec3 spacing{1.0f};       // mm between voxel centres along i, j, k
+  glm::vec3 origin{0.0f};        // patient/world position of voxel (0, 0, 0)
+  glm::mat3 direction{1.0f};     // columns: unit directions of i, j, k in patient space
+  glm::mat4 transform{1.0f};     // placement in the scene, applied after index_to_patient()
+  std::vector<std::byte> voxels; // i fastest, then j, then k; rescale slope/intercept applied
+  glm::vec2 value_range{0.0f};   // min and max voxel value (transfer functions normalise by it)
+  int transfer_function = -1;    // index into Scene::transfer_functions, -1 for none
+
+  size_t voxel_count() const { return size_t{dims.x} * dims.y * dims.z; }
+  size_t byte_size() const { return voxels.size(); }
+  // Voxel index (i, j, k) to patient space: origin + direction * (spacing * index).
+  glm::mat4 index_to_patient() const;
+  glm::mat4 index_to_world() const { return transform * index_to_patient(); }
+  // World-space axis-aligned bounds of the voxel centres' box.
+  std::pair<glm::vec3, glm::vec3> world_bounds() const;
+  // The value of voxel (i, j, k) as float, whatever the type.
+  float value(uint32_t i, uint32_t j, uint32_t k) const;
+};
+
+// Piecewise-linear RGBA over intensity normalised to [0, 1] by the volume's value range.
+struct TransferFunction {
+  struct Stop {
+    float position = 0.0f;  // 0..1
+    glm::vec4 color{0.0f};  // straight (not premultiplied) RGBA, 0..1
+  };
+  std::string name;
+  std::filesystem::path source;
+  std::vector<Stop> stops;  // sorted by position
+  // Colour at t in [0, 1]: clamped to the first and last stop outside them.
+  glm::vec4 sample(float t) const;
+};
+
+struct Mesh {
+  std::string name;
+  std::filesystem::path source;
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;  // one per position
+  std::vector<uint32_t> indices;   // triangles
+  glm::vec4 color{0.8f, 0.8f, 0.8f, 1.0f};  // straight RGBA; alpha < 1 is transparent
+  glm::mat4 transform{1.0f};
+
+  size_t triangle_count() const { return indices.size() / 3; }
+};
+
+struct Label {
+  int id = 0;
+  std::string text;
+  glm::vec3 anchor{0.0f};  // world space
+  glm::vec2 size{0.0f};    // pixels; zero means "from the text" (decided when drawing)
+};
+
+// The thesis program's final paper settings (see docs/ARCHITECTURE.md, "Cost weights").
+struct CostWeights {
+  float label_shadow = 1e5f;
+  float anchor_constraint = 1e6f;
+  float connector_shadow = 100.0f;
+  float integral_costs = 20.0f;
+  float distance_to_anchor = 0.015f;
+  float connector_direction = 1.0f;
+  float previous_position = 0.0f;
+};
+
+struct SceneSettings {
+  int layer_count = 4;
+  CostWeights weights;
+};
+
+struct Scene {
+  std::filesystem::path source;
+  std::vector<Volume> volumes;
+  std::vector<TransferFunction> transfer_functions;
+  std::vector<Mesh> meshes;
+  std::vector<Label> labels;
+  Camera camera;
+  std::vector<CameraPose> camera_positions;  // named poses ("--camera NAME")
+  SceneSettings settings;
+  std::vector<std::string> warnings;  // e.g. a referenced file that does not exist
+};
+
+// The scene's camera, or its named position `name` (an Error listing the names if there is none).
+Camera camera_for(const Scene& scene, const std::string& name);
+
+}  // namespace strata
