@@ -109,13 +109,12 @@ void bench_sat(DeviceOptions& device, graph::Extent size, uint32_t runs) {
 
   SummedAreaTable sat(ctx);
   graph::Graph graph;
-  const graph::ResourceId in = graph.import_resource("input", {false, true});
-  const graph::ResourceId out = graph.import_resource("output", {false, false});
+  const graph::ResourceId in =
+      graph.import_buffer("input", {.buffer = input.handle(), .has_content = true});
+  const graph::ResourceId out = graph.import_buffer("output", {.buffer = output.handle()});
   sat.add_to(graph, in, out);
   graph::GraphRunner runner(ctx, std::move(graph));
   runner.set_viewport(size);
-  runner.bind_buffer(in, input.handle());
-  runner.bind_buffer(out, output.handle());
 
   // The timed result must also be right: compare it once with the CPU reference.
   runner.run_now();
@@ -157,12 +156,8 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
   renderer.add_to(graph);
   graph::GraphRunner runner(ctx, std::move(graph));
   runner.set_viewport(size);
-  renderer.bind(runner);
   RenderStats last;
-  const Timings t = measure(runner, 3, runs, [&] {
-    renderer.bind(runner);
-    last = renderer.collect(runner);
-  });
+  const Timings t = measure(runner, 3, runs, [&] { last = renderer.collect(runner); });
   double resolve_ms = 0.0;
   for (const auto& [name, stat] : t.passes) {
     if (name == "render.resolve") resolve_ms = stat.median;
@@ -225,72 +220,56 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint
   LabelledRenderer frame(ctx, scene, camera_for(scene, o.camera), size, settings);
   frame.run();  // warm up, and grow the HA-Buffer if it must
   graph::GraphRunner& runner = frame.runner();
-  // The label loop is one placement.label pass per label and one more: each but the first
-  // finishes a label.
-  const auto is_label = [&](uint32_t pass) {
-    return pass < runner.graph().passes().size() &&
-           runner.graph().passes()[pass].name == "placement.label";
-  };
-  const auto ends_label = [&](uint32_t pass) {
-    return is_label(pass) && pass > 0 && is_label(pass - 1);
-  };
-  const Timings t = measure(runner, 1, runs, [&] { frame.bind(); });
-  // The whole placement again with timestamps only where groups begin and end: a stamp after
-  // each of the labels + 1 passes waits for the GPU to drain and costs time the real frame does
-  // not spend.
+  const graph::PassId loop = frame.placement().label_loop;
+  const Timings t = measure(runner, 1, runs);
+  // The whole placement again with timestamps only where groups begin and end (a stamp waits for
+  // the GPU to drain and costs time the real frame does not spend).
   runner.set_timestamps_per_pass(false);
   double whole_ms = 0.0;
-  for (const auto& [name, stat] : measure(runner, 1, runs, [&] { frame.bind(); }).groups) {
+  for (const auto& [name, stat] : measure(runner, 1, runs).groups) {
     if (name == "placement") whole_ms = stat.median;
   }
   runner.set_timestamps_per_pass(true);
 
-  // The thesis program's structure: back to the CPU after every label, reading its result.
+  // The thesis program's structure: back to the CPU after every label, reading its result. The
+  // loop's barrier b follows dispatch b, and dispatches 1 .. N each finish a label.
   std::vector<double> readback_ms;
   for (uint32_t run = 0; run < std::max(1u, runs / 4); ++run) {
-    frame.bind();
     std::chrono::steady_clock::time_point start;
-    bool started = false;
-    runner.run_split([&](uint32_t pass) {
-                       return ends_label(pass) || (!is_label(pass) && is_label(pass + 1));
-                     },
-                     [&](uint32_t pass) {
-                       if (!started) {
-                         start = std::chrono::steady_clock::now();
-                         started = true;
-                         return;
-                       }
-                       if (!ends_label(pass)) return;
-                       runner.download_buffer(frame.placement_results());
-                       if (!is_label(pass + 1)) {
-                         readback_ms.push_back(std::chrono::duration<double, std::milli>(
-                                                   std::chrono::steady_clock::now() - start)
-                                                   .count());
-                       }
-                     });
+    const auto before_loop = [&](const graph::SplitPoint& s) {
+      return s.pass + 1 == loop && !s.barrier;
+    };
+    const auto ends_label = [&](const graph::SplitPoint& s) {
+      return s.pass == loop && (!s.barrier || *s.barrier >= 1);
+    };
+    runner.run_split(
+        [&](const graph::SplitPoint& s) { return before_loop(s) || ends_label(s); },
+        [&](const graph::SplitPoint& s) {
+          if (before_loop(s)) {
+            start = std::chrono::steady_clock::now();
+            return;
+          }
+          runner.download_buffer(frame.placement().results);
+          if (!s.barrier) {
+            readback_ms.push_back(
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                    .count());
+          }
+        });
   }
-  double placement_ms = 0.0, loop_ms = 0.0;
+  double placement_ms = 0.0;
   for (const auto& [name, stat] : t.groups) {
     if (name == "placement") placement_ms = stat.median;
   }
-  // The label loop on the GPU: from the first label pass's start to the last one's end.
-  {
-    std::vector<double> spans;
-    runner.run_now();
-    double first = 1e30, last = 0.0;
-    for (const graph::PassTiming& pt : runner.timings()) {
-      if (!pt.name.starts_with("placement.label")) continue;
-      first = std::min(first, pt.begin_ms);
-      last = std::max(last, pt.end_ms);
-    }
-    loop_ms = last > first ? last - first : 0.0;
-  }
+  // The label loop on the GPU: its pass's time.
+  runner.run_now();
+  const double loop_ms = runner.timings()[loop].ms;
   // How many 32x32 tiles each label's passes took (of all the image's tiles): the speculative
   // one (bucket 0) and the main one beyond bucket 0.
   double first_tiles = 0.0, rest_tiles = 0.0;
   {
     runner.run_now();
-    const std::vector<std::byte> bytes = runner.download_buffer(frame.placement_buckets());
+    const std::vector<std::byte> bytes = runner.download_buffer(frame.placement().buckets);
     std::vector<gpu::PlacementBucketsGpu> buckets(bytes.size() / sizeof(gpu::PlacementBucketsGpu));
     std::memcpy(buckets.data(), bytes.data(), buckets.size() * sizeof(gpu::PlacementBucketsGpu));
     // (dispatches 0 .. labels ran: entry s of each label s, and one more)

@@ -110,11 +110,10 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   target.add_output(graph, out.final);
   graph::GraphRunner runner(ctx, std::move(graph));
   runner.set_viewport(size);
+  target.bind(runner);
   RenderStats stats;
   // An overflowing HA-Buffer grows for the next frame; an offline image waits for a clean one.
   for (int attempt = 0; attempt < 4; ++attempt) {
-    renderer.bind(runner);
-    target.bind(runner);
     runner.run_now();
     stats = renderer.collect(runner);
     if (stats.overflow == 0) break;

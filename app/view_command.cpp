@@ -95,14 +95,8 @@ void view(DeviceOptions& device, const ViewOptions& o) {
                   double(stats.samples) / (double(e.width) * e.height));
     glfwSetWindowTitle(window.handle, title);
   };
-  if (renderer) {
-    runner.set_viewport(target.extent().width ? target.extent() : size);
-    renderer->bind(runner);
-  }
-  const uint32_t drawn = run_loop(window.handle, target, runner, o.frames, [&] {
-    before_frame();
-    if (renderer) renderer->bind(runner);
-  });
+  if (renderer) runner.set_viewport(target.extent().width ? target.extent() : size);
+  const uint32_t drawn = run_loop(window.handle, target, runner, o.frames, before_frame);
   vkDeviceWaitIdle(ctx.device());
   if (renderer) before_frame();
   double gpu_ms = 0.0;

@@ -55,7 +55,6 @@ struct LabelledRenderer::Parts {
   LabelDrawing drawing;
   HeadlessTarget target;
   Buffer glyphs;
-  graph::ResourceId glyph_id = 0;
 };
 
 LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camera& camera,
@@ -100,39 +99,34 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
 
   graph::Graph graph;
   const VolumeRenderer::Outputs rendered = p.renderer.add_to(graph);
-  const Placement::Resources placed =
-      p.placement.add_to(graph, rendered.final, rendered.layers, render.layer_count);
-  results_id_ = placed.results;
-  buckets_id_ = placed.buckets;
+  placed_ = p.placement.add_to(graph, {.final_image = rendered.final,
+                                       .layers = rendered.layers,
+                                       .layer_count = render.layer_count});
   layers_id_ = rendered.layers;
-  p.glyph_id = graph.import_resource("labels.glyphs", {false, true});
+  const graph::ResourceId glyph_buffer =
+      graph.import_buffer("labels.glyphs", {.buffer = p.glyphs.handle(), .has_content = true});
   const graph::ResourceId labelled = graph.add_image("labels.final", {VK_FORMAT_R8G8B8A8_UNORM});
-  p.drawing.add_to(graph, rendered.layers, placed.labels, placed.placements, p.glyph_id,
-                   render.layer_count, labelled, render.background);
+  p.drawing.add_to(graph, {.layers = rendered.layers,
+                           .layer_count = render.layer_count,
+                           .labels = placed_.labels,
+                           .placements = placed_.placements,
+                           .glyphs = glyph_buffer,
+                           .output = labelled,
+                           .background = render.background});
   p.target.add_output(graph, labelled);
   runner_ = std::make_unique<graph::GraphRunner>(ctx, std::move(graph));
   runner_->set_viewport(size);
+  p.target.bind(*runner_);
 }
 
 LabelledRenderer::~LabelledRenderer() = default;
 
-std::vector<PipelineReport>
-LabelledRenderer::placement_pipelines() const {
+std::vector<PipelineReport> LabelledRenderer::placement_pipelines() const {
   return parts_->placement.pipeline_statistics();
-}
-
-void LabelledRenderer::bind() {
-  Parts& p = *parts_;
-  p.renderer.bind(*runner_);
-  p.placement.bind(*runner_);
-  p.drawing.bind(*runner_);
-  runner_->bind_buffer(p.glyph_id, p.glyphs.handle());
-  p.target.bind(*runner_);
 }
 
 void LabelledRenderer::run_frame() {
   for (int attempt = 0; attempt < 4; ++attempt) {
-    bind();
     runner_->run_now();
     stats_ = parts_->renderer.collect(*runner_);
     if (stats_.overflow == 0) break;

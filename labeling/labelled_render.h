@@ -71,14 +71,11 @@ class LabelledRenderer {
   // between frames, never inside one.
   void run();
   graph::GraphRunner& runner() { return *runner_; }
-  // The placement's per-label results buffer (the baseline benchmark reads it after each label).
-  graph::ResourceId placement_results() const { return results_id_; }
-  // Per label, its tiles per bucket and how many its main pass took (benchmark statistics).
-  graph::ResourceId placement_buckets() const { return buckets_id_; }
+  // The placement's resources and its label loop's pass: the baseline benchmark reads the
+  // per-label results after each label, and the buckets give its tile statistics.
+  const Placement::Outputs& placement() const { return placed_; }
   // The placement's pipelines and what the driver reports of each (benchmark output).
   std::vector<PipelineReport> placement_pipelines() const;
-  // Binds the imported resources (after anything that reallocates the runner's transients).
-  void bind();
   // The picture and layout of the last run.
   LabelledFrame result() const;
 
@@ -95,8 +92,7 @@ class LabelledRenderer {
   double total_cost() const;
 
   RenderStats stats_;
-  graph::ResourceId results_id_ = 0;
-  graph::ResourceId buckets_id_ = 0;
+  Placement::Outputs placed_{};
   graph::ResourceId layers_id_ = 0;
   LabellingSettings settings_;
 };

@@ -65,42 +65,37 @@ gpu::LabelDrawParams LabelDrawing::params(graph::Extent viewport) const {
           glm::vec4(background_, 1.0f)};
 }
 
-void LabelDrawing::add_to(graph::Graph& graph, ResourceId layers, ResourceId labels_buffer,
-                          ResourceId placements_buffer, ResourceId glyphs_buffer,
-                          uint32_t layer_count, ResourceId final_out, glm::vec3 background) {
-  layer_count_ = layer_count;
-  background_ = background;
-  atlas_id_ = graph.import_resource("labels.font_atlas",
-                                    {true, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
+  layer_count_ = in.layer_count;
+  background_ = in.background;
+  const ResourceId atlas =
+      graph.import_image("labels.font_atlas",
+                         {.image = atlas_.handle(),
+                          .view = atlas_.view(),
+                          .format = VK_FORMAT_R8_UNORM,
+                          .has_content = true,
+                          .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
   graph.add_pass({"labels.draw",
                   graph::PassKind::compute,
-                  {{layers, Use::storage_read_write, LABEL_DRAW_BINDING_LAYERS},
-                   {labels_buffer, Use::storage_read, LABEL_DRAW_BINDING_LABELS},
-                   {placements_buffer, Use::storage_read, LABEL_DRAW_BINDING_PLACEMENTS},
-                   {glyphs_buffer, Use::storage_read, LABEL_DRAW_BINDING_GLYPHS},
-                   {atlas_id_, Use::sampled, LABEL_DRAW_BINDING_ATLAS}},
+                  {{in.layers, Use::storage_read_write, LABEL_DRAW_BINDING_LAYERS},
+                   {in.labels, Use::storage_read, LABEL_DRAW_BINDING_LABELS},
+                   {in.placements, Use::storage_read, LABEL_DRAW_BINDING_PLACEMENTS},
+                   {in.glyphs, Use::storage_read, LABEL_DRAW_BINDING_GLYPHS},
+                   {atlas, Use::sampled, LABEL_DRAW_BINDING_ATLAS}},
                   [this](graph::PassContext& pc) {
-                    pc.bind(draw_);
-                    draw_.push_constants(pc.cmd, params(pc.viewport));
-                    vkCmdDispatch(pc.cmd, group_count(pc.viewport.width, LABEL_DRAW_GROUP),
-                                  group_count(pc.viewport.height, LABEL_DRAW_GROUP), layer_count_);
+                    pc.dispatch(draw_, params(pc.viewport),
+                                {pc.viewport.width, pc.viewport.height, layer_count_});
                   },
                   "labels"});
   graph.add_pass({"labels.composite",
                   graph::PassKind::compute,
-                  {{layers, Use::storage_read, LABEL_DRAW_BINDING_LAYERS},
-                   {final_out, Use::storage_write, LABEL_DRAW_BINDING_FINAL}},
+                  {{in.layers, Use::storage_read, LABEL_DRAW_BINDING_LAYERS},
+                   {in.output, Use::storage_write, LABEL_DRAW_BINDING_FINAL}},
                   [this](graph::PassContext& pc) {
-                    pc.bind(composite_);
-                    composite_.push_constants(pc.cmd, params(pc.viewport));
-                    vkCmdDispatch(pc.cmd, group_count(pc.viewport.width, LABEL_DRAW_GROUP),
-                                  group_count(pc.viewport.height, LABEL_DRAW_GROUP), 1);
+                    pc.dispatch(composite_, params(pc.viewport),
+                                {pc.viewport.width, pc.viewport.height, 1});
                   },
                   "labels"});
-}
-
-void LabelDrawing::bind(graph::GraphRunner& runner) const {
-  runner.bind_image(atlas_id_, atlas_.handle(), atlas_.view(), VK_FORMAT_R8_UNORM);
 }
 
 namespace {

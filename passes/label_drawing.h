@@ -27,15 +27,17 @@ class LabelDrawing {
   // Uploads the font's atlas once.
   LabelDrawing(Context& ctx, const FontAtlas& font);
 
-  // Adds both passes. `layers`: the renderer's rgba16f array image (layer_count >= 2 layers, so
-  // that its view is an array), read and written in place. `labels_buffer` (LabelGpu[]),
-  // `placements_buffer` (PlacementGpu[], one per label) and `glyphs_buffer` (GlyphGpu[]) must have
-  // content; `final_out` is a viewport-sized rgba8 image the composite overwrites.
-  void add_to(graph::Graph& graph, graph::ResourceId layers, graph::ResourceId labels_buffer,
-              graph::ResourceId placements_buffer, graph::ResourceId glyphs_buffer,
-              uint32_t layer_count, graph::ResourceId final_out, glm::vec3 background);
-  // Binds the font atlas imported by add_to.
-  void bind(graph::GraphRunner& runner) const;
+  struct Inputs {
+    graph::ResourceId layers;  // the renderer's rgba16f array image, read and written in place
+    uint32_t layer_count = 1;
+    graph::ResourceId labels;      // LabelGpu[], with content
+    graph::ResourceId placements;  // PlacementGpu[], one per label, with content
+    graph::ResourceId glyphs;      // GlyphGpu[], with content
+    graph::ResourceId output;      // a viewport-sized rgba8 image the composite overwrites
+    glm::vec3 background{0.0f};
+  };
+  // Adds both passes; the font atlas is imported with its handle.
+  void add_to(graph::Graph& graph, const Inputs& in);
 
   // How many labels of the labels buffer to draw (read when the graph is recorded); the shader
   // never reads past the end of the labels or placements buffer either way.
@@ -48,7 +50,6 @@ class LabelDrawing {
   Image atlas_;
   ComputePipeline draw_;
   ComputePipeline composite_;
-  graph::ResourceId atlas_id_ = 0;
   uint32_t layer_count_ = 0;
   uint32_t label_count_ = LABEL_MAX;
   glm::vec3 background_{0.0f};

@@ -74,216 +74,230 @@ void Placement::set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_
   settings_ = settings;
 }
 
-Placement::Resources Placement::add_to(graph::Graph& graph, ResourceId final_image,
-                                       ResourceId layers, uint32_t layer_count) {
-  layer_count_ = layer_count;
-  const uint32_t n = std::max(label_count_, 1u);
-  const auto fixed = [](VkDeviceSize bytes) {
-    return graph::BufferInfo{[bytes](graph::Extent) { return bytes; }};
-  };
-  const auto per_pixel = [](VkDeviceSize bytes) {
-    return graph::BufferInfo{
-        [bytes](graph::Extent e) { return VkDeviceSize{e.width} * e.height * bytes; }};
-  };
-  Resources r;
-  r.labels = graph.add_buffer("placement.labels", fixed(n * sizeof(gpu::LabelGpu)));
-  const ResourceId order = graph.add_buffer("placement.order", fixed(n * sizeof(uint32_t)));
-  const ResourceId results = graph.add_buffer("placement.results", fixed(n * sizeof(uint64_t)));
-  r.results = results;
-  r.placements = graph.add_buffer("placement.placements", fixed(n * sizeof(gpu::PlacementGpu)));
-  r.saliency = graph.add_buffer("placement.saliency", per_pixel(sizeof(float)));
-  r.costs = graph.add_buffer("placement.integral_costs", per_pixel(sizeof(float) * layer_count));
-  r.tables = graph.add_buffer("placement.tables", per_pixel(sizeof(float) * layer_count));
-  r.constraints = graph.add_buffer("placement.constraints", per_pixel(sizeof(uint32_t)));
-  const auto per_label_tile = [n](VkDeviceSize bytes) {
-    return graph::BufferInfo{[n, bytes](graph::Extent e) {
-      const glm::uvec2 tiles = gpu::placement_tiles(e.width, e.height);
-      return VkDeviceSize{n} * tiles.x * tiles.y * bytes;
-    }};
-  };
-  const ResourceId bounds = graph.add_buffer("placement.bounds", per_label_tile(sizeof(float)));
-  const ResourceId tiles =
-      graph.add_buffer("placement.tiles", per_label_tile(2 * sizeof(uint32_t)));
-  // (one more than labels: a place_label dispatch each, and the last one's main pass)
-  const ResourceId buckets =
-      graph.add_buffer("placement.buckets", fixed((n + 1) * sizeof(gpu::PlacementBucketsGpu)));
-  r.buckets = buckets;
-  const ResourceId lower = graph.add_buffer("placement.lower", fixed(n * sizeof(uint32_t)));
-  const ResourceId args = graph.add_buffer("placement.args", fixed((n + 1) * 3 * sizeof(uint32_t)));
-  const ResourceId speculative =
-      graph.add_buffer("placement.speculative", graph::BufferInfo{[](graph::Extent e) {
-                         const glm::uvec2 across = gpu::placement_tiles(e.width, e.height);
-                         return VkDeviceSize{2} * across.x * across.y * sizeof(uint64_t);
-                       }});
-  const ResourceId samples =
-      graph.add_buffer("placement.samples", graph::BufferInfo{[](graph::Extent e) {
-                         const glm::uvec2 across = gpu::placement_tiles(e.width, e.height);
-                         return VkDeviceSize{across.x} * across.y * sizeof(uint64_t);
-                       }});
-  const ResourceId regions =
-      graph.add_buffer("placement.regions", fixed(VkDeviceSize{n} * n * sizeof(gpu::PairRegionsGpu)));
-  readback_id_ = graph.import_resource("placement.readback",
-                                       {false, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::host_read});
+namespace {
 
-  graph.add_pass({"placement.upload",
-                  graph::PassKind::transfer,
-                  {{r.labels, Use::transfer_dst},
-                   {order, Use::transfer_dst},
-                   {results, Use::transfer_dst},
-                   {r.constraints, Use::transfer_dst},
-                   {buckets, Use::transfer_dst},
-                   {lower, Use::transfer_dst},
-                   {speculative, Use::transfer_dst},
-                   {samples, Use::transfer_dst},
-                   {regions, Use::transfer_dst}},
-                  [this, r, order, results, buckets, lower, speculative, samples,
-                   regions](graph::PassContext& pc) {
-                    if (!labels_.empty()) {
-                      vkCmdUpdateBuffer(pc.cmd, pc.buffer(r.labels), 0,
-                                        labels_.size() * sizeof(gpu::LabelGpu), labels_.data());
-                    }
-                    if (!order_.empty()) {
-                      vkCmdUpdateBuffer(pc.cmd, pc.buffer(order), 0,
-                                        order_.size() * sizeof(uint32_t), order_.data());
-                    }
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(results), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(r.constraints), 0, VK_WHOLE_SIZE, 0);
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(buckets), 0, VK_WHOLE_SIZE, 0);
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(lower), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
-                    // (each speculative workgroup writes its tile's entry before anything reads it)
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(speculative), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(samples), 0, VK_WHOLE_SIZE, 0xFFFFFFFFu);
-                    // No regions: a label that is never placed constrains nobody.
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(regions), 0, VK_WHOLE_SIZE, 0);
-                  },
-                  "placement"});
-  const auto per_pixel_dispatch = [this](const ComputePipeline& pipeline, graph::PassContext& pc) {
-    pc.bind(pipeline);
-    pipeline.push_constants(pc.cmd, params(pc.viewport, 0));
-    vkCmdDispatch(pc.cmd, group_count(pc.viewport.width, PLACEMENT_GROUP),
-                  group_count(pc.viewport.height, PLACEMENT_GROUP), 1);
-  };
+graph::BufferInfo fixed(VkDeviceSize bytes) {
+  return {[bytes](graph::Extent) { return bytes; }};
+}
+
+graph::BufferInfo per_pixel(VkDeviceSize bytes) {
+  return {[bytes](graph::Extent e) { return VkDeviceSize{e.width} * e.height * bytes; }};
+}
+
+// `bytes` per 32x32 tile of candidates, `copies` times.
+graph::BufferInfo per_tile(VkDeviceSize bytes, VkDeviceSize copies = 1) {
+  return {[bytes, copies](graph::Extent e) {
+    const glm::uvec2 tiles = gpu::placement_tiles(e.width, e.height);
+    return copies * tiles.x * tiles.y * bytes;
+  }};
+}
+
+}  // namespace
+
+Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
+  layer_count_ = in.layer_count;
+  const Buffers b = add_buffers(graph);
+  add_upload(graph, b);
+  add_costs(graph, b, in);
+  add_bounds(graph, b);
+  const graph::PassId loop = add_label_loop(graph, b);
+  add_finalize(graph, b);
+  return {b.labels, b.placements, b.saliency, b.costs,   b.tables,
+          b.constraints, b.results, b.buckets, loop};
+}
+
+Placement::Buffers Placement::add_buffers(graph::Graph& graph) const {
+  const uint32_t n = std::max(label_count_, 1u);
+  const uint32_t layers = layer_count_;
+  Buffers b;
+  b.labels = graph.add_buffer("placement.labels", fixed(n * sizeof(gpu::LabelGpu)));
+  b.order = graph.add_buffer("placement.order", fixed(n * sizeof(uint32_t)));
+  b.results = graph.add_buffer("placement.results", fixed(n * sizeof(uint64_t)));
+  b.placements = graph.add_buffer("placement.placements", fixed(n * sizeof(gpu::PlacementGpu)));
+  b.saliency = graph.add_buffer("placement.saliency", per_pixel(sizeof(float)));
+  b.costs = graph.add_buffer("placement.integral_costs", per_pixel(sizeof(float) * layers));
+  b.tables = graph.add_buffer("placement.tables", per_pixel(sizeof(float) * layers));
+  b.constraints = graph.add_buffer("placement.constraints", per_pixel(sizeof(uint32_t)));
+  b.bounds = graph.add_buffer("placement.bounds", per_tile(sizeof(float), n));
+  b.tiles = graph.add_buffer("placement.tiles", per_tile(2 * sizeof(uint32_t), n));
+  // (one more than labels: a place_label dispatch each, and the last one's main pass)
+  b.buckets =
+      graph.add_buffer("placement.buckets", fixed((n + 1) * sizeof(gpu::PlacementBucketsGpu)));
+  b.lower = graph.add_buffer("placement.lower", fixed(n * sizeof(uint32_t)));
+  b.args = graph.add_buffer("placement.args", fixed((n + 1) * 3 * sizeof(uint32_t)));
+  b.speculative = graph.add_buffer("placement.speculative", per_tile(sizeof(uint64_t), 2));
+  b.samples = graph.add_buffer("placement.samples", per_tile(sizeof(uint64_t)));
+  b.regions = graph.add_buffer("placement.regions",
+                               fixed(VkDeviceSize{n} * n * sizeof(gpu::PairRegionsGpu)));
+  b.readback = graph.import_buffer(
+      "placement.readback", {.buffer = readback_.handle(), .final_use = Use::host_read});
+  return b;
+}
+
+// The frame's labels and order; everything the loop accumulates starts empty.
+void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
   graph.add_pass(
-      {"placement.saliency",
-       graph::PassKind::compute,
-       {{final_image, Use::storage_read, PLACEMENT_BINDING_FINAL},
-        {r.saliency, Use::storage_write, PLACEMENT_BINDING_SALIENCY}},
-       [this, per_pixel_dispatch](graph::PassContext& pc) { per_pixel_dispatch(saliency_, pc); },
+      {"placement.upload",
+       graph::PassKind::transfer,
+       {{b.labels, Use::transfer_dst},
+        {b.order, Use::transfer_dst},
+        {b.results, Use::transfer_dst},
+        {b.constraints, Use::transfer_dst},
+        {b.buckets, Use::transfer_dst},
+        {b.lower, Use::transfer_dst},
+        {b.speculative, Use::transfer_dst},
+        {b.samples, Use::transfer_dst},
+        {b.regions, Use::transfer_dst}},
+       [this, b](graph::PassContext& pc) {
+         if (!labels_.empty()) {
+           vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.labels), 0,
+                             labels_.size() * sizeof(gpu::LabelGpu), labels_.data());
+         }
+         if (!order_.empty()) {
+           vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.order), 0, order_.size() * sizeof(uint32_t),
+                             order_.data());
+         }
+         const auto fill = [&pc](ResourceId id, uint32_t value) {
+           vkCmdFillBuffer(pc.cmd, pc.buffer(id), 0, VK_WHOLE_SIZE, value);
+         };
+         fill(b.results, 0xFFFFFFFFu);  // "not placed"
+         fill(b.constraints, 0);
+         fill(b.buckets, 0);
+         fill(b.lower, 0xFFFFFFFFu);
+         // (each speculative workgroup writes its tile's entry before anything reads it)
+         fill(b.speculative, 0xFFFFFFFFu);
+         fill(b.samples, 0xFFFFFFFFu);
+         fill(b.regions, 0);  // a label that is never placed constrains nobody
+       },
        "placement"});
-  graph.add_pass({"placement.integral_costs",
-                  graph::PassKind::compute,
-                  {{r.saliency, Use::storage_read, PLACEMENT_BINDING_SALIENCY},
-                   {layers, Use::storage_read, PLACEMENT_BINDING_LAYERS},
-                   {r.costs, Use::storage_write, PLACEMENT_BINDING_COSTS}},
-                  [this, per_pixel_dispatch](graph::PassContext& pc) {
-                    per_pixel_dispatch(integral_costs_, pc);
-                  },
-                  "placement"});
-  tables_.add_to(graph, r.costs, r.tables, "placement.sat", layer_count);
-  // Tile bounds, bucket counts, tiles sorted by bucket: for every label at once.
+}
+
+// Saliency (eq. 3.5), integral costs per layer (eq. 3.3/3.4) and their summed-area tables.
+void Placement::add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in) {
+  const auto per_pixel_pass = [this, &graph](const char* name, const ComputePipeline& pipeline,
+                                             std::vector<graph::ResourceUse> uses) {
+    graph.add_pass({name, graph::PassKind::compute, std::move(uses),
+                    [this, &pipeline](graph::PassContext& pc) {
+                      pc.dispatch(pipeline, params(pc.viewport, 0),
+                                  {pc.viewport.width, pc.viewport.height, 1});
+                    },
+                    "placement"});
+  };
+  per_pixel_pass("placement.saliency", saliency_,
+                 {{in.final_image, Use::storage_read, PLACEMENT_BINDING_FINAL},
+                  {b.saliency, Use::storage_write, PLACEMENT_BINDING_SALIENCY}});
+  per_pixel_pass("placement.integral_costs", integral_costs_,
+                 {{b.saliency, Use::storage_read, PLACEMENT_BINDING_SALIENCY},
+                  {in.layers, Use::storage_read, PLACEMENT_BINDING_LAYERS},
+                  {b.costs, Use::storage_write, PLACEMENT_BINDING_COSTS}});
+  tables_.add_to(graph, b.costs, b.tables, "placement.sat", in.layer_count);
+}
+
+// Tile bounds, bucket counts, tiles sorted by bucket: for every label at once, since none of it
+// depends on where earlier labels go.
+void Placement::add_bounds(graph::Graph& graph, const Buffers& b) {
+  static constexpr const char* names[] = {"placement.bounds", "placement.buckets",
+                                          "placement.tiles"};
   for (const uint32_t phase :
        {PLACEMENT_PHASE_BOUNDS, PLACEMENT_PHASE_COUNT, PLACEMENT_PHASE_SORT}) {
-    static constexpr const char* names[] = {"placement.bounds", "placement.buckets",
-                                            "placement.tiles"};
     graph.add_pass(
         {names[phase],
          graph::PassKind::compute,
-         {{r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
-          {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
-          {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
-          // (one shader for the three phases: the bounds phase writes the bounds and
-          // the later ones read them, but each binds them writable; the tile list and
-          // the sizes are bound in each phase, only the last writes them)
-          {bounds, phase == PLACEMENT_PHASE_BOUNDS ? Use::storage_write : Use::storage_read_write,
+         {{b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
+          {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+          {b.order, Use::storage_read, PLACEMENT_BINDING_ORDER},
+          // (one shader for the three phases: the bounds phase writes the bounds and the later
+          // ones read them, but each binds them writable; the tile list and the sizes are bound
+          // in each phase, only the last writes them)
+          {b.bounds, phase == PLACEMENT_PHASE_BOUNDS ? Use::storage_write : Use::storage_read_write,
            PLACEMENT_BINDING_BOUNDS},
-          {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
-          {tiles, Use::storage_write, PLACEMENT_BINDING_TILES},
-          {lower, Use::storage_read_write, PLACEMENT_BINDING_LOWER},
-          {args, Use::storage_write, PLACEMENT_BINDING_ARGS}},
+          {b.buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
+          {b.tiles, Use::storage_write, PLACEMENT_BINDING_TILES},
+          {b.lower, Use::storage_read_write, PLACEMENT_BINDING_LOWER},
+          {b.args, Use::storage_write, PLACEMENT_BINDING_ARGS}},
          [this, phase](graph::PassContext& pc) {
            if (order_.empty()) return;
-           pc.bind(bounds_);
            gpu::PlacementParams p = params(pc.viewport, 0);
            p.phase = phase;
-           bounds_.push_constants(pc.cmd, p);
            const glm::uvec2 across = gpu::placement_tiles(pc.viewport.width, pc.viewport.height);
            const uint32_t tile_count = across.x * across.y;
            // Bounds: a workgroup of 64 per tile (its cells); then 64 tiles per group.
-           vkCmdDispatch(pc.cmd,
-                         phase == PLACEMENT_PHASE_BOUNDS ? tile_count : group_count(tile_count, 64),
-                         static_cast<uint32_t>(order_.size()), 1);
+           const uint32_t groups =
+               phase == PLACEMENT_PHASE_BOUNDS ? tile_count : group_count(tile_count, 64);
+           pc.dispatch_groups(bounds_, p, {groups, uint32_t(order_.size()), 1});
          },
          "placement"});
   }
-  // One dispatch per label and one more (dispatch j: the main pass of order position j - 1 and
-  // the speculative pass of j); each sizes the next one's main pass, and the next dispatch.
-  std::vector<graph::ResourceUse> label_uses{
-      {r.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
-      {r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
-      {order, Use::storage_read, PLACEMENT_BINDING_ORDER},
-      {results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
-      {r.constraints, Use::storage_read_write, PLACEMENT_BINDING_CONSTRAINTS},
-      {buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
-      {tiles, Use::storage_read_write, PLACEMENT_BINDING_TILES},
-      {args, Use::storage_read_write, PLACEMENT_BINDING_ARGS},
-      {speculative, Use::storage_read_write, PLACEMENT_BINDING_SPECULATIVE},
-      {regions, Use::storage_read_write, PLACEMENT_BINDING_REGIONS},
-      {samples, Use::storage_read_write, PLACEMENT_BINDING_SAMPLES}};
-  // (direct: the sizes are still written, but no barrier waits for them)
-  if (indirect_) label_uses.push_back({args, Use::indirect});
-  for (uint32_t step = 0; step <= label_count_; ++step) {
-    graph.add_pass({"placement.label", graph::PassKind::compute, label_uses,
-                    [this, step, args](graph::PassContext& pc) {
-                      // (fewer labels enabled this frame, or none)
-                      if (order_.empty() || step > order_.size()) return;
-                      pc.bind(place_);
-                      place_.push_constants(pc.cmd, params(pc.viewport, step));
-                      if (indirect_) {
-                        vkCmdDispatchIndirect(pc.cmd, pc.buffer(args),
-                                              VkDeviceSize{step} * 3 * sizeof(uint32_t));
-                        return;
-                      }
-                      // Room for any classification, the passes' tiles and the region
-                      // writer.
-                      const glm::uvec2 across =
-                          gpu::placement_tiles(pc.viewport.width, pc.viewport.height);
-                      const uint32_t tile_count = across.x * across.y;
-                      const glm::uvec3 groups = gpu::placement_dispatch_size(
-                          gpu::placement_classify_groups(tile_count) +
-                          std::min(2 * tile_count, std::max(layout_.direct_groups, 1u)) + 1);
-                      vkCmdDispatch(pc.cmd, groups.x, groups.y, groups.z);
-                    },
-                    "placement"});
-  }
+}
+
+// The greedy loop as one graph pass: a place_label dispatch per label and one more (dispatch j:
+// the main pass of order position j - 1 and the speculative pass of j), each reading what the one
+// before wrote, so the graph's barrier helper separates them. Each dispatch sizes the next one's
+// main pass, and the next dispatch.
+graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
+  std::vector<graph::ResourceUse> uses{
+      {b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
+      {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+      {b.order, Use::storage_read, PLACEMENT_BINDING_ORDER},
+      {b.results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
+      {b.constraints, Use::storage_read_write, PLACEMENT_BINDING_CONSTRAINTS},
+      {b.buckets, Use::storage_read_write, PLACEMENT_BINDING_BUCKETS},
+      {b.tiles, Use::storage_read_write, PLACEMENT_BINDING_TILES},
+      {b.args, Use::storage_read_write, PLACEMENT_BINDING_ARGS},
+      {b.speculative, Use::storage_read_write, PLACEMENT_BINDING_SPECULATIVE},
+      {b.regions, Use::storage_read_write, PLACEMENT_BINDING_REGIONS},
+      {b.samples, Use::storage_read_write, PLACEMENT_BINDING_SAMPLES}};
+  // (direct: the sizes are still written, but nothing waits for them)
+  if (indirect_) uses.push_back({b.args, Use::indirect});
+  const ResourceId args = b.args;
+  return graph.add_pass({"placement.labels", graph::PassKind::compute, std::move(uses),
+                         [this, args](graph::PassContext& pc) {
+                           for (uint32_t step = 0; !order_.empty() && step <= order_.size();
+                                ++step) {
+                             if (step > 0) pc.barrier();
+                             const gpu::PlacementParams p = params(pc.viewport, step);
+                             if (indirect_) {
+                               pc.dispatch_indirect(place_, p, args,
+                                                    VkDeviceSize{step} * 3 * sizeof(uint32_t));
+                             } else {
+                               pc.dispatch_groups(place_, p, direct_groups(pc.viewport));
+                             }
+                           }
+                         },
+                         "placement"});
+}
+
+// A direct place_label dispatch: room for any classification, the passes' tiles and the region
+// writer (workgroups past the sizes the GPU wrote leave at once).
+glm::uvec3 Placement::direct_groups(graph::Extent viewport) const {
+  const glm::uvec2 across = gpu::placement_tiles(viewport.width, viewport.height);
+  const uint32_t tile_count = across.x * across.y;
+  const uint32_t tiles = std::min(2 * tile_count, std::max(layout_.direct_groups, 1u));
+  return gpu::placement_dispatch_size(gpu::placement_classify_groups(tile_count) + tiles + 1);
+}
+
+// Each label's position and whether it is shown, copied to the host after the frame.
+void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
   graph.add_pass({"placement.finalize",
                   graph::PassKind::compute,
-                  {{r.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
-                   {results, Use::storage_read, PLACEMENT_BINDING_RESULTS},
-                   {r.placements, Use::storage_write, PLACEMENT_BINDING_PLACEMENTS}},
+                  {{b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+                   {b.results, Use::storage_read, PLACEMENT_BINDING_RESULTS},
+                   {b.placements, Use::storage_write, PLACEMENT_BINDING_PLACEMENTS}},
                   [this](graph::PassContext& pc) {
-                    pc.bind(finalize_);
-                    finalize_.push_constants(pc.cmd, params(pc.viewport, 0));
-                    vkCmdDispatch(pc.cmd, group_count(label_count_, 64), 1, 1);
+                    pc.dispatch(finalize_, params(pc.viewport, 0), {label_count_, 1, 1});
                   },
                   "placement"});
-  const ResourceId readback = readback_id_;
-  const ResourceId placements = r.placements;
   graph.add_pass({"placement.readback",
                   graph::PassKind::transfer,
-                  {{placements, Use::transfer_src}, {readback, Use::transfer_dst}},
-                  [this, placements, readback](graph::PassContext& pc) {
+                  {{b.placements, Use::transfer_src}, {b.readback, Use::transfer_dst}},
+                  [this, b](graph::PassContext& pc) {
                     const VkBufferCopy region{0, 0, readback_.size()};
-                    vkCmdCopyBuffer(pc.cmd, pc.buffer(placements), pc.buffer(readback), 1, &region);
+                    vkCmdCopyBuffer(pc.cmd, pc.buffer(b.placements), pc.buffer(b.readback), 1,
+                                    &region);
                   }});
-  return r;
 }
 
-void Placement::bind(graph::GraphRunner& runner) {
-  runner.bind_buffer(readback_id_, readback_.handle());
-}
-
-std::vector<PipelineReport> Placement::pipeline_statistics()
-    const {
+std::vector<PipelineReport> Placement::pipeline_statistics() const {
   std::vector<PipelineReport> out;
   for (const ComputePipeline* p : {&saliency_, &integral_costs_, &bounds_, &place_, &finalize_}) {
     out.push_back({p->name(), p->statistics()});

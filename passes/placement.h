@@ -61,17 +61,22 @@ struct PlacementLayout {
 
 class Placement {
  public:
-  struct Resources {
+  struct Inputs {
+    graph::ResourceId final_image;  // the label-free final image (rgba8)
+    graph::ResourceId layers;       // the depth layers (rgba16f array), premultiplied
+    uint32_t layer_count = 1;
+  };
+  struct Outputs {
     graph::ResourceId labels, placements, saliency, costs, tables, constraints, results;
     graph::ResourceId buckets;  // PlacementBucketsGpu per order position (benchmark statistics)
+    graph::PassId label_loop;   // the pass that places the labels one by one
   };
 
-  // `label_count` fixes the number of per-label passes; a frame may enable fewer labels.
+  // `label_count` sizes the per-label buffers; a frame may enable fewer labels.
   Placement(Context& ctx, uint32_t label_count, PlacementLayout layout = {});
 
-  Resources add_to(graph::Graph& graph, graph::ResourceId final_image, graph::ResourceId layers,
-                   uint32_t layer_count);
-  void bind(graph::GraphRunner& runner);
+  // Adds the placement's passes: upload, costs, bounds, the label loop, finalize and readback.
+  Outputs add_to(graph::Graph& graph, const Inputs& in);
 
   // This frame's labels (label_count of them; disabled ones are skipped) and insertion order
   // (indices of the enabled labels). Read when the frame is recorded.
@@ -85,6 +90,18 @@ class Placement {
   std::vector<PipelineReport> pipeline_statistics() const;
 
  private:
+  struct Buffers {
+    graph::ResourceId labels, order, results, placements, saliency, costs, tables, constraints;
+    graph::ResourceId bounds, tiles, buckets, lower, args, speculative, samples, regions;
+    graph::ResourceId readback;
+  };
+  Buffers add_buffers(graph::Graph& graph) const;
+  void add_upload(graph::Graph& graph, const Buffers& b);
+  void add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in);
+  void add_bounds(graph::Graph& graph, const Buffers& b);
+  graph::PassId add_label_loop(graph::Graph& graph, const Buffers& b);
+  void add_finalize(graph::Graph& graph, const Buffers& b);
+  glm::uvec3 direct_groups(graph::Extent viewport) const;
   gpu::PlacementParams params(graph::Extent viewport, uint32_t step) const;
 
   Context& ctx_;
@@ -98,7 +115,6 @@ class Placement {
   ComputePipeline saliency_, integral_costs_, bounds_, place_, finalize_;
   SummedAreaTable tables_;
   Buffer readback_;
-  graph::ResourceId readback_id_ = 0;
 };
 
 }  // namespace strata

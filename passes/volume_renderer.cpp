@@ -242,6 +242,10 @@ std::vector<float> split_depths(const RenderInputs& in, const Camera& camera,
 
 gpu::FrameGpu frame_data(const RenderInputs& in, const Camera& camera,
                          const RenderSettings& settings, graph::Extent e, uint32_t table_size) {
+  if (uint64_t{e.width} * e.height > (1u << 24)) {
+    throw Error("render: " + std::to_string(e.width) + "x" + std::to_string(e.height) +
+                " is more than the HA-Buffer's 16M pixels");
+  }
   if (settings.layer_count < 1 || settings.layer_count > VR_MAX_LAYERS) {
     throw Error("layers: " + std::to_string(settings.layer_count) + " is not in 1.." +
                 std::to_string(VR_MAX_LAYERS));
@@ -336,16 +340,23 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
       graph.add_image("render.layers", {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count, true});
   out.final = graph.add_image("render.final", {VK_FORMAT_R8G8B8A8_UNORM});
   out.depth = graph.add_image("render.depth", {VK_FORMAT_R32_SFLOAT});
-  const graph::ImportInfo sampled_image{true, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-  const graph::ImportInfo filled_buffer{false, true};
-  ids_.atlas = graph.import_resource("render.atlas", sampled_image);
-  ids_.transfer = graph.import_resource("render.transfer_table", filled_buffer);
-  ids_.volumes = graph.import_resource("render.volumes", filled_buffer);
-  ids_.occupancy = graph.import_resource("render.occupancy", filled_buffer);
-  ids_.vertices = graph.import_resource("render.vertices", filled_buffer);
-  ids_.indices = graph.import_resource("render.indices", filled_buffer);
-  ids_.readback = graph.import_resource("render.counters_readback",
-                                        {false, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::host_read});
+  const auto uploaded = [&graph](const char* name, const Buffer& buffer) {
+    return graph.import_buffer(name, {.buffer = buffer.handle(), .has_content = true});
+  };
+  ids_.atlas = graph.import_image("render.atlas",
+                                  {.image = atlas_.handle(),
+                                   .view = atlas_.view(),
+                                   .format = kAtlasFormat,
+                                   .has_content = true,
+                                   .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  ids_.transfer = uploaded("render.transfer_table", transfer_table_);
+  ids_.volumes = uploaded("render.volumes", volumes_);
+  ids_.occupancy = uploaded("render.occupancy", occupancy_);
+  ids_.vertices = uploaded("render.vertices", vertices_);
+  ids_.indices = uploaded("render.indices", indices_);
+  ids_.readback = graph.import_buffer(
+      "render.counters_readback",
+      {.buffer = counters_readback_.handle(), .final_use = Use::host_read});
 
   graph.add_pass({"render.clear",
                   graph::PassKind::transfer,
@@ -384,9 +395,7 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {out.final, Use::storage_write, VR_BINDING_FINAL},
                    {out.depth, Use::storage_write, VR_BINDING_DEPTH}},
                   [this](graph::PassContext& pc) {
-                    pc.bind(resolve_);
-                    vkCmdDispatch(pc.cmd, group_count(pc.viewport.width, VR_RESOLVE_GROUP),
-                                  group_count(pc.viewport.height, VR_RESOLVE_GROUP), 1);
+                    pc.dispatch(resolve_, {pc.viewport.width, pc.viewport.height, 1});
                   },
                   "render"});
   const ResourceId readback = ids_.readback;
@@ -398,21 +407,6 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                     vkCmdCopyBuffer(pc.cmd, pc.buffer(counters), pc.buffer(readback), 1, &region);
                   }});
   return out;
-}
-
-void VolumeRenderer::bind(graph::GraphRunner& runner) {
-  const graph::Extent e = runner.viewport();
-  if (uint64_t{e.width} * e.height > (1u << 24)) {
-    throw Error("render: " + std::to_string(e.width) + "x" + std::to_string(e.height) +
-                " is more than the HA-Buffer's 16M pixels");
-  }
-  runner.bind_image(ids_.atlas, atlas_.handle(), atlas_.view(), kAtlasFormat);
-  runner.bind_buffer(ids_.transfer, transfer_table_.handle());
-  runner.bind_buffer(ids_.volumes, volumes_.handle());
-  runner.bind_buffer(ids_.occupancy, occupancy_.handle());
-  runner.bind_buffer(ids_.vertices, vertices_.handle());
-  runner.bind_buffer(ids_.indices, indices_.handle());
-  runner.bind_buffer(ids_.readback, counters_readback_.handle());
 }
 
 void VolumeRenderer::record_build(graph::PassContext& pc) const {

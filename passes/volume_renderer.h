@@ -88,9 +88,9 @@ class VolumeRenderer {
   // empty-space grids, meshes into one vertex and one index buffer.
   VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings settings = {});
 
+  // Adds the renderer's passes; the uploaded scene and the counter readback are imported with
+  // their handles.
   Outputs add_to(graph::Graph& graph);
-  // Binds the uploaded scene and the counter readback; call after the runner has its viewport.
-  void bind(graph::GraphRunner& runner);
 
   void set_camera(const Camera& camera) { camera_ = camera; }
   RenderSettings& settings() { return settings_; }

@@ -124,22 +124,25 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
   drawing.set_label_count(static_cast<uint32_t>(s.labels.size()));
 
   graph::Graph g;
-  const graph::ImportInfo filled_buffer{false, true};
-  const auto layers_id =
-      g.import_resource("layers", {true, true, VK_IMAGE_LAYOUT_GENERAL, graph::Use::transfer_src});
-  const auto labels_id = g.import_resource("labels", filled_buffer);
-  const auto placements_id = g.import_resource("placements", filled_buffer);
-  const auto glyphs_id = g.import_resource("glyphs", filled_buffer);
+  const auto filled = [&g](const char* name, const Buffer& buffer) {
+    return g.import_buffer(name, {.buffer = buffer.handle(), .has_content = true});
+  };
+  const auto layers_id = g.import_image("layers", {.image = layers.handle(),
+                                                   .view = layers.view(),
+                                                   .format = layers.desc().format,
+                                                   .has_content = true,
+                                                   .initial_layout = VK_IMAGE_LAYOUT_GENERAL,
+                                                   .final_use = graph::Use::transfer_src});
   const auto final_id = g.add_image("final", {VK_FORMAT_R8G8B8A8_UNORM});
-  drawing.add_to(g, layers_id, labels_id, placements_id, glyphs_id, s.layer_count, final_id,
-                 s.background);
+  drawing.add_to(g, {.layers = layers_id,
+                     .layer_count = s.layer_count,
+                     .labels = filled("labels", labels),
+                     .placements = filled("placements", placements),
+                     .glyphs = filled("glyphs", glyphs),
+                     .output = final_id,
+                     .background = s.background});
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(s.size);
-  runner.bind_image(layers_id, layers.handle(), layers.view(), layers.desc().format);
-  runner.bind_buffer(labels_id, labels.handle());
-  runner.bind_buffer(placements_id, placements.handle());
-  runner.bind_buffer(glyphs_id, glyphs.handle());
-  drawing.bind(runner);
   runner.run_now();
 
   DrawnLabels out;

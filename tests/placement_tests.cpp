@@ -110,14 +110,18 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
 
   Placement placement(ctx, uint32_t(in.labels.size()), layout);
   graph::Graph g;
-  const auto final_id = g.import_resource("final", {true, true, VK_IMAGE_LAYOUT_GENERAL});
-  const auto layers_id = g.import_resource("layers", {true, true, VK_IMAGE_LAYOUT_GENERAL});
-  const Placement::Resources r = placement.add_to(g, final_id, layers_id, in.layer_count);
+  const auto general = [&g](const char* name, const Image& image) {
+    return g.import_image(name, {.image = image.handle(),
+                                 .view = image.view(),
+                                 .format = image.desc().format,
+                                 .has_content = true,
+                                 .initial_layout = VK_IMAGE_LAYOUT_GENERAL});
+  };
+  const Placement::Outputs r = placement.add_to(g, {.final_image = general("final", final_image),
+                                                      .layers = general("layers", layers),
+                                                      .layer_count = in.layer_count});
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(in.size);
-  runner.bind_image(final_id, final_image.handle(), final_image.view(), VK_FORMAT_R8G8B8A8_UNORM);
-  runner.bind_image(layers_id, layers.handle(), layers.view(), VK_FORMAT_R16G16B16A16_SFLOAT);
-  placement.bind(runner);
   placement.set_frame(in.labels, in.order, settings);
   runner.run_now();
   GpuPlacement out;

@@ -123,8 +123,8 @@ TEST_SUITE("cpu") {
 
   TEST_CASE("an_import_with_content_can_be_read_without_a_writer") {
     Graph g;
-    const ResourceId volume =
-        g.import_resource("volume", {true, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+    const ResourceId volume = g.import_image(
+        "volume", {.has_content = true, .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
     g.add_pass(pass("raycast", PassKind::compute, {{volume, Use::sampled}}));
     const CompiledGraph c = compile(g);
     CHECK(c.pass_barriers[0].empty());  // already in the layout it is read in, nothing to wait for
@@ -132,11 +132,10 @@ TEST_SUITE("cpu") {
 
   TEST_CASE("final_uses_of_imports_get_their_barriers_after_the_last_pass") {
     Graph g;
-    const ResourceId swapchain =
-        g.import_resource("swapchain", {true, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::present,
-                                        VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT});
-    const ResourceId readback =
-        g.import_resource("positions", {false, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::host_read});
+    const ResourceId swapchain = g.import_image(
+        "swapchain",
+        {.final_use = Use::present, .initial_stage = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT});
+    const ResourceId readback = g.import_buffer("positions", {.final_use = Use::host_read});
     g.add_pass(pass("blit", PassKind::transfer,
                     {{swapchain, Use::transfer_dst}, {readback, Use::transfer_dst}}));
     const CompiledGraph c = compile(g);
@@ -151,7 +150,7 @@ TEST_SUITE("cpu") {
 
   TEST_CASE("an_import_handed_on_unwritten_is_an_error") {
     Graph g;
-    g.import_resource("swapchain", {true, false, VK_IMAGE_LAYOUT_UNDEFINED, Use::present});
+    g.import_image("swapchain", {.final_use = Use::present});
     CHECK_THROWS_WITH_AS(compile(g), doctest::Contains("'swapchain'"), GraphError);
   }
 

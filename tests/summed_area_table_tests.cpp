@@ -19,14 +19,12 @@ std::vector<float> gpu_table(Context& ctx, const std::vector<float>& values, gra
   upload(ctx, input, as_bytes(values));
   SummedAreaTable sat(ctx);
   graph::Graph graph;
-  const auto in = graph.import_resource("input", {false, true});
-  const auto out = graph.import_resource(
-      "output", {false, false, VK_IMAGE_LAYOUT_UNDEFINED, graph::Use::transfer_src});
+  const auto in = graph.import_buffer("input", {.buffer = input.handle(), .has_content = true});
+  const auto out = graph.import_buffer(
+      "output", {.buffer = output.handle(), .final_use = graph::Use::transfer_src});
   sat.add_to(graph, in, out);
   graph::GraphRunner runner(ctx, std::move(graph));
   runner.set_viewport(size);
-  runner.bind_buffer(in, input.handle());
-  runner.bind_buffer(out, output.handle());
   runner.run_now();
   return download_as<float>(ctx, output);
 }

@@ -94,7 +94,6 @@ GpuResult render_gpu(Context& ctx, const Scene& scene, const Camera& camera,
   target.add_output(g, out.final);
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(size);
-  renderer.bind(runner);
   target.bind(runner);
   runner.run_now();
   GpuResult r;
@@ -281,14 +280,13 @@ TEST_SUITE("gpu") {
     target.add_output(g, renderer.add_to(g).final);
     graph::GraphRunner runner(ctx, std::move(g));
     runner.set_viewport(size);
+    target.bind(runner);
     const RenderInputs inputs = prepare_render_inputs(scene, 2048);
     const std::vector<uint8_t> expected =
         to_rgba8(render_reference(inputs, camera, {}, size).final);
 
     std::vector<RenderStats> frames;
     for (int frame = 0; frame < 2; ++frame) {
-      renderer.bind(runner);
-      target.bind(runner);
       runner.run_now();
       frames.push_back(renderer.collect(runner));
     }

@@ -366,6 +366,19 @@ uint32_t Context::memory_type(uint32_t allowed_types, VkMemoryPropertyFlags want
 }
 
 void Context::run_now(const std::function<void(VkCommandBuffer)>& record) {
+  const VkCommandBuffer cmd = begin_commands();
+  try {
+    record(cmd);
+  } catch (...) {
+    // (a recording that failed, e.g. on an undeclared resource, leaves nothing behind)
+    vkEndCommandBuffer(cmd);
+    vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+    throw;
+  }
+  submit_and_wait(cmd);
+}
+
+VkCommandBuffer Context::begin_commands() {
   VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   alloc.commandPool = pool_;
   alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
@@ -375,7 +388,10 @@ void Context::run_now(const std::function<void(VkCommandBuffer)>& record) {
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   STRATA_VK(vkBeginCommandBuffer(cmd, &begin));
-  record(cmd);
+  return cmd;
+}
+
+void Context::submit_and_wait(VkCommandBuffer cmd) {
   STRATA_VK(vkEndCommandBuffer(cmd));
 
   VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};

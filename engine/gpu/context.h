@@ -115,6 +115,10 @@ class Context {
   // Records `record` into a fresh command buffer, submits it and waits: for uploads, readbacks and
   // tests, never inside a frame.
   void run_now(const std::function<void(VkCommandBuffer)>& record);
+  // The two halves of run_now, for work that returns to the host part-way (GraphRunner::run_split):
+  // a fresh command buffer in the recording state; and its submission, a wait, and its release.
+  VkCommandBuffer begin_commands();
+  void submit_and_wait(VkCommandBuffer cmd);
 
  private:
   Instance instance_;

@@ -5,17 +5,78 @@
 
 namespace strata::graph {
 
-VkBuffer PassContext::buffer(ResourceId id) const {
-  return runner_->bound_.at(id).buffer;
-}
-VkImage PassContext::image(ResourceId id) const {
-  return runner_->bound_.at(id).image;
-}
-VkImageView PassContext::view(ResourceId id) const {
-  return runner_->bound_.at(id).view;
+const ResourceUse& PassContext::declared(ResourceId id) const {
+  const PassInfo& pass = runner_->graph_.passes()[pass_];
+  for (const ResourceUse& u : pass.uses) {
+    if (u.resource == id) return u;
+  }
+  const auto& resources = runner_->graph_.resources();
+  throw GraphError("pass '" + pass.name + "' touches " +
+                   (id < resources.size() ? "'" + resources[id].name + "'"
+                                          : "resource #" + std::to_string(id)) +
+                   ", which it did not declare");
 }
 
-void PassContext::bind(const Pipeline& pipeline) const {
+VkBuffer PassContext::buffer(ResourceId id) const {
+  declared(id);
+  return runner_->bound_[id].buffer;
+}
+VkImage PassContext::image(ResourceId id) const {
+  declared(id);
+  return runner_->bound_[id].image;
+}
+VkImageView PassContext::view(ResourceId id) const {
+  declared(id);
+  return runner_->bound_[id].view;
+}
+
+VkBuffer PassContext::indirect_buffer(ResourceId id) const {
+  const PassInfo& pass = runner_->graph_.passes()[pass_];
+  declared(id);
+  for (const ResourceUse& u : pass.uses) {
+    if (u.resource == id && u.use == Use::indirect) return runner_->bound_[id].buffer;
+  }
+  throw GraphError("pass '" + pass.name + "' dispatches from '" +
+                   runner_->graph_.resources()[id].name + "', which it did not declare indirect");
+}
+
+void PassContext::prepare(const ComputePipeline& pipeline, const void* push, uint32_t size) {
+  if (bound_ != &pipeline) bind(pipeline);
+  if (push) pipeline.push_constants(cmd, push, size);
+}
+
+void PassContext::dispatch_threads(const ComputePipeline& pipeline, glm::uvec3 threads) {
+  const std::array<uint32_t, 3> size = pipeline.local_size();
+  vkCmdDispatch(cmd, group_count(threads.x, size[0]), group_count(threads.y, size[1]),
+                group_count(threads.z, size[2]));
+}
+
+void PassContext::barrier() {
+  const PassInfo& pass = runner_->graph_.passes()[pass_];
+  if (pass.kind != PassKind::compute) {
+    throw GraphError("pass '" + pass.name + "' asks for a barrier between dispatches, but it is " +
+                     "not a compute pass");
+  }
+  VkMemoryBarrier2 memory{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+  memory.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  memory.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+  memory.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  memory.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+  for (const ResourceUse& u : pass.uses) {
+    if (u.use != Use::indirect) continue;
+    memory.dstStageMask |= VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
+    memory.dstAccessMask |= VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT;
+  }
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.memoryBarrierCount = 1;
+  dep.pMemoryBarriers = &memory;
+  vkCmdPipelineBarrier2(cmd, &dep);
+  const VkCommandBuffer next = runner_->split(cmd, {pass_, barriers_++});
+  if (next != cmd) bound_ = nullptr;  // a new command buffer has nothing bound
+  cmd = next;
+}
+
+void PassContext::bind(const Pipeline& pipeline) {
   std::vector<DescriptorResource> resources;
   const PassInfo& pass = runner_->graph_.passes()[pass_];
   for (const ResourceUse& u : pass.uses) {
@@ -26,12 +87,20 @@ void PassContext::bind(const Pipeline& pipeline) const {
                          runner_->compiled_.layout[pass_][u.resource], sampler});
   }
   pipeline.bind(cmd, resources);
+  bound_ = &pipeline;
 }
 
 GraphRunner::GraphRunner(Context& ctx, Graph graph)
     : ctx_(ctx), graph_(std::move(graph)), compiled_(compile(graph_)) {
   bound_.resize(graph_.resources().size());
   owned_.resize(graph_.resources().size());
+  for (size_t i = 0; i < graph_.resources().size(); ++i) {
+    const ResourceInfo& r = graph_.resources()[i];
+    if (!r.imported) continue;
+    bound_[i] = r.is_image ? Bound{VK_NULL_HANDLE, r.imported_image.image, r.imported_image.view,
+                                   r.imported_image.format}
+                           : Bound{r.imported_buffer.buffer};
+  }
   VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
   info.queryType = VK_QUERY_TYPE_TIMESTAMP;
   info.queryCount = static_cast<uint32_t>(2 * std::max<size_t>(1, graph_.passes().size()));
@@ -163,7 +232,7 @@ bool GraphRunner::stamps_end(uint32_t p) const {
   return per_pass_stamps_ || p + 1 == passes.size() || passes[p + 1].group != passes[p].group;
 }
 
-void GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
+VkCommandBuffer GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
   emit(cmd, compiled_.pass_barriers[p]);
   if (stamps_begin(p)) {
     vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p);
@@ -175,8 +244,9 @@ void GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
   pc.pass_ = p;
   graph_.passes()[p].record(pc);
   if (stamps_end(p)) {
-    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p + 1);
+    vkCmdWriteTimestamp2(pc.cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p + 1);
   }
+  return pc.cmd;
 }
 
 void GraphRunner::record(VkCommandBuffer cmd) {
@@ -187,24 +257,30 @@ void GraphRunner::record(VkCommandBuffer cmd) {
   emit(cmd, compiled_.final_barriers);
 }
 
-void GraphRunner::run_split(const std::function<bool(uint32_t)>& split_after,
-                            const std::function<void(uint32_t)>& after) {
+VkCommandBuffer GraphRunner::split(VkCommandBuffer cmd, const SplitPoint& point) {
+  if (!split_at_ || !(*split_at_)(point)) return cmd;
+  ctx_.submit_and_wait(cmd);
+  (*after_split_)(point);
+  return ctx_.begin_commands();
+}
+
+void GraphRunner::run_split(const std::function<bool(const SplitPoint&)>& split_at,
+                            const std::function<void(const SplitPoint&)>& after) {
   check_bound();
+  split_at_ = &split_at;
+  after_split_ = &after;
   const auto passes = static_cast<uint32_t>(graph_.passes().size());
-  uint32_t p = 0;
-  while (p < passes) {
-    uint32_t last = p;
-    ctx_.run_now([&](VkCommandBuffer cmd) {
-      if (p == 0) vkCmdResetQueryPool(cmd, queries_, 0, 2 * passes);
-      for (last = p; last < passes; ++last) {
-        record_pass(cmd, last);
-        if (split_after(last)) break;
-      }
-      if (last >= passes - 1) emit(cmd, compiled_.final_barriers);
-    });
-    if (last < passes) after(last);
-    p = last + 1;
+  VkCommandBuffer cmd = ctx_.begin_commands();
+  vkCmdResetQueryPool(cmd, queries_, 0, 2 * passes);
+  for (uint32_t p = 0; p < passes; ++p) {
+    cmd = record_pass(cmd, p);
+    if (p + 1 < passes) cmd = split(cmd, {p});
   }
+  emit(cmd, compiled_.final_barriers);
+  split_at_ = nullptr;
+  after_split_ = nullptr;
+  ctx_.submit_and_wait(cmd);
+  if (passes > 0 && split_at({passes - 1})) after({passes - 1});
 }
 
 void GraphRunner::run_now() {

@@ -2,12 +2,16 @@
 // records every pass behind the barriers compile() derived, and wraps each pass in timestamps.
 #pragma once
 
+#include <array>
 #include <functional>
+#include <optional>
 #include <memory>
 #include <span>
 #include <string>
 #include <variant>
 #include <vector>
+
+#include <glm/glm.hpp>
 
 #include "engine/graph/render_graph.h"
 #include "engine/gpu/resources.h"
@@ -21,10 +25,18 @@ namespace strata::graph {
 
 class GraphRunner;
 
-// What a pass's record function sees: its command buffer, the viewport, and its resources.
+// A place where GraphRunner::run_split may return to the host: after a pass, or at one of the
+// barriers a pass records between its dependent dispatches.
+struct SplitPoint {
+  PassId pass = 0;
+  std::optional<uint32_t> barrier;  // which of the pass's barriers; none: after the whole pass
+};
+
+// What a pass's record function sees: its command buffer, the viewport, and the resources it
+// declared. Asking for one it did not declare is a GraphError naming the pass and the resource.
 class PassContext {
  public:
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;  // may change at barrier() (GraphRunner::run_split)
   Extent viewport;
 
   VkBuffer buffer(ResourceId id) const;
@@ -32,12 +44,48 @@ class PassContext {
   VkImageView view(ResourceId id) const;
   // Binds `pipeline` and pushes every resource this pass declared with a binding index (sampled
   // images with the graph's linear clamp-to-edge sampler).
-  void bind(const Pipeline& pipeline) const;
+  void bind(const Pipeline& pipeline);
+
+  // Binds `pipeline` (unless this pass bound it last), pushes `push` and dispatches: enough
+  // workgroups of the pipeline's reflected size to cover `threads`, exactly `groups`, or the
+  // counts in the indirect-declared buffer `args` at `offset`.
+  template <typename Push>
+  void dispatch(const ComputePipeline& pipeline, const Push& push, glm::uvec3 threads) {
+    prepare(pipeline, &push, sizeof push);
+    dispatch_threads(pipeline, threads);
+  }
+  void dispatch(const ComputePipeline& pipeline, glm::uvec3 threads) {
+    prepare(pipeline, nullptr, 0);
+    dispatch_threads(pipeline, threads);
+  }
+  template <typename Push>
+  void dispatch_groups(const ComputePipeline& pipeline, const Push& push, glm::uvec3 groups) {
+    prepare(pipeline, &push, sizeof push);
+    vkCmdDispatch(cmd, groups.x, groups.y, groups.z);
+  }
+  template <typename Push>
+  void dispatch_indirect(const ComputePipeline& pipeline, const Push& push, ResourceId args,
+                         VkDeviceSize offset) {
+    prepare(pipeline, &push, sizeof push);
+    vkCmdDispatchIndirect(cmd, indirect_buffer(args), offset);
+  }
+
+  // Between two dependent dispatches of this (compute) pass: its shader writes become visible to
+  // its later dispatches, and to their indirect reads when it declared an indirect use. The
+  // graph's barriers order passes; this orders the steps inside one.
+  void barrier();
 
  private:
   friend class GraphRunner;
-  const GraphRunner* runner_ = nullptr;
-  uint32_t pass_ = 0;
+  const ResourceUse& declared(ResourceId id) const;
+  VkBuffer indirect_buffer(ResourceId id) const;
+  void prepare(const ComputePipeline& pipeline, const void* push, uint32_t size);
+  void dispatch_threads(const ComputePipeline& pipeline, glm::uvec3 threads);
+
+  GraphRunner* runner_ = nullptr;
+  PassId pass_ = 0;
+  const Pipeline* bound_ = nullptr;  // the pipeline this pass bound last in `cmd`
+  uint32_t barriers_ = 0;
 };
 
 struct PassTiming {
@@ -57,18 +105,19 @@ class GraphRunner {
   void set_viewport(Extent viewport);
   Extent viewport() const { return viewport_; }
 
-  // Imported resources are bound before each record.
+  // Re-binds an import whose handle changes between runs (a swapchain image, a resized
+  // readback); the others keep the handle they were imported with.
   void bind_buffer(ResourceId id, VkBuffer buffer);
   void bind_image(ResourceId id, VkImage image, VkImageView view, VkFormat format);
 
   void record(VkCommandBuffer cmd);
   // Records into a fresh command buffer, submits and waits (headless runs, benchmarks, tests).
   void run_now();
-  // The same work split into one submission per run of passes, waiting on the host after every
-  // pass for which `split_after` is true and calling `after` there: the structure of a program
-  // that returns to the CPU between passes (benchmark baselines).
-  void run_split(const std::function<bool(uint32_t pass)>& split_after,
-                 const std::function<void(uint32_t pass)>& after);
+  // The same work split into several submissions: at every point (after a pass, or at a pass's
+  // barrier) for which `split_at` is true it submits, waits on the host and calls `after`, the
+  // structure of a program that returns to the CPU there (benchmark baselines).
+  void run_split(const std::function<bool(const SplitPoint&)>& split_at,
+                 const std::function<void(const SplitPoint&)>& after);
 
   // Re-creates the transient resources (after a size function's answer changed, e.g. a grown
   // hash table), keeping the viewport.
@@ -99,7 +148,12 @@ class GraphRunner {
   };
   void emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) const;
   void check_bound() const;
-  void record_pass(VkCommandBuffer cmd, uint32_t pass);
+  // Records pass p; returns the command buffer that is current after it (run_split may submit
+  // inside a pass and go on in a new one).
+  VkCommandBuffer record_pass(VkCommandBuffer cmd, uint32_t pass);
+  // Inside run_split: submits `cmd` and waits if `split_at` wants it at `point`, then calls
+  // `after`; returns the command buffer to go on recording in.
+  VkCommandBuffer split(VkCommandBuffer cmd, const SplitPoint& point);
   // Whether pass p stamps its begin / its end (every pass, or a group's first / last).
   bool stamps_begin(uint32_t pass) const;
   bool stamps_end(uint32_t pass) const;
@@ -113,6 +167,8 @@ class GraphRunner {
   std::vector<Bound> bound_;
   VkQueryPool queries_ = VK_NULL_HANDLE;
   VkSampler linear_sampler_ = VK_NULL_HANDLE;
+  const std::function<bool(const SplitPoint&)>* split_at_ = nullptr;  // inside run_split only
+  const std::function<void(const SplitPoint&)>* after_split_ = nullptr;
 };
 
 }  // namespace strata::graph

@@ -3,8 +3,8 @@
 namespace strata {
 
 void HeadlessTarget::add_output(graph::Graph& graph, graph::ResourceId frame) {
-  readback_id_ = graph.import_resource(
-      "readback", {false, false, VK_IMAGE_LAYOUT_UNDEFINED, graph::Use::host_read});
+  // (bound by bind(): its size follows the viewport)
+  readback_id_ = graph.import_buffer("readback", {.final_use = graph::Use::host_read});
   const graph::ResourceId readback = readback_id_;
   graph.add_pass({"readback",
                   graph::PassKind::transfer,

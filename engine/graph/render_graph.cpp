@@ -1,6 +1,7 @@
 #include "engine/graph/render_graph.h"
 
 #include <algorithm>
+#include <utility>
 
 namespace strata::graph {
 namespace {
@@ -243,15 +244,25 @@ ResourceId Graph::add_buffer(std::string name, BufferInfo info) {
   return static_cast<ResourceId>(resources_.size() - 1);
 }
 
-ResourceId Graph::import_resource(std::string name, ImportInfo info) {
-  ResourceInfo r{std::move(name), info.is_image, true};
-  r.import = info;
+ResourceId Graph::import_buffer(std::string name, BufferImport info) {
+  ResourceInfo r{std::move(name), false, true};
+  r.import = {info.has_content, VK_IMAGE_LAYOUT_UNDEFINED, info.final_use};
+  r.imported_buffer = info;
   resources_.push_back(std::move(r));
   return static_cast<ResourceId>(resources_.size() - 1);
 }
 
-void Graph::add_pass(PassInfo pass) {
+ResourceId Graph::import_image(std::string name, ImageImport info) {
+  ResourceInfo r{std::move(name), true, true};
+  r.import = {info.has_content, info.initial_layout, info.final_use, info.initial_stage};
+  r.imported_image = info;
+  resources_.push_back(std::move(r));
+  return static_cast<ResourceId>(resources_.size() - 1);
+}
+
+PassId Graph::add_pass(PassInfo pass) {
   passes_.push_back(std::move(pass));
+  return static_cast<PassId>(passes_.size() - 1);
 }
 
 CompiledGraph compile(const Graph& graph) {
@@ -302,6 +313,90 @@ CompiledGraph compile(const Graph& graph) {
     }
   }
   return out;
+}
+
+namespace {
+
+// The names of the flags set in `flags`, joined by '|' ("none" when there are none).
+std::string flag_names(uint64_t flags, std::initializer_list<std::pair<uint64_t, const char*>> names) {
+  std::string out;
+  for (const auto& [bit, name] : names) {
+    if ((flags & bit) == 0) continue;
+    out += (out.empty() ? "" : "|") + std::string(name);
+    flags &= ~bit;
+  }
+  if (flags != 0) out += (out.empty() ? "" : "|") + std::string("other");
+  return out.empty() ? "none" : out;
+}
+
+std::string stage_names(VkPipelineStageFlags2 stages) {
+  return flag_names(stages, {{VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, "compute"},
+                             {VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT, "vertex"},
+                             {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, "fragment"},
+                             {VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, "indirect"},
+                             {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, "transfer"},
+                             {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, "color"},
+                             {VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
+                                  VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                              "depth"},
+                             {VK_PIPELINE_STAGE_2_HOST_BIT, "host"}});
+}
+
+std::string access_names(VkAccessFlags2 access) {
+  return flag_names(access, {{VK_ACCESS_2_SHADER_STORAGE_READ_BIT, "storage_read"},
+                             {VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, "storage_write"},
+                             {VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, "sampled"},
+                             {VK_ACCESS_2_UNIFORM_READ_BIT, "uniform"},
+                             {VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT, "indirect"},
+                             {VK_ACCESS_2_TRANSFER_READ_BIT, "transfer_read"},
+                             {VK_ACCESS_2_TRANSFER_WRITE_BIT, "transfer_write"},
+                             {VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT |
+                                  VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                              "color"},
+                             {VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                              "depth"},
+                             {VK_ACCESS_2_HOST_READ_BIT, "host_read"}});
+}
+
+std::string describe_barrier(const Graph& graph, const Barrier& b) {
+  std::string out = "    barrier '" + graph.resources()[b.resource].name + "': " +
+                    stage_names(b.src_stage) + " " + access_names(b.src_access) + " -> " +
+                    stage_names(b.dst_stage) + " " + access_names(b.dst_access);
+  if (b.is_image && b.old_layout != b.new_layout) {
+    out += ", layout " + std::to_string(b.old_layout) + " -> " + std::to_string(b.new_layout);
+  }
+  return out + "\n";
+}
+
+}  // namespace
+
+std::string describe(const Graph& graph, const CompiledGraph& compiled) {
+  static constexpr const char* kinds[] = {"compute", "graphics", "transfer"};
+  std::string out;
+  for (size_t p = 0; p < graph.passes().size(); ++p) {
+    const PassInfo& pass = graph.passes()[p];
+    out += "pass " + std::to_string(p) + " '" + pass.name + "' (" +
+           kinds[static_cast<int>(pass.kind)] + (pass.group.empty() ? "" : ", " + pass.group) +
+           ")\n";
+    for (const Barrier& b : compiled.pass_barriers[p]) out += describe_barrier(graph, b);
+    for (const ResourceUse& u : pass.uses) {
+      out += "    uses '" + graph.resources()[u.resource].name + "' as " + to_string(u.use);
+      if (u.binding) out += " at binding " + std::to_string(*u.binding);
+      out += "\n";
+    }
+  }
+  out += "after the last pass\n";
+  for (const Barrier& b : compiled.final_barriers) out += describe_barrier(graph, b);
+  out += std::to_string(graph.passes().size()) + " passes, " +
+         std::to_string(barrier_count(compiled)) + " barriers\n";
+  return out;
+}
+
+size_t barrier_count(const CompiledGraph& compiled) {
+  size_t count = compiled.final_barriers.size();
+  for (const auto& barriers : compiled.pass_barriers) count += barriers.size();
+  return count;
 }
 
 }  // namespace strata::graph

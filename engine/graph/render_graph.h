@@ -3,8 +3,9 @@
 // (graph_runner.h) creates the resources, records the passes and times each one on the GPU.
 //
 // Passes run in the order they are added. A resource is transient (created by the graph, sized
-// from the viewport) or imported (owned outside, bound before each run: a swapchain image, an
-// uploaded volume, a buffer the host reads afterwards).
+// from the viewport) or imported (owned outside and handed over with its handle when imported: an
+// uploaded volume, a buffer the host reads afterwards; only what changes from run to run, such as
+// the swapchain image, is bound again before a run).
 #pragma once
 
 #include <cstdint>
@@ -23,6 +24,7 @@ class ComputePipeline;
 namespace strata::graph {
 
 using ResourceId = uint32_t;
+using PassId = uint32_t;
 
 struct Extent {
   uint32_t width = 0;
@@ -71,14 +73,32 @@ struct BufferInfo {
   std::function<VkDeviceSize(Extent viewport)> size;
 };
 
-// Where an imported resource starts and how it must be left.
-struct ImportInfo {
-  bool is_image = false;
+// A buffer owned outside the graph: its handle, whether it holds content the passes may read,
+// and how it must be left (host_read for a readback).
+struct BufferImport {
+  VkBuffer buffer = VK_NULL_HANDLE;  // null: bound before each run (GraphRunner::bind_buffer)
+  bool has_content = false;
+  std::optional<Use> final_use;
+};
+
+// An image owned outside the graph, with where it starts and how it must be left.
+struct ImageImport {
+  VkImage image = VK_NULL_HANDLE;  // null: bound before each run (a swapchain image)
+  VkImageView view = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
   bool has_content = false;
   VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
-  std::optional<Use> final_use;  // host_read, present, transfer_src, sampled, ...
+  std::optional<Use> final_use;  // present, transfer_src, sampled, ...
   // The stage at which the outside producer's dependency ends (for a swapchain image, the wait
   // stage of the acquire semaphore), so the first barrier chains onto it.
+  VkPipelineStageFlags2 initial_stage = VK_PIPELINE_STAGE_2_NONE;
+};
+
+// What compile() needs of either kind of import.
+struct ImportInfo {
+  bool has_content = false;
+  VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  std::optional<Use> final_use;
   VkPipelineStageFlags2 initial_stage = VK_PIPELINE_STAGE_2_NONE;
 };
 
@@ -99,14 +119,17 @@ struct ResourceInfo {
   ImageInfo image;
   BufferInfo buffer;
   ImportInfo import;
+  BufferImport imported_buffer;  // the handles an import came with
+  ImageImport imported_image;
 };
 
 class Graph {
  public:
   ResourceId add_image(std::string name, ImageInfo info);
   ResourceId add_buffer(std::string name, BufferInfo info);
-  ResourceId import_resource(std::string name, ImportInfo info);
-  void add_pass(PassInfo pass);
+  ResourceId import_buffer(std::string name, BufferImport info);
+  ResourceId import_image(std::string name, ImageImport info);
+  PassId add_pass(PassInfo pass);
 
   const std::vector<ResourceInfo>& resources() const { return resources_; }
   const std::vector<PassInfo>& passes() const { return passes_; }
@@ -154,5 +177,11 @@ class GraphError : public std::runtime_error {
 };
 
 CompiledGraph compile(const Graph& graph);
+
+// The compiled graph as text, one pass a paragraph: its uses (resource, how, binding) and the
+// barriers before it, then the final barriers (`strata render --dump-graph`, tests).
+std::string describe(const Graph& graph, const CompiledGraph& compiled);
+// Barriers the graph emits in one run: before each pass and after the last.
+size_t barrier_count(const CompiledGraph& compiled);
 
 }  // namespace strata::graph

@@ -90,9 +90,10 @@ WindowTarget::~WindowTarget() {
 }
 
 void WindowTarget::add_output(graph::Graph& graph, graph::ResourceId frame) {
-  swapchain_id_ = graph.import_resource(
-      "swapchain", {true, false, VK_IMAGE_LAYOUT_UNDEFINED, graph::Use::present,
-                    VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT});
+  // (bound to the acquired image before each frame)
+  swapchain_id_ = graph.import_image(
+      "swapchain",
+      {.final_use = graph::Use::present, .initial_stage = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT});
   const graph::ResourceId target = swapchain_id_;
   graph.add_pass({"present.blit",
                   graph::PassKind::transfer,
