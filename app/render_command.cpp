@@ -30,7 +30,13 @@ struct RenderOptions {
   bool decoret = false;
   std::string order = "scene";
   std::string layout;
+  bool dump_graph = false;
 };
+
+// --dump-graph: the frame's compiled graph (passes, their uses and barriers) on stdout.
+void print_graph(const RenderOptions& o, graph::GraphRunner& runner) {
+  if (o.dump_graph) std::fputs(graph::describe(runner.graph(), runner.compiled()).c_str(), stdout);
+}
 
 // Layer images are premultiplied rgba16f; written as straight-alpha PNGs.
 void dump_layers(graph::GraphRunner& runner, graph::ResourceId layers, graph::Extent size,
@@ -80,8 +86,10 @@ void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
     settings.order = InsertionOrder::apollonius;
     settings.placement.hard = true;
   }
-  const LabelledFrame frame =
-      render_labelled(ctx, scene, camera_for(scene, o.camera), size, settings);
+  LabelledRenderer renderer(ctx, scene, camera_for(scene, o.camera), size, settings);
+  print_graph(o, renderer.runner());
+  renderer.run();
+  const LabelledFrame frame = renderer.result();
   write_png(o.output, size.width, size.height, frame.image);
   uint32_t shown = 0;
   for (const LabelLayout& l : frame.labels) shown += l.shown;
@@ -111,6 +119,7 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   graph::GraphRunner runner(ctx, std::move(graph));
   runner.set_viewport(size);
   target.bind(runner);
+  print_graph(o, runner);
   RenderStats stats;
   // An overflowing HA-Buffer grows for the next frame; an offline image waits for a clean one.
   for (int attempt = 0; attempt < 4; ++attempt) {
@@ -137,6 +146,7 @@ void render_test_pattern(DeviceOptions& device, const RenderOptions& o) {
   graph::GraphRunner runner(ctx, std::move(graph));
   runner.set_viewport(size);
   target.bind(runner);
+  print_graph(o, runner);
   runner.run_now();
   write_png(o.output, size.width, size.height, target.pixels());
   std::printf("wrote %s (%ux%u)\n", o.output.c_str(), size.width, size.height);
@@ -168,6 +178,8 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
                 "Stein & Decoret's setting: one layer, Apollonius order, hard constraints");
   cmd->add_option("--layout", o->layout,
                   "JSON file to write each label's layer, anchor, box, cost");
+  cmd->add_flag("--dump-graph", o->dump_graph,
+                "print the frame's render graph: passes, their uses and barriers");
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
       ->capture_default_str();
   cmd->callback([&device, o] {

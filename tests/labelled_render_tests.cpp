@@ -48,6 +48,23 @@ TEST_SUITE("gpu") {
   }
 }
 
+TEST_SUITE("gpu") {
+  // The labelled frame's graph, built (on the test device, for its pipelines) but not run: its
+  // passes and barriers do not grow with the labels, and a change that multiplies them fails here.
+  TEST_CASE_FIXTURE(test::GpuTest, "labelled_frame_graph_keeps_its_passes_and_barriers_for_any_label_count") {
+    for (const char* file : {"head.json", "head-100.json"}) {
+      CAPTURE(file);
+      const Scene scene = load_scene(std::string(STRATA_SOURCE_DIR "/assets/scenes/") + file);
+      LabelledRenderer renderer(ctx, scene, camera_for(scene, "front"), {64, 64}, {});
+      const graph::GraphRunner& runner = renderer.runner();
+      CHECK(runner.graph().passes().size() == 19);
+      CHECK(graph::barrier_count(runner.compiled()) == 50);
+      const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
+      CHECK(loop.name == "placement.labels");
+    }
+  }
+}
+
 namespace {
 
 double total_cost(const LabelledFrame& frame) {

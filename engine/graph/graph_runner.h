@@ -66,8 +66,9 @@ class PassContext {
   template <typename Push>
   void dispatch_indirect(const ComputePipeline& pipeline, const Push& push, ResourceId args,
                          VkDeviceSize offset) {
+    const VkBuffer buffer = indirect_buffer(args);
     prepare(pipeline, &push, sizeof push);
-    vkCmdDispatchIndirect(cmd, indirect_buffer(args), offset);
+    vkCmdDispatchIndirect(cmd, buffer, offset);
   }
 
   // Between two dependent dispatches of this (compute) pass: its shader writes become visible to
@@ -137,6 +138,7 @@ class GraphRunner {
   const Graph& graph() const { return graph_; }
   // Mutable so that a test can drop a barrier and show that validation catches it.
   CompiledGraph& compiled() { return compiled_; }
+  const CompiledGraph& compiled() const { return compiled_; }
 
  private:
   friend class PassContext;

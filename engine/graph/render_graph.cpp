@@ -359,12 +359,35 @@ std::string access_names(VkAccessFlags2 access) {
                              {VK_ACCESS_2_HOST_READ_BIT, "host_read"}});
 }
 
+const char* layout_name(VkImageLayout layout) {
+  switch (layout) {
+    case VK_IMAGE_LAYOUT_UNDEFINED:
+      return "undefined";
+    case VK_IMAGE_LAYOUT_GENERAL:
+      return "general";
+    case VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL:
+      return "color_attachment";
+    case VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL:
+      return "depth_attachment";
+    case VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL:
+      return "shader_read_only";
+    case VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL:
+      return "transfer_src";
+    case VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL:
+      return "transfer_dst";
+    case VK_IMAGE_LAYOUT_PRESENT_SRC_KHR:
+      return "present_src";
+    default:
+      return "other";
+  }
+}
+
 std::string describe_barrier(const Graph& graph, const Barrier& b) {
   std::string out = "    barrier '" + graph.resources()[b.resource].name + "': " +
                     stage_names(b.src_stage) + " " + access_names(b.src_access) + " -> " +
                     stage_names(b.dst_stage) + " " + access_names(b.dst_access);
   if (b.is_image && b.old_layout != b.new_layout) {
-    out += ", layout " + std::to_string(b.old_layout) + " -> " + std::to_string(b.new_layout);
+    out += std::string(", layout ") + layout_name(b.old_layout) + " -> " + layout_name(b.new_layout);
   }
   return out + "\n";
 }
