@@ -71,9 +71,8 @@ void PassContext::barrier() {
   dep.memoryBarrierCount = 1;
   dep.pMemoryBarriers = &memory;
   vkCmdPipelineBarrier2(cmd, &dep);
-  const VkCommandBuffer next = runner_->split(cmd, {pass_, barriers_++});
-  if (next != cmd) bound_ = nullptr;  // a new command buffer has nothing bound
-  cmd = next;
+  // (a new command buffer has nothing bound; its handle may be the old one's, reused)
+  if (runner_->split(cmd, {pass_, barriers_++})) bound_ = nullptr;
 }
 
 void PassContext::bind(const Pipeline& pipeline) {
@@ -257,11 +256,12 @@ void GraphRunner::record(VkCommandBuffer cmd) {
   emit(cmd, compiled_.final_barriers);
 }
 
-VkCommandBuffer GraphRunner::split(VkCommandBuffer cmd, const SplitPoint& point) {
-  if (!split_at_ || !(*split_at_)(point)) return cmd;
+bool GraphRunner::split(VkCommandBuffer& cmd, const SplitPoint& point) {
+  if (!split_at_ || !(*split_at_)(point)) return false;
   ctx_.submit_and_wait(cmd);
   (*after_split_)(point);
-  return ctx_.begin_commands();
+  cmd = ctx_.begin_commands();
+  return true;
 }
 
 void GraphRunner::run_split(const std::function<bool(const SplitPoint&)>& split_at,
@@ -274,7 +274,7 @@ void GraphRunner::run_split(const std::function<bool(const SplitPoint&)>& split_
   vkCmdResetQueryPool(cmd, queries_, 0, 2 * passes);
   for (uint32_t p = 0; p < passes; ++p) {
     cmd = record_pass(cmd, p);
-    if (p + 1 < passes) cmd = split(cmd, {p});
+    if (p + 1 < passes) split(cmd, {p});
   }
   emit(cmd, compiled_.final_barriers);
   split_at_ = nullptr;

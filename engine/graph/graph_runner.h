@@ -153,9 +153,9 @@ class GraphRunner {
   // Records pass p; returns the command buffer that is current after it (run_split may submit
   // inside a pass and go on in a new one).
   VkCommandBuffer record_pass(VkCommandBuffer cmd, uint32_t pass);
-  // Inside run_split: submits `cmd` and waits if `split_at` wants it at `point`, then calls
-  // `after`; returns the command buffer to go on recording in.
-  VkCommandBuffer split(VkCommandBuffer cmd, const SplitPoint& point);
+  // Inside run_split: if `split_at` wants it at `point`, submits `cmd`, waits, calls `after` and
+  // replaces `cmd` with a fresh command buffer; returns whether it did.
+  bool split(VkCommandBuffer& cmd, const SplitPoint& point);
   // Whether pass p stamps its begin / its end (every pass, or a group's first / last).
   bool stamps_begin(uint32_t pass) const;
   bool stamps_end(uint32_t pass) const;
