@@ -317,75 +317,48 @@ CompiledGraph compile(const Graph& graph) {
 
 namespace {
 
-// The names of the flags set in `flags`, joined by '|' ("none" when there are none).
-std::string flag_names(uint64_t flags, std::initializer_list<std::pair<uint64_t, const char*>> names) {
+// The names of the pipeline stages set in `stages`, joined by '|'.
+std::string stage_names(VkPipelineStageFlags2 stages) {
+  static constexpr std::pair<VkPipelineStageFlags2, const char*> names[] = {
+      {VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, "compute"},
+      {VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, "graphics"},
+      {VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, "indirect"},
+      {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, "transfer"},
+      {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, "color"},
+      {VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+       "depth"},
+      {VK_PIPELINE_STAGE_2_HOST_BIT, "host"}};
   std::string out;
-  for (const auto& [bit, name] : names) {
-    if ((flags & bit) == 0) continue;
+  for (const auto& [bits, name] : names) {
+    if ((stages & bits) == 0) continue;
     out += (out.empty() ? "" : "|") + std::string(name);
-    flags &= ~bit;
+    stages &= ~bits;
   }
-  if (flags != 0) out += (out.empty() ? "" : "|") + std::string("other");
+  if (stages != 0) out += (out.empty() ? "" : "|") + std::string("other");
   return out.empty() ? "none" : out;
 }
 
-std::string stage_names(VkPipelineStageFlags2 stages) {
-  return flag_names(stages, {{VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, "compute"},
-                             {VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT, "vertex"},
-                             {VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, "fragment"},
-                             {VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, "indirect"},
-                             {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, "transfer"},
-                             {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, "color"},
-                             {VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                                  VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                              "depth"},
-                             {VK_PIPELINE_STAGE_2_HOST_BIT, "host"}});
-}
-
-std::string access_names(VkAccessFlags2 access) {
-  return flag_names(access, {{VK_ACCESS_2_SHADER_STORAGE_READ_BIT, "storage_read"},
-                             {VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, "storage_write"},
-                             {VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, "sampled"},
-                             {VK_ACCESS_2_UNIFORM_READ_BIT, "uniform"},
-                             {VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT, "indirect"},
-                             {VK_ACCESS_2_TRANSFER_READ_BIT, "transfer_read"},
-                             {VK_ACCESS_2_TRANSFER_WRITE_BIT, "transfer_write"},
-                             {VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT |
-                                  VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                              "color"},
-                             {VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                              "depth"},
-                             {VK_ACCESS_2_HOST_READ_BIT, "host_read"}});
-}
-
 const char* layout_name(VkImageLayout layout) {
-  switch (layout) {
-    case VK_IMAGE_LAYOUT_UNDEFINED:
-      return "undefined";
-    case VK_IMAGE_LAYOUT_GENERAL:
-      return "general";
-    case VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL:
-      return "color_attachment";
-    case VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL:
-      return "depth_attachment";
-    case VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL:
-      return "shader_read_only";
-    case VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL:
-      return "transfer_src";
-    case VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL:
-      return "transfer_dst";
-    case VK_IMAGE_LAYOUT_PRESENT_SRC_KHR:
-      return "present_src";
-    default:
-      return "other";
+  static constexpr std::pair<VkImageLayout, const char*> names[] = {
+      {VK_IMAGE_LAYOUT_UNDEFINED, "undefined"},
+      {VK_IMAGE_LAYOUT_GENERAL, "general"},
+      {VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, "color_attachment"},
+      {VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, "depth_attachment"},
+      {VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, "shader_read_only"},
+      {VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, "transfer_src"},
+      {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, "transfer_dst"},
+      {VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, "present_src"}};
+  for (const auto& [value, name] : names) {
+    if (value == layout) return name;
   }
+  return "other";
 }
 
 std::string describe_barrier(const Graph& graph, const Barrier& b) {
   std::string out = "    barrier '" + graph.resources()[b.resource].name + "': " +
-                    stage_names(b.src_stage) + " " + access_names(b.src_access) + " -> " +
-                    stage_names(b.dst_stage) + " " + access_names(b.dst_access);
+                    stage_names(b.src_stage) + " -> " + stage_names(b.dst_stage);
+  // (what the pass then does with the resource is its use, listed below the barriers)
+  if (b.src_access == VK_ACCESS_2_NONE) out += ", execution only";
   if (b.is_image && b.old_layout != b.new_layout) {
     out += std::string(", layout ") + layout_name(b.old_layout) + " -> " + layout_name(b.new_layout);
   }
