@@ -1,14 +1,15 @@
 #include "labeling/labelled_render.h"
 
 #include <cmath>
-#include <cstdio>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
+#include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
+#include "engine/scene/io/transfer_function_loader.h"
 #include "labeling/insertion_order.h"
 #include "labeling/text_layout.h"
 #include "passes/label_drawing.h"
@@ -226,25 +227,23 @@ LabelledFrame render_labelled(Context& ctx, const Scene& scene, const Camera& ca
 }
 
 std::string layout_json(const LabelledFrame& frame) {
-  std::string out = "{\n  \"width\": " + std::to_string(frame.size.width) +
-                    ",\n  \"height\": " + std::to_string(frame.size.height) + ",\n  \"labels\": [";
-  char line[512];
-  for (size_t i = 0; i < frame.labels.size(); ++i) {
-    const LabelLayout& l = frame.labels[i];
-    std::string text;
-    for (char c : l.text) {
-      if (c == '"' || c == '\\') text += '\\';
-      if (static_cast<unsigned char>(c) >= 0x20) text += c;
-    }
-    std::snprintf(line, sizeof line,
-                  "%s\n    {\"id\": %d, \"text\": \"%s\", \"layer\": %u, \"anchor\": [%.2f, %.2f], "
-                  "\"box\": [%.2f, %.2f, %.0f, %.0f], \"shown\": %s, \"cost\": %.4f}",
-                  i ? "," : "", l.id, text.c_str(), l.layer, double(l.anchor.x), double(l.anchor.y),
-                  double(l.box_origin.x), double(l.box_origin.y), double(l.box_size.x),
-                  double(l.box_size.y), l.shown ? "true" : "false", double(l.cost));
-    out += line;
+  using ordered_json = nlohmann::ordered_json;
+  ordered_json labels = ordered_json::array();
+  for (const LabelLayout& l : frame.labels) {
+    labels.push_back({{"id", l.id},
+                      {"text", l.text},
+                      {"layer", l.layer},
+                      {"anchor", {shortest_double(l.anchor.x), shortest_double(l.anchor.y)}},
+                      {"box",
+                       {shortest_double(l.box_origin.x), shortest_double(l.box_origin.y),
+                        shortest_double(l.box_size.x), shortest_double(l.box_size.y)}},
+                      {"shown", l.shown},
+                      {"cost", shortest_double(l.cost)}});
   }
-  return out + "\n  ]\n}\n";
+  const ordered_json layout = {
+      {"width", frame.size.width}, {"height", frame.size.height}, {"labels", labels}};
+  // Label texts come from scene files: bytes that are not UTF-8 are replaced, never thrown on.
+  return layout.dump(2, ' ', false, ordered_json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace strata

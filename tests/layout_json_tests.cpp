@@ -1,0 +1,61 @@
+// `strata render --layout`'s file: valid JSON whatever the label texts hold, numbers as placed.
+#include <doctest/doctest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "labeling/labelled_render.h"
+
+namespace strata {
+namespace {
+
+// 1000 bytes of text with everything JSON must escape and a two-byte UTF-8 character.
+std::string awkward_text() {
+  const std::string piece = "Nucleus \"caudatus\" \\ left \xC3\xA9";  // é
+  std::string text;
+  while (text.size() + piece.size() <= 1000) text += piece;
+  text.append(1000 - text.size(), 'x');
+  return text;
+}
+
+}  // namespace
+
+TEST_SUITE("cpu") {
+  TEST_CASE("layout_json_round_trips_long_and_unicode_texts") {
+    LabelledFrame frame;
+    frame.size = {640, 480};
+    LabelLayout label;
+    label.id = 17;
+    label.text = awkward_text();
+    label.layer = 2;
+    label.anchor = {123.25f, 0.1f};
+    label.box_origin = {300.5f, 41.75f};
+    label.box_size = {96.0f, 18.0f};
+    label.shown = true;
+    label.cost = 3.14159f;
+    frame.labels = {label, LabelLayout{}};
+    REQUIRE(label.text.size() == 1000);
+
+    const nlohmann::json layout = nlohmann::json::parse(layout_json(frame));
+    CHECK(layout["width"] == 640);
+    CHECK(layout["height"] == 480);
+    REQUIRE(layout["labels"].size() == 2);
+    const nlohmann::json& l = layout["labels"][0];
+    CHECK(l["id"] == 17);
+    CHECK(l["text"].get<std::string>() == label.text);
+    CHECK(l["layer"] == 2);
+    // Floats are written with the digits that read back as the very same float.
+    const auto as_float = [](const nlohmann::json& value) { return value.get<float>(); };
+    CHECK(as_float(l["anchor"][0]) == label.anchor.x);
+    CHECK(as_float(l["anchor"][1]) == label.anchor.y);
+    CHECK(as_float(l["box"][0]) == label.box_origin.x);
+    CHECK(as_float(l["box"][1]) == label.box_origin.y);
+    CHECK(as_float(l["box"][2]) == label.box_size.x);
+    CHECK(as_float(l["box"][3]) == label.box_size.y);
+    CHECK(l["shown"] == true);
+    CHECK(as_float(l["cost"]) == label.cost);
+    CHECK(layout["labels"][1]["text"] == "");
+    CHECK(layout["labels"][1]["shown"] == false);
+  }
+}
+
+}  // namespace strata
