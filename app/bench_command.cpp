@@ -8,10 +8,13 @@
 #include <map>
 #include <random>
 
+#include <nlohmann/json.hpp>
+
 #include "app/commands.h"
-#include "engine/graph/graph_runner.h"
 #include "engine/gpu/resources.h"
+#include "engine/graph/graph_runner.h"
 #include "engine/scene/io/scene_loader.h"
+#include "engine/scene/io/transfer_function_loader.h"
 #include "labeling/labelled_render.h"
 #include "passes/summed_area_table.h"
 #include "passes/volume_renderer.h"
@@ -19,6 +22,8 @@
 
 namespace strata::app {
 namespace {
+
+using ordered_json = nlohmann::ordered_json;
 
 struct Stat {
   double median = 0.0;
@@ -30,15 +35,6 @@ Stat stat_of(std::vector<double> samples) {
   const size_t n = samples.size();
   const double median = n % 2 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
   return {median, samples.front()};
-}
-
-std::string json_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) >= 0x20) out += c;
-  }
-  return out;
 }
 
 struct Timings {
@@ -73,26 +69,36 @@ Timings measure(graph::GraphRunner& runner, uint32_t warmup, uint32_t runs,
   return out;
 }
 
-// {"device", "driver", <header>, "runs", "passes", "groups"<tail>}: header and tail are JSON
-// members ("key": value) each followed by ",\n" (header) or preceded by ",\n" (tail).
-void print_json(Context& ctx, const std::string& header, uint32_t runs, const Timings& t,
-                const std::string& tail = "") {
-  const auto print_list = [](const char* key,
-                             const std::vector<std::pair<std::string, Stat>>& list) {
-    std::printf("  \"%s\": [", key);
-    for (size_t i = 0; i < list.size(); ++i) {
-      std::printf("%s\n    {\"name\": \"%s\", \"median_ms\": %.6f, \"min_ms\": %.6f}", i ? "," : "",
-                  json_escape(list[i].first).c_str(), list[i].second.median, list[i].second.min);
-    }
-    std::printf("\n  ]");
-  };
-  std::printf("{\n  \"device\": \"%s\",\n  \"driver\": \"%s\",\n%s  \"runs\": %u,\n",
-              json_escape(ctx.report().name).c_str(), json_escape(ctx.report().driver).c_str(),
-              header.c_str(), runs);
-  print_list("passes", t.passes);
-  std::printf(",\n");
-  print_list("groups", t.groups);
-  std::printf("%s\n}\n", tail.c_str());
+// Milliseconds rounded to whole nanoseconds, the finest a GPU timestamp resolves: further digits
+// are noise of the arithmetic.
+double ms_json(double ms) {
+  return std::round(ms * 1e6) / 1e6;
+}
+
+// [{name, median_ms, min_ms}] in the order the passes or groups first ran.
+ordered_json stats_json(const std::vector<std::pair<std::string, Stat>>& list) {
+  ordered_json out = ordered_json::array();
+  for (const auto& [name, stat] : list) {
+    out.push_back(
+        {{"name", name}, {"median_ms", ms_json(stat.median)}, {"min_ms", ms_json(stat.min)}});
+  }
+  return out;
+}
+
+// One benchmark's report: the device, what was measured (`setup`: the benchmark's name and
+// parameters), the timings, then what the benchmark derived from them (`results`). Scripts read
+// the keys by name; the fixed order is for people.
+void print_json(Context& ctx, const ordered_json& setup, uint32_t runs, const Timings& t,
+                const ordered_json& results = ordered_json::object()) {
+  ordered_json report = {{"device", ctx.report().name}, {"driver", ctx.report().driver}};
+  report.update(setup);
+  report["runs"] = runs;
+  report["passes"] = stats_json(t.passes);
+  report["groups"] = stats_json(t.groups);
+  report.update(results);
+  // Device names and scene paths are bytes, not always UTF-8: replace what is not, never throw.
+  const std::string text = report.dump(2, ' ', false, ordered_json::error_handler_t::replace);
+  std::printf("%s\n", text.c_str());
 }
 
 void bench_sat(DeviceOptions& device, graph::Extent size, uint32_t runs) {
@@ -125,12 +131,11 @@ void bench_sat(DeviceOptions& device, graph::Extent size, uint32_t runs) {
     max_relative =
         std::max(max_relative, std::abs(gpu[i] - cpu[i]) / std::max(1.0, std::abs(cpu[i])));
   }
-  char header[256];
-  std::snprintf(header, sizeof header,
-                "  \"benchmark\": \"sat\",\n  \"width\": %u,\n  \"height\": %u,\n"
-                "  \"max_relative_error\": %.3g,\n",
-                size.width, size.height, max_relative);
-  print_json(ctx, header, runs, measure(runner, 3, runs));
+  const ordered_json setup = {{"benchmark", "sat"},
+                              {"width", size.width},
+                              {"height", size.height},
+                              {"max_relative_error", max_relative}};
+  print_json(ctx, setup, runs, measure(runner, 3, runs));
 }
 
 struct RenderBenchOptions {
@@ -166,26 +171,27 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
   // are in shared memory).
   const double rays = double(size.width) * size.height;
   const double fetches = double(last.fetches);
-  char header[512], tail[768];
-  std::snprintf(
-      header, sizeof header,
-      "  \"benchmark\": \"render\",\n  \"scene\": \"%s\",\n  \"camera\": \"%s\",\n"
-      "  \"width\": %u,\n  \"height\": %u,\n  \"layers\": %u,\n  \"empty_space_skipping\": %s,\n"
-      "  \"step\": %g,\n",
-      json_escape(o.scene).c_str(), json_escape(o.camera).c_str(), size.width, size.height,
-      o.layers, o.no_skipping ? "false" : "true",
-      double(frame_data(renderer.inputs(), renderer.camera(), settings, size, 1).step));
-  std::snprintf(
-      tail, sizeof tail,
-      ",\n  \"samples_per_ray\": %.2f,\n  \"shaded_samples_per_ray\": %.2f,\n"
-      "  \"habuffer_fragments\": %u,\n  \"habuffer_slots\": %u,\n  \"habuffer_load_factor\": "
-      "%.3f,\n"
-      "  \"habuffer_overflow\": %u,\n  \"resolve_overflow\": %u,\n"
-      "  \"texture_fetches_per_frame\": %.0f,\n  \"resolve_fetch_rate_gtexel_per_s\": %.3f",
-      double(last.samples) / rays, double(last.shaded) / rays, last.fragments, last.table_size,
-      last.load_factor(), last.overflow, last.resolve_overflow, fetches,
-      resolve_ms > 0.0 ? fetches / (resolve_ms * 1e-3) * 1e-9 : 0.0);
-  print_json(ctx, header, runs, t, tail);
+  // The sampling distance the frame used (--step 0 asks for half a voxel).
+  const float step = frame_data(renderer.inputs(), renderer.camera(), settings, size, 1).step;
+  const ordered_json setup = {{"benchmark", "render"},
+                              {"scene", o.scene},
+                              {"camera", o.camera},
+                              {"width", size.width},
+                              {"height", size.height},
+                              {"layers", o.layers},
+                              {"empty_space_skipping", !o.no_skipping},
+                              {"step", shortest_double(step)}};
+  const ordered_json results = {{"samples_per_ray", double(last.samples) / rays},
+                                {"shaded_samples_per_ray", double(last.shaded) / rays},
+                                {"habuffer_fragments", last.fragments},
+                                {"habuffer_slots", last.table_size},
+                                {"habuffer_load_factor", last.load_factor()},
+                                {"habuffer_overflow", last.overflow},
+                                {"resolve_overflow", last.resolve_overflow},
+                                {"texture_fetches_per_frame", last.fetches},
+                                {"resolve_fetch_rate_gtexel_per_s",
+                                 resolve_ms > 0.0 ? fetches / (resolve_ms * 1e-3) * 1e-9 : 0.0}};
+  print_json(ctx, setup, runs, t, results);
 }
 
 struct PlacementBenchOptions {
@@ -208,6 +214,17 @@ void resize_labels(Scene& scene, uint32_t count) {
     l.id = int(i) + 1;
     scene.labels.push_back(l);
   }
+}
+
+// What the driver reports per pipeline (registers, ...), if anything: {pipeline: {name: value}}.
+ordered_json pipelines_json(const std::vector<PipelineReport>& reports) {
+  ordered_json out = ordered_json::object();
+  for (const auto& [name, statistics] : reports) {
+    if (statistics.empty()) continue;
+    ordered_json& entry = out[name];
+    for (const auto& s : statistics) entry[s.name] = s.value;
+  }
+  return out;
 }
 
 void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint32_t runs) {
@@ -289,39 +306,26 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint
   const double baseline_total = placement_ms - loop_ms + baseline.median;
   uint32_t enabled = 0;
   for (const LabelLayout& l : frame.result().labels) enabled += l.shown;
-  char header[512], tail[1024];
-  std::snprintf(
-      header, sizeof header,
-      "  \"benchmark\": \"placement\",\n  \"scene\": \"%s\",\n  \"width\": %u,\n"
-      "  \"height\": %u,\n  \"labels\": %zu,\n  \"labels_shown\": %u,\n  \"layers\": %u,\n",
-      json_escape(o.scene).c_str(), size.width, size.height, scene.labels.size(), enabled,
-      frame.result().layering.layer_count);
-  std::snprintf(tail, sizeof tail,
-                ",\n  \"placement_ms\": %.6f,\n  \"placement_ms_stamped_per_pass\": %.6f,\n"
-                "  \"label_loop_ms\": %.6f,\n"
-                "  \"label_loop_with_readback_per_label_ms\": %.6f,\n"
-                "  \"placement_with_readback_per_label_ms\": %.6f,\n  \"speedup\": %.2f,\n"
-                "  \"tiles\": %u,\n  \"tiles_per_label_speculative\": %.1f,\n"
-                "  \"tiles_per_label_main_beyond_speculative\": %.1f",
-                whole_ms, placement_ms, loop_ms, baseline.median, baseline_total,
-                whole_ms > 0.0 ? baseline_total / whole_ms : 0.0,
-                gpu::placement_tiles(size.width, size.height).x *
-                    gpu::placement_tiles(size.width, size.height).y,
-                first_tiles, rest_tiles);
-  std::string pipelines;  // what the driver reports per pipeline (registers, ...), if anything
-  for (const auto& [name, stats] : frame.placement_pipelines()) {
-    if (stats.empty()) continue;
-    pipelines +=
-        std::string(pipelines.empty() ? "" : ",") + "\n    \"" + json_escape(name) + "\": {";
-    for (size_t i = 0; i < stats.size(); ++i) {
-      pipelines += std::string(i ? ", " : "") + "\"" + json_escape(stats[i].name) + "\": \"" +
-                   json_escape(stats[i].value) + "\"";
-    }
-    pipelines += "}";
-  }
-  const std::string rest =
-      tail + (pipelines.empty() ? "" : ",\n  \"pipelines\": {" + pipelines + "\n  }");
-  print_json(ctx, header, runs, t, rest);
+  const ordered_json setup = {{"benchmark", "placement"},
+                              {"scene", o.scene},
+                              {"width", size.width},
+                              {"height", size.height},
+                              {"labels", scene.labels.size()},
+                              {"labels_shown", enabled},
+                              {"layers", frame.result().layering.layer_count}};
+  const glm::uvec2 tiles = gpu::placement_tiles(size.width, size.height);
+  ordered_json results = {{"placement_ms", ms_json(whole_ms)},
+                          {"placement_ms_stamped_per_pass", ms_json(placement_ms)},
+                          {"label_loop_ms", ms_json(loop_ms)},
+                          {"label_loop_with_readback_per_label_ms", ms_json(baseline.median)},
+                          {"placement_with_readback_per_label_ms", ms_json(baseline_total)},
+                          {"speedup", whole_ms > 0.0 ? baseline_total / whole_ms : 0.0},
+                          {"tiles", tiles.x * tiles.y},
+                          {"tiles_per_label_speculative", first_tiles},
+                          {"tiles_per_label_main_beyond_speculative", rest_tiles}};
+  const ordered_json pipelines = pipelines_json(frame.placement_pipelines());
+  if (!pipelines.empty()) results["pipelines"] = pipelines;
+  print_json(ctx, setup, runs, t, results);
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
 #include "engine/core/png.h"
 #include "gpu_fixture.h"
 
@@ -33,10 +35,23 @@ TEST_SUITE("cli") {
   TEST_CASE("bench_sat_prints_json_with_device_passes_and_a_checked_result") {
     const auto r = run_strata("bench sat --size 96x40 --runs 3");
     CHECK(r.exit_code == 0);
-    CHECK(r.output.find("\"device\": \"llvmpipe") != std::string::npos);
-    CHECK(r.output.find("\"name\": \"summed_area_table.scan\"") != std::string::npos);
-    CHECK(r.output.find("\"name\": \"summed_area_table\", \"median_ms\"") != std::string::npos);
-    CHECK(r.output.find("\"max_relative_error\": ") != std::string::npos);
+    // The report is the one object in the output; stderr's lines may come before or after it.
+    const size_t start = r.output.find("{\n"), end = r.output.rfind("\n}");
+    REQUIRE(end != std::string::npos);
+    REQUIRE(start < end);
+    const nlohmann::json report = nlohmann::json::parse(r.output.substr(start, end + 2 - start));
+    CHECK(report["device"].get<std::string>().starts_with("llvmpipe"));
+    CHECK(report["benchmark"] == "sat");
+    CHECK(report["runs"] == 3);
+    const auto named = [](const nlohmann::json& list, const std::string& name) {
+      for (const auto& entry : list) {
+        if (entry["name"] == name) return entry;
+      }
+      return nlohmann::json();
+    };
+    CHECK(named(report["passes"], "summed_area_table.scan")["median_ms"].is_number());
+    CHECK(named(report["groups"], "summed_area_table")["min_ms"].is_number());
+    CHECK(report["max_relative_error"].get<double>() < 1e-5);
   }
 
   TEST_CASE("no_vulkan_driver_is_one_clear_error_and_exit_1") {
