@@ -1,7 +1,7 @@
 # Compiles every GLSL shader in a folder to SPIR-V with glslangValidator at build time and embeds
 # the words in a static library. Each shader's #include dependencies come from glslang's depfile,
 # so editing a header in shaders/shared/ rebuilds exactly the shaders that include it.
-# The library exposes strata::embedded_shaders() (engine/shader_library.h reads it by name).
+# The library exposes strata::embedded_shaders() (engine/gpu/shader_library.h reads it by name).
 function(strata_add_shaders target)
   cmake_parse_arguments(ARG "" "DIRECTORY" "" ${ARGN})
   file(GLOB sources CONFIGURE_DEPENDS ${ARG_DIRECTORY}/*.comp ${ARG_DIRECTORY}/*.vert

@@ -1,5 +1,5 @@
-// The demo image (until scenes and rendering land): shaders/shared/test_pattern.h drawn into a
-// colour image, its luminance summed into a table, and the right half box-filtered from it.
+// What `strata render` and `strata view` show without a scene: shaders/shared/test_pattern.h drawn
+// into a colour image, its luminance summed into a table, and the right half box-filtered from it.
 #pragma once
 
 #include <vector>

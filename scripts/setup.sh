@@ -12,7 +12,7 @@ packages=(
   libspirv-cross-c-shared-dev
   # libraries
   libglm-dev libglfw3-dev libimgui-dev doctest-dev libcli11-dev libstb-dev
-  fonts-dejavu-core  # label text (engine/font.cpp)
+  fonts-dejavu-core  # label text (engine/core/font.cpp)
   # file formats: gzip, DICOM, meshes, JSON, XML
   zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev
   # window tests without a display

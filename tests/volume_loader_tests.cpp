@@ -1,4 +1,4 @@
-// The volume readers (engine/volume_loader.h): real data from Debian's archive
+// The volume readers (engine/scene/io/volume_loader.h): real data from Debian's archive
 // (scripts/fetch-data.sh), files written here at run time, and the bad inputs a user's file can
 // hold: each must give one strata::Error naming the file and the reason.
 #include <doctest/doctest.h>

@@ -16,7 +16,7 @@ namespace strata {
 
 class Context;
 
-// The SPIR-V of shaders/<name> (e.g. "summed_area_table_tiles.comp"); throws Error if unknown.
+// The SPIR-V of shaders/<name> (e.g. "summed_area_table_scan.comp"); throws Error if unknown.
 std::span<const uint32_t> shader_code(std::string_view name);
 std::vector<std::string_view> shader_names();
 

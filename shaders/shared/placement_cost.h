@@ -1,5 +1,5 @@
 // Constraints (thesis 3.2.1, 4.1.1) and the cost of eq. 3.1 at one candidate position, written
-// once for the GPU (place_label.comp) and the CPU reference (labeling/placement_reference.cpp).
+// once for the GPU (place_label.comp) and the CPU reference (passes/placement_reference.cpp).
 // The includer provides:
 //   params                         PlacementParams
 //   uint placed_count()            how many placed labels to test against (all placed so far,
