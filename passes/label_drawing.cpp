@@ -15,6 +15,8 @@ using graph::Use;
 namespace gpu {
 namespace {
 
+using glm::ivec2;  // the software sampler's texel coordinates, by their GLSL name like the rest
+
 // labels.draw's pixel on the CPU: the shared loop is included inside this struct, so its
 // functions see the buffer accessors and the software sampler below as members.
 struct LabelDrawReference {

@@ -9,6 +9,8 @@ namespace strata {
 namespace gpu {
 namespace {
 
+using glm::ivec3;  // the software sampler's voxel coordinates, by their GLSL name like the rest
+
 // One pixel's work on the CPU. The shared resolve is included inside this struct, so its
 // functions see `frame` and the sampling functions below as members.
 struct Reference {

@@ -1,14 +1,57 @@
-// Lets one header declare structs and constants for both C++ and GLSL.
+// Lets one header declare structs, constants and functions for both C++ and GLSL.
 #ifndef STRATA_SHARED_COMMON_H
 #define STRATA_SHARED_COMMON_H
 
 #ifdef __cplusplus
 #include <cstdint>
-#define STRATA_BEGIN namespace strata::gpu { using uint = uint32_t;
+
+#include <glm/glm.hpp>
+
+// The GLSL types and built-in functions the shared headers use, under their GLSL names. Each is
+// taken from GLM by name: a using-directive would pour all of GLM into strata::gpu, where its
+// other names could silently win overload resolution over strata's own.
+namespace strata::gpu {
+using uint = uint32_t;
+using glm::mat3;
+using glm::mat4;
+using glm::uvec2;
+using glm::uvec3;
+using glm::uvec4;
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
+
+using glm::abs;
+using glm::all;
+using glm::ceil;
+using glm::clamp;
+using glm::dot;
+using glm::floor;
+using glm::greaterThanEqual;
+using glm::length;
+using glm::lessThanEqual;
+using glm::max;
+using glm::min;
+using glm::mix;
+using glm::normalize;
+using glm::packUnorm4x8;
+using glm::pow;
+using glm::sin;
+using glm::smoothstep;
+using glm::sqrt;
+using glm::transpose;
+using glm::unpackUnorm4x8;
+}  // namespace strata::gpu
+
+#define STRATA_BEGIN namespace strata::gpu {
 #define STRATA_END }
+// A function defined in a shared header is inline in C++, so that every file may include it;
+// GLSL has no such keyword.
+#define STRATA_INLINE inline
 #else
 #define STRATA_BEGIN
 #define STRATA_END
+#define STRATA_INLINE
 #endif
 
 #endif

@@ -18,11 +18,6 @@
 #define LABEL_DRAW_BINDING_FINAL 5       // rgba8: the layers composited over the background
 
 STRATA_BEGIN
-#ifdef __cplusplus
-#define LABEL_INLINE inline
-#else
-#define LABEL_INLINE
-#endif
 
 struct LabelDrawParams {
   uint width;
@@ -46,21 +41,21 @@ const float LABEL_MARKER_RADIUS = 4.0f;
 const float LABEL_MARKER_OUTLINE = 1.5f;
 
 // Eq. 3.9's "over" for premultiplied colours, front to back.
-LABEL_INLINE vec4 label_over(vec4 front, vec4 back) {
+STRATA_INLINE vec4 label_over(vec4 front, vec4 back) {
   return front + (1.0f - front.a) * back;
 }
 
-LABEL_INLINE vec4 label_premultiplied(vec4 color, float coverage) {
+STRATA_INLINE vec4 label_premultiplied(vec4 color, float coverage) {
   float a = color.a * coverage;
   return vec4(vec3(color) * a, a);
 }
 
 // Coverage of a pixel whose centre is `signed_distance` outside a shape (negative: inside).
-LABEL_INLINE float label_edge_coverage(float signed_distance) {
+STRATA_INLINE float label_edge_coverage(float signed_distance) {
   return clamp(0.5f - signed_distance, 0.0f, 1.0f);
 }
 
-LABEL_INLINE float label_segment_distance(vec2 p, vec2 a, vec2 b) {
+STRATA_INLINE float label_segment_distance(vec2 p, vec2 a, vec2 b) {
   vec2 ab = b - a;
   float length2 = dot(ab, ab);
   float t = length2 > 0.0f ? clamp(dot(p - a, ab) / length2, 0.0f, 1.0f) : 0.0f;
@@ -68,14 +63,14 @@ LABEL_INLINE float label_segment_distance(vec2 p, vec2 a, vec2 b) {
 }
 
 // Signed distance from p to a box with rounded corners (negative inside).
-LABEL_INLINE float label_box_distance(vec2 p, vec2 centre, vec2 half_size, float radius) {
+STRATA_INLINE float label_box_distance(vec2 p, vec2 centre, vec2 half_size, float radius) {
   vec2 q = abs(p - centre) - half_size + radius;
   return length(max(q, vec2(0.0f))) + min(max(q.x, q.y), 0.0f) - radius;
 }
 
 // The connector (from the anchor to the nearest point of the box), the box and its border at p,
 // premultiplied: everything of a label but its text and anchor marker.
-LABEL_INLINE vec4 label_frame(vec2 p, vec2 anchor, vec2 centre, vec2 size, bool connector) {
+STRATA_INLINE vec4 label_frame(vec2 p, vec2 anchor, vec2 centre, vec2 size, bool connector) {
   vec2 half_size = 0.5f * size;
   vec4 color = vec4(0.0f);
   if (connector) {
@@ -91,7 +86,7 @@ LABEL_INLINE vec4 label_frame(vec2 p, vec2 anchor, vec2 centre, vec2 size, bool 
 }
 
 // A filled disc with a dark rim on the anchor, premultiplied.
-LABEL_INLINE vec4 label_anchor_marker(vec2 p, vec2 anchor) {
+STRATA_INLINE vec4 label_anchor_marker(vec2 p, vec2 anchor) {
   float d = length(p - anchor);
   vec4 rim =
       label_premultiplied(LABEL_MARKER_OUTLINE_COLOR, label_edge_coverage(d - LABEL_MARKER_RADIUS));
@@ -102,7 +97,7 @@ LABEL_INLINE vec4 label_anchor_marker(vec2 p, vec2 anchor) {
 
 // True when p lies outside everything a label draws (box, connector, marker and their ramps), so
 // the label's shapes need not be evaluated there: they would all be exactly zero.
-LABEL_INLINE bool label_far_from(vec2 p, vec2 anchor, vec2 centre, vec2 size) {
+STRATA_INLINE bool label_far_from(vec2 p, vec2 anchor, vec2 centre, vec2 size) {
   float margin = LABEL_MARKER_RADIUS + 1.0f;
   vec2 lo = min(centre - 0.5f * size, anchor) - margin;
   vec2 hi = max(centre + 0.5f * size, anchor) + margin;
@@ -110,7 +105,7 @@ LABEL_INLINE bool label_far_from(vec2 p, vec2 anchor, vec2 centre, vec2 size) {
 }
 
 // The final pixel: the layers' front-to-back composite over the background, opaque.
-LABEL_INLINE vec4 label_over_background(vec4 layers, vec3 background) {
+STRATA_INLINE vec4 label_over_background(vec4 layers, vec3 background) {
   return vec4(vec3(layers) + (1.0f - layers.a) * background, 1.0f);
 }
 STRATA_END

@@ -5,10 +5,6 @@
 
 #include "common.h"
 
-#ifdef __cplusplus
-#include <glm/glm.hpp>
-#endif
-
 #define LABEL_MAX 256
 
 // LabelGpu.flags
@@ -20,9 +16,6 @@
 #define PLACEMENT_SHOWN 1u
 
 STRATA_BEGIN
-#ifdef __cplusplus
-using namespace glm;
-#endif
 
 struct LabelGpu {
   vec2 anchor;       // pixels, x right, y down (pixel centres at +0.5)

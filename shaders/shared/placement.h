@@ -77,9 +77,6 @@
 #define PLACEMENT_PHASE_SORT 2u     // ... tiles sorted by bucket, the first dispatch's size
 
 STRATA_BEGIN
-#ifdef __cplusplus
-using namespace glm;
-#endif
 
 // Cost weights of eq. 3.1 (defaults: the thesis program's final paper settings).
 struct CostWeightsGpu {
@@ -136,66 +133,42 @@ struct PlacementBucketsGpu {
   uint cursors[PLACEMENT_BUCKETS];
 };
 
-#ifdef __cplusplus
-inline
-#endif
 // The top-left pixel of a label box of `size` whose candidate pixel is p.
-vec2 box_origin(uvec2 p, vec2 size) { return vec2(p) - floor(size * 0.5f); }
+STRATA_INLINE vec2 box_origin(uvec2 p, vec2 size) { return vec2(p) - floor(size * 0.5f); }
 
 // The classifying workgroups of a label whose tile list has `beyond` entries past bucket 0.
-#ifdef __cplusplus
-inline
-#endif
-    uint
-    placement_classify_groups(uint beyond) {
+STRATA_INLINE uint placement_classify_groups(uint beyond) {
   return (beyond + PLACEMENT_CLASSIFY_TILES - 1u) / PLACEMENT_CLASSIFY_TILES;
 }
 
 // The workgroups of a place_label dispatch sized to its passes: a main pass of `main_tiles`, the
 // next label's speculative pass and classification (its list: `listed` entries, `spec_tiles` of
 // them in bucket 0), and the region writer.
-#ifdef __cplusplus
-inline
-#endif
-    uint
-    placement_label_groups(uint main_tiles, uint spec_tiles, uint listed) {
+STRATA_INLINE uint placement_label_groups(uint main_tiles, uint spec_tiles, uint listed) {
   return main_tiles + spec_tiles + placement_classify_groups(listed - spec_tiles) + 1u;
 }
 
-#ifdef __cplusplus
-inline
-#endif
 // The workgroup counts of an indirect dispatch over `count` tiles (x is limited to 65535).
-uvec3 placement_dispatch_size(uint count) {
+STRATA_INLINE uvec3 placement_dispatch_size(uint count) {
   return uvec3(min(count, 65535u), (count + 65534u) / 65535u, 1u);
 }
 
-#ifdef __cplusplus
-inline
-#endif
 // How many 32 x 32 tiles cover the viewport across and down.
-uvec2 placement_tiles(uint width, uint height) {
+STRATA_INLINE uvec2 placement_tiles(uint width, uint height) {
   return uvec2((width + PLACEMENT_TILE - 1u) / PLACEMENT_TILE,
                (height + PLACEMENT_TILE - 1u) / PLACEMENT_TILE);
 }
 
-#ifdef __cplusplus
-inline
-#endif
-    // How far above the label's lowest bound bucket b starts: 0, then bucket_width * 4^(b - 1). The
-    // sort and the main pass's sizing both use this, so they agree to the last bit.
-    float
-    placement_bucket_edge(uint b, float bucket_width) {
+// How far above the label's lowest bound bucket b starts: 0, then bucket_width * 4^(b - 1). The
+// sort and the main pass's sizing both use this, so they agree to the last bit.
+STRATA_INLINE float placement_bucket_edge(uint b, float bucket_width) {
   float edge = b == 0u ? 0.0f : bucket_width;
   for (uint k = 1u; k < b; ++k) edge *= PLACEMENT_BUCKET_GROWTH;
   return edge;
 }
 
-#ifdef __cplusplus
-inline
-#endif
 // The bucket of a tile whose lower cost bound lies `above` the label's lowest.
-uint placement_bucket(float above, float bucket_width) {
+STRATA_INLINE uint placement_bucket(float above, float bucket_width) {
   uint b = 0u;
   while (b + 1u < PLACEMENT_BUCKETS && above >= placement_bucket_edge(b + 1u, bucket_width)) ++b;
   return b;

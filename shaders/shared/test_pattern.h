@@ -6,10 +6,6 @@
 
 #include "common.h"
 
-#ifdef __cplusplus
-#include <glm/glm.hpp>
-#endif
-
 #define TEST_PATTERN_GROUP 16
 #define TEST_PATTERN_BINDING_COLOR 0      // rgba8 storage image
 #define TEST_PATTERN_BINDING_LUMINANCE 1  // float per pixel, for the summed-area table
@@ -23,13 +19,6 @@ struct TestPatternParams {
   uint blur_radius;  // box-filter half size, in pixels, for the right half of the image
   uint pad;
 };
-
-#ifdef __cplusplus
-using namespace glm;  // GLSL's vector types and functions, by the same names
-#define STRATA_INLINE inline
-#else
-#define STRATA_INLINE
-#endif
 
 // uv in [0, 1]^2, y down. Returns linear RGB in [0, 1]. Every edge is a narrow smooth ramp, not
 // a step: CPU and GPU round divisions differently, and a step at a pixel centre would flip.

@@ -6,10 +6,6 @@
 
 #include "common.h"
 
-#ifdef __cplusplus
-#include <glm/glm.hpp>
-#endif
-
 #define VR_MAX_VOLUMES 8
 #define VR_MAX_LAYERS 8
 #define VR_MAX_FRAGMENTS 16   // per pixel in the resolve; more are counted, not drawn
@@ -47,9 +43,6 @@
 #define VR_BINDING_DEPTH 13           // image2D r32f, eye depth where alpha first passes depth_alpha
 
 STRATA_BEGIN
-#ifdef __cplusplus
-using namespace glm;
-#endif
 
 struct VolumeGpu {
   mat4 world_to_texture;  // world -> [0,1]^3 (voxel centres at (i + 0.5) / dims)

@@ -10,15 +10,10 @@
 #endif
 
 STRATA_BEGIN
-#ifdef __cplusplus
-#define VR_INLINE inline
-#else
-#define VR_INLINE
-#endif
 
 // Two-sided Blinn-Phong with a headlight (light and eye in the same direction, so the half vector
 // is the light): straight RGBA in, premultiplied RGBA out.
-VR_INLINE vec4 shade_blinn_phong(vec4 color, vec3 normal, vec3 to_eye) {
+STRATA_INLINE vec4 shade_blinn_phong(vec4 color, vec3 normal, vec3 to_eye) {
   vec3 n = normalize(normal);
   if (dot(n, to_eye) < 0.0f) n = -n;
   float diffuse = max(dot(n, to_eye), 0.0f);
@@ -29,18 +24,18 @@ VR_INLINE vec4 shade_blinn_phong(vec4 color, vec3 normal, vec3 to_eye) {
 }
 
 // Eq. 3.9, front to back: `back` (premultiplied) seen through what `front` has accumulated.
-VR_INLINE vec4 over(vec4 front, vec4 back) { return front + (1.0f - front.a) * back; }
+STRATA_INLINE vec4 over(vec4 front, vec4 back) { return front + (1.0f - front.a) * back; }
 
 // Transfer-function alpha is defined per `reference` distance; a step of `step` absorbs more or
 // less (the usual opacity correction).
-VR_INLINE float corrected_alpha(float alpha, float step, float reference) {
+STRATA_INLINE float corrected_alpha(float alpha, float step, float reference) {
   return 1.0f - pow(max(1.0f - alpha, 0.0f), step / reference);
 }
 
-VR_INLINE float split_depth(vec4 splits[2], uint i) { return splits[i / 4u][int(i % 4u)]; }
+STRATA_INLINE float split_depth(vec4 splits[2], uint i) { return splits[i / 4u][int(i % 4u)]; }
 
 // Mesh colour as the HA-Buffer stores it: shaded, premultiplied, rgba8.
-VR_INLINE uint mesh_payload_color(vec4 color, vec3 normal, vec3 to_eye) {
+STRATA_INLINE uint mesh_payload_color(vec4 color, vec3 normal, vec3 to_eye) {
   return packUnorm4x8(shade_blinn_phong(color, normal, to_eye));
 }
 STRATA_END
