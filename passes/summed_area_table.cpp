@@ -11,8 +11,11 @@ using graph::Use;
 namespace {
 
 gpu::SatParams params_for(graph::Extent e, uint32_t layers = 1) {
-  return {e.width, e.height, group_count(e.width, SAT_TILE), group_count(e.height, SAT_TILE), layers,
-          0, 0, 0};
+  return {.width = e.width,
+          .height = e.height,
+          .tiles_x = group_count(e.width, SAT_TILE),
+          .tiles_y = group_count(e.height, SAT_TILE),
+          .layers = layers};
 }
 
 }  // namespace

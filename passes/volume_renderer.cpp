@@ -132,9 +132,11 @@ RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimens
         int16_t* row = &in.atlas[4 * (size_t(z0 + az) * dims.y + ay) * dims.x];
         for (uint32_t ax = 0; ax < dims.x; ++ax) {
           const int i = std::clamp(int(ax) - int(VR_ATLAS_BORDER), 0, vd.x - 1);
-          const auto at = [&](int x, int y, int z) {
-            return int(t[(size_t(std::clamp(z, 0, vd.z - 1)) * vd.y + size_t(std::clamp(y, 0, vd.y - 1))) * vd.x +
-                         size_t(std::clamp(x, 0, vd.x - 1))]);
+          const auto at = [&](int x, int y, int z) {  // clamped to the volume's edge
+            const size_t cz = size_t(std::clamp(z, 0, vd.z - 1));
+            const size_t cy = size_t(std::clamp(y, 0, vd.y - 1));
+            const size_t cx = size_t(std::clamp(x, 0, vd.x - 1));
+            return int(t[(cz * vd.y + cy) * vd.x + cx]);
           };
           row[4 * ax + 0] = int16_t((at(i + 1, j, k) - at(i - 1, j, k)) / 2);
           row[4 * ax + 1] = int16_t((at(i, j + 1, k) - at(i, j - 1, k)) / 2);
