@@ -259,20 +259,19 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint
     const auto ends_label = [&](const graph::SplitPoint& s) {
       return s.pass == loop && (!s.barrier || *s.barrier >= 1);
     };
-    runner.run_split(
-        [&](const graph::SplitPoint& s) { return before_loop(s) || ends_label(s); },
-        [&](const graph::SplitPoint& s) {
-          if (before_loop(s)) {
-            start = std::chrono::steady_clock::now();
-            return;
-          }
-          runner.download_buffer(frame.placement().results);
-          if (!s.barrier) {
-            readback_ms.push_back(
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                    .count());
-          }
-        });
+    runner.run_split([&](const graph::SplitPoint& s) { return before_loop(s) || ends_label(s); },
+                     [&](const graph::SplitPoint& s) {
+                       if (before_loop(s)) {
+                         start = std::chrono::steady_clock::now();
+                         return;
+                       }
+                       runner.download_buffer(frame.placement().results);
+                       if (!s.barrier) {
+                         readback_ms.push_back(std::chrono::duration<double, std::milli>(
+                                                   std::chrono::steady_clock::now() - start)
+                                                   .count());
+                       }
+                     });
   }
   double placement_ms = 0.0;
   for (const auto& [name, stat] : t.groups) {

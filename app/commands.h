@@ -5,8 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "engine/gpu/context.h"
 #include "engine/core/error.h"
+#include "engine/gpu/context.h"
 #include "engine/graph/render_graph.h"
 #include "engine/scene/scene.h"
 

@@ -4,9 +4,9 @@
 #include <glm/gtc/packing.hpp>
 
 #include "app/commands.h"
+#include "engine/core/png.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
-#include "engine/core/png.h"
 #include "engine/scene/io/scene_loader.h"
 #include "labeling/labelled_render.h"
 #include "passes/test_pattern.h"

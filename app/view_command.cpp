@@ -7,8 +7,8 @@
 
 #include "app/commands.h"
 #include "engine/graph/graph_runner.h"
-#include "engine/scene/io/scene_loader.h"
 #include "engine/graph/window_target.h"
+#include "engine/scene/io/scene_loader.h"
 #include "passes/test_pattern.h"
 #include "passes/volume_renderer.h"
 

@@ -70,13 +70,12 @@ gpu::LabelDrawParams LabelDrawing::params(graph::Extent viewport) const {
 void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
   layer_count_ = in.layer_count;
   background_ = in.background;
-  const ResourceId atlas =
-      graph.import_image("labels.font_atlas",
-                         {.image = atlas_.handle(),
-                          .view = atlas_.view(),
-                          .format = VK_FORMAT_R8_UNORM,
-                          .has_content = true,
-                          .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  const ResourceId atlas = graph.import_image(
+      "labels.font_atlas", {.image = atlas_.handle(),
+                            .view = atlas_.view(),
+                            .format = VK_FORMAT_R8_UNORM,
+                            .has_content = true,
+                            .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
   graph.add_pass({"labels.draw",
                   graph::PassKind::compute,
                   {{in.layers, Use::storage_read_write, LABEL_DRAW_BINDING_LAYERS},
@@ -89,15 +88,15 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
                                 {pc.viewport.width, pc.viewport.height, layer_count_});
                   },
                   "labels"});
-  graph.add_pass({"labels.composite",
-                  graph::PassKind::compute,
-                  {{in.layers, Use::storage_read, LABEL_DRAW_BINDING_LAYERS},
-                   {in.output, Use::storage_write, LABEL_DRAW_BINDING_FINAL}},
-                  [this](graph::PassContext& pc) {
-                    pc.dispatch(composite_, params(pc.viewport),
-                                {pc.viewport.width, pc.viewport.height, 1});
-                  },
-                  "labels"});
+  graph.add_pass(
+      {"labels.composite",
+       graph::PassKind::compute,
+       {{in.layers, Use::storage_read, LABEL_DRAW_BINDING_LAYERS},
+        {in.output, Use::storage_write, LABEL_DRAW_BINDING_FINAL}},
+       [this](graph::PassContext& pc) {
+         pc.dispatch(composite_, params(pc.viewport), {pc.viewport.width, pc.viewport.height, 1});
+       },
+       "labels"});
 }
 
 namespace {

@@ -14,10 +14,10 @@
 #include <glm/glm.hpp>
 
 #include "engine/core/font.h"
-#include "engine/graph/graph_runner.h"
-#include "engine/graph/render_graph.h"
 #include "engine/gpu/resources.h"
 #include "engine/gpu/shader_library.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/graph/render_graph.h"
 #include "shared/label_drawing.h"
 
 namespace strata {

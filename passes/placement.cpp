@@ -2,8 +2,8 @@
 
 #include <cstring>
 
-#include "engine/gpu/context.h"
 #include "engine/core/error.h"
+#include "engine/gpu/context.h"
 
 namespace strata {
 
@@ -102,8 +102,8 @@ Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
   add_bounds(graph, b);
   const graph::PassId loop = add_label_loop(graph, b);
   add_finalize(graph, b);
-  return {b.labels, b.placements, b.saliency, b.costs,   b.tables,
-          b.constraints, b.results, b.buckets, loop};
+  return {b.labels,      b.placements, b.saliency, b.costs, b.tables,
+          b.constraints, b.results,    b.buckets,  loop};
 }
 
 Placement::Buffers Placement::add_buffers(graph::Graph& graph) const {
@@ -129,47 +129,46 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) const {
   b.samples = graph.add_buffer("placement.samples", per_tile(sizeof(uint64_t)));
   b.regions = graph.add_buffer("placement.regions",
                                fixed(VkDeviceSize{n} * n * sizeof(gpu::PairRegionsGpu)));
-  b.readback = graph.import_buffer(
-      "placement.readback", {.buffer = readback_.handle(), .final_use = Use::host_read});
+  b.readback = graph.import_buffer("placement.readback",
+                                   {.buffer = readback_.handle(), .final_use = Use::host_read});
   return b;
 }
 
 // The frame's labels and order; everything the loop accumulates starts empty.
 void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
-  graph.add_pass(
-      {"placement.upload",
-       graph::PassKind::transfer,
-       {{b.labels, Use::transfer_dst},
-        {b.order, Use::transfer_dst},
-        {b.results, Use::transfer_dst},
-        {b.constraints, Use::transfer_dst},
-        {b.buckets, Use::transfer_dst},
-        {b.lower, Use::transfer_dst},
-        {b.speculative, Use::transfer_dst},
-        {b.samples, Use::transfer_dst},
-        {b.regions, Use::transfer_dst}},
-       [this, b](graph::PassContext& pc) {
-         if (!labels_.empty()) {
-           vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.labels), 0,
-                             labels_.size() * sizeof(gpu::LabelGpu), labels_.data());
-         }
-         if (!order_.empty()) {
-           vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.order), 0, order_.size() * sizeof(uint32_t),
-                             order_.data());
-         }
-         const auto fill = [&pc](ResourceId id, uint32_t value) {
-           vkCmdFillBuffer(pc.cmd, pc.buffer(id), 0, VK_WHOLE_SIZE, value);
-         };
-         fill(b.results, 0xFFFFFFFFu);  // "not placed"
-         fill(b.constraints, 0);
-         fill(b.buckets, 0);
-         fill(b.lower, 0xFFFFFFFFu);
-         // (each speculative workgroup writes its tile's entry before anything reads it)
-         fill(b.speculative, 0xFFFFFFFFu);
-         fill(b.samples, 0xFFFFFFFFu);
-         fill(b.regions, 0);  // a label that is never placed constrains nobody
-       },
-       "placement"});
+  graph.add_pass({"placement.upload",
+                  graph::PassKind::transfer,
+                  {{b.labels, Use::transfer_dst},
+                   {b.order, Use::transfer_dst},
+                   {b.results, Use::transfer_dst},
+                   {b.constraints, Use::transfer_dst},
+                   {b.buckets, Use::transfer_dst},
+                   {b.lower, Use::transfer_dst},
+                   {b.speculative, Use::transfer_dst},
+                   {b.samples, Use::transfer_dst},
+                   {b.regions, Use::transfer_dst}},
+                  [this, b](graph::PassContext& pc) {
+                    if (!labels_.empty()) {
+                      vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.labels), 0,
+                                        labels_.size() * sizeof(gpu::LabelGpu), labels_.data());
+                    }
+                    if (!order_.empty()) {
+                      vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.order), 0,
+                                        order_.size() * sizeof(uint32_t), order_.data());
+                    }
+                    const auto fill = [&pc](ResourceId id, uint32_t value) {
+                      vkCmdFillBuffer(pc.cmd, pc.buffer(id), 0, VK_WHOLE_SIZE, value);
+                    };
+                    fill(b.results, 0xFFFFFFFFu);  // "not placed"
+                    fill(b.constraints, 0);
+                    fill(b.buckets, 0);
+                    fill(b.lower, 0xFFFFFFFFu);
+                    // (each speculative workgroup writes its tile's entry before anything reads it)
+                    fill(b.speculative, 0xFFFFFFFFu);
+                    fill(b.samples, 0xFFFFFFFFu);
+                    fill(b.regions, 0);  // a label that is never placed constrains nobody
+                  },
+                  "placement"});
 }
 
 // Saliency (eq. 3.5), integral costs per layer (eq. 3.3/3.4) and their summed-area tables.
@@ -250,21 +249,20 @@ graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
   // (direct: the sizes are still written, but nothing waits for them)
   if (indirect_) uses.push_back({b.args, Use::indirect});
   const ResourceId args = b.args;
-  return graph.add_pass({"placement.labels", graph::PassKind::compute, std::move(uses),
-                         [this, args](graph::PassContext& pc) {
-                           for (uint32_t step = 0; !order_.empty() && step <= order_.size();
-                                ++step) {
-                             if (step > 0) pc.barrier();
-                             const gpu::PlacementParams p = params(pc.viewport, step);
-                             if (indirect_) {
-                               pc.dispatch_indirect(place_, p, args,
-                                                    VkDeviceSize{step} * 3 * sizeof(uint32_t));
-                             } else {
-                               pc.dispatch_groups(place_, p, direct_groups(pc.viewport));
-                             }
-                           }
-                         },
-                         "placement"});
+  return graph.add_pass(
+      {"placement.labels", graph::PassKind::compute, std::move(uses),
+       [this, args](graph::PassContext& pc) {
+         for (uint32_t step = 0; !order_.empty() && step <= order_.size(); ++step) {
+           if (step > 0) pc.barrier();
+           const gpu::PlacementParams p = params(pc.viewport, step);
+           if (indirect_) {
+             pc.dispatch_indirect(place_, p, args, VkDeviceSize{step} * 3 * sizeof(uint32_t));
+           } else {
+             pc.dispatch_groups(place_, p, direct_groups(pc.viewport));
+           }
+         }
+       },
+       "placement"});
 }
 
 // A direct place_label dispatch: room for any classification, the passes' tiles and the region

@@ -12,10 +12,10 @@
 #include <utility>
 #include <vector>
 
-#include "engine/graph/graph_runner.h"
 #include "engine/gpu/resources.h"
-#include "engine/scene/scene.h"
 #include "engine/gpu/shader_library.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/scene/scene.h"
 #include "passes/summed_area_table.h"
 #include "shared/placement.h"
 

@@ -21,7 +21,7 @@ struct Placer {
   std::vector<uint64_t> results;
   std::vector<PairRegionsGpu> regions;  // the label being placed against each placed label
 
-  std::vector<vec2> anchors;             // every shown label's anchor
+  std::vector<vec2> anchors;  // every shown label's anchor
 
   // Every label placed so far, every anchor: the GPU's tile culling only skips what cannot matter.
   uint placed_count() const { return params.step; }
@@ -92,7 +92,9 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
   }
   // The greedy loop: each label's argmin over every pixel (ties: the lowest pixel index).
   gpu::Placer placer{placement_params(settings, size, layer_count, uint32_t(labels.size()), 0),
-                     labels, order, out.tables,
+                     labels,
+                     order,
+                     out.tables,
                      std::vector<uint64_t>(labels.size(), PLACEMENT_NONE),
                      std::vector<gpu::PairRegionsGpu>(labels.size()),
                      {}};
@@ -114,7 +116,8 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
         if (!placer.candidate_allowed(me, p)) continue;
         const glm::vec2 origin = gpu::box_origin(p, me.size);
         const glm::vec2 centre = origin + me.size * 0.5f;
-        const uint32_t bits = placer.constraint_bits(me, centre, 0u, std::numeric_limits<float>::infinity());
+        const uint32_t bits =
+            placer.constraint_bits(me, centre, 0u, std::numeric_limits<float>::infinity());
         const uint32_t pixel = y * w + x;
         if (settings.write_constraints) out.constraints[pixel] = bits;
         if (settings.hard && bits != 0u) continue;

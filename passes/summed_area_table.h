@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/graph/render_graph.h"
 #include "engine/gpu/shader_library.h"
+#include "engine/graph/render_graph.h"
 
 namespace strata {
 

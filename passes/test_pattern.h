@@ -4,8 +4,8 @@
 
 #include <vector>
 
-#include "engine/graph/render_graph.h"
 #include "engine/gpu/shader_library.h"
+#include "engine/graph/render_graph.h"
 #include "passes/summed_area_table.h"
 
 namespace strata {

@@ -31,15 +31,19 @@ struct Reference {
     for (int corner = 0; corner < 8; ++corner) {
       const ivec3 o(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
       const ivec3 p = clamp(ivec3(base) + o, ivec3(0), top);
-      const float w = (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
+      const float w =
+          (o.x ? f.x : 1.0f - f.x) * (o.y ? f.y : 1.0f - f.y) * (o.z ? f.z : 1.0f - f.z);
       const int16_t* texel =
-          &in.atlas[4 * ((size_t(p.z) * in.atlas_dims.y + size_t(p.y)) * in.atlas_dims.x + size_t(p.x))];
+          &in.atlas[4 * ((size_t(p.z) * in.atlas_dims.y + size_t(p.y)) * in.atlas_dims.x +
+                         size_t(p.x))];
       sum += w * vec4(float(texel[0]), float(texel[1]), float(texel[2]), float(texel[3]));
     }
     return sum / 32767.0f;
   }
 
-  vec4 table_entry(uint v, int i) const { return in.transfer_table[size_t(v) * VR_TF_SIZE + size_t(i)]; }
+  vec4 table_entry(uint v, int i) const {
+    return in.transfer_table[size_t(v) * VR_TF_SIZE + size_t(i)];
+  }
 
   bool brick_empty(uint v, vec3 tc) const {
     const VolumeGpu& vol = in.volumes[v];

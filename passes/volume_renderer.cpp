@@ -6,8 +6,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "engine/gpu/context.h"
 #include "engine/core/error.h"
+#include "engine/gpu/context.h"
 #include "engine/graph/graph_runner.h"
 #include "shared/volume_render.h"
 
@@ -338,8 +338,8 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
       "render.counters",
       {[](graph::Extent) { return VkDeviceSize{VR_COUNTER_COUNT * sizeof(uint32_t)}; }});
   Outputs out;
-  out.layers =
-      graph.add_image("render.layers", {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count, true});
+  out.layers = graph.add_image("render.layers",
+                               {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count, true});
   out.final = graph.add_image("render.final", {VK_FORMAT_R8G8B8A8_UNORM});
   out.depth = graph.add_image("render.depth", {VK_FORMAT_R32_SFLOAT});
   const auto uploaded = [&graph](const char* name, const Buffer& buffer) {
@@ -356,23 +356,22 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
   ids_.occupancy = uploaded("render.occupancy", occupancy_);
   ids_.vertices = uploaded("render.vertices", vertices_);
   ids_.indices = uploaded("render.indices", indices_);
-  ids_.readback = graph.import_buffer(
-      "render.counters_readback",
-      {.buffer = counters_readback_.handle(), .final_use = Use::host_read});
+  ids_.readback =
+      graph.import_buffer("render.counters_readback",
+                          {.buffer = counters_readback_.handle(), .final_use = Use::host_read});
 
-  graph.add_pass({"render.clear",
-                  graph::PassKind::transfer,
-                  {{frame, Use::transfer_dst},
-                   {keys, Use::transfer_dst},
-                   {counters, Use::transfer_dst}},
-                  [this, frame, keys, counters](graph::PassContext& pc) {
-                    const gpu::FrameGpu data = frame_data(inputs_, camera_, settings_, pc.viewport,
-                                                          slots_for(pc.viewport));
-                    vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
-                  },
-                  "render"});
+  graph.add_pass(
+      {"render.clear",
+       graph::PassKind::transfer,
+       {{frame, Use::transfer_dst}, {keys, Use::transfer_dst}, {counters, Use::transfer_dst}},
+       [this, frame, keys, counters](graph::PassContext& pc) {
+         const gpu::FrameGpu data =
+             frame_data(inputs_, camera_, settings_, pc.viewport, slots_for(pc.viewport));
+         vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
+         vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
+         vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
+       },
+       "render"});
   graph.add_pass({"render.habuffer_build",
                   graph::PassKind::graphics,
                   {{frame, Use::uniform, VR_BINDING_FRAME},

@@ -7,11 +7,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "engine/gpu/resources.h"
+#include "engine/gpu/shader_library.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/render_graph.h"
-#include "engine/gpu/resources.h"
 #include "engine/scene/scene.h"
-#include "engine/gpu/shader_library.h"
 #include "shared/volume_render.h"
 
 namespace strata {

@@ -5,8 +5,8 @@
 #include <fstream>
 #include <map>
 
-#include "engine/scene/atlas.h"
 #include "engine/core/error.h"
+#include "engine/scene/atlas.h"
 #include "engine/scene/io/volume_loader.h"
 
 namespace strata {

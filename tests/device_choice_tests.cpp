@@ -1,8 +1,8 @@
 // Device choice and the requirement check, on hand-made device reports: no device needed.
 #include <doctest/doctest.h>
 
-#include "engine/gpu/context.h"
 #include "engine/core/error.h"
+#include "engine/gpu/context.h"
 
 namespace strata {
 namespace {

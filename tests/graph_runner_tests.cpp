@@ -91,15 +91,16 @@ TEST_SUITE("gpu") {
     graph::Graph g;
     const auto declared = g.add_buffer("declared", {[](graph::Extent) { return 64; }});
     const auto hidden = g.add_buffer("hidden", {[](graph::Extent) { return 64; }});
-    g.add_pass({"fill", graph::PassKind::transfer, {{declared, graph::Use::transfer_dst}},
+    g.add_pass({"fill",
+                graph::PassKind::transfer,
+                {{declared, graph::Use::transfer_dst}},
                 [&](graph::PassContext& pc) {
                   vkCmdFillBuffer(pc.cmd, pc.buffer(declared), 0, VK_WHOLE_SIZE, 0);
                   vkCmdFillBuffer(pc.cmd, pc.buffer(hidden), 0, VK_WHOLE_SIZE, 0);
                 }});
     graph::GraphRunner runner(ctx, std::move(g));
     runner.set_viewport({4, 4});
-    CHECK_THROWS_WITH_AS(runner.run_now(),
-                         "pass 'fill' touches 'hidden', which it did not declare",
+    CHECK_THROWS_WITH_AS(runner.run_now(), "pass 'fill' touches 'hidden', which it did not declare",
                          graph::GraphError);
   }
 
@@ -107,11 +108,15 @@ TEST_SUITE("gpu") {
     const ComputePipeline finalize(ctx, "placement_finalize.comp");
     graph::Graph g;
     const auto args = g.add_buffer("args", {[](graph::Extent) { return 64; }});
-    g.add_pass({"zero", graph::PassKind::transfer, {{args, graph::Use::transfer_dst}},
+    g.add_pass({"zero",
+                graph::PassKind::transfer,
+                {{args, graph::Use::transfer_dst}},
                 [&](graph::PassContext& pc) {
                   vkCmdFillBuffer(pc.cmd, pc.buffer(args), 0, VK_WHOLE_SIZE, 0);
                 }});
-    g.add_pass({"dispatch", graph::PassKind::compute, {{args, graph::Use::storage_read}},
+    g.add_pass({"dispatch",
+                graph::PassKind::compute,
+                {{args, graph::Use::storage_read}},
                 [&](graph::PassContext& pc) { pc.dispatch_indirect(finalize, 0u, args, 0); }});
     graph::GraphRunner runner(ctx, std::move(g));
     runner.set_viewport({4, 4});

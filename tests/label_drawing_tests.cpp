@@ -17,9 +17,9 @@
 
 #include "engine/core/error.h"
 #include "engine/core/font.h"
-#include "engine/graph/graph_runner.h"
 #include "engine/core/png.h"
 #include "engine/gpu/resources.h"
+#include "engine/graph/graph_runner.h"
 #include "gpu_fixture.h"
 #include "labeling/text_layout.h"
 #include "passes/label_drawing.h"

@@ -51,7 +51,8 @@ TEST_SUITE("gpu") {
 TEST_SUITE("gpu") {
   // The labelled frame's graph, built (on the test device, for its pipelines) but not run: its
   // passes and barriers do not grow with the labels, and a change that multiplies them fails here.
-  TEST_CASE_FIXTURE(test::GpuTest, "labelled_frame_graph_keeps_its_passes_and_barriers_for_any_label_count") {
+  TEST_CASE_FIXTURE(test::GpuTest,
+                    "labelled_frame_graph_keeps_its_passes_and_barriers_for_any_label_count") {
     for (const char* file : {"head.json", "head-100.json"}) {
       CAPTURE(file);
       const Scene scene = load_scene(std::string(STRATA_SOURCE_DIR "/assets/scenes/") + file);
@@ -91,7 +92,8 @@ TEST_SUITE("gpu") {
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
     LabellingSettings settings;
     settings.internal = true;
-    const LabelledFrame frame = render_labelled(ctx, scene, camera_for(scene, "front"), {128, 128}, settings);
+    const LabelledFrame frame =
+        render_labelled(ctx, scene, camera_for(scene, "front"), {128, 128}, settings);
     for (const LabelLayout& l : frame.labels) {
       CAPTURE(l.text);
       CHECK(l.shown);

@@ -11,8 +11,8 @@
 
 #include <glm/gtc/packing.hpp>
 
-#include "engine/graph/graph_runner.h"
 #include "engine/gpu/resources.h"
+#include "engine/graph/graph_runner.h"
 #include "gpu_fixture.h"
 #include "passes/placement.h"
 #include "passes/placement_reference.h"
@@ -118,8 +118,8 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
                                  .initial_layout = VK_IMAGE_LAYOUT_GENERAL});
   };
   const Placement::Outputs r = placement.add_to(g, {.final_image = general("final", final_image),
-                                                      .layers = general("layers", layers),
-                                                      .layer_count = in.layer_count});
+                                                    .layers = general("layers", layers),
+                                                    .layer_count = in.layer_count});
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(in.size);
   placement.set_frame(in.labels, in.order, settings);

@@ -124,7 +124,8 @@ TEST_SUITE("cpu") {
   TEST_CASE("an_import_with_content_can_be_read_without_a_writer") {
     Graph g;
     const ResourceId volume = g.import_image(
-        "volume", {.has_content = true, .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+        "volume",
+        {.has_content = true, .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
     g.add_pass(pass("raycast", PassKind::compute, {{volume, Use::sampled}}));
     const CompiledGraph c = compile(g);
     CHECK(c.pass_barriers[0].empty());  // already in the layout it is read in, nothing to wait for

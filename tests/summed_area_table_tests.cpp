@@ -4,8 +4,8 @@
 #include <cmath>
 #include <random>
 
-#include "engine/graph/graph_runner.h"
 #include "engine/gpu/resources.h"
+#include "engine/graph/graph_runner.h"
 #include "gpu_fixture.h"
 #include "passes/summed_area_table.h"
 

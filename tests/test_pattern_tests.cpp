@@ -4,9 +4,9 @@
 
 #include <cstdlib>
 
+#include "engine/core/png.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
-#include "engine/core/png.h"
 #include "gpu_fixture.h"
 #include "passes/test_pattern.h"
 

@@ -40,8 +40,7 @@ const char* const gradient_head =
 
 TEST_SUITE("loaders") {
   TEST_CASE("gra_import_keeps_each_stops_position_colour_and_alpha") {
-    const fs::path path =
-        fs::path(STRATA_TEST_DATA) / "voly-labeller/transferfunctions/dice4.gra";
+    const fs::path path = fs::path(STRATA_TEST_DATA) / "voly-labeller/transferfunctions/dice4.gra";
     const strata::TransferFunction tf = strata::load_transfer_function(path);
     CHECK(tf.name == "dice4");
     CHECK(tf.source == path);

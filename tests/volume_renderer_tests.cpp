@@ -11,9 +11,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 
+#include "engine/core/png.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
-#include "engine/core/png.h"
 #include "engine/scene/io/scene_loader.h"
 #include "gpu_fixture.h"
 #include "passes/volume_render_reference.h"

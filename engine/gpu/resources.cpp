@@ -126,9 +126,9 @@ Image::Image(Context& ctx, const ImageDesc& desc) : device_(ctx.device()), desc_
 
   VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   view.image = image_;
-  view.viewType = desc.type == VK_IMAGE_TYPE_3D ? VK_IMAGE_VIEW_TYPE_3D
+  view.viewType = desc.type == VK_IMAGE_TYPE_3D   ? VK_IMAGE_VIEW_TYPE_3D
                   : desc.layers > 1 || desc.array ? VK_IMAGE_VIEW_TYPE_2D_ARRAY
-                                                : VK_IMAGE_VIEW_TYPE_2D;
+                                                  : VK_IMAGE_VIEW_TYPE_2D;
   view.format = desc.format;
   view.subresourceRange = {aspect_of(desc.format), 0, 1, 0, desc.layers};
   STRATA_VK(vkCreateImageView(device_, &view, nullptr, &view_));

@@ -11,10 +11,10 @@ const ResourceUse& PassContext::declared(ResourceId id) const {
     if (u.resource == id) return u;
   }
   const auto& resources = runner_->graph_.resources();
-  throw GraphError("pass '" + pass.name + "' touches " +
-                   (id < resources.size() ? "'" + resources[id].name + "'"
-                                          : "resource #" + std::to_string(id)) +
-                   ", which it did not declare");
+  throw GraphError(
+      "pass '" + pass.name + "' touches " +
+      (id < resources.size() ? "'" + resources[id].name + "'" : "resource #" + std::to_string(id)) +
+      ", which it did not declare");
 }
 
 VkBuffer PassContext::buffer(ResourceId id) const {

@@ -4,8 +4,8 @@
 
 #include <array>
 #include <functional>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <variant>
@@ -13,9 +13,9 @@
 
 #include <glm/glm.hpp>
 
-#include "engine/graph/render_graph.h"
 #include "engine/gpu/resources.h"
 #include "engine/gpu/shader_library.h"
+#include "engine/graph/render_graph.h"
 
 namespace strata {
 class Context;

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <span>
 
-#include "engine/graph/graph_runner.h"
 #include "engine/gpu/resources.h"
+#include "engine/graph/graph_runner.h"
 
 namespace strata {
 

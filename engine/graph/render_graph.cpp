@@ -355,12 +355,13 @@ const char* layout_name(VkImageLayout layout) {
 }
 
 std::string describe_barrier(const Graph& graph, const Barrier& b) {
-  std::string out = "    barrier '" + graph.resources()[b.resource].name + "': " +
-                    stage_names(b.src_stage) + " -> " + stage_names(b.dst_stage);
+  std::string out = "    barrier '" + graph.resources()[b.resource].name +
+                    "': " + stage_names(b.src_stage) + " -> " + stage_names(b.dst_stage);
   // (what the pass then does with the resource is its use, listed below the barriers)
   if (b.src_access == VK_ACCESS_2_NONE) out += ", execution only";
   if (b.is_image && b.old_layout != b.new_layout) {
-    out += std::string(", layout ") + layout_name(b.old_layout) + " -> " + layout_name(b.new_layout);
+    out +=
+        std::string(", layout ") + layout_name(b.old_layout) + " -> " + layout_name(b.new_layout);
   }
   return out + "\n";
 }

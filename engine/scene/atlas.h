@@ -13,9 +13,9 @@
 namespace strata {
 
 struct AtlasRegion {
-  int index = 0;       // the value of its voxels in the label volume
-  std::string name;    // as in the names file, e.g. "Precentral_L"
-  int colour = 0;      // the names file's third column
+  int index = 0;     // the value of its voxels in the label volume
+  std::string name;  // as in the names file, e.g. "Precentral_L"
+  int colour = 0;    // the names file's third column
 };
 
 std::vector<AtlasRegion> load_atlas_names(const std::filesystem::path& path);

@@ -48,7 +48,8 @@ std::pair<glm::vec3, glm::vec3> Volume::world_bounds() const {
   const glm::mat4 m = index_to_world();
   glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
   for (int corner = 0; corner < 8; ++corner) {
-    const glm::vec3 ijk((corner & 1) ? float(dims.x - 1) : 0.0f, (corner & 2) ? float(dims.y - 1) : 0.0f,
+    const glm::vec3 ijk((corner & 1) ? float(dims.x - 1) : 0.0f,
+                        (corner & 2) ? float(dims.y - 1) : 0.0f,
                         (corner & 4) ? float(dims.z - 1) : 0.0f);
     const glm::vec3 p = glm::vec3(m * glm::vec4(ijk, 1.0f));
     lo = glm::min(lo, p);

@@ -25,13 +25,13 @@ struct Volume {
   std::filesystem::path source;
   VoxelType type = VoxelType::uint8;
   glm::uvec3 dims{0};
-  glm::vec3 spacing{1.0f};       // mm between voxel centres along i, j, k
-  glm::vec3 origin{0.0f};        // patient/world position of voxel (0, 0, 0)
-  glm::mat3 direction{1.0f};     // columns: unit directions of i, j, k in patient space
-  glm::mat4 transform{1.0f};     // placement in the scene, applied after index_to_patient()
-  std::vector<std::byte> voxels; // i fastest, then j, then k; rescale slope/intercept applied
-  glm::vec2 value_range{0.0f};   // min and max voxel value (transfer functions normalise by it)
-  int transfer_function = -1;    // index into Scene::transfer_functions, -1 for none
+  glm::vec3 spacing{1.0f};        // mm between voxel centres along i, j, k
+  glm::vec3 origin{0.0f};         // patient/world position of voxel (0, 0, 0)
+  glm::mat3 direction{1.0f};      // columns: unit directions of i, j, k in patient space
+  glm::mat4 transform{1.0f};      // placement in the scene, applied after index_to_patient()
+  std::vector<std::byte> voxels;  // i fastest, then j, then k; rescale slope/intercept applied
+  glm::vec2 value_range{0.0f};    // min and max voxel value (transfer functions normalise by it)
+  int transfer_function = -1;     // index into Scene::transfer_functions, -1 for none
 
   size_t voxel_count() const { return size_t{dims.x} * dims.y * dims.z; }
   size_t byte_size() const { return voxels.size(); }
@@ -61,8 +61,8 @@ struct Mesh {
   std::string name;
   std::filesystem::path source;
   std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;  // one per position
-  std::vector<uint32_t> indices;   // triangles
+  std::vector<glm::vec3> normals;           // one per position
+  std::vector<uint32_t> indices;            // triangles
   glm::vec4 color{0.8f, 0.8f, 0.8f, 1.0f};  // straight RGBA; alpha < 1 is transparent
   glm::mat4 transform{1.0f};
 

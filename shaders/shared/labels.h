@@ -8,8 +8,8 @@
 #define LABEL_MAX 256
 
 // LabelGpu.flags
-#define LABEL_ENABLED 1u    // the anchor is in view and in front of the camera: place and draw it
-#define LABEL_INTERNAL 2u   // internal labelling: the label is drawn centred on its anchor
+#define LABEL_ENABLED 1u   // the anchor is in view and in front of the camera: place and draw it
+#define LABEL_INTERNAL 2u  // internal labelling: the label is drawn centred on its anchor
 
 // PlacementGpu.shown
 #define PLACEMENT_HIDDEN 0u  // not placed (disabled, or no allowed position in hard mode)
@@ -18,13 +18,13 @@
 STRATA_BEGIN
 
 struct LabelGpu {
-  vec2 anchor;       // pixels, x right, y down (pixel centres at +0.5)
-  vec2 size;         // label box width and height in pixels
-  vec2 previous;     // the label's position in the previous frame (box centre, pixels)
+  vec2 anchor;         // pixels, x right, y down (pixel centres at +0.5)
+  vec2 size;           // label box width and height in pixels
+  vec2 previous;       // the label's position in the previous frame (box centre, pixels)
   float anchor_depth;  // eye depth of the anchor
-  uint layer;        // depth layer the label is placed and drawn on
-  uint flags;        // LABEL_*
-  uint glyph_first;  // the label's glyphs in the glyph buffer
+  uint layer;          // depth layer the label is placed and drawn on
+  uint flags;          // LABEL_*
+  uint glyph_first;    // the label's glyphs in the glyph buffer
   uint glyph_count;
   uint pad;
 };

@@ -6,15 +6,15 @@
 
 #include "labels.h"
 
-#define PLACEMENT_GROUP 16               // per-pixel passes: 16 x 16 threads per workgroup
-#define PLACEMENT_TILE 32                // place_label: 32 x 32 candidates per workgroup ...
-#define PLACE_GROUP_X 16                 // ... of 16 x 16 threads, 2 x 2 candidates each (on an
-#define PLACE_GROUP_Y 16                 // H200, 16 x 8 and 8 x 8 ran slower, 32 x 16 no faster)
+#define PLACEMENT_GROUP 16  // per-pixel passes: 16 x 16 threads per workgroup
+#define PLACEMENT_TILE 32   // place_label: 32 x 32 candidates per workgroup ...
+#define PLACE_GROUP_X 16    // ... of 16 x 16 threads, 2 x 2 candidates each (on an
+#define PLACE_GROUP_Y 16    // H200, 16 x 8 and 8 x 8 ran slower, 32 x 16 no faster)
 #define PLACE_SPAN_X (PLACEMENT_TILE / PLACE_GROUP_X)  // candidates per invocation across ...
 #define PLACE_SPAN_Y (PLACEMENT_TILE / PLACE_GROUP_Y)  // ... and down
-#define PLACEMENT_CELL 4                 // placement_bounds: 4 x 4 candidates per cell
-#define VR_MAX_LAYERS_FOR_PLACEMENT 8    // as VR_MAX_LAYERS
-#define SALIENCY_SCALE 100.0f            // |CIELAB gradient| of this size counts as saliency 1
+#define PLACEMENT_CELL 4               // placement_bounds: 4 x 4 candidates per cell
+#define VR_MAX_LAYERS_FOR_PLACEMENT 8  // as VR_MAX_LAYERS
+#define SALIENCY_SCALE 100.0f          // |CIELAB gradient| of this size counts as saliency 1
 
 // Constraint bits (one constraint image, thesis 4.1.1).
 #define CONSTRAINT_LABEL 1u      // the new box or connector would touch a placed label's shadow
@@ -72,9 +72,9 @@
 #define PLACEMENT_BUCKET_GROWTH 4.0f
 
 // PlacementParams.phase
-#define PLACEMENT_PHASE_BOUNDS 0u   // placement_bounds.comp: tile bounds and each label's lowest
-#define PLACEMENT_PHASE_COUNT 1u    // ... tiles per bucket
-#define PLACEMENT_PHASE_SORT 2u     // ... tiles sorted by bucket, the first dispatch's size
+#define PLACEMENT_PHASE_BOUNDS 0u  // placement_bounds.comp: tile bounds and each label's lowest
+#define PLACEMENT_PHASE_COUNT 1u   // ... tiles per bucket
+#define PLACEMENT_PHASE_SORT 2u    // ... tiles sorted by bucket, the first dispatch's size
 
 STRATA_BEGIN
 
@@ -96,21 +96,21 @@ struct PlacementParams {
   uint height;
   uint layer_count;
   uint label_count;
-  uint step;          // place_label: the dispatch (main pass of order position step - 1,
-                      // speculative pass of step)
-  uint hard;          // 1: constraint violations are forbidden (the label may end up hidden)
+  uint step;               // place_label: the dispatch (main pass of order position step - 1,
+                           // speculative pass of step)
+  uint hard;               // 1: constraint violations are forbidden (the label may end up hidden)
   uint write_constraints;  // 1: store the constraint bits of every pixel (tests, debugging)
-  float margin;       // pixels added around label boxes in the constraints
+  float margin;            // pixels added around label boxes in the constraints
   float saliency_weight;   // eq. 3.3: beta, how much saliency modulates occlusion behind
   float occlusion_weight;  // eq. 3.4 (one layer): alpha
   float single_saliency_weight;  // eq. 3.4: beta
-  uint phase;         // placement_bounds.comp: PLACEMENT_PHASE_*
-  float bucket_width;  // cost above the label's lowest tile bound that bucket 0 holds
-  uint order_count;    // labels in the insertion order
-  uint label;          // place_label: the label at order position step - 1 (main pass) ...
-  uint spec_label;     // ... and at step (speculative pass)
-  uint finish_lanes;   // place_label: invocations of the last workgroup taking list entries
-                       // (0: all; fewer make more chunks, for tests)
+  uint phase;                    // placement_bounds.comp: PLACEMENT_PHASE_*
+  float bucket_width;            // cost above the label's lowest tile bound that bucket 0 holds
+  uint order_count;              // labels in the insertion order
+  uint label;         // place_label: the label at order position step - 1 (main pass) ...
+  uint spec_label;    // ... and at step (speculative pass)
+  uint finish_lanes;  // place_label: invocations of the last workgroup taking list entries
+                      // (0: all; fewer make more chunks, for tests)
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,
@@ -134,7 +134,9 @@ struct PlacementBucketsGpu {
 };
 
 // The top-left pixel of a label box of `size` whose candidate pixel is p.
-STRATA_INLINE vec2 box_origin(uvec2 p, vec2 size) { return vec2(p) - floor(size * 0.5f); }
+STRATA_INLINE vec2 box_origin(uvec2 p, vec2 size) {
+  return vec2(p) - floor(size * 0.5f);
+}
 
 // The classifying workgroups of a label whose tile list has `beyond` entries past bucket 0.
 STRATA_INLINE uint placement_classify_groups(uint beyond) {

@@ -67,10 +67,14 @@ ShadowPlanes shadow_planes(vec2 a, vec2 h, vec2 v0, vec2 v1, vec2 v2, vec2 v3, b
     vec2 n = vec2(-e.y, e.x);
     if (dot(n, a - v0) < 0.0f) n = -n;
     vec4 plane = dilated_plane(n, dot(n, v0), h);
-    if (r.p[2] == vec4(0.0f)) r.p[2] = plane;
-    else if (r.p[3] == vec4(0.0f)) r.p[3] = plane;
-    else if (r.p[4] == vec4(0.0f)) r.p[4] = plane;
-    else r.p[5] = plane;
+    if (r.p[2] == vec4(0.0f))
+      r.p[2] = plane;
+    else if (r.p[3] == vec4(0.0f))
+      r.p[3] = plane;
+    else if (r.p[4] == vec4(0.0f))
+      r.p[4] = plane;
+    else
+      r.p[5] = plane;
   }
   return r;
 }
@@ -136,8 +140,8 @@ uint region_bits(PairRegionsGpu r, vec2 c, uint known) {
     bits |= CONSTRAINT_LABEL;
   }
   if ((r.info.x & REGION_CONNECTOR) != 0u && (known & CONSTRAINT_CONNECTOR) == 0u &&
-      region_holds(r.connector[0], r.connector[1], r.connector[2], r.connector[3],
-                   r.connector[4], r.connector[5], c)) {
+      region_holds(r.connector[0], r.connector[1], r.connector[2], r.connector[3], r.connector[4],
+                   r.connector[5], c)) {
     bits |= CONSTRAINT_CONNECTOR;
   }
   return bits;

@@ -36,8 +36,8 @@ vec4 transfer(uint v, float t) {
   float x = t * float(VR_TF_SIZE) - 0.5f;
   float base = floor(x);
   int i = int(base);
-  return mix(table_entry(v, clamp(i, 0, VR_TF_SIZE - 1)), table_entry(v, clamp(i + 1, 0, VR_TF_SIZE - 1)),
-             x - base);
+  return mix(table_entry(v, clamp(i, 0, VR_TF_SIZE - 1)),
+             table_entry(v, clamp(i + 1, 0, VR_TF_SIZE - 1)), x - base);
 }
 
 bool inside_unit_box(vec3 tc) {
@@ -45,7 +45,8 @@ bool inside_unit_box(vec3 tc) {
          tc.z <= 1.0f;
 }
 
-// The sum of every live (entered, not yet left) volume's shaded, opacity-corrected sample at p (premultiplied).
+// The sum of every live (entered, not yet left) volume's shaded, opacity-corrected sample at p
+// (premultiplied).
 vec4 sample_volumes(uint live, vec3 p, vec3 to_eye, float step_world) {
   vec4 sum = vec4(0.0f);
   for (uint v = 0u; v < frame.volume_count; ++v) {
@@ -86,9 +87,12 @@ vec2 brick_state(uint live, vec3 origin, vec3 direction, float z, float dz) {
     vec3 per_unit = 1.0f / (vec3(vol.texel) * float(VR_BRICK));
     vec3 cell = floor(tc * per_unit);
     float t = 3.4e38f;
-    if (abs(d.x) > 1e-12f) t = min(t, ((cell.x + (d.x > 0.0f ? 1.0f : 0.0f)) / per_unit.x - tc.x) / d.x);
-    if (abs(d.y) > 1e-12f) t = min(t, ((cell.y + (d.y > 0.0f ? 1.0f : 0.0f)) / per_unit.y - tc.y) / d.y);
-    if (abs(d.z) > 1e-12f) t = min(t, ((cell.z + (d.z > 0.0f ? 1.0f : 0.0f)) / per_unit.z - tc.z) / d.z);
+    if (abs(d.x) > 1e-12f)
+      t = min(t, ((cell.x + (d.x > 0.0f ? 1.0f : 0.0f)) / per_unit.x - tc.x) / d.x);
+    if (abs(d.y) > 1e-12f)
+      t = min(t, ((cell.y + (d.y > 0.0f ? 1.0f : 0.0f)) / per_unit.y - tc.y) / d.y);
+    if (abs(d.z) > 1e-12f)
+      t = min(t, ((cell.z + (d.z > 0.0f ? 1.0f : 0.0f)) / per_unit.z - tc.z) / d.z);
     exit_z = min(exit_z, z + max(t, 0.0f));
   }
   if (exit_z > 3.0e38f) exit_z = z + dz;  // no live volume here: nothing to see at z
@@ -111,7 +115,9 @@ Ray pixel_ray(vec2 pixel) {
   return ray;
 }
 
-float grid_depth(float k, float dz) { return frame.near_depth + (k + 0.5f) * dz; }
+float grid_depth(float k, float dz) {
+  return frame.near_depth + (k + 0.5f) * dz;
+}
 float grid_index_at_or_after(float z, float dz) {
   return max(ceil((z - frame.near_depth) / dz - 0.5f), 0.0f);
 }
@@ -134,7 +140,8 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   // Volumes the near plane cuts: their rays start at the near plane.
   uint live = 0u;
   for (uint v = 0u; v < frame.volume_count; ++v) {
-    vec3 tc = vec3(volume_info(v).world_to_texture * vec4(origin + direction * frame.near_depth, 1.0f));
+    vec3 tc =
+        vec3(volume_info(v).world_to_texture * vec4(origin + direction * frame.near_depth, 1.0f));
     if (inside_unit_box(tc)) live |= 1u << v;
   }
 

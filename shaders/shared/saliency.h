@@ -27,7 +27,8 @@ STRATA_INLINE vec3 rgb_to_lab(vec3 srgb) {
 
 // Eq. 3.5 from the CIELAB values of a 3x3 neighbourhood (row-major, centre at index 4), scaled
 // so that a gradient of SALIENCY_SCALE counts 1.
-STRATA_INLINE float sobel_saliency(vec3 n0, vec3 n1, vec3 n2, vec3 n3, vec3 n5, vec3 n6, vec3 n7, vec3 n8) {
+STRATA_INLINE float sobel_saliency(vec3 n0, vec3 n1, vec3 n2, vec3 n3, vec3 n5, vec3 n6, vec3 n7,
+                                   vec3 n8) {
   vec3 gx = (n2 + 2.0f * n5 + n8) - (n0 + 2.0f * n3 + n6);
   vec3 gy = (n6 + 2.0f * n7 + n8) - (n0 + 2.0f * n1 + n2);
   return sqrt(dot(gx, gx) + dot(gy, gy)) / SALIENCY_SCALE;
@@ -35,11 +36,14 @@ STRATA_INLINE float sobel_saliency(vec3 n0, vec3 n1, vec3 n2, vec3 n3, vec3 n5, 
 
 // Eq. 3.3 (several layers) and eq. 3.4 (one layer): the integral cost of a pixel for `layer`,
 // from the alpha of each layer (occlusion) and the saliency. o[] has layer_count entries.
-STRATA_INLINE float integral_cost(float occlusion_in_front, float occlusion_behind, float occlusion_all,
-                               float saliency, uint layer_count, float saliency_weight,
-                               float occlusion_weight, float single_saliency_weight) {
-  if (layer_count == 1u) return occlusion_weight * occlusion_all + single_saliency_weight * saliency;
-  return occlusion_in_front + (saliency_weight * saliency + (1.0f - saliency_weight)) * occlusion_behind;
+STRATA_INLINE float integral_cost(float occlusion_in_front, float occlusion_behind,
+                                  float occlusion_all, float saliency, uint layer_count,
+                                  float saliency_weight, float occlusion_weight,
+                                  float single_saliency_weight) {
+  if (layer_count == 1u)
+    return occlusion_weight * occlusion_all + single_saliency_weight * saliency;
+  return occlusion_in_front +
+         (saliency_weight * saliency + (1.0f - saliency_weight)) * occlusion_behind;
 }
 STRATA_END
 

@@ -11,13 +11,14 @@
 #include "common.h"
 
 #define SAT_TILE 32
-#define SAT_GROUP_ROWS 8      // a workgroup is SAT_TILE x SAT_GROUP_ROWS threads
-#define SAT_RUN 4             // elements each thread scans serially along a tile line
+#define SAT_GROUP_ROWS 8  // a workgroup is SAT_TILE x SAT_GROUP_ROWS threads
+#define SAT_RUN 4         // elements each thread scans serially along a tile line
 #define SAT_CARRY_GROUP 64
 
 #define SAT_BINDING_INPUT 0
 #define SAT_BINDING_OUTPUT 1
-#define SAT_BINDING_CARRIES 2  // row carries [tiles_x][height], then column carries [tiles_y][width]
+#define SAT_BINDING_CARRIES \
+  2  // row carries [tiles_x][height], then column carries [tiles_y][width]
 
 STRATA_BEGIN
 struct SatParams {

@@ -41,7 +41,9 @@ STRATA_INLINE vec3 test_pattern(vec2 uv) {
   return clamp(color, vec3(0.0f), vec3(1.0f));
 }
 
-STRATA_INLINE float luminance(vec3 c) { return dot(c, vec3(0.2126f, 0.7152f, 0.0722f)); }
+STRATA_INLINE float luminance(vec3 c) {
+  return dot(c, vec3(0.2126f, 0.7152f, 0.0722f));
+}
 STRATA_END
 
 #endif

@@ -8,23 +8,23 @@
 
 #define VR_MAX_VOLUMES 8
 #define VR_MAX_LAYERS 8
-#define VR_MAX_FRAGMENTS 16   // per pixel in the resolve; more are counted, not drawn
-#define VR_MAX_AGE 255        // probes per insertion before a fragment counts as overflow
-#define VR_TF_SIZE 256        // entries per transfer-function row
-#define VR_BRICK 8            // voxels per brick edge for empty-space skipping
-#define VR_RESOLVE_GROUP 8    // resolve workgroup is 8 x 8 pixels
+#define VR_MAX_FRAGMENTS 16  // per pixel in the resolve; more are counted, not drawn
+#define VR_MAX_AGE 255       // probes per insertion before a fragment counts as overflow
+#define VR_TF_SIZE 256       // entries per transfer-function row
+#define VR_BRICK 8           // voxels per brick edge for empty-space skipping
+#define VR_RESOLVE_GROUP 8   // resolve workgroup is 8 x 8 pixels
 
 // Payload kinds (bits 8..9 of payload.y); bit 10: the fragment enters its volume.
 #define VR_KIND_MESH 0u
 #define VR_KIND_VOLUME_FACE 1u
 
 // Counters written on the GPU, read back a frame later.
-#define VR_COUNTER_OVERFLOW 0           // fragments that found no free slot
-#define VR_COUNTER_FRAGMENTS 1          // fragments the resolve found
-#define VR_COUNTER_RESOLVE_OVERFLOW 2   // fragments beyond VR_MAX_FRAGMENTS in one pixel
-#define VR_COUNTER_SAMPLES 3            // ray positions sampled
-#define VR_COUNTER_SHADED 4             // volume samples shaded (alpha > 0)
-#define VR_COUNTER_FETCHES 5            // atlas fetches (one per live volume per sample)
+#define VR_COUNTER_OVERFLOW 0          // fragments that found no free slot
+#define VR_COUNTER_FRAGMENTS 1         // fragments the resolve found
+#define VR_COUNTER_RESOLVE_OVERFLOW 2  // fragments beyond VR_MAX_FRAGMENTS in one pixel
+#define VR_COUNTER_SAMPLES 3           // ray positions sampled
+#define VR_COUNTER_SHADED 4            // volume samples shaded (alpha > 0)
+#define VR_COUNTER_FETCHES 5           // atlas fetches (one per live volume per sample)
 #define VR_COUNTER_COUNT 6
 
 #define VR_BINDING_FRAME 0
@@ -34,24 +34,25 @@
 #define VR_BINDING_COUNTERS 5
 #define VR_BINDING_VERTICES 6
 #define VR_BINDING_INDICES 7
-#define VR_BINDING_ATLAS 8            // sampler3D: every volume, normalised, with borders
-#define VR_ATLAS_BORDER 2             // voxels of replicated edge around each volume in the atlas
-#define VR_BINDING_TRANSFER 9         // vec4[VR_TF_SIZE] per volume, straight RGBA
-#define VR_BINDING_OCCUPANCY 10       // one uint per brick, all volumes one after the other
-#define VR_BINDING_LAYERS 11          // image2DArray rgba16f, premultiplied
-#define VR_BINDING_FINAL 12           // image2D rgba8, layers over the background
-#define VR_BINDING_DEPTH 13           // image2D r32f, eye depth where alpha first passes depth_alpha
+#define VR_BINDING_ATLAS 8       // sampler3D: every volume, normalised, with borders
+#define VR_ATLAS_BORDER 2        // voxels of replicated edge around each volume in the atlas
+#define VR_BINDING_TRANSFER 9    // vec4[VR_TF_SIZE] per volume, straight RGBA
+#define VR_BINDING_OCCUPANCY 10  // one uint per brick, all volumes one after the other
+#define VR_BINDING_LAYERS 11     // image2DArray rgba16f, premultiplied
+#define VR_BINDING_FINAL 12      // image2D rgba8, layers over the background
+#define VR_BINDING_DEPTH 13      // image2D r32f, eye depth where alpha first passes depth_alpha
 
 STRATA_BEGIN
 
 struct VolumeGpu {
   mat4 world_to_texture;  // world -> [0,1]^3 (voxel centres at (i + 0.5) / dims)
   mat4 texture_to_world;
-  vec4 atlas_offset;  // xyz: atlas coordinate of texture coordinate 0; w: transfer row centre (0..1)
-  vec4 atlas_scale;   // xyz: atlas units per texture unit; w: reference step in world units
-                      // (transfer-function alpha is per this distance: opacity correction)
-  vec4 texel;         // xyz: 1 / dims (central differences, texture units); w: unused
-  uvec4 bricks;     // xyz: brick grid size; w: first brick's index in the occupancy buffer
+  vec4
+      atlas_offset;  // xyz: atlas coordinate of texture coordinate 0; w: transfer row centre (0..1)
+  vec4 atlas_scale;  // xyz: atlas units per texture unit; w: reference step in world units
+                     // (transfer-function alpha is per this distance: opacity correction)
+  vec4 texel;        // xyz: 1 / dims (central differences, texture units); w: unused
+  uvec4 bricks;      // xyz: brick grid size; w: first brick's index in the occupancy buffer
 };
 
 struct FrameGpu {
@@ -59,19 +60,19 @@ struct FrameGpu {
   mat4 view_to_world;
   mat4 view_to_clip;
   mat4 clip_to_view;
-  vec4 splits[2];    // layer boundaries (eye depth): split i is splits[i / 4][i % 4]
-  vec4 background;   // straight RGB, a = 1
+  vec4 splits[2];   // layer boundaries (eye depth): split i is splits[i / 4][i % 4]
+  vec4 background;  // straight RGB, a = 1
   uint width;
   uint height;
   uint layer_count;
   uint volume_count;
-  uint table_size;   // HA-Buffer slots
-  uint skip_empty;   // 1: empty-space skipping
+  uint table_size;  // HA-Buffer slots
+  uint skip_empty;  // 1: empty-space skipping
   uint pad0;
   uint pad1;
   float near_depth;  // eye depth of the near and far planes
   float far_depth;
-  float step;        // sampling distance along rays, world units
+  float step;               // sampling distance along rays, world units
   float termination_alpha;  // early ray termination, per layer
   float depth_alpha;        // the depth image records where alpha first reaches this
   float pad2;

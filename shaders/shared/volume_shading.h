@@ -24,7 +24,9 @@ STRATA_INLINE vec4 shade_blinn_phong(vec4 color, vec3 normal, vec3 to_eye) {
 }
 
 // Eq. 3.9, front to back: `back` (premultiplied) seen through what `front` has accumulated.
-STRATA_INLINE vec4 over(vec4 front, vec4 back) { return front + (1.0f - front.a) * back; }
+STRATA_INLINE vec4 over(vec4 front, vec4 back) {
+  return front + (1.0f - front.a) * back;
+}
 
 // Transfer-function alpha is defined per `reference` distance; a step of `step` absorbs more or
 // less (the usual opacity correction).
@@ -32,7 +34,9 @@ STRATA_INLINE float corrected_alpha(float alpha, float step, float reference) {
   return 1.0f - pow(max(1.0f - alpha, 0.0f), step / reference);
 }
 
-STRATA_INLINE float split_depth(vec4 splits[2], uint i) { return splits[i / 4u][int(i % 4u)]; }
+STRATA_INLINE float split_depth(vec4 splits[2], uint i) {
+  return splits[i / 4u][int(i % 4u)];
+}
 
 // Mesh colour as the HA-Buffer stores it: shaded, premultiplied, rgba8.
 STRATA_INLINE uint mesh_payload_color(vec4 color, vec3 normal, vec3 to_eye) {

@@ -10,9 +10,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
-#include "engine/scene/atlas.h"
 #include "engine/core/error.h"
 #include "engine/core/text_file.h"
+#include "engine/scene/atlas.h"
 #include "engine/scene/io/mesh_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
 #include "engine/scene/io/volume_loader.h"

@@ -140,7 +140,8 @@ void VolyImporter::camera(const Node& px) {
   size_t index = 0;
   for (const pugi::xml_node item : positions->xml.children("item")) {
     const Node node{item, file_, positions->field + ".item[" + std::to_string(index++) + "]"};
-    scene_.camera_positions.push_back({node.child("name").text(), node.child("viewMatrix").matrix()});
+    scene_.camera_positions.push_back(
+        {node.child("name").text(), node.child("viewMatrix").matrix()});
   }
 }
 
