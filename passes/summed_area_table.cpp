@@ -40,13 +40,10 @@ void SummedAreaTable::add_to(graph::Graph& graph, ResourceId input, ResourceId o
     graph.add_pass({group + "." + name, graph::PassKind::compute, std::move(uses),
                     [&pipeline, per_tile, layers](graph::PassContext& pc) {
                       const gpu::SatParams p = params_for(pc.viewport, layers);
-                      pc.bind(pipeline);
-                      pipeline.push_constants(pc.cmd, p);
                       if (per_tile) {
-                        vkCmdDispatch(pc.cmd, p.tiles_x, p.tiles_y, layers);
-                      } else {
-                        vkCmdDispatch(pc.cmd, group_count(p.width + p.height, SAT_CARRY_GROUP),
-                                      layers, 1);
+                        pc.dispatch_groups(pipeline, p, {p.tiles_x, p.tiles_y, layers});
+                      } else {  // a thread per image row and column, per layer
+                        pc.dispatch(pipeline, p, {p.width + p.height, layers, 1});
                       }
                     },
                     group});

@@ -24,10 +24,7 @@ graph::ResourceId TestPattern::add_to(graph::Graph& graph, uint32_t blur_radius)
 
   auto dispatch = [blur_radius](const ComputePipeline& pipeline, graph::PassContext& pc) {
     const gpu::TestPatternParams p{pc.viewport.width, pc.viewport.height, blur_radius, 0};
-    pc.bind(pipeline);
-    pipeline.push_constants(pc.cmd, p);
-    vkCmdDispatch(pc.cmd, group_count(p.width, TEST_PATTERN_GROUP),
-                  group_count(p.height, TEST_PATTERN_GROUP), 1);
+    pc.dispatch(pipeline, p, {p.width, p.height, 1});
   };
   graph.add_pass({"pattern.draw",
                   graph::PassKind::compute,

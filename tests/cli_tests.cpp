@@ -13,6 +13,26 @@ namespace strata {
 
 using test::run_strata;
 
+namespace {
+
+// A bench report: the one JSON object in the output (stderr's lines may come before or after).
+nlohmann::json bench_report(const std::string& output) {
+  const size_t start = output.find("{\n"), end = output.rfind("\n}");
+  REQUIRE(end != std::string::npos);
+  REQUIRE(start < end);
+  return nlohmann::json::parse(output.substr(start, end + 2 - start));
+}
+
+// The entry of a bench report's "passes" or "groups" list with this name (null if none).
+nlohmann::json named(const nlohmann::json& list, const std::string& name) {
+  for (const auto& entry : list) {
+    if (entry["name"] == name) return entry;
+  }
+  return nlohmann::json();
+}
+
+}  // namespace
+
 TEST_SUITE("cli") {
   TEST_CASE("devices_lists_lavapipe_as_usable") {
     const auto r = run_strata("devices");
@@ -35,23 +55,36 @@ TEST_SUITE("cli") {
   TEST_CASE("bench_sat_prints_json_with_device_passes_and_a_checked_result") {
     const auto r = run_strata("bench sat --size 96x40 --runs 3");
     CHECK(r.exit_code == 0);
-    // The report is the one object in the output; stderr's lines may come before or after it.
-    const size_t start = r.output.find("{\n"), end = r.output.rfind("\n}");
-    REQUIRE(end != std::string::npos);
-    REQUIRE(start < end);
-    const nlohmann::json report = nlohmann::json::parse(r.output.substr(start, end + 2 - start));
+    const nlohmann::json report = bench_report(r.output);
     CHECK(report["device"].get<std::string>().starts_with("llvmpipe"));
     CHECK(report["benchmark"] == "sat");
     CHECK(report["runs"] == 3);
-    const auto named = [](const nlohmann::json& list, const std::string& name) {
-      for (const auto& entry : list) {
-        if (entry["name"] == name) return entry;
-      }
-      return nlohmann::json();
-    };
     CHECK(named(report["passes"], "summed_area_table.scan")["median_ms"].is_number());
     CHECK(named(report["groups"], "summed_area_table")["min_ms"].is_number());
     CHECK(report["max_relative_error"].get<double>() < 1e-5);
+  }
+
+  // The placement benchmark, validated: the label loop as one pass, and its baseline returning to
+  // the host at every barrier inside that pass.
+  TEST_CASE("bench_placement_runs_validated_with_its_readback_baseline") {
+    const auto r = run_strata("--validate bench placement --scene " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --size 96 --labels 6 --runs 1");
+    CHECK(r.exit_code == 0);
+    CHECK(r.output.find("validation:") == std::string::npos);
+    const nlohmann::json report = bench_report(r.output);
+    CHECK(report["benchmark"] == "placement");
+    CHECK(report["labels"] == 6);
+    CHECK(named(report["passes"], "placement.labels")["median_ms"].get<double>() > 0.0);
+    CHECK(report["label_loop_ms"].get<double>() > 0.0);
+    CHECK(report["label_loop_with_readback_per_label_ms"].get<double>() > 0.0);
+  }
+
+  TEST_CASE("dump_graph_prints_the_frame_passes_and_barriers") {
+    const auto r = run_strata("render " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --size 48 --dump-graph -o /dev/null");
+    CHECK(r.exit_code == 0);
+    CHECK(r.output.find("pass 13 'placement.labels' (compute, placement)") != std::string::npos);
+    CHECK(r.output.find("19 passes, 50 barriers") != std::string::npos);
   }
 
   TEST_CASE("no_vulkan_driver_is_one_clear_error_and_exit_1") {
