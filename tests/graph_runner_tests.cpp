@@ -84,46 +84,51 @@ std::vector<float> table_in_one_pass(Context& ctx, const std::vector<float>& val
   return download_as<float>(ctx, output);
 }
 
+graph::BufferInfo small_buffer() {
+  return {[](graph::Extent) { return VkDeviceSize{64}; }};
+}
+
+// A transfer pass that declares `declared` and zeroes `touched`.
+graph::PassInfo fill(const char* name, graph::ResourceId declared, graph::ResourceId touched) {
+  return {name,
+          graph::PassKind::transfer,
+          {{declared, graph::Use::transfer_dst}},
+          [touched](graph::PassContext& pc) {
+            vkCmdFillBuffer(pc.cmd, pc.buffer(touched), 0, VK_WHOLE_SIZE, 0);
+          }};
+}
+
+// Records `g` on the test device and expects the graph error `message`.
+void check_recording_fails(Context& ctx, graph::Graph g, const char* message) {
+  graph::GraphRunner runner(ctx, std::move(g));
+  runner.set_viewport({4, 4});
+  CHECK_THROWS_WITH_AS(runner.run_now(), message, graph::GraphError);
+}
+
 }  // namespace
 
 TEST_SUITE("gpu") {
   TEST_CASE_FIXTURE(test::GpuTest, "a_pass_that_touches_a_resource_it_did_not_declare_fails") {
     graph::Graph g;
-    const auto declared = g.add_buffer("declared", {[](graph::Extent) { return 64; }});
-    const auto hidden = g.add_buffer("hidden", {[](graph::Extent) { return 64; }});
-    g.add_pass({"fill",
-                graph::PassKind::transfer,
-                {{declared, graph::Use::transfer_dst}},
-                [&](graph::PassContext& pc) {
-                  vkCmdFillBuffer(pc.cmd, pc.buffer(declared), 0, VK_WHOLE_SIZE, 0);
-                  vkCmdFillBuffer(pc.cmd, pc.buffer(hidden), 0, VK_WHOLE_SIZE, 0);
-                }});
-    graph::GraphRunner runner(ctx, std::move(g));
-    runner.set_viewport({4, 4});
-    CHECK_THROWS_WITH_AS(runner.run_now(), "pass 'fill' touches 'hidden', which it did not declare",
-                         graph::GraphError);
+    const auto declared = g.add_buffer("declared", small_buffer());
+    const auto hidden = g.add_buffer("hidden", small_buffer());
+    g.add_pass(fill("fill", declared, hidden));
+    check_recording_fails(ctx, std::move(g),
+                          "pass 'fill' touches 'hidden', which it did not declare");
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "an_indirect_dispatch_needs_an_indirect_declaration") {
     const ComputePipeline finalize(ctx, "placement_finalize.comp");
     graph::Graph g;
-    const auto args = g.add_buffer("args", {[](graph::Extent) { return 64; }});
-    g.add_pass({"zero",
-                graph::PassKind::transfer,
-                {{args, graph::Use::transfer_dst}},
-                [&](graph::PassContext& pc) {
-                  vkCmdFillBuffer(pc.cmd, pc.buffer(args), 0, VK_WHOLE_SIZE, 0);
-                }});
+    const auto args = g.add_buffer("args", small_buffer());
+    g.add_pass(fill("zero", args, args));
     g.add_pass({"dispatch",
                 graph::PassKind::compute,
                 {{args, graph::Use::storage_read}},
                 [&](graph::PassContext& pc) { pc.dispatch_indirect(finalize, 0u, args, 0); }});
-    graph::GraphRunner runner(ctx, std::move(g));
-    runner.set_viewport({4, 4});
-    CHECK_THROWS_WITH_AS(runner.run_now(),
-                         "pass 'dispatch' dispatches from 'args', which it did not declare "
-                         "indirect",
-                         graph::GraphError);
+    check_recording_fails(
+        ctx, std::move(g),
+        "pass 'dispatch' dispatches from 'args', which it did not declare indirect");
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "dependent_dispatches_in_one_pass_are_ordered_by_its_barriers") {
