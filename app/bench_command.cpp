@@ -313,15 +313,16 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint
                               {"labels_shown", enabled},
                               {"layers", frame.result().layering.layer_count}};
   const glm::uvec2 tiles = gpu::placement_tiles(size.width, size.height);
-  ordered_json results = {{"placement_ms", ms_json(whole_ms)},
-                          {"placement_ms_stamped_per_pass", ms_json(placement_ms)},
-                          {"label_loop_ms", ms_json(loop_ms)},
-                          {"label_loop_with_readback_per_label_ms", ms_json(baseline.median)},
-                          {"placement_with_readback_per_label_ms", ms_json(baseline_total)},
-                          {"speedup", whole_ms > 0.0 ? baseline_total / whole_ms : 0.0},
-                          {"tiles", tiles.x * tiles.y},
-                          {"tiles_per_label_speculative", first_tiles},
-                          {"tiles_per_label_main_beyond_speculative", rest_tiles}};
+  ordered_json results = {
+      {"placement_ms", ms_json(whole_ms)},
+      {"placement_ms_stamped_per_pass", ms_json(placement_ms)},
+      {"label_loop_ms", ms_json(loop_ms)},
+      {"label_loop_with_readback_per_label_ms", ms_json(baseline.median)},
+      {"placement_with_readback_per_label_ms", ms_json(baseline_total)},
+      {"speedup", whole_ms > 0.0 ? std::round(baseline_total / whole_ms * 100.0) / 100.0 : 0.0},
+      {"tiles", tiles.x * tiles.y},
+      {"tiles_per_label_speculative", first_tiles},
+      {"tiles_per_label_main_beyond_speculative", rest_tiles}};
   const ordered_json pipelines = pipelines_json(frame.placement_pipelines());
   if (!pipelines.empty()) results["pipelines"] = pipelines;
   print_json(ctx, setup, runs, t, results);
