@@ -1,0 +1,91 @@
+#include "passes/label_forces.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/core/error.h"
+
+namespace strata {
+
+using graph::Use;
+
+gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_count,
+                                double seconds) {
+  if (!(settings.speed > 0.0f) || !(settings.epsilon > 0.0f) || !(settings.snap >= 0.0f)) {
+    throw Error("forces: speed and epsilon must be > 0 and snap >= 0");
+  }
+  if (!(seconds >= 0.0 && seconds <= 60.0)) {
+    throw Error("forces: a frame of " + std::to_string(seconds) + " s");
+  }
+  const double travel = seconds * double(settings.speed);
+  const auto steps = static_cast<uint32_t>(std::max(1.0, std::ceil(travel / settings.epsilon)));
+  gpu::ForcesParams p{};
+  p.label_count = label_count;
+  p.steps = steps;
+  p.step_seconds = static_cast<float>(seconds / steps);
+  p.speed = settings.speed;
+  p.epsilon = settings.epsilon;
+  p.snap = settings.snap;
+  p.anchor_relative = settings.anchor_relative ? 1u : 0u;
+  return p;
+}
+
+LabelForces::LabelForces(Context& ctx, uint32_t label_count)
+    : ctx_(ctx),
+      label_count_(label_count),
+      params_(forces_params({}, label_count, 0.0)),
+      forces_(ctx, "label_forces.comp"),
+      state_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::LabelStateGpu),
+             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                 VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+             MemoryKind::device_local) {
+  reset();
+}
+
+void LabelForces::reset() {
+  const std::vector<gpu::LabelStateGpu> empty(std::max(1u, label_count_), gpu::LabelStateGpu{});
+  upload(ctx_, state_, as_bytes(empty));
+}
+
+void LabelForces::set_frame(const ForceSettings& settings, double seconds) {
+  params_ = forces_params(settings, label_count_, seconds);
+}
+
+std::vector<gpu::LabelStateGpu> LabelForces::state() const {
+  std::vector<gpu::LabelStateGpu> out = download_as<gpu::LabelStateGpu>(ctx_, state_);
+  out.resize(label_count_);
+  return out;
+}
+
+LabelForces::Outputs LabelForces::add_to(graph::Graph& graph, const Inputs& in) {
+  const uint32_t n = std::max(label_count_, 1u);
+  Outputs out;
+  out.state = graph.import_buffer("forces.state", {.buffer = state_.handle(), .has_content = true});
+  out.drawn = graph.add_buffer(
+      "forces.drawn", {[n](graph::Extent) { return VkDeviceSize{n} * sizeof(gpu::PlacementGpu); }});
+  graph.add_pass({"labels.forces",
+                  graph::PassKind::compute,
+                  {{in.labels, Use::storage_read, FORCES_BINDING_LABELS},
+                   {in.targets, Use::storage_read, FORCES_BINDING_TARGETS},
+                   {out.state, Use::storage_read_write, FORCES_BINDING_STATE},
+                   {out.drawn, Use::storage_write, FORCES_BINDING_DRAWN}},
+                  [this](graph::PassContext& pc) {
+                    pc.dispatch(forces_, params_, {label_count_, 1, 1});
+                  },
+                  "labels"});
+  return out;
+}
+
+std::vector<gpu::PlacementGpu> forces_reference(const std::vector<gpu::LabelGpu>& labels,
+                                                const std::vector<gpu::PlacementGpu>& targets,
+                                                std::vector<gpu::LabelStateGpu>& state,
+                                                const gpu::ForcesParams& params) {
+  std::vector<gpu::PlacementGpu> drawn(labels.size());
+  for (size_t i = 0; i < labels.size(); ++i) {
+    state[i] = gpu::forces_update(labels[i], targets[i], state[i], params);
+    drawn[i] = gpu::forces_drawn(labels[i], targets[i], state[i], params);
+  }
+  return drawn;
+}
+
+}  // namespace strata

@@ -1,0 +1,71 @@
+// Forces (thesis 3.4): after the placement, each label's drawn position moves toward the
+// position the placement chose (eq. 3.6-3.8: unit force, attenuated within epsilon, sub-stepped,
+// snapped when close), so that labels glide while the camera moves instead of jumping. The drawn
+// positions live on the GPU from frame to frame; nothing waits for the CPU.
+//   labels.forces  per label: the state moves, and the placement drawing reads is written
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "engine/gpu/resources.h"
+#include "engine/gpu/shader_library.h"
+#include "engine/graph/graph_runner.h"
+#include "engine/graph/render_graph.h"
+#include "shared/forces.h"
+
+namespace strata {
+
+struct ForceSettings {
+  // Where a label lives between frames: as an offset from its anchor, so that it moves rigidly
+  // with the anchor while the camera turns and the forces act on the offset; or, as in the
+  // thesis, as a position on screen.
+  bool anchor_relative = true;
+  float speed = 600.0f;   // pixels per second at full force
+  float epsilon = 24.0f;  // pixels: within this the force shrinks toward the target (eq. 3.7)
+  float snap = 0.5f;      // pixels: within this the label is put on its target
+};
+
+// The push constants of one frame of `seconds`: enough sub-steps that none moves a label by more
+// than epsilon, so no step overshoots its target.
+gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_count,
+                                double seconds);
+
+class LabelForces {
+ public:
+  struct Inputs {
+    graph::ResourceId labels;   // LabelGpu[]: this frame's anchors and flags
+    graph::ResourceId targets;  // PlacementGpu[]: the placement's result
+  };
+  struct Outputs {
+    graph::ResourceId drawn;  // PlacementGpu[]: where the labels are drawn
+    graph::ResourceId state;  // LabelStateGpu[]: the drawn positions kept across frames
+  };
+
+  LabelForces(Context& ctx, uint32_t label_count);
+
+  Outputs add_to(graph::Graph& graph, const Inputs& in);
+
+  // The next frame's settings and duration (a fixed 1 / fps offline, so videos are repeatable).
+  void set_frame(const ForceSettings& settings, double seconds);
+  // Forgets every drawn position: the next frame puts each label on its target.
+  void reset();
+  // The state after the last completed frame (waits; tests and tools).
+  std::vector<gpu::LabelStateGpu> state() const;
+
+ private:
+  Context& ctx_;
+  uint32_t label_count_;
+  gpu::ForcesParams params_{};
+  ComputePipeline forces_;
+  Buffer state_;
+};
+
+// The CPU reference: one frame of forces over every label. `state` is updated in place; returns
+// where each label is drawn.
+std::vector<gpu::PlacementGpu> forces_reference(const std::vector<gpu::LabelGpu>& labels,
+                                                const std::vector<gpu::PlacementGpu>& targets,
+                                                std::vector<gpu::LabelStateGpu>& state,
+                                                const gpu::ForcesParams& params);
+
+}  // namespace strata

@@ -1,0 +1,166 @@
+// Forces (eq. 3.6-3.8): the GPU pass against its CPU reference, and how a label moves.
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <random>
+
+#include "engine/core/error.h"
+#include "engine/gpu/resources.h"
+#include "engine/graph/graph_runner.h"
+#include "gpu_fixture.h"
+#include "passes/label_forces.h"
+
+namespace strata {
+namespace {
+
+gpu::LabelGpu label_at(glm::vec2 anchor, bool enabled = true) {
+  gpu::LabelGpu l{};
+  l.anchor = anchor;
+  l.size = {60.0f, 16.0f};
+  l.flags = enabled ? LABEL_ENABLED : 0u;
+  return l;
+}
+
+gpu::PlacementGpu target_at(glm::vec2 position, bool shown = true) {
+  return {position, 1.0f, shown ? PLACEMENT_SHOWN : PLACEMENT_HIDDEN};
+}
+
+gpu::LabelStateGpu placed_at(glm::vec2 position) {
+  return {position, LABEL_STATE_PLACED, 0};
+}
+
+// One label followed over frames of 1/30 s toward a fixed target: the distances, frame by frame.
+std::vector<float> approach(const ForceSettings& settings, glm::vec2 start, glm::vec2 goal,
+                            int frames) {
+  const gpu::ForcesParams params = forces_params(settings, 1, 1.0 / 30.0);
+  std::vector<gpu::LabelStateGpu> state{placed_at(start)};
+  std::vector<float> distances;
+  for (int f = 0; f < frames; ++f) {
+    const auto drawn = forces_reference({label_at({0.0f, 0.0f})}, {target_at(goal)}, state, params);
+    distances.push_back(glm::length(goal - drawn[0].position));
+  }
+  return distances;
+}
+
+template <typename T>
+std::vector<T> as(const std::vector<std::byte>& bytes) {
+  std::vector<T> out(bytes.size() / sizeof(T));
+  std::memcpy(out.data(), bytes.data(), out.size() * sizeof(T));
+  return out;
+}
+
+}  // namespace
+
+TEST_SUITE("cpu") {
+  TEST_CASE("a_frame_is_split_into_steps_that_never_move_a_label_past_epsilon") {
+    const ForceSettings s;  // 600 px/s, epsilon 24 px
+    CHECK(forces_params(s, 1, 1.0 / 30.0).steps == 1);
+    const gpu::ForcesParams second = forces_params(s, 1, 1.0);
+    CHECK(second.steps == 25);
+    CHECK(second.step_seconds * second.speed <= second.epsilon);
+    CHECK_THROWS_AS(forces_params({.speed = 0.0f}, 1, 0.1), Error);
+  }
+
+  TEST_CASE("a_label_converges_to_a_still_target_without_overshoot_and_stays") {
+    const glm::vec2 start{100.0f, 100.0f}, goal{400.0f, 500.0f};  // 500 px apart
+    const std::vector<float> d = approach({}, start, goal, 60);
+    for (size_t f = 1; f < d.size(); ++f) CHECK(d[f] <= d[f - 1]);
+    // At 600 px/s the unit force covers 480 px in 24 frames; then the attenuated tail and the snap.
+    CHECK(d[23] == doctest::Approx(20.0f).epsilon(1e-3));
+    size_t arrived = 0;
+    while (arrived < d.size() && d[arrived] > 0.0f) ++arrived;
+    CHECK(arrived < 40);
+    for (size_t f = arrived; f < d.size(); ++f) CHECK(d[f] == 0.0f);
+  }
+
+  TEST_CASE("within_epsilon_the_force_shrinks_with_the_distance") {
+    // 12 px away with epsilon 24: a step of 20 px at full force would overshoot; the attenuated
+    // force moves it 12 * 20 / 24 = 10 px.
+    const std::vector<float> d = approach({}, {0.0f, 0.0f}, {12.0f, 0.0f}, 1);
+    CHECK(d[0] == doctest::Approx(2.0f).epsilon(1e-5));
+  }
+
+  TEST_CASE("anchored_labels_move_rigidly_with_their_anchor_screen_labels_lag") {
+    std::vector<gpu::LabelStateGpu> anchored(1), screen(1);
+    const gpu::ForcesParams a = forces_params({.anchor_relative = true}, 1, 1.0 / 30.0);
+    const gpu::ForcesParams s = forces_params({.anchor_relative = false}, 1, 1.0 / 30.0);
+    const glm::vec2 offset{80.0f, -40.0f};
+    for (int f = 0; f < 20; ++f) {
+      const glm::vec2 anchor{100.0f + 15.0f * float(f), 300.0f};  // 450 px/s to the right
+      const std::vector<gpu::LabelGpu> labels{label_at(anchor)};
+      const std::vector<gpu::PlacementGpu> targets{target_at(anchor + offset)};
+      CHECK(forces_reference(labels, targets, anchored, a)[0].position == anchor + offset);
+      const glm::vec2 lag = forces_reference(labels, targets, screen, s)[0].position - anchor;
+      if (f > 0) CHECK(glm::length(lag - offset) > 1.0f);
+    }
+  }
+
+  TEST_CASE("hidden_and_disabled_labels_keep_their_drawn_position") {
+    std::vector<gpu::LabelStateGpu> state{placed_at({10.0f, 20.0f}), placed_at({30.0f, 40.0f})};
+    const gpu::ForcesParams p = forces_params({.anchor_relative = false}, 2, 1.0 / 30.0);
+    const auto drawn =
+        forces_reference({label_at({0.0f, 0.0f}), label_at({0.0f, 0.0f}, false)},
+                         {target_at({500.0f, 500.0f}, false), target_at({500.0f, 0.0f})}, state, p);
+    CHECK(state[0].position == glm::vec2(10.0f, 20.0f));
+    CHECK(state[1].position == glm::vec2(30.0f, 40.0f));
+    CHECK(drawn[0].shown == PLACEMENT_HIDDEN);
+  }
+}
+
+TEST_SUITE("gpu") {
+  TEST_CASE_FIXTURE(test::GpuTest, "forces_pass_matches_cpu_reference_exactly_over_frames") {
+    const uint32_t count = 150;  // more than one workgroup
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> pixel(0.0f, 512.0f);
+    std::vector<gpu::LabelGpu> labels(count);
+    std::vector<gpu::PlacementGpu> targets(count);
+    Buffer label_buffer(ctx, count * sizeof(gpu::LabelGpu), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                        MemoryKind::device_local);
+    Buffer target_buffer(ctx, count * sizeof(gpu::PlacementGpu), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                         MemoryKind::device_local);
+    for (const bool anchored : {true, false}) {
+      CAPTURE(anchored);
+      LabelForces forces(ctx, count);
+      graph::Graph g;
+      const LabelForces::Outputs out = forces.add_to(
+          g, {.labels =
+                  g.import_buffer("labels", {.buffer = label_buffer.handle(), .has_content = true}),
+              .targets = g.import_buffer("targets",
+                                         {.buffer = target_buffer.handle(), .has_content = true})});
+      graph::GraphRunner runner(ctx, std::move(g));
+      runner.set_viewport({512, 512});
+      std::vector<gpu::LabelStateGpu> state(count);
+      for (int frame = 0; frame < 6; ++frame) {
+        CAPTURE(frame);
+        for (uint32_t i = 0; i < count; ++i) {
+          labels[i] = label_at({pixel(rng), pixel(rng)}, i % 7 != 0);
+          targets[i] = target_at({pixel(rng), pixel(rng)}, i % 5 != 0);
+        }
+        upload(ctx, label_buffer, as_bytes(labels));
+        upload(ctx, target_buffer, as_bytes(targets));
+        // Frames of varied length: one sub-step, several, and a still frame.
+        const double seconds = frame == 3 ? 0.0 : 0.02 * (frame + 1);
+        const ForceSettings settings{.anchor_relative = anchored, .speed = 900.0f};
+        forces.set_frame(settings, seconds);
+        runner.run_now();
+        const std::vector<gpu::PlacementGpu> expected =
+            forces_reference(labels, targets, state, forces_params(settings, count, seconds));
+        const auto drawn = as<gpu::PlacementGpu>(runner.download_buffer(out.drawn));
+        const std::vector<gpu::LabelStateGpu> gpu_state = forces.state();
+        int mismatches = 0;
+        for (uint32_t i = 0; i < count; ++i) {
+          const bool same =
+              drawn[i].position == expected[i].position && drawn[i].shown == expected[i].shown &&
+              gpu_state[i].position == state[i].position && gpu_state[i].flags == state[i].flags;
+          if (!same && mismatches++ < 3) {
+            MESSAGE("label " << i << ": gpu " << drawn[i].position.x << "," << drawn[i].position.y
+                             << " cpu " << expected[i].position.x << "," << expected[i].position.y);
+          }
+        }
+        CHECK(mismatches == 0);
+      }
+    }
+  }
+}
+
+}  // namespace strata
