@@ -13,6 +13,7 @@
 #include "labeling/insertion_order.h"
 #include "labeling/text_layout.h"
 #include "passes/label_drawing.h"
+#include "passes/label_forces.h"
 
 namespace strata {
 namespace {
@@ -47,12 +48,14 @@ struct LabelledRenderer::Parts {
         const FontAtlas& font, size_t glyph_count)
       : renderer(ctx, scene, render),
         placement(ctx, label_count),
+        forces(ctx, label_count),
         drawing(ctx, font),
         target(ctx),
         glyphs(ctx, std::max<size_t>(1, glyph_count) * sizeof(gpu::GlyphGpu),
                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local) {}
   VolumeRenderer renderer;
   Placement placement;
+  LabelForces forces;
   LabelDrawing drawing;
   HeadlessTarget target;
   Buffer glyphs;
@@ -60,49 +63,63 @@ struct LabelledRenderer::Parts {
 
 LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camera& camera,
                                    graph::Extent size, const LabellingSettings& settings)
-    : scene_(scene), size_(size) {
-  // Layering on the CPU, from the camera alone: k-means++ on the visible anchors' depths.
-  const std::vector<ProjectedPoint> anchors = project_anchors(scene, camera, size);
-  std::vector<float> depths;
-  for (const auto& a : anchors) depths.push_back(a.visible ? a.eye_depth : std::nanf(""));
-  layering_ = layer_labels(depths, settings.layer_count, camera.near_plane, camera.far_plane,
-                           settings.seed);
-  RenderSettings render = settings.render;
-  render.layer_count = layering_.layer_count;
-  render.splits = layering_.split_depths;
-
-  // Labels: anchors, boxes from their texts, layers.
-  const FontAtlas font = load_font_atlas(settings.font_pixels);
+    : ctx_(ctx), scene_(scene), size_(size), settings_(settings) {
   labels_.resize(scene.labels.size());
+  for (size_t i = 0; i < scene.labels.size(); ++i) labels_[i].size = scene.labels[i].size;
+  project_and_layer(camera);
+
+  // Boxes from the texts: sizes and glyph ranges stay; anchors and layers follow the camera.
+  const FontAtlas font = load_font_atlas(settings.font_pixels);
   std::vector<std::string> texts;
-  for (size_t i = 0; i < scene.labels.size(); ++i) {
-    gpu::LabelGpu& l = labels_[i];
-    l.anchor = anchors[i].pixel;
-    l.size = scene.labels[i].size;
-    l.previous = anchors[i].pixel;
-    l.anchor_depth = anchors[i].eye_depth;
-    l.layer = layering_.label_layer[i];
-    l.flags = (anchors[i].visible ? LABEL_ENABLED : 0u) | (settings.internal ? LABEL_INTERNAL : 0u);
-    texts.push_back(scene.labels[i].text);
-  }
+  for (const Label& label : scene.labels) texts.push_back(label.text);
   const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, texts, labels_);
 
-  parts_ =
-      std::make_unique<Parts>(ctx, scene, render, uint32_t(labels_.size()), font, glyphs.size());
+  parts_ = std::make_unique<Parts>(ctx, scene, settings.render, uint32_t(labels_.size()), font,
+                                   glyphs.size());
   Parts& p = *parts_;
   p.renderer.set_camera(camera);
   p.drawing.set_label_count(uint32_t(labels_.size()));
   if (!glyphs.empty()) upload(ctx, p.glyphs, as_bytes(glyphs));
-  settings_ = settings;
-  p.placement.set_frame(labels_,
-                        insertion_order(labels_, layering_, scene_order(uint32_t(labels_.size()))),
-                        settings.placement);
+  set_order(scene_order(uint32_t(labels_.size())));
+  build_graph();
+}
+
+// Layering on the CPU, from the camera alone: k-means++ on the visible anchors' depths.
+void LabelledRenderer::project_and_layer(const Camera& camera) {
+  const std::vector<ProjectedPoint> anchors = project_anchors(scene_, camera, size_);
+  std::vector<float> depths;
+  for (const auto& a : anchors) depths.push_back(a.visible ? a.eye_depth : std::nanf(""));
+  layering_ = layer_labels(depths, settings_.layer_count, camera.near_plane, camera.far_plane,
+                           settings_.seed);
+  for (size_t i = 0; i < labels_.size(); ++i) {
+    gpu::LabelGpu& l = labels_[i];
+    l.anchor = anchors[i].pixel;
+    l.previous = anchors[i].pixel;  // (the GPU's forces state replaces it once drawn)
+    l.anchor_depth = anchors[i].eye_depth;
+    l.layer = layering_.label_layer[i];
+    l.flags =
+        (anchors[i].visible ? LABEL_ENABLED : 0u) | (settings_.internal ? LABEL_INTERNAL : 0u);
+  }
+}
+
+// The frame's graph: renderer, placement, forces, drawing, readback. Rebuilt only when the
+// layering's layer count changes (the layer images are sized by it).
+void LabelledRenderer::build_graph() {
+  Parts& p = *parts_;
+  RenderSettings& render = p.renderer.settings();
+  render.layer_count = layering_.layer_count;
+  render.splits = layering_.split_depths;
+  graph_layers_ = layering_.layer_count;
 
   graph::Graph graph;
   const VolumeRenderer::Outputs rendered = p.renderer.add_to(graph);
+  const graph::ResourceId state = p.forces.import_state(graph);
   placed_ = p.placement.add_to(graph, {.final_image = rendered.final,
                                        .layers = rendered.layers,
-                                       .layer_count = render.layer_count});
+                                       .layer_count = render.layer_count,
+                                       .previous = state});
+  const LabelForces::Outputs moved = p.forces.add_to(
+      graph, {.labels = placed_.labels, .targets = placed_.placements, .state = state});
   layers_id_ = rendered.layers;
   const graph::ResourceId glyph_buffer =
       graph.import_buffer("labels.glyphs", {.buffer = p.glyphs.handle(), .has_content = true});
@@ -110,14 +127,32 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
   p.drawing.add_to(graph, {.layers = rendered.layers,
                            .layer_count = render.layer_count,
                            .labels = placed_.labels,
-                           .placements = placed_.placements,
+                           .placements = moved.drawn,
                            .glyphs = glyph_buffer,
                            .output = labelled,
                            .background = render.background});
   p.target.add_output(graph, labelled);
-  runner_ = std::make_unique<graph::GraphRunner>(ctx, std::move(graph));
-  runner_->set_viewport(size);
+  runner_ = std::make_unique<graph::GraphRunner>(ctx_, std::move(graph));
+  runner_->set_viewport(size_);
   p.target.bind(*runner_);
+}
+
+void LabelledRenderer::set_order(const std::vector<uint32_t>& within) {
+  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within),
+                              settings_.placement);
+}
+
+void LabelledRenderer::set_camera(const Camera& camera) {
+  project_and_layer(camera);
+  parts_->renderer.set_camera(camera);
+  parts_->renderer.settings().splits = layering_.split_depths;
+  set_order(scene_order(uint32_t(labels_.size())));
+  if (layering_.layer_count != graph_layers_) build_graph();
+}
+
+void LabelledRenderer::advance(double seconds) {
+  parts_->forces.set_frame(settings_.forces, seconds);
+  run_frame();
 }
 
 LabelledRenderer::~LabelledRenderer() = default;
@@ -167,15 +202,16 @@ double LabelledRenderer::total_cost() const {
 }
 
 void LabelledRenderer::run() {
-  Placement& placement = parts_->placement;
-  const auto set_order = [&](const std::vector<uint32_t>& within) {
-    placement.set_frame(labels_, insertion_order(labels_, layering_, within), settings_.placement);
+  // A still: every frame puts the labels on their placement (the forces start afresh).
+  const auto run_still = [this] {
+    parts_->forces.reset();
+    run_frame();
   };
   set_order(scene_order(uint32_t(labels_.size())));
-  run_frame();
+  run_still();
   if (settings_.order == InsertionOrder::apollonius) {
     set_order(apollonius_layers_order());
-    run_frame();
+    run_still();
   } else if (settings_.order == InsertionOrder::optimized) {
     std::vector<uint32_t> best = scene_order(uint32_t(labels_.size()));
     double best_cost = total_cost();
@@ -183,7 +219,7 @@ void LabelledRenderer::run() {
       const std::vector<uint32_t> candidate =
           random_order(uint32_t(labels_.size()), settings_.seed + t + 1);
       set_order(candidate);
-      run_frame();
+      run_still();
       const double cost = total_cost();
       if (cost < best_cost) {
         best_cost = cost;
@@ -191,7 +227,7 @@ void LabelledRenderer::run() {
       }
     }
     set_order(best);
-    run_frame();
+    run_still();
   }
 }
 
@@ -204,6 +240,7 @@ LabelledFrame LabelledRenderer::result() const {
   const auto pixels = parts_->target.pixels();
   frame.image.assign(pixels.begin(), pixels.end());
   const auto results = parts_->placement.results();
+  const auto drawn = parts_->forces.drawn();
   for (size_t i = 0; i < labels_.size(); ++i) {
     LabelLayout l;
     l.id = scene_.labels[i].id;
@@ -211,8 +248,8 @@ LabelledFrame LabelledRenderer::result() const {
     l.layer = labels_[i].layer;
     l.anchor = labels_[i].anchor;
     l.box_size = labels_[i].size;
-    l.box_origin = results[i].position - labels_[i].size * 0.5f;
-    l.shown = results[i].shown == PLACEMENT_SHOWN;
+    l.box_origin = drawn[i].position - labels_[i].size * 0.5f;
+    l.shown = drawn[i].shown == PLACEMENT_SHOWN;
     l.cost = results[i].cost;
     frame.labels.push_back(l);
   }

@@ -11,6 +11,7 @@
 #include "engine/core/font.h"
 #include "engine/scene/scene.h"
 #include "labeling/layering.h"
+#include "passes/label_forces.h"
 #include "passes/placement.h"
 #include "passes/volume_renderer.h"
 
@@ -28,6 +29,7 @@ struct LabellingSettings {
   InsertionOrder order = InsertionOrder::scene;
   uint32_t optimize_tries = 8;  // InsertionOrder::optimized: random orders tried
   PlacementSettings placement;
+  ForceSettings forces;   // how drawn positions follow the placement from frame to frame
   bool internal = false;  // internal labelling: every label drawn on its anchor
   float font_pixels = 14.0f;
   uint64_t seed = 1;      // k-means++
@@ -66,10 +68,16 @@ class LabelledRenderer {
                    const LabellingSettings& settings);
   ~LabelledRenderer();
 
-  // One frame, waited for; re-rendered while the HA-Buffer overflows (it grows each time). The
-  // Apollonius and optimised orders take more frames: they need a frame's image or costs, read
-  // between frames, never inside one.
+  // A still, waited for: the labels put on their placement; re-rendered while the HA-Buffer
+  // overflows (it grows each time). The Apollonius and optimised orders take more frames: they
+  // need a frame's image or costs, read between frames, never inside one.
   void run();
+  // Moves the camera: anchors, layering and the renderer's layers follow; the labels' drawn
+  // positions stay on the GPU for the forces of the next frames.
+  void set_camera(const Camera& camera);
+  // One frame of an animation, `seconds` after the last: placement, then the forces move the
+  // drawn positions toward it (a label seen for the first time starts on its placement).
+  void advance(double seconds);
   graph::GraphRunner& runner() { return *runner_; }
   // The placement's resources and its label loop's pass: the baseline benchmark reads the
   // per-label results after each label, and the buckets give its tile statistics.
@@ -81,6 +89,7 @@ class LabelledRenderer {
 
  private:
   struct Parts;
+  Context& ctx_;
   const Scene& scene_;
   graph::Extent size_;
   Layering layering_;
@@ -88,12 +97,16 @@ class LabelledRenderer {
   std::unique_ptr<Parts> parts_;
   std::unique_ptr<graph::GraphRunner> runner_;
   void run_frame();
+  void project_and_layer(const Camera& camera);
+  void build_graph();
+  void set_order(const std::vector<uint32_t>& within);
   std::vector<uint32_t> apollonius_layers_order();
   double total_cost() const;
 
   RenderStats stats_;
   Placement::Outputs placed_{};
   graph::ResourceId layers_id_ = 0;
+  uint32_t graph_layers_ = 0;  // the layer count the graph was built for
   LabellingSettings settings_;
 };
 

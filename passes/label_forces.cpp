@@ -38,7 +38,9 @@ LabelForces::LabelForces(Context& ctx, uint32_t label_count)
       state_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::LabelStateGpu),
              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                  VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-             MemoryKind::device_local) {
+             MemoryKind::device_local),
+      readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu),
+                VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback) {
   reset();
 }
 
@@ -57,22 +59,39 @@ std::vector<gpu::LabelStateGpu> LabelForces::state() const {
   return out;
 }
 
+std::span<const gpu::PlacementGpu> LabelForces::drawn() const {
+  return {reinterpret_cast<const gpu::PlacementGpu*>(readback_.mapped()), label_count_};
+}
+
+graph::ResourceId LabelForces::import_state(graph::Graph& graph) const {
+  return graph.import_buffer("forces.state", {.buffer = state_.handle(), .has_content = true});
+}
+
 LabelForces::Outputs LabelForces::add_to(graph::Graph& graph, const Inputs& in) {
   const uint32_t n = std::max(label_count_, 1u);
   Outputs out;
-  out.state = graph.import_buffer("forces.state", {.buffer = state_.handle(), .has_content = true});
   out.drawn = graph.add_buffer(
       "forces.drawn", {[n](graph::Extent) { return VkDeviceSize{n} * sizeof(gpu::PlacementGpu); }});
   graph.add_pass({"labels.forces",
                   graph::PassKind::compute,
                   {{in.labels, Use::storage_read, FORCES_BINDING_LABELS},
                    {in.targets, Use::storage_read, FORCES_BINDING_TARGETS},
-                   {out.state, Use::storage_read_write, FORCES_BINDING_STATE},
+                   {in.state, Use::storage_read_write, FORCES_BINDING_STATE},
                    {out.drawn, Use::storage_write, FORCES_BINDING_DRAWN}},
                   [this](graph::PassContext& pc) {
                     pc.dispatch(forces_, params_, {label_count_, 1, 1});
                   },
                   "labels"});
+  const graph::ResourceId readback = graph.import_buffer(
+      "forces.readback", {.buffer = readback_.handle(), .final_use = Use::host_read});
+  const graph::ResourceId drawn = out.drawn;
+  graph.add_pass({"forces.readback",
+                  graph::PassKind::transfer,
+                  {{drawn, Use::transfer_src}, {readback, Use::transfer_dst}},
+                  [this, drawn, readback](graph::PassContext& pc) {
+                    const VkBufferCopy region{0, 0, readback_.size()};
+                    vkCmdCopyBuffer(pc.cmd, pc.buffer(drawn), pc.buffer(readback), 1, &region);
+                  }});
   return out;
 }
 
@@ -83,7 +102,7 @@ std::vector<gpu::PlacementGpu> forces_reference(const std::vector<gpu::LabelGpu>
   std::vector<gpu::PlacementGpu> drawn(labels.size());
   for (size_t i = 0; i < labels.size(); ++i) {
     state[i] = gpu::forces_update(labels[i], targets[i], state[i], params);
-    drawn[i] = gpu::forces_drawn(labels[i], targets[i], state[i], params);
+    drawn[i] = gpu::forces_drawn(targets[i], state[i]);
   }
   return drawn;
 }

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "engine/gpu/resources.h"
@@ -36,14 +37,18 @@ class LabelForces {
   struct Inputs {
     graph::ResourceId labels;   // LabelGpu[]: this frame's anchors and flags
     graph::ResourceId targets;  // PlacementGpu[]: the placement's result
+    graph::ResourceId state;    // import_state()'s
   };
   struct Outputs {
     graph::ResourceId drawn;  // PlacementGpu[]: where the labels are drawn
-    graph::ResourceId state;  // LabelStateGpu[]: the drawn positions kept across frames
   };
 
   LabelForces(Context& ctx, uint32_t label_count);
 
+  // The state kept across frames (LabelStateGpu[]), imported into `graph`: before the placement,
+  // which reads last frame's drawn positions from it.
+  graph::ResourceId import_state(graph::Graph& graph) const;
+  // The forces pass, and a copy of the drawn placements for the host.
   Outputs add_to(graph::Graph& graph, const Inputs& in);
 
   // The next frame's settings and duration (a fixed 1 / fps offline, so videos are repeatable).
@@ -52,6 +57,8 @@ class LabelForces {
   void reset();
   // The state after the last completed frame (waits; tests and tools).
   std::vector<gpu::LabelStateGpu> state() const;
+  // Where the labels were drawn in the last completed frame.
+  std::span<const gpu::PlacementGpu> drawn() const;
 
  private:
   Context& ctx_;
@@ -59,6 +66,7 @@ class LabelForces {
   gpu::ForcesParams params_{};
   ComputePipeline forces_;
   Buffer state_;
+  Buffer readback_;
 };
 
 // The CPU reference: one frame of forces over every label. `state` is updated in place; returns

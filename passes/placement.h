@@ -7,6 +7,7 @@
 // placements are copied to the host after the frame; nothing waits for them inside it.
 #pragma once
 
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -17,6 +18,7 @@
 #include "engine/graph/graph_runner.h"
 #include "engine/scene/scene.h"
 #include "passes/summed_area_table.h"
+#include "shared/forces.h"
 #include "shared/placement.h"
 
 namespace strata {
@@ -65,6 +67,9 @@ class Placement {
     graph::ResourceId final_image;  // the label-free final image (rgba8)
     graph::ResourceId layers;       // the depth layers (rgba16f array), premultiplied
     uint32_t layer_count = 1;
+    // LabelStateGpu[] (passes/label_forces.h): last frame's drawn positions become the labels'
+    // previous positions (eq. 3.1's eta term); none: the anchors set_frame() gave.
+    std::optional<graph::ResourceId> previous;
   };
   struct Outputs {
     graph::ResourceId labels, placements, saliency, costs, tables, constraints, results;
@@ -96,7 +101,9 @@ class Placement {
     graph::ResourceId readback;
   };
   Buffers add_buffers(graph::Graph& graph) const;
-  void add_upload(graph::Graph& graph, const Buffers& b);
+  void add_upload(graph::Graph& graph, const Buffers& b, std::optional<graph::ResourceId> previous);
+  void copy_previous(graph::PassContext& pc, graph::ResourceId state,
+                     graph::ResourceId labels) const;
   void add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in);
   void add_bounds(graph::Graph& graph, const Buffers& b);
   graph::PassId add_label_loop(graph::Graph& graph, const Buffers& b);

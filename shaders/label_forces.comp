@@ -15,5 +15,5 @@ void main() {
   if (i >= params.label_count) return;
   const LabelStateGpu state = forces_update(labels[i], targets[i], states[i], params);
   states[i] = state;
-  drawn[i] = forces_drawn(labels[i], targets[i], state, params);
+  drawn[i] = forces_drawn(targets[i], state);
 }

@@ -84,7 +84,7 @@ TEST_SUITE("cli") {
                               "/assets/scenes/head.json --size 48 --dump-graph -o /dev/null");
     CHECK(r.exit_code == 0);
     CHECK(r.output.find("pass 13 'placement.labels' (compute, placement)") != std::string::npos);
-    CHECK(r.output.find("19 passes, 50 barriers") != std::string::npos);
+    CHECK(r.output.find("21 passes, 54 barriers") != std::string::npos);
   }
 
   TEST_CASE("no_vulkan_driver_is_one_clear_error_and_exit_1") {

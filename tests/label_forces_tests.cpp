@@ -26,7 +26,10 @@ gpu::PlacementGpu target_at(glm::vec2 position, bool shown = true) {
 }
 
 gpu::LabelStateGpu placed_at(glm::vec2 position) {
-  return {position, LABEL_STATE_PLACED, 0};
+  gpu::LabelStateGpu s{};
+  s.position = position;
+  s.flags = LABEL_STATE_PLACED;
+  return s;
 }
 
 // One label followed over frames of 1/30 s toward a fixed target: the distances, frame by frame.
@@ -122,11 +125,13 @@ TEST_SUITE("gpu") {
       CAPTURE(anchored);
       LabelForces forces(ctx, count);
       graph::Graph g;
+      const graph::ResourceId state_id = forces.import_state(g);
       const LabelForces::Outputs out = forces.add_to(
           g, {.labels =
                   g.import_buffer("labels", {.buffer = label_buffer.handle(), .has_content = true}),
               .targets = g.import_buffer("targets",
-                                         {.buffer = target_buffer.handle(), .has_content = true})});
+                                         {.buffer = target_buffer.handle(), .has_content = true}),
+              .state = state_id});
       graph::GraphRunner runner(ctx, std::move(g));
       runner.set_viewport({512, 512});
       std::vector<gpu::LabelStateGpu> state(count);
@@ -151,7 +156,8 @@ TEST_SUITE("gpu") {
         for (uint32_t i = 0; i < count; ++i) {
           const bool same =
               drawn[i].position == expected[i].position && drawn[i].shown == expected[i].shown &&
-              gpu_state[i].position == state[i].position && gpu_state[i].flags == state[i].flags;
+              gpu_state[i].position == state[i].position && gpu_state[i].drawn == state[i].drawn &&
+              gpu_state[i].flags == state[i].flags;
           if (!same && mismatches++ < 3) {
             MESSAGE("label " << i << ": gpu " << drawn[i].position.x << "," << drawn[i].position.y
                              << " cpu " << expected[i].position.x << "," << expected[i].position.y);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdlib>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "engine/core/png.h"
 #include "engine/scene/io/scene_loader.h"
 #include "gpu_fixture.h"
@@ -58,8 +60,8 @@ TEST_SUITE("gpu") {
       const Scene scene = load_scene(std::string(STRATA_SOURCE_DIR "/assets/scenes/") + file);
       LabelledRenderer renderer(ctx, scene, camera_for(scene, "front"), {64, 64}, {});
       const graph::GraphRunner& runner = renderer.runner();
-      CHECK(runner.graph().passes().size() == 19);
-      CHECK(graph::barrier_count(runner.compiled()) == 50);
+      CHECK(runner.graph().passes().size() == 21);
+      CHECK(graph::barrier_count(runner.compiled()) == 54);
       const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
       CHECK(loop.name == "placement.labels");
     }
@@ -126,6 +128,50 @@ TEST_SUITE("gpu") {
       }
     }
     CHECK(shown > 0);
+  }
+}
+
+TEST_SUITE("gpu") {
+  // Dynamic labelling: after a camera move the drawn labels glide to the new placement at the
+  // forces' speed (never more per frame), reach it, and then stay.
+  TEST_CASE_FIXTURE(test::GpuTest, "labels_glide_to_the_new_placement_after_a_camera_move") {
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    const graph::Extent size{128, 128};
+    const Camera start = camera_for(scene, "front");
+    Camera moved = start;  // 8 degrees around the head's vertical axis
+    moved.view = start.view * glm::rotate(glm::mat4(1.0f), glm::radians(8.0f), {0.0f, 0.0f, 1.0f});
+    LabellingSettings settings;
+    settings.forces.speed = 300.0f;  // 10 px per frame at 30 frames per second
+    LabelledRenderer renderer(ctx, scene, start, size, settings);
+    renderer.run();
+    LabelledFrame last = renderer.result();
+    renderer.set_camera(moved);
+    const auto offset = [](const LabelLayout& l) {
+      return l.box_origin + 0.5f * l.box_size - l.anchor;
+    };
+    float largest_step = 0.0f;
+    for (int frame = 0; frame < 24; ++frame) {
+      renderer.advance(1.0 / 30.0);
+      const LabelledFrame now = renderer.result();
+      for (size_t i = 0; i < now.labels.size(); ++i) {
+        if (!now.labels[i].shown || !last.labels[i].shown) continue;
+        largest_step =
+            std::max(largest_step, glm::length(offset(now.labels[i]) - offset(last.labels[i])));
+      }
+      last = now;
+    }
+    CHECK(largest_step > 0.0f);            // the labels did move ...
+    CHECK(largest_step <= 10.0f + 1e-3f);  // ... never by more than the forces allow
+    const LabelledFrame still = render_labelled(ctx, scene, moved, size, settings);
+    renderer.advance(1.0 / 30.0);
+    const LabelledFrame settled = renderer.result();
+    for (size_t i = 0; i < still.labels.size(); ++i) {
+      CAPTURE(still.labels[i].text);
+      CHECK(settled.labels[i].shown == still.labels[i].shown);
+      if (!still.labels[i].shown) continue;
+      CHECK(glm::length(settled.labels[i].box_origin - still.labels[i].box_origin) <= 1.0f);
+      CHECK(settled.labels[i].box_origin == last.labels[i].box_origin);  // and it stays
+    }
   }
 }
 

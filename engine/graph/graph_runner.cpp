@@ -53,15 +53,21 @@ void PassContext::dispatch_threads(const ComputePipeline& pipeline, glm::uvec3 t
 
 void PassContext::barrier() {
   const PassInfo& pass = runner_->graph_.passes()[pass_];
-  if (pass.kind != PassKind::compute) {
-    throw GraphError("pass '" + pass.name + "' asks for a barrier between dispatches, but it is " +
-                     "not a compute pass");
+  if (pass.kind == PassKind::graphics) {
+    throw GraphError("pass '" + pass.name + "' asks for a barrier between its commands, but it is " +
+                     "a graphics pass");
   }
   VkMemoryBarrier2 memory{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-  memory.srcStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-  memory.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-  memory.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-  memory.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+  if (pass.kind == PassKind::compute) {
+    memory.srcStageMask = memory.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    memory.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+    memory.dstAccessMask =
+        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+  } else {  // transfer: copies and fills that overwrite or read what the pass wrote before
+    memory.srcStageMask = memory.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
+    memory.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    memory.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  }
   for (const ResourceUse& u : pass.uses) {
     if (u.use != Use::indirect) continue;
     memory.dstStageMask |= VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;

@@ -71,9 +71,10 @@ class PassContext {
     vkCmdDispatchIndirect(cmd, buffer, offset);
   }
 
-  // Between two dependent dispatches of this (compute) pass: its shader writes become visible to
-  // its later dispatches, and to their indirect reads when it declared an indirect use. The
-  // graph's barriers order passes; this orders the steps inside one.
+  // Between two dependent commands of this pass: in a compute pass, its shader writes become
+  // visible to its later dispatches (and to their indirect reads when it declared an indirect
+  // use); in a transfer pass, its copies and fills are ordered. The graph's barriers order
+  // passes; this orders the steps inside one.
   void barrier();
 
  private:

@@ -21,8 +21,12 @@ STRATA_BEGIN
 // What persists of a label between frames.
 struct LabelStateGpu {
   vec2 position;  // drawn box centre: an offset from the anchor, or pixels (ForcesParams)
+  vec2 drawn;     // where the box centre was drawn (pixels; the anchor while never placed):
+                  // the next frame's previous position (eq. 3.1's eta term)
   uint flags;     // LABEL_STATE_*
-  uint pad;
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 
 struct ForcesParams {
@@ -49,28 +53,27 @@ STRATA_INLINE vec2 force_step(vec2 l, vec2 p, float seconds, float speed, float 
 // hidden or disabled one keeps where it was.
 STRATA_INLINE LabelStateGpu forces_update(LabelGpu label, PlacementGpu target, LabelStateGpu state,
                                           ForcesParams params) {
+  if ((state.flags & LABEL_STATE_PLACED) == 0u) state.drawn = label.anchor;
   if ((label.flags & LABEL_ENABLED) == 0u || target.shown != PLACEMENT_SHOWN) return state;
   vec2 goal = params.anchor_relative != 0u ? target.position - label.anchor : target.position;
-  if ((state.flags & LABEL_STATE_PLACED) == 0u) {
-    state.position = goal;
-    state.flags |= LABEL_STATE_PLACED;
-    return state;
-  }
-  vec2 l = state.position;
-  for (uint s = 0u; s < params.steps; ++s) {
-    l = force_step(l, goal, params.step_seconds, params.speed, params.epsilon);
-    if (length(goal - l) < params.snap) l = goal;
+  vec2 l = goal;
+  if ((state.flags & LABEL_STATE_PLACED) != 0u) {
+    l = state.position;
+    for (uint s = 0u; s < params.steps; ++s) {
+      l = force_step(l, goal, params.step_seconds, params.speed, params.epsilon);
+      if (length(goal - l) < params.snap) l = goal;
+    }
   }
   state.position = l;
+  state.flags |= LABEL_STATE_PLACED;
+  state.drawn = params.anchor_relative != 0u ? label.anchor + l : l;
   return state;
 }
 
 // Where the label is drawn this frame: its state's position, shown when the placement shows it.
-STRATA_INLINE PlacementGpu forces_drawn(LabelGpu label, PlacementGpu target, LabelStateGpu state,
-                                        ForcesParams params) {
+STRATA_INLINE PlacementGpu forces_drawn(PlacementGpu target, LabelStateGpu state) {
   PlacementGpu drawn = target;
-  if ((state.flags & LABEL_STATE_PLACED) == 0u) return drawn;
-  drawn.position = params.anchor_relative != 0u ? label.anchor + state.position : state.position;
+  if ((state.flags & LABEL_STATE_PLACED) != 0u) drawn.position = state.drawn;
   return drawn;
 }
 
