@@ -84,13 +84,14 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
   build_graph();
 }
 
-// Layering on the CPU, from the camera alone: k-means++ on the visible anchors' depths.
+// Layering on the CPU, from the camera alone: k-means++ on the visible anchors' depths, after the
+// first frame warm-started from the last one's planes and with hysteresis.
 void LabelledRenderer::project_and_layer(const Camera& camera) {
   const std::vector<ProjectedPoint> anchors = project_anchors(scene_, camera, size_);
   std::vector<float> depths;
   for (const auto& a : anchors) depths.push_back(a.visible ? a.eye_depth : std::nanf(""));
-  layering_ = layer_labels(depths, settings_.layer_count, camera.near_plane, camera.far_plane,
-                           settings_.seed);
+  layering_ = follow_layering(layering_, depths, settings_.layer_count, camera.near_plane,
+                              camera.far_plane, settings_.hysteresis, settings_.seed);
   for (size_t i = 0; i < labels_.size(); ++i) {
     gpu::LabelGpu& l = labels_[i];
     l.anchor = anchors[i].pixel;

@@ -29,8 +29,9 @@ struct LabellingSettings {
   InsertionOrder order = InsertionOrder::scene;
   uint32_t optimize_tries = 8;  // InsertionOrder::optimized: random orders tried
   PlacementSettings placement;
-  ForceSettings forces;   // how drawn positions follow the placement from frame to frame
-  bool internal = false;  // internal labelling: every label drawn on its anchor
+  ForceSettings forces;        // how drawn positions follow the placement from frame to frame
+  LayerHysteresis hysteresis;  // how labels keep their layers while the camera moves
+  bool internal = false;       // internal labelling: every label drawn on its anchor
   float font_pixels = 14.0f;
   uint64_t seed = 1;      // k-means++
   RenderSettings render;  // its layer_count and splits come from the layering

@@ -130,15 +130,9 @@ std::vector<float> renumber_front_to_back(const std::vector<double>& centres,
   return sorted_centres;
 }
 
-}  // namespace
-
-std::vector<uint32_t> kmeans_plus_plus(std::span<const float> values, uint32_t k, uint64_t seed,
-                                       std::vector<float>* centres) {
-  if (centres) centres->clear();
-  if (values.empty()) return {};
-  k = std::clamp(k, 1u, count_distinct(values));
-  SplitMix64 rng{seed};
-  std::vector<double> centre = seed_centres(values, k, rng);
+// Lloyd's iterations from `centre`; returns each value's cluster, numbered front to back.
+std::vector<uint32_t> lloyd(std::span<const float> values, std::vector<double> centre,
+                            std::vector<float>* centres) {
   std::vector<uint32_t> cluster(values.size(), unassigned);
   for (int iteration = 0; iteration < max_lloyd_iterations; ++iteration) {
     if (!assign(values, centre, cluster)) break;
@@ -147,6 +141,17 @@ std::vector<uint32_t> kmeans_plus_plus(std::span<const float> values, uint32_t k
   std::vector<float> sorted_centres = renumber_front_to_back(centre, cluster);
   if (centres) *centres = std::move(sorted_centres);
   return cluster;
+}
+
+}  // namespace
+
+std::vector<uint32_t> kmeans_plus_plus(std::span<const float> values, uint32_t k, uint64_t seed,
+                                       std::vector<float>* centres) {
+  if (centres) centres->clear();
+  if (values.empty()) return {};
+  k = std::clamp(k, 1u, count_distinct(values));
+  SplitMix64 rng{seed};
+  return lloyd(values, seed_centres(values, k, rng), centres);
 }
 
 float eye_depth_to_ndc_z(float eye_depth, float near_plane, float far_plane) {
@@ -187,22 +192,27 @@ std::vector<float> cluster_medians(const std::vector<Member>& members,
 
 }  // namespace
 
-Layering layer_labels(std::span<const float> anchor_eye_depths, uint32_t layer_count,
-                      float near_plane, float far_plane, uint64_t seed) {
-  std::vector<Member> members;
-  std::vector<float> ndc_z;
-  for (const float depth : anchor_eye_depths) {
-    if (!usable_depth(depth, near_plane, far_plane)) continue;
-    members.push_back({eye_depth_to_ndc_z(depth, near_plane, far_plane), depth});
-    ndc_z.push_back(members.back().ndc_z);
-  }
-  std::vector<float> centres;
-  const std::vector<uint32_t> cluster =
-      kmeans_plus_plus(ndc_z, std::clamp(layer_count, 1u, max_layer_count), seed, &centres);
+namespace {
 
+std::vector<Member> usable_members(std::span<const float> depths, float near_plane,
+                                   float far_plane) {
+  std::vector<Member> members;
+  for (const float depth : depths) {
+    if (usable_depth(depth, near_plane, far_plane)) {
+      members.push_back({eye_depth_to_ndc_z(depth, near_plane, far_plane), depth});
+    }
+  }
+  return members;
+}
+
+// The layering of clusters `cluster` (numbered front to back, `count` of them): planes at the
+// medians, and each label on the layer whose plane is at or behind its anchor.
+Layering layering_of(const std::vector<Member>& members, const std::vector<uint32_t>& cluster,
+                     size_t count, std::span<const float> anchor_eye_depths, float near_plane,
+                     float far_plane) {
   Layering layering;
-  layering.plane_depths = cluster_medians(members, cluster, centres.size());
-  layering.layer_count = std::max<uint32_t>(1, static_cast<uint32_t>(centres.size()));
+  layering.plane_depths = cluster_medians(members, cluster, count);
+  layering.layer_count = std::max<uint32_t>(1, static_cast<uint32_t>(count));
   if (!layering.plane_depths.empty()) {
     layering.split_depths.assign(layering.plane_depths.begin(), layering.plane_depths.end() - 1);
   }
@@ -213,6 +223,65 @@ Layering layer_labels(std::span<const float> anchor_eye_depths, uint32_t layer_c
     const auto first_not_less = std::lower_bound(splits.begin(), splits.end(), depth);
     layering.label_layer.push_back(usable ? static_cast<uint32_t>(first_not_less - splits.begin())
                                           : 0u);
+  }
+  return layering;
+}
+
+std::vector<float> ndc_z_of(std::span<const Member> members) {
+  std::vector<float> z;
+  for (const Member& m : members) z.push_back(m.ndc_z);
+  return z;
+}
+
+}  // namespace
+
+Layering layer_labels(std::span<const float> anchor_eye_depths, uint32_t layer_count,
+                      float near_plane, float far_plane, uint64_t seed) {
+  const std::vector<Member> members = usable_members(anchor_eye_depths, near_plane, far_plane);
+  std::vector<float> centres;
+  const std::vector<uint32_t> cluster = kmeans_plus_plus(
+      ndc_z_of(members), std::clamp(layer_count, 1u, max_layer_count), seed, &centres);
+  return layering_of(members, cluster, centres.size(), anchor_eye_depths, near_plane, far_plane);
+}
+
+Layering follow_layering(const Layering& previous, std::span<const float> anchor_eye_depths,
+                         uint32_t layer_count, float near_plane, float far_plane,
+                         const LayerHysteresis& hysteresis, uint64_t seed) {
+  const std::vector<Member> members = usable_members(anchor_eye_depths, near_plane, far_plane);
+  const std::vector<float> z = ndc_z_of(members);
+  const uint32_t k = std::clamp(layer_count, 1u, max_layer_count);
+  if (members.empty() || previous.plane_depths.size() != std::min(k, count_distinct(z)) ||
+      previous.label_layer.size() != anchor_eye_depths.size()) {
+    return layer_labels(anchor_eye_depths, layer_count, near_plane, far_plane, seed);
+  }
+  // Warm start: the previous planes, where the camera now puts their eye depths.
+  std::vector<double> start;
+  for (const float plane : previous.plane_depths) {
+    start.push_back(eye_depth_to_ndc_z(plane, near_plane, far_plane));
+  }
+  std::vector<float> centres;
+  const std::vector<uint32_t> cluster = lloyd(z, start, &centres);
+  Layering layering =
+      layering_of(members, cluster, centres.size(), anchor_eye_depths, near_plane, far_plane);
+  if (layering.layer_count != previous.layer_count) return layering;
+
+  // A label stays on its previous layer while its anchor is within the margin of that slab.
+  std::vector<float> plane_z;
+  for (const float plane : layering.plane_depths) {
+    plane_z.push_back(eye_depth_to_ndc_z(plane, near_plane, far_plane));
+  }
+  const auto last = static_cast<uint32_t>(plane_z.size() - 1);
+  for (size_t i = 0; i < anchor_eye_depths.size(); ++i) {
+    const float depth = anchor_eye_depths[i];
+    const uint32_t was = previous.label_layer[i];
+    if (!usable_depth(depth, near_plane, far_plane) || was == layering.label_layer[i]) continue;
+    const float d = eye_depth_to_ndc_z(depth, near_plane, far_plane);
+    // The slab of layer l is (plane l-1, plane l]; the last one has no back side.
+    const bool front_ok =
+        was == 0 || d > plane_z[was - 1] - hysteresis.margin * (plane_z[was] - plane_z[was - 1]);
+    const bool back_ok =
+        was >= last || d <= plane_z[was] + hysteresis.margin * (plane_z[was + 1] - plane_z[was]);
+    if (front_ok && back_ok) layering.label_layer[i] = was;
   }
   return layering;
 }

@@ -60,4 +60,19 @@ struct Layering {
 Layering layer_labels(std::span<const float> anchor_eye_depths, uint32_t layer_count,
                       float near_plane, float far_plane, uint64_t seed = 1);
 
+// How the layering holds still while the camera moves.
+struct LayerHysteresis {
+  // A label leaves its layer only once its anchor is past the layer's slab by more than this
+  // share of the distance (in NDC z) between the two planes on that side.
+  float margin = 0.25f;
+};
+
+// The next frame's layering, following `previous` (the same labels, the camera moved): Lloyd's
+// iterations start from the previous planes instead of a k-means++ seeding, so small moves keep
+// the clusters; and a label keeps its previous layer while its anchor stays within the margin of
+// that layer's slab. Falls back to layer_labels when the layer count cannot stay the same.
+Layering follow_layering(const Layering& previous, std::span<const float> anchor_eye_depths,
+                         uint32_t layer_count, float near_plane, float far_plane,
+                         const LayerHysteresis& hysteresis, uint64_t seed = 1);
+
 }  // namespace strata

@@ -168,6 +168,37 @@ TEST_SUITE("cpu") {
     CHECK(layering.split_depths == reference.split_depths);
     CHECK(layering.label_layer == std::vector<uint32_t>{0, 0, 0, 1, 0, 1, 0, 1, 0});
   }
+
+  TEST_CASE("layer_hysteresis_keeps_layers_under_a_small_move_and_switches_under_a_large_one") {
+    const std::vector<float> before{100, 101, 102, 103, 104, 200, 201, 202};
+    const Layering previous = layer_labels(before, 2, 1.0f, 1000.0f);
+    REQUIRE(previous.label_layer == std::vector<uint32_t>{0, 0, 0, 1, 1, 1, 1, 1});
+    // Unchanged depths: the warm start finds the same planes.
+    const Layering same = follow_layering(previous, before, 2, 1.0f, 1000.0f, {});
+    CHECK(same.plane_depths == previous.plane_depths);
+    CHECK(same.label_layer == previous.label_layer);
+
+    // Half a millimetre moves the front cluster's median: from scratch, labels 2 and 3 swap
+    // layers; followed, nobody changes layer.
+    std::vector<float> small = before;
+    small[3] = 101.5f;
+    const Layering fresh = layer_labels(small, 2, 1.0f, 1000.0f);
+    CHECK(fresh.label_layer[2] == 1);
+    CHECK(fresh.label_layer[3] == 0);
+    CHECK(follow_layering(previous, small, 2, 1.0f, 1000.0f, {}).label_layer ==
+          previous.label_layer);
+
+    // Far in front of its layer's slab, label 3 does switch; label 2 just behind the moved plane
+    // does not.
+    std::vector<float> large = before;
+    large[3] = 50.0f;
+    const Layering moved = follow_layering(previous, large, 2, 1.0f, 1000.0f, {});
+    CHECK(moved.label_layer[3] == 0);
+    CHECK(moved.label_layer[2] == 0);
+    // Without a margin, following is the plain assignment.
+    const Layering no_margin = follow_layering(previous, small, 2, 1.0f, 1000.0f, {.margin = 0.0f});
+    CHECK(no_margin.label_layer[2] == 1);
+  }
 }
 
 }  // namespace strata
