@@ -76,6 +76,7 @@ TEST_SUITE("cli") {
     CHECK(report["labels"] == 6);
     CHECK(named(report["passes"], "placement.labels")["median_ms"].get<double>() > 0.0);
     CHECK(report["label_loop_ms"].get<double>() > 0.0);
+    CHECK(report["forces_ms"].get<double>() > 0.0);
     CHECK(report["label_loop_with_readback_per_label_ms"].get<double>() > 0.0);
   }
 
