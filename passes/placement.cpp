@@ -44,6 +44,7 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
       bounds_(ctx, "placement_bounds.comp"),
       place_(ctx, "place_label.comp"),
       finalize_(ctx, "placement_finalize.comp"),
+      previous_(ctx, "label_previous.comp"),
       tables_(ctx) {
   if (label_count > LABEL_MAX) {
     throw Error("placement: " + std::to_string(label_count) + " labels; strata places at most " +
@@ -98,7 +99,8 @@ graph::BufferInfo per_tile(VkDeviceSize bytes, VkDeviceSize copies = 1) {
 Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
   layer_count_ = in.layer_count;
   const Buffers b = add_buffers(graph);
-  add_upload(graph, b, in.previous);
+  add_upload(graph, b);
+  if (in.previous) add_previous(graph, b, *in.previous);
   add_costs(graph, b, in);
   add_bounds(graph, b);
   const graph::PassId loop = add_label_loop(graph, b);
@@ -135,23 +137,23 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) const {
   return b;
 }
 
-// The frame's labels and order (with last frame's drawn positions as the previous ones, when
-// given); everything the loop accumulates starts empty.
-void Placement::add_upload(graph::Graph& graph, const Buffers& b,
-                           std::optional<ResourceId> previous) {
-  std::vector<graph::ResourceUse> uses{
-      {b.labels, Use::transfer_dst},      {b.order, Use::transfer_dst},
-      {b.results, Use::transfer_dst},     {b.constraints, Use::transfer_dst},
-      {b.buckets, Use::transfer_dst},     {b.lower, Use::transfer_dst},
-      {b.speculative, Use::transfer_dst}, {b.samples, Use::transfer_dst},
-      {b.regions, Use::transfer_dst}};
-  if (previous) uses.push_back({*previous, Use::transfer_src});
-  graph.add_pass({"placement.upload", graph::PassKind::transfer, std::move(uses),
-                  [this, b, previous](graph::PassContext& pc) {
+// The frame's labels and order; everything the loop accumulates starts empty.
+void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
+  graph.add_pass({"placement.upload",
+                  graph::PassKind::transfer,
+                  {{b.labels, Use::transfer_dst},
+                   {b.order, Use::transfer_dst},
+                   {b.results, Use::transfer_dst},
+                   {b.constraints, Use::transfer_dst},
+                   {b.buckets, Use::transfer_dst},
+                   {b.lower, Use::transfer_dst},
+                   {b.speculative, Use::transfer_dst},
+                   {b.samples, Use::transfer_dst},
+                   {b.regions, Use::transfer_dst}},
+                  [this, b](graph::PassContext& pc) {
                     if (!labels_.empty()) {
                       vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.labels), 0,
                                         labels_.size() * sizeof(gpu::LabelGpu), labels_.data());
-                      if (previous) copy_previous(pc, *previous, b.labels);
                     }
                     if (!order_.empty()) {
                       vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.order), 0,
@@ -172,16 +174,20 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b,
                   "placement"});
 }
 
-// Each label's previous position (eq. 3.1's eta) from where the forces drew it last frame.
-void Placement::copy_previous(graph::PassContext& pc, ResourceId state, ResourceId labels) const {
-  pc.barrier();  // (after the labels' upload, which the copy partly overwrites)
-  std::vector<VkBufferCopy> regions(labels_.size());
-  for (size_t i = 0; i < regions.size(); ++i) {
-    regions[i] = {i * sizeof(gpu::LabelStateGpu) + offsetof(gpu::LabelStateGpu, drawn),
-                  i * sizeof(gpu::LabelGpu) + offsetof(gpu::LabelGpu, previous), sizeof(glm::vec2)};
-  }
-  vkCmdCopyBuffer(pc.cmd, pc.buffer(state), pc.buffer(labels), uint32_t(regions.size()),
-                  regions.data());
+// Each label's previous position (eq. 3.1's eta) from where the forces drew it last frame; only
+// recorded while eta has a weight (the thesis's settings give it none).
+void Placement::add_previous(graph::Graph& graph, const Buffers& b, ResourceId state) {
+  graph.add_pass({"placement.previous",
+                  graph::PassKind::compute,
+                  {{b.labels, Use::storage_read_write, FORCES_BINDING_LABELS},
+                   {state, Use::storage_read, FORCES_BINDING_STATE}},
+                  [this](graph::PassContext& pc) {
+                    if (settings_.weights.previous_position == 0.0f) return;
+                    gpu::ForcesParams p{};
+                    p.label_count = label_count_;
+                    pc.dispatch(previous_, p, {label_count_, 1, 1});
+                  },
+                  "placement"});
 }
 
 // Saliency (eq. 3.5), integral costs per layer (eq. 3.3/3.4) and their summed-area tables.

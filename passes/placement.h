@@ -101,9 +101,8 @@ class Placement {
     graph::ResourceId readback;
   };
   Buffers add_buffers(graph::Graph& graph) const;
-  void add_upload(graph::Graph& graph, const Buffers& b, std::optional<graph::ResourceId> previous);
-  void copy_previous(graph::PassContext& pc, graph::ResourceId state,
-                     graph::ResourceId labels) const;
+  void add_upload(graph::Graph& graph, const Buffers& b);
+  void add_previous(graph::Graph& graph, const Buffers& b, graph::ResourceId state);
   void add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in);
   void add_bounds(graph::Graph& graph, const Buffers& b);
   graph::PassId add_label_loop(graph::Graph& graph, const Buffers& b);
@@ -119,7 +118,7 @@ class Placement {
   std::vector<gpu::LabelGpu> labels_;
   std::vector<uint32_t> order_;
   PlacementSettings settings_;
-  ComputePipeline saliency_, integral_costs_, bounds_, place_, finalize_;
+  ComputePipeline saliency_, integral_costs_, bounds_, place_, finalize_, previous_;
   SummedAreaTable tables_;
   Buffer readback_;
 };

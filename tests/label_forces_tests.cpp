@@ -111,7 +111,7 @@ TEST_SUITE("cpu") {
 }
 
 TEST_SUITE("gpu") {
-  TEST_CASE_FIXTURE(test::GpuTest, "forces_pass_matches_cpu_reference_exactly_over_frames") {
+  TEST_CASE_FIXTURE(test::GpuTest, "forces_pass_matches_cpu_reference_over_frames") {
     const uint32_t count = 150;  // more than one workgroup
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> pixel(0.0f, 512.0f);
@@ -152,17 +152,27 @@ TEST_SUITE("gpu") {
             forces_reference(labels, targets, state, forces_params(settings, count, seconds));
         const auto drawn = as<gpu::PlacementGpu>(runner.download_buffer(out.drawn));
         const std::vector<gpu::LabelStateGpu> gpu_state = forces.state();
+        // Bit for bit on a CPU device (lavapipe rounds as the C++ does); elsewhere within 1e-3 px:
+        // Vulkan lets a GPU divide and take square roots to a few ulps, and fuse multiply-adds.
+        const float tolerance =
+            ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0.0f : 1e-3f;
+        const auto close = [tolerance](glm::vec2 a, glm::vec2 b) {
+          return glm::all(glm::lessThanEqual(glm::abs(a - b), glm::vec2(tolerance)));
+        };
         int mismatches = 0;
         for (uint32_t i = 0; i < count; ++i) {
-          const bool same =
-              drawn[i].position == expected[i].position && drawn[i].shown == expected[i].shown &&
-              gpu_state[i].position == state[i].position && gpu_state[i].drawn == state[i].drawn &&
-              gpu_state[i].flags == state[i].flags;
+          const bool same = close(drawn[i].position, expected[i].position) &&
+                            drawn[i].shown == expected[i].shown &&
+                            close(gpu_state[i].position, state[i].position) &&
+                            close(gpu_state[i].drawn, state[i].drawn) &&
+                            gpu_state[i].flags == state[i].flags;
           if (!same && mismatches++ < 3) {
             MESSAGE("label " << i << ": gpu " << drawn[i].position.x << "," << drawn[i].position.y
                              << " cpu " << expected[i].position.x << "," << expected[i].position.y);
           }
         }
+        // The state the next frame starts from is the reference's (tolerance does not build up).
+        state = gpu_state;
         CHECK(mismatches == 0);
       }
     }

@@ -8,12 +8,14 @@
 
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include <glm/gtc/packing.hpp>
 
 #include "engine/gpu/resources.h"
 #include "engine/graph/graph_runner.h"
 #include "gpu_fixture.h"
+#include "passes/label_forces.h"
 #include "passes/placement.h"
 #include "passes/placement_reference.h"
 
@@ -89,8 +91,10 @@ std::vector<T> as(const std::vector<std::byte>& bytes) {
   return out;
 }
 
+// `previous`: the forces' state whose drawn positions become the labels' previous positions.
 GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSettings& settings,
-                          const PlacementLayout& layout = {}) {
+                          const PlacementLayout& layout = {},
+                          const std::vector<gpu::LabelStateGpu>& previous = {}) {
   Image final_image(ctx, {VK_FORMAT_R8G8B8A8_UNORM,
                           {in.size.width, in.size.height, 1},
                           VK_IMAGE_TYPE_2D,
@@ -117,9 +121,17 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
                                  .has_content = true,
                                  .initial_layout = VK_IMAGE_LAYOUT_GENERAL});
   };
+  Buffer state(ctx, std::max<size_t>(1, previous.size()) * sizeof(gpu::LabelStateGpu),
+               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
+  if (!previous.empty()) upload(ctx, state, as_bytes(previous));
+  std::optional<graph::ResourceId> state_id;
+  if (!previous.empty()) {
+    state_id = g.import_buffer("state", {.buffer = state.handle(), .has_content = true});
+  }
   const Placement::Outputs r = placement.add_to(g, {.final_image = general("final", final_image),
                                                     .layers = general("layers", layers),
-                                                    .layer_count = in.layer_count});
+                                                    .layer_count = in.layer_count,
+                                                    .previous = state_id});
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(in.size);
   placement.set_frame(in.labels, in.order, settings);
@@ -197,6 +209,36 @@ TEST_SUITE("gpu") {
       for (const auto& p : gpu.placements) shown += p.shown == PLACEMENT_SHOWN;
       CHECK(shown == count);
     }
+  }
+
+  // Eq. 3.1's eta with last frame's drawn positions (from the forces' state, on the GPU) gives
+  // the reference's positions for those previous positions.
+  TEST_CASE_FIXTURE(test::GpuTest, "previous_positions_come_from_the_forces_state") {
+    Inputs in = disc_scene(4);
+    PlacementSettings settings;
+    settings.weights.previous_position = 0.2f;
+    std::vector<gpu::LabelStateGpu> state(in.labels.size());
+    for (size_t i = 0; i < state.size(); ++i) {
+      if (i == 3) continue;  // never drawn: its previous position stays the anchor
+      state[i].drawn = in.labels[i].anchor + glm::vec2(-14.0f + 9.0f * float(i), 11.0f);
+      state[i].flags = LABEL_STATE_PLACED;
+      in.labels[i].previous = in.labels[i].anchor;  // what the GPU must replace
+    }
+    const GpuPlacement gpu = place_on_gpu(ctx, in, settings, {}, state);
+    Inputs expected = in;
+    for (size_t i = 0; i < 3; ++i) expected.labels[i].previous = state[i].drawn;
+    const ReferencePlacement cpu =
+        place_reference(expected.final_rgba8, expected.layers, expected.layer_count,
+                        expected.labels, expected.order, settings, expected.size);
+    check_placements(gpu, cpu);
+    // The term matters here: with the anchors as previous positions the result differs.
+    const ReferencePlacement anchored = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                        in.labels, in.order, settings, in.size);
+    bool differs = false;
+    for (size_t i = 0; i < cpu.placements.size(); ++i) {
+      differs |= cpu.placements[i].position != anchored.placements[i].position;
+    }
+    CHECK(differs);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "bucket_width_changes_the_passes_not_the_positions") {
