@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   add_view_command(app, device);
   add_bench_command(app, device);
   add_info_command(app);
+  add_eval_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

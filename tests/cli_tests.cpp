@@ -8,6 +8,7 @@
 
 #include "engine/core/png.h"
 #include "gpu_fixture.h"
+#include "test_files.h"
 
 namespace strata {
 
@@ -136,6 +137,64 @@ TEST_SUITE("cli") {
     const auto r = run_strata("info " + path);
     CHECK(r.exit_code == 1);
     CHECK(r.output.find("strata: error: " + path) != std::string::npos);
+  }
+
+  // Two frames: boxes overlapping by 10 x 10 px, then label 1 jumps 50 px and label 2 hides.
+  TEST_CASE("eval_prints_frame_and_sequence_metrics_of_layout_files") {
+    const auto folder = test::fresh_folder("cli", "eval");
+    const std::string a = test::write_file(folder / "a.json", R"({"width": 100, "height": 100,
+      "labels": [{"id": 1, "anchor": [10, 10], "box": [20, 20, 20, 10], "shown": true},
+                 {"id": 2, "anchor": [50, 50], "box": [30, 20, 20, 10], "shown": true}]})");
+    const std::string b = test::write_file(folder / "b.json", R"({"width": 100, "height": 100,
+      "labels": [{"id": 1, "anchor": [10, 10], "box": [50, 60, 20, 10], "shown": true},
+                 {"id": 2, "anchor": [50, 50], "box": [30, 20, 20, 10], "shown": false}]})");
+    const auto one = run_strata("eval " + a);
+    CHECK(one.exit_code == 0);
+    const nlohmann::json single = nlohmann::json::parse(one.output);
+    CHECK(single["frames"] == 1);
+    CHECK(single["frame"]["shown"] == 2);
+    CHECK(single["frame"]["overlaps"] == 1);
+    const auto two = run_strata("eval " + a + " " + b);
+    CHECK(two.exit_code == 0);
+    const nlohmann::json report = nlohmann::json::parse(two.output);
+    CHECK(report["frames"] == 2);
+    CHECK(report["per_frame"][0]["overlap_area_px2"] == 100.0);
+    CHECK(report["per_frame"][1]["hidden"] == 1);
+    CHECK(report["total"]["overlaps"] == 1);
+    CHECK(report["sequence"]["movement_mean_px"] == 50.0);
+    CHECK(report["sequence"]["jumps"] == 1);
+    CHECK(report["sequence"]["show_hide_flips"] == 1);
+  }
+
+  TEST_CASE("eval_of_a_missing_or_malformed_file_is_one_error_naming_it_and_exit_1") {
+    const auto folder = test::fresh_folder("cli", "eval_errors");
+    const std::string bad = test::write_file(folder / "bad.json", R"({"width": 8, "height": 8,
+      "labels": [{"id": 1, "anchor": [1, 1], "box": [0, 0, 4], "shown": true}]})");
+    const auto malformed = run_strata("eval " + bad + " " + folder.string() + "/missing.json");
+    CHECK(malformed.exit_code == 1);
+    CHECK(malformed.output.find("strata: error: " + bad + ": labels[0].box: expected 4 numbers") !=
+          std::string::npos);
+    const auto absent = run_strata("eval " + folder.string() + "/missing.json");
+    CHECK(absent.exit_code == 1);
+    CHECK(absent.output == "strata: error: " + folder.string() + "/missing.json: no such file\n");
+  }
+
+  // The layout render writes reads back: eval counts the labels the file holds.
+  TEST_CASE("eval_reads_the_layout_that_render_writes") {
+    const std::string layout = (test::fresh_folder("cli", "eval_render") / "head.json").string();
+    const auto render = run_strata("render " STRATA_SOURCE_DIR
+                                   "/assets/scenes/head.json --size 128 -o /dev/null --layout " +
+                                   layout);
+    REQUIRE(render.exit_code == 0);
+    const nlohmann::json written = nlohmann::json::parse(test::read_file(layout));
+    size_t shown = 0;
+    for (const auto& label : written["labels"]) shown += label["shown"].get<bool>() ? 1 : 0;
+    const auto r = run_strata("eval " + layout);
+    CHECK(r.exit_code == 0);
+    const nlohmann::json frame = nlohmann::json::parse(r.output)["frame"];
+    CHECK(frame["labels"] == written["labels"].size());
+    CHECK(frame["shown"] == shown);
+    CHECK(shown > 0);
   }
 
   TEST_CASE("bad_sizes_and_unwritable_outputs_are_errors_naming_the_culprit") {

@@ -1,0 +1,305 @@
+// The layout-quality metrics of `strata eval` on hand-made layouts whose answers are known.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "labeling/layout_metrics.h"
+#include "test_files.h"
+
+namespace strata {
+namespace {
+
+// A label with its box's top-left corner and size; shown on layer 0 unless said otherwise.
+LayoutLabel label(int id, glm::dvec2 anchor, glm::dvec2 origin, glm::dvec2 size, bool shown = true,
+                  uint32_t layer = 0) {
+  LayoutLabel l;
+  l.id = id;
+  l.anchor = anchor;
+  l.box_origin = origin;
+  l.box_size = size;
+  l.shown = shown;
+  l.layer = layer;
+  return l;
+}
+
+// A label drawn over its anchor (no leader): the box centred on the anchor.
+LayoutLabel internal_label(int id, glm::dvec2 origin, glm::dvec2 size, bool shown = true) {
+  return label(id, origin + 0.5 * size, origin, size, shown);
+}
+
+Layout layout(uint32_t width, uint32_t height, std::vector<LayoutLabel> labels) {
+  Layout l;
+  l.width = width;
+  l.height = height;
+  l.labels = std::move(labels);
+  return l;
+}
+
+Segment segment(glm::dvec2 a, glm::dvec2 b) {
+  return {a, b};
+}
+Rect rect(glm::dvec2 min, glm::dvec2 max) {
+  return {min, max};
+}
+
+// A label whose box centre sits at anchor + offset.
+LayoutLabel offset_label(int id, glm::dvec2 anchor, glm::dvec2 offset, bool shown = true,
+                         uint32_t layer = 0) {
+  const glm::dvec2 size{20.0, 10.0};
+  return label(id, anchor, anchor + offset - 0.5 * size, size, shown, layer);
+}
+
+std::string layout_error(const std::string& name, const std::string& text) {
+  const auto folder = test::fresh_folder("cpu", "layout_metrics_" + name);
+  const auto path = test::write_file(folder / "layout.json", text);
+  return test::error_of([&] { read_layout(path); });
+}
+
+}  // namespace
+
+TEST_SUITE("cpu") {
+  TEST_CASE("segments_cross_only_at_a_point_inside_both") {
+    CHECK(segments_cross(segment({0, 0}, {10, 10}), segment({0, 10}, {10, 0})));
+    // A shared endpoint, an endpoint on the other segment (T), collinear overlap, parallel.
+    CHECK_FALSE(segments_cross(segment({0, 0}, {10, 10}), segment({10, 10}, {20, 0})));
+    CHECK_FALSE(segments_cross(segment({0, 0}, {10, 10}), segment({5, 5}, {5, 20})));
+    CHECK_FALSE(segments_cross(segment({0, 0}, {10, 0}), segment({5, 0}, {15, 0})));
+    CHECK_FALSE(segments_cross(segment({0, 0}, {10, 0}), segment({0, 1}, {10, 1})));
+    // The lines cross, the segments do not.
+    CHECK_FALSE(segments_cross(segment({0, 0}, {4, 4}), segment({0, 10}, {10, 0})));
+  }
+
+  TEST_CASE("a_segment_enters_a_rectangle_only_through_its_interior") {
+    const Rect r = rect({0, 0}, {10, 10});
+    CHECK(segment_enters_interior(segment({-5, 5}, {15, 5}), r));
+    CHECK(segment_enters_interior(segment({5, 5}, {6, 6}), r));            // wholly inside
+    CHECK(segment_enters_interior(segment({-5, 5}, {1, 5}), r));           // ends inside
+    CHECK_FALSE(segment_enters_interior(segment({-5, 0}, {15, 0}), r));    // along an edge
+    CHECK_FALSE(segment_enters_interior(segment({-5, 5}, {0, 5}), r));     // ends on an edge
+    CHECK_FALSE(segment_enters_interior(segment({-1, 1}, {1, -1}), r));    // touches a corner
+    CHECK_FALSE(segment_enters_interior(segment({-5, 20}, {15, 20}), r));  // misses
+    CHECK_FALSE(segment_enters_interior(segment({11, -5}, {20, 5}), r));
+  }
+
+  TEST_CASE("the_leader_ends_at_the_closest_point_of_the_box") {
+    const Rect r = rect({10, 20}, {30, 30});
+    CHECK(closest_point(r, {0, 0}) == glm::dvec2(10, 20));
+    CHECK(closest_point(r, {20, 50}) == glm::dvec2(20, 30));
+    CHECK(closest_point(r, {15, 25}) == glm::dvec2(15, 25));
+    const auto leader = leader_of(label(1, {20, 50}, {10, 20}, {20, 10}));
+    REQUIRE(leader);
+    CHECK(leader->a == glm::dvec2(20, 50));
+    CHECK(leader->b == glm::dvec2(20, 30));
+    // An anchor inside the box or on its edge has no leader.
+    CHECK_FALSE(leader_of(label(1, {15, 25}, {10, 20}, {20, 10})));
+    CHECK_FALSE(leader_of(label(1, {30, 25}, {10, 20}, {20, 10})));
+  }
+
+  TEST_CASE("overlapping_boxes_count_one_pair_with_the_exact_shared_area") {
+    const FrameMetrics m = frame_metrics(
+        layout(100, 100,
+               {internal_label(1, {0, 0}, {10, 10}), internal_label(2, {6, 4}, {10, 10}),
+                // Touches box 1 at a corner only.
+                internal_label(3, {-5, 10}, {5, 5}),
+                // Hidden: never overlaps.
+                internal_label(4, {2, 2}, {5, 5}, false)}));
+    CHECK(m.labels == 4);
+    CHECK(m.shown == 3);
+    CHECK(m.hidden == 1);
+    CHECK(m.overlaps == 1);
+    CHECK(m.overlap_area == 24.0);  // 4 x 6
+    CHECK(intersection_area(rect({0, 0}, {10, 10}), rect({10, 0}, {20, 10})) == 0.0);
+  }
+
+  TEST_CASE("two_crossing_leaders_are_one_crossing_split_by_layer") {
+    // (10,10) to (50,50) and (50,10) to (10,50) cross at (30,30).
+    const auto frame = [](uint32_t second_layer) {
+      return layout(100, 100,
+                    {label(1, {10, 10}, {50, 50}, {10, 10}, true, 0),
+                     label(2, {50, 10}, {0, 50}, {10, 10}, true, second_layer)});
+    };
+    const FrameMetrics apart = frame_metrics(frame(1));
+    CHECK(apart.leader_crossings == 1);
+    CHECK(apart.leader_crossings_same_layer == 0);
+    CHECK(apart.leaders_through_boxes == 0);
+    const FrameMetrics together = frame_metrics(frame(0));
+    CHECK(together.leader_crossings == 1);
+    CHECK(together.leader_crossings_same_layer == 1);
+  }
+
+  TEST_CASE("leaders_touching_at_an_endpoint_do_not_cross") {
+    // Label 2's anchor lies on label 1's leader; label 3's leader starts where label 1's does.
+    const FrameMetrics m = frame_metrics(
+        layout(100, 100,
+               {label(1, {10, 10}, {50, 50}, {10, 10}), label(2, {30, 30}, {30, 60}, {10, 10}),
+                label(3, {10, 10}, {-20, 5}, {10, 10}),
+                // Hidden: its leader would cross label 1's.
+                label(4, {50, 10}, {0, 50}, {10, 10}, false)}));
+    CHECK(m.leaders == 3);
+    CHECK(m.leader_crossings == 0);
+  }
+
+  TEST_CASE("a_leader_through_a_third_label_box_counts_and_one_along_an_edge_does_not") {
+    const FrameMetrics m = frame_metrics(
+        layout(100, 100,
+               {label(1, {10, 50}, {80, 45}, {10, 10}),    // leader (10,50)-(80,50)
+                internal_label(2, {40, 40}, {10, 20}),     // the leader crosses it
+                internal_label(3, {20, 50}, {10, 10}),     // the leader runs on its top
+                internal_label(4, {60, 20}, {10, 30})}));  // its bottom touches y = 50
+    CHECK(m.leaders_through_boxes == 1);
+    CHECK(m.overlaps == 0);
+  }
+
+  TEST_CASE("an_anchor_strictly_inside_another_shown_box_is_covered") {
+    const FrameMetrics m = frame_metrics(
+        layout(100, 100,
+               {internal_label(1, {0, 0}, {20, 20}),            // its own anchor: not covered
+                label(2, {10, 10}, {60, 60}, {10, 10}, false),  // hidden, anchor under box 1
+                label(3, {5, 5}, {50, 0}, {10, 10}),            // shown, anchor under box 1
+                label(4, {20, 10}, {60, 20}, {10, 10}),         // anchor on box 1's edge
+                label(5, {80, 80}, {30, 30}, {30, 30}, false),  // hidden box: covers nothing
+                internal_label(6, {40, 40}, {10, 10})}));
+    CHECK(m.anchors_covered == 2);
+    // Label 3's leader starts inside box 1.
+    CHECK(m.leaders_through_boxes == 1);
+  }
+
+  TEST_CASE("a_label_partly_outside_the_image_counts_and_one_touching_its_corner_does_not") {
+    const FrameMetrics m = frame_metrics(layout(
+        100, 80,
+        {internal_label(1, {-5, 10}, {20, 10}), internal_label(2, {90, 70}, {10, 10}),
+         internal_label(3, {50, 75}, {10, 10}), internal_label(4, {-50, -50}, {10, 10}, false)}));
+    CHECK(m.outside_image == 2);
+  }
+
+  TEST_CASE("leader_lengths_are_fractions_of_the_image_diagonal") {
+    // Diagonal 500; leaders 50 and 150 long, and a label without one.
+    const FrameMetrics m = frame_metrics(layout(
+        300, 400,
+        {label(1, {0, 0}, {30, 40}, {10, 10}), label(2, {100, 100}, {100, 250}, {10, 10}),
+         internal_label(3, {200, 200}, {10, 10}), label(4, {0, 0}, {300, 300}, {10, 10}, false)}));
+    CHECK(m.leaders == 2);
+    CHECK(m.leader_length_max == doctest::Approx(0.3).epsilon(1e-12));
+    CHECK(m.leader_length_mean == doctest::Approx(0.4 / 3.0).epsilon(1e-12));
+  }
+
+  TEST_CASE("the_nearest_rank_percentile_is_the_ceil_qn_th_smallest") {
+    std::vector<double> twenty;
+    for (int i = 20; i >= 1; --i) twenty.push_back(i);
+    CHECK(nearest_rank_percentile(twenty, 0.95) == 19.0);
+    CHECK(nearest_rank_percentile({3, 1, 2}, 0.95) == 3.0);
+    CHECK(nearest_rank_percentile({0, 50, 3, 5, 40}, 0.5) == 5.0);
+    CHECK(nearest_rank_percentile({}, 0.95) == 0.0);
+  }
+
+  TEST_CASE("a_three_frame_sequence_has_its_known_movements_jump_switch_and_flip") {
+    // Label 1 moves 3 then 5 px against its anchor; label 2 jumps 50 px, then switches layer;
+    // label 3 is hidden after frame 0; label 4's anchor moves 100 px and its box moves exactly
+    // 40 px against it (no jump: the threshold is strict); label 5 appears in frame 2 only.
+    const Layout f0 =
+        layout(200, 200,
+               {offset_label(1, {10, 10}, {20, 0}), offset_label(2, {50, 50}, {0, 30}),
+                offset_label(3, {90, 90}, {0, 20}), offset_label(4, {20, 150}, {0, 0})});
+    const Layout f1 =
+        layout(200, 200,
+               {offset_label(1, {10, 10}, {20, 3}), offset_label(2, {50, 50}, {30, 70}),
+                offset_label(3, {90, 90}, {0, 20}, false), offset_label(4, {120, 150}, {24, 32})});
+    const Layout f2 =
+        layout(200, 200,
+               {offset_label(1, {10, 10}, {23, 7}), offset_label(2, {50, 50}, {30, 70}, true, 1),
+                offset_label(3, {90, 90}, {0, 20}, false), offset_label(5, {100, 100}, {0, 20})});
+    const SequenceMetrics m = sequence_metrics({f0, f1, f2});
+    CHECK(m.frames == 3);
+    CHECK(m.label_frame_pairs == 7);  // 4 from frame 0 to 1, 3 from 1 to 2
+    CHECK(m.shown_pairs == 5);
+    // Movements 3, 50, 40, 5, 0.
+    CHECK(m.movement_mean == doctest::Approx(98.0 / 5.0).epsilon(1e-12));
+    CHECK(m.movement_p95 == doctest::Approx(50.0).epsilon(1e-12));
+    CHECK(m.jumps == 1);
+    CHECK(m.jump_share == doctest::Approx(0.2));
+    CHECK(m.layer_switches == 1);
+    CHECK(m.layer_switch_share == doctest::Approx(0.2));
+    CHECK(m.show_hide_flips == 1);
+    CHECK(m.show_hide_flip_share == doctest::Approx(1.0 / 7.0));
+    REQUIRE(m.per_frame.size() == 3);
+    CHECK(m.per_frame[1].hidden == 1);
+    CHECK(m.total.labels == 12);
+    CHECK(m.total.shown == 10);
+    CHECK(m.total.hidden == 2);
+  }
+
+  TEST_CASE("summed_frame_metrics_pool_leader_lengths_over_every_shown_label") {
+    FrameMetrics a, b;
+    a.shown = 1;
+    a.leader_length_mean = 0.4;
+    a.leader_length_max = 0.4;
+    a.overlaps = 2;
+    a.overlap_area = 10.0;
+    b.shown = 3;
+    b.leader_length_mean = 0.2;
+    b.leader_length_max = 0.5;
+    b.overlaps = 1;
+    b.overlap_area = 2.5;
+    const FrameMetrics total = sum_frame_metrics({a, b});
+    CHECK(total.shown == 4);
+    CHECK(total.overlaps == 3);
+    CHECK(total.overlap_area == 12.5);
+    CHECK(total.leader_length_mean == doctest::Approx(0.25));
+    CHECK(total.leader_length_max == 0.5);
+  }
+
+  TEST_CASE("read_layout_reads_what_render_writes") {
+    const auto folder = test::fresh_folder("cpu", "layout_metrics_read");
+    const auto path = test::write_file(folder / "layout.json",
+                                       R"({"width": 128, "height": 96, "labels": [
+          {"id": 3, "text": "Caudate", "layer": 1, "anchor": [10.5, 20], "box": [30, 40, 50, 12],
+           "shown": true, "cost": 0.25},
+          {"id": 4, "anchor": [1, 2], "box": [1, 2, 0, 0], "shown": false, "cost": null,
+           "from_a_later_version": 1}]})");
+    const Layout l = read_layout(path);
+    CHECK(l.width == 128);
+    CHECK(l.height == 96);
+    REQUIRE(l.labels.size() == 2);
+    CHECK(l.labels[0].id == 3);
+    CHECK(l.labels[0].text == "Caudate");
+    CHECK(l.labels[0].layer == 1);
+    CHECK(l.labels[0].anchor == glm::dvec2(10.5, 20));
+    CHECK(l.labels[0].box_origin == glm::dvec2(30, 40));
+    CHECK(l.labels[0].box_size == glm::dvec2(50, 12));
+    CHECK(l.labels[0].shown);
+    CHECK(l.labels[0].cost == 0.25);
+    CHECK_FALSE(l.labels[1].shown);
+    CHECK(std::isnan(l.labels[1].cost));
+  }
+
+  TEST_CASE("read_layout_errors_name_the_file_and_field") {
+    const std::string head = R"({"width": 64, "height": 64, "labels": [)";
+    const std::string good = R"({"id": 1, "anchor": [1, 2], "box": [0, 0, 4, 4], "shown": true})";
+    const auto error = [&](const std::string& name, const std::string& labels) {
+      return layout_error(name, head + labels + "]}");
+    };
+    CHECK(error("box", good + R"(, {"id": 2, "anchor": [1, 2], "box": [0, 0, 4], "shown": true})")
+              .ends_with("layout.json: labels[1].box: expected 4 numbers"));
+    CHECK(error("size", R"({"id": 2, "anchor": [1, 2], "box": [0, 0, -4, 4], "shown": true})")
+              .ends_with("labels[0].box: width and height must be >= 0"));
+    CHECK(error("anchor", R"({"id": 2, "anchor": [1, "2"], "box": [0, 0, 4, 4], "shown": 1})")
+              .ends_with("labels[0].anchor: expected 2 numbers"));
+    CHECK(error("shown", R"({"id": 2, "anchor": [1, 2], "box": [0, 0, 4, 4]})")
+              .ends_with("labels[0]: missing key 'shown'"));
+    CHECK(error("layer", R"({"id": 2, "anchor": [1, 2], "box": [0, 0, 4, 4], "shown": true,
+                             "layer": -1})")
+              .ends_with("labels[0].layer: expected an integer >= 0"));
+    CHECK(error("duplicate", good + ", " + good)
+              .ends_with("labels[1].id: duplicate id 1 (also labels[0])"));
+    CHECK(layout_error("width", R"({"width": 0, "height": 64, "labels": []})")
+              .ends_with("layout.json: width: expected a positive integer"));
+    CHECK(layout_error("labels", R"({"width": 8, "height": 64})")
+              .ends_with("layout.json: missing key 'labels'"));
+    CHECK(layout_error("syntax", R"({"width": 8,)").find("layout.json: parse error") !=
+          std::string::npos);
+    CHECK(test::error_of([] { read_layout("/nonexistent/layout.json"); }) ==
+          "/nonexistent/layout.json: no such file");
+  }
+}
+
+}  // namespace strata
