@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "engine/core/error.h"
+#include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
 
 namespace strata {
@@ -17,30 +18,7 @@ namespace {
 using nlohmann::json;
 using nlohmann::ordered_json;
 
-// Where a JSON value is, for error messages: "a.json: labels[3].box: ...".
-struct Field {
-  const std::string& file;
-  std::string path;
-
-  Field operator/(const std::string& key) const {
-    return {file, path.empty() ? key : path + "." + key};
-  }
-  Field operator[](size_t index) const { return {file, path + "[" + std::to_string(index) + "]"}; }
-  [[noreturn]] void fail(const std::string& reason) const {
-    throw Error(file + ": " + (path.empty() ? "" : path + ": ") + reason);
-  }
-};
-
-const json& required(const json& object, const Field& field, const char* key) {
-  const auto it = object.find(key);
-  if (it == object.end()) field.fail(std::string("missing key '") + key + "'");
-  return *it;
-}
-
-const json* optional(const json& object, const char* key) {
-  const auto it = object.find(key);
-  return it == object.end() ? nullptr : &*it;
-}
+using Field = JsonField;
 
 uint32_t image_extent(const json& value, const Field& field) {
   if (!value.is_number_unsigned() || value.get<uint64_t>() == 0 ||

@@ -12,14 +12,12 @@ namespace {
 // A label with its box's top-left corner and size; shown on layer 0 unless said otherwise.
 LayoutLabel label(int id, glm::dvec2 anchor, glm::dvec2 origin, glm::dvec2 size, bool shown = true,
                   uint32_t layer = 0) {
-  LayoutLabel l;
-  l.id = id;
-  l.anchor = anchor;
-  l.box_origin = origin;
-  l.box_size = size;
-  l.shown = shown;
-  l.layer = layer;
-  return l;
+  return {.id = id,
+          .layer = layer,
+          .anchor = anchor,
+          .box_origin = origin,
+          .box_size = size,
+          .shown = shown};
 }
 
 // A label drawn over its anchor (no leader): the box centred on the anchor.

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
+#include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
 #include "engine/scene/atlas.h"
 #include "engine/scene/io/mesh_loader.h"
@@ -23,28 +24,7 @@ namespace {
 
 using nlohmann::json;
 
-// Where a JSON value is, for error messages: "scene.json: volumes[0].transform: ...".
-struct Field {
-  const std::string& file;
-  std::string path;
-
-  Field operator/(const std::string& key) const {
-    return {file, path.empty() ? key : path + "." + key};
-  }
-  Field operator[](size_t index) const { return {file, path + "[" + std::to_string(index) + "]"}; }
-  [[noreturn]] void fail(const std::string& reason) const {
-    throw Error(file + ": " + (path.empty() ? "" : path + ": ") + reason);
-  }
-  // Runs a loader for the file this field names and puts the field before its error.
-  template <typename F>
-  auto wrap(F&& load) const {
-    try {
-      return load();
-    } catch (const Error& e) {
-      fail(e.what());
-    }
-  }
-};
+using Field = JsonField;
 
 void check_keys(const json& object, const Field& field, std::initializer_list<const char*> keys) {
   if (!object.is_object()) field.fail("expected an object");
@@ -54,17 +34,6 @@ void check_keys(const json& object, const Field& field, std::initializer_list<co
     for (const char* k : keys) expected += (expected.empty() ? "" : ", ") + std::string(k);
     field.fail("unknown key '" + key + "' (expected " + expected + ")");
   }
-}
-
-const json* optional(const json& object, const char* key) {
-  const auto it = object.find(key);
-  return it == object.end() ? nullptr : &*it;
-}
-
-const json& required(const json& object, const Field& field, const char* key) {
-  const json* value = optional(object, key);
-  if (!value) field.fail(std::string("missing key '") + key + "'");
-  return *value;
 }
 
 float number(const json& value, const Field& field) {

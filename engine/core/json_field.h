@@ -1,0 +1,51 @@
+// Where a value sits in a JSON file, for errors that name it ("scene.json: volumes[0].transform:
+// expected 16 numbers"), and the key lookups every JSON reader of strata makes.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "engine/core/error.h"
+
+namespace strata {
+
+struct JsonField {
+  const std::string& file;
+  std::string path;
+
+  JsonField operator/(const std::string& key) const {
+    return {file, path.empty() ? key : path + "." + key};
+  }
+  JsonField operator[](size_t index) const {
+    return {file, path + "[" + std::to_string(index) + "]"};
+  }
+  [[noreturn]] void fail(const std::string& reason) const {
+    throw Error(file + ": " + (path.empty() ? "" : path + ": ") + reason);
+  }
+  // Runs a loader for the file this field names and puts the field before its error.
+  template <typename F>
+  auto wrap(F&& load) const {
+    try {
+      return load();
+    } catch (const Error& e) {
+      fail(e.what());
+    }
+  }
+};
+
+// The member `key` of `object`, or none.
+inline const nlohmann::json* optional(const nlohmann::json& object, const char* key) {
+  const auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+// The member `key` of `object`; an error naming the field when it is missing.
+inline const nlohmann::json& required(const nlohmann::json& object, const JsonField& field,
+                                      const char* key) {
+  const nlohmann::json* value = optional(object, key);
+  if (!value) field.fail(std::string("missing key '") + key + "'");
+  return *value;
+}
+
+}  // namespace strata
