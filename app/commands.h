@@ -31,5 +31,6 @@ void add_view_command(CLI::App& app, DeviceOptions& device);
 void add_bench_command(CLI::App& app, DeviceOptions& device);
 void add_info_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
+void add_video_command(CLI::App& app, DeviceOptions& device);
 
 }  // namespace strata::app

@@ -15,6 +15,8 @@ packages=(
   fonts-dejavu-core  # label text (engine/core/font.cpp)
   # file formats: gzip, DICOM, meshes, JSON, XML
   zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev
+  # videos: H.264 in MP4 through FFmpeg's libraries; ffprobe checks them in the tests
+  libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
   # window tests without a display
   xvfb xauth
 )
