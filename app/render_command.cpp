@@ -8,6 +8,7 @@
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
 #include "engine/scene/io/scene_loader.h"
+#include "labeling/camera_path.h"
 #include "labeling/labelled_render.h"
 #include "passes/test_pattern.h"
 #include "passes/volume_renderer.h"
@@ -68,11 +69,42 @@ RenderSettings render_settings(const RenderOptions& o) {
   return settings;
 }
 
-// strata's main job: the labelled image (labeling/labelled_render.h).
-void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
-  const graph::Extent size = parse_size(o.size, "--size");
-  const Scene scene = load_scene_reporting(o.scene);
-  Context ctx(device.context());
+// One image of the scene: its camera, and the files it goes to (layout and layers if asked for).
+struct Still {
+  Camera camera;
+  std::string image;
+  std::string layout;
+  std::string layers;
+};
+
+// A file with the position's name before its extension: out.png and front give out-front.png.
+std::string named_for(const std::string& path, const std::string& position) {
+  if (path.empty()) return path;
+  const std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + "-" + position + p.extension().string())).string();
+}
+
+// --camera front,left: one still per position, each file named after it (the thesis program's
+// screenshots). One position, or none, writes the files as given. Every name is looked up before
+// anything renders, so a typo costs no time and leaves no partial set of files.
+std::vector<Still> stills(const Scene& scene, const RenderOptions& o) {
+  const std::vector<std::string> names = split_camera_list(o.camera);
+  if (names.size() == 1)
+    return {{camera_position(scene, o.camera), o.output, o.layout, o.dump_layers}};
+  std::vector<Still> out;
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (names[i].empty()) {
+      throw Error("--camera '" + o.camera + "': part " + std::to_string(i + 1) + " is empty");
+    }
+    std::string layers = o.dump_layers;
+    while (layers.size() > 1 && layers.back() == '/') layers.pop_back();
+    out.push_back({camera_position(scene, names[i]), named_for(o.output, names[i]),
+                   named_for(o.layout, names[i]), layers.empty() ? "" : layers + "-" + names[i]});
+  }
+  return out;
+}
+
+LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene) {
   LabellingSettings settings;
   settings.layer_count = o.layers;
   settings.render = render_settings(o);
@@ -86,32 +118,63 @@ void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
     settings.order = InsertionOrder::apollonius;
     settings.placement.hard = true;
   }
-  LabelledRenderer renderer(ctx, scene, camera_for(scene, o.camera), size, settings);
+  return settings;
+}
+
+void write_layout(const std::string& path, const LabelledFrame& frame) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw Error(path + ": cannot write the layout file");
+  const std::string json = layout_json(frame);
+  const bool ok = std::fwrite(json.data(), 1, json.size(), f) == json.size();
+  if (std::fclose(f) != 0 || !ok) throw Error(path + ": cannot write the layout file");
+  std::printf("wrote %s\n", path.c_str());
+}
+
+void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions& o,
+                           graph::Extent size, const Still& still) {
+  LabelledRenderer renderer(ctx, scene, still.camera, size, labelling_settings(o, scene));
   print_graph(o, renderer.runner());
   renderer.run();
   const LabelledFrame frame = renderer.result();
-  write_png(o.output, size.width, size.height, frame.image);
+  write_png(still.image, size.width, size.height, frame.image);
   uint32_t shown = 0;
   for (const LabelLayout& l : frame.labels) shown += l.shown;
-  std::printf("wrote %s (%ux%u, %u layers): %u of %zu labels shown\n", o.output.c_str(), size.width,
-              size.height, frame.layering.layer_count, shown, frame.labels.size());
-  if (!o.layout.empty()) {
-    std::FILE* f = std::fopen(o.layout.c_str(), "w");
-    if (!f) throw Error(o.layout + ": cannot write the layout file");
-    const std::string json = layout_json(frame);
-    const bool ok = std::fwrite(json.data(), 1, json.size(), f) == json.size();
-    if (std::fclose(f) != 0 || !ok) throw Error(o.layout + ": cannot write the layout file");
-    std::printf("wrote %s\n", o.layout.c_str());
-  }
+  std::printf("wrote %s (%ux%u, %u layers): %u of %zu labels shown\n", still.image.c_str(),
+              size.width, size.height, frame.layering.layer_count, shown, frame.labels.size());
+  if (!still.layout.empty()) write_layout(still.layout, frame);
 }
 
+// strata's main job: the labelled image (labeling/labelled_render.h), once per position.
+void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
+  const graph::Extent size = parse_size(o.size, "--size");
+  const Scene scene = load_scene_reporting(o.scene);
+  const std::vector<Still> all = stills(scene, o);
+  Context ctx(device.context());
+  for (const Still& still : all) render_labelled_still(ctx, scene, o, size, still);
+}
+
+// An overflowing HA-Buffer grows for the next frame; an offline image waits for a clean one.
+RenderStats render_until_clean(VolumeRenderer& renderer, graph::GraphRunner& runner,
+                               graph::Extent size) {
+  RenderStats stats;
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    runner.run_now();
+    stats = renderer.collect(runner);
+    if (stats.overflow == 0) break;
+    std::fprintf(stderr, "strata: HA-Buffer overflow (%u fragments), table grows to %u slots\n",
+                 stats.overflow, renderer.table_slots(size));
+  }
+  return stats;
+}
+
+// The label-free image; the renderer and its graph are built once and run for each position.
 void render_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const Scene scene = load_scene_reporting(o.scene);
+  const std::vector<Still> all = stills(scene, o);
   Context ctx(device.context());
   const RenderSettings settings = render_settings(o);
   VolumeRenderer renderer(ctx, scene, settings);
-  renderer.set_camera(camera_for(scene, o.camera));
   HeadlessTarget target(ctx);
   graph::Graph graph;
   const VolumeRenderer::Outputs out = renderer.add_to(graph);
@@ -120,20 +183,16 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   runner.set_viewport(size);
   target.bind(runner);
   print_graph(o, runner);
-  RenderStats stats;
-  // An overflowing HA-Buffer grows for the next frame; an offline image waits for a clean one.
-  for (int attempt = 0; attempt < 4; ++attempt) {
-    runner.run_now();
-    stats = renderer.collect(runner);
-    if (stats.overflow == 0) break;
-    std::fprintf(stderr, "strata: HA-Buffer overflow (%u fragments), table grows to %u slots\n",
-                 stats.overflow, renderer.table_slots(size));
+  for (const Still& still : all) {
+    renderer.set_camera(still.camera);
+    const RenderStats stats = render_until_clean(renderer, runner, size);
+    write_png(still.image, size.width, size.height, target.pixels());
+    std::printf(
+        "wrote %s (%ux%u, %u layers): %u fragments, load factor %.2f, %.1f samples per ray\n",
+        still.image.c_str(), size.width, size.height, o.layers, stats.fragments,
+        stats.load_factor(), double(stats.samples) / (double(size.width) * size.height));
+    if (!still.layers.empty()) dump_layers(runner, out.layers, size, o.layers, still.layers);
   }
-  write_png(o.output, size.width, size.height, target.pixels());
-  std::printf("wrote %s (%ux%u, %u layers): %u fragments, load factor %.2f, %.1f samples per ray\n",
-              o.output.c_str(), size.width, size.height, o.layers, stats.fragments,
-              stats.load_factor(), double(stats.samples) / (double(size.width) * size.height));
-  if (!o.dump_layers.empty()) dump_layers(runner, out.layers, size, o.layers, o.dump_layers);
 }
 
 void render_test_pattern(DeviceOptions& device, const RenderOptions& o) {
@@ -161,7 +220,9 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
                   "scene file (.json, or .xml of the thesis program); none: a test pattern");
   cmd->add_option("-o,--output", o->output, "PNG file to write")->capture_default_str();
   cmd->add_option("--size", o->size, "image size, N or WxH")->capture_default_str();
-  cmd->add_option("--camera", o->camera, "named camera position of the scene");
+  cmd->add_option("--camera", o->camera,
+                  "named camera position of the scene, or several (front,left): one image each, "
+                  "named after it (out-front.png, out-left.png)");
   cmd->add_option("--layers", o->layers, "depth layers, 1 to 8")->capture_default_str();
   cmd->add_option("--dump-layers", o->dump_layers,
                   "folder to write each (label-free) layer image to");

@@ -89,6 +89,81 @@ TEST_SUITE("cli") {
     CHECK(r.output.find("22 passes, 55 barriers") != std::string::npos);
   }
 
+  // The thesis program's screenshots: one still per named position, named after it.
+  TEST_CASE("render_with_several_positions_writes_one_png_per_position") {
+    const std::string dir = test::output_dir() + "/stills";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const auto r = run_strata("render " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --size 64 "
+                              "--camera front,left -o " +
+                              dir + "/head.png --layout " + dir + "/layout.json");
+    CHECK(r.exit_code == 0);
+    for (const char* name : {"front", "left"}) {
+      CAPTURE(name);
+      const Rgba8Image image = read_png(dir + "/head-" + name + ".png");
+      CHECK(image.width == 64);
+      CHECK(image.height == 64);
+      CHECK(std::filesystem::exists(dir + "/layout-" + name + ".json"));
+    }
+    CHECK(!std::filesystem::exists(dir + "/head.png"));
+    CHECK(read_png(dir + "/head-front.png").pixels != read_png(dir + "/head-left.png").pixels);
+  }
+
+  TEST_CASE("an_unknown_position_in_the_list_is_one_error_naming_it") {
+    const std::string dir = test::output_dir() + "/stills-unknown";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const auto r = run_strata("render " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --size 32 "
+                              "--camera front,back -o " +
+                              dir + "/head.png");
+    CHECK(r.exit_code == 1);
+    CHECK(r.output.find("strata: error: ") != std::string::npos);
+    CHECK(r.output.find("no camera position named 'back'") != std::string::npos);
+    CHECK(std::filesystem::is_empty(dir));  // names are checked before anything renders
+  }
+
+  // A turntable video: the frame count and size ffprobe reads, a layout per frame, and strata
+  // eval over the sequence.
+  TEST_CASE("video_of_a_turntable_has_its_frames_and_layouts") {
+    const std::string dir = test::output_dir() + "/turntable";
+    std::filesystem::remove_all(dir);
+    const auto r = run_strata("--validate video " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --orbit 12 --seconds 0.2 --fps 30 "
+                              "--size 64 -o " +
+                              dir + ".mp4 --layout-dir " + dir);
+    CHECK(r.exit_code == 0);
+    CHECK(r.output.find("validation:") == std::string::npos);
+    CHECK(r.output.find("wrote 7 frames (64x64, 30 fps)") != std::string::npos);
+    std::FILE* pipe = popen(("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                             "stream=width,height,nb_read_frames -of csv=p=0 " +
+                             dir + ".mp4")
+                                .c_str(),
+                            "r");
+    REQUIRE(pipe != nullptr);
+    char line[128] = {};
+    const bool read = std::fgets(line, sizeof line, pipe) != nullptr;
+    pclose(pipe);
+    CHECK(read);
+    CHECK(std::string(line).starts_with("64,64,7"));
+    const auto eval = run_strata("eval " + dir + "/frame-0000*.json");
+    CHECK(eval.exit_code == 0);
+    const nlohmann::json report = bench_report(eval.output);
+    CHECK(report["frames"] == 7);
+    CHECK(report["sequence"]["jumps"] == 0);
+  }
+
+  TEST_CASE("video_with_two_paths_or_none_is_one_clear_error") {
+    const auto both = run_strata("video " STRATA_SOURCE_DIR
+                                 "/assets/scenes/head.json --orbit 10 --path front -o x.mp4");
+    CHECK(both.exit_code == 1);
+    CHECK(both.output.find("give --path or --orbit, not both") != std::string::npos);
+    const auto none = run_strata("video " STRATA_SOURCE_DIR "/assets/scenes/head.json -o x.mp4");
+    CHECK(none.exit_code == 1);
+    CHECK(none.output.find("give a camera path") != std::string::npos);
+  }
+
   TEST_CASE("no_vulkan_driver_is_one_clear_error_and_exit_1") {
     const auto r =
         run_strata("render -o /dev/null",

@@ -39,6 +39,8 @@ struct VideoFile::Codec {
       const int result = avcodec_receive_packet(encoder, packet);
       if (result == AVERROR(EAGAIN) || result == AVERROR_EOF) return;
       check(result, "encoding a frame");
+      // Every frame lasts one frame: without a duration the MP4's edit list cuts the last frame.
+      if (packet->duration == 0) packet->duration = 1;
       av_packet_rescale_ts(packet, encoder->time_base, stream->time_base);
       packet->stream_index = stream->index;
       check(av_interleaved_write_frame(format, packet), "writing a frame");
@@ -59,6 +61,7 @@ VideoFile::VideoFile(const std::string& path, uint32_t width, uint32_t height, d
     : codec_(std::make_unique<Codec>()) {
   Codec& c = *codec_;
   c.path = path;
+  av_log_set_level(AV_LOG_ERROR);  // (the encoder's statistics are not for the user)
   c.width = width;
   c.height = height;
   if (width % 2 || height % 2) {

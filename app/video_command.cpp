@@ -1,0 +1,154 @@
+// `strata video`: the labelled scene along a camera path or a turntable, one frame every 1 / fps
+// seconds, with the labels moved by the forces between frames (a fixed time step, so the same
+// command gives the same frames). Frames go into an H.264 MP4 (-o NAME.mp4) or a folder as a
+// numbered PNG sequence, and with --layout-dir each frame's layout as JSON (for `strata eval`).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include <unistd.h>
+
+#include "app/commands.h"
+#include "engine/core/png.h"
+#include "engine/core/video_file.h"
+#include "labeling/camera_path.h"
+#include "labeling/labelled_render.h"
+
+namespace strata::app {
+namespace {
+
+struct VideoOptions {
+  std::string scene;
+  std::string path;
+  double orbit = 0.0;    // degrees; 0: --path
+  double seconds = 0.0;  // of the orbit; 0: 30 degrees a second
+  std::string camera;    // where the orbit starts
+  double fps = 30.0;
+  std::string size = "512";
+  std::string output;
+  std::string layout_dir;
+  bool screen_space = false;
+  bool no_forces = false;
+  uint32_t layers = 4;
+};
+
+CameraPath camera_path(const Scene& scene, const VideoOptions& o) {
+  if (!o.path.empty() && o.orbit != 0.0) throw Error("video: give --path or --orbit, not both");
+  if (!o.path.empty()) return parse_camera_path(scene, o.path);
+  if (o.orbit == 0.0) throw Error("video: give a camera path (--path) or a turntable (--orbit)");
+  const double seconds = o.seconds > 0.0 ? o.seconds : std::abs(o.orbit) / 30.0;
+  return orbit_path(scene, camera_for(scene, o.camera), o.orbit, seconds);
+}
+
+// "frame 12/60, 8.3 frames/s, 6 s left" on one line of a terminal; nothing when stderr is not one.
+class Progress {
+ public:
+  explicit Progress(size_t total) : total_(total), quiet_(!isatty(STDERR_FILENO)) {}
+  void frame_done(size_t done) const {
+    if (quiet_) return;
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
+    const double rate = elapsed > 0.0 ? double(done) / elapsed : 0.0;
+    const double left = rate > 0.0 ? double(total_ - done) / rate : 0.0;
+    std::fprintf(stderr, "\rframe %zu/%zu, %.1f frames/s, %.0f s left   ", done, total_, rate,
+                 left);
+    if (done == total_) std::fputc('\n', stderr);
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  size_t total_;
+  bool quiet_;
+  Clock::time_point start_ = Clock::now();
+};
+
+void write_text(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  if (!out.flush()) throw Error(file.string() + ": cannot write");
+}
+
+std::string frame_name(size_t frame, const char* extension) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame-%05zu.%s", frame, extension);
+  return name;
+}
+
+void video(DeviceOptions& device, const VideoOptions& o) {
+  const graph::Extent size = parse_size(o.size, "--size");
+  if (!(o.fps > 0.0 && o.fps <= 240.0)) throw Error("--fps: expected 0 < fps <= 240");
+  const Scene scene = load_scene_reporting(o.scene);
+  const std::vector<Camera> cameras = sample(camera_path(scene, o), o.fps);
+  const std::filesystem::path output = o.output;
+  const bool mp4 = output.extension() == ".mp4";
+  if (!mp4 && output.has_extension()) {
+    throw Error("-o " + o.output + ": give NAME.mp4, or a folder for a PNG sequence");
+  }
+  std::unique_ptr<VideoFile> file;
+  if (mp4) {
+    file = std::make_unique<VideoFile>(o.output, size.width, size.height, o.fps);
+  } else {
+    std::filesystem::create_directories(output);
+  }
+  if (!o.layout_dir.empty()) std::filesystem::create_directories(o.layout_dir);
+
+  Context ctx(device.context());
+  LabellingSettings settings;
+  settings.layer_count = o.layers;
+  settings.placement.weights = scene.settings.weights;
+  settings.forces.anchor_relative = !o.screen_space;
+  LabelledRenderer renderer(ctx, scene, cameras.front(), size, settings);
+  renderer.run();  // the first frame: the labels settled on their placement
+  const Progress progress(cameras.size());
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    if (f > 0) {
+      renderer.set_camera(cameras[f]);
+      if (o.no_forces) {
+        renderer.run();  // every frame placed from scratch: today's behaviour, for comparison
+      } else {
+        renderer.advance(1.0 / o.fps);
+      }
+    }
+    const LabelledFrame frame = renderer.result();
+    if (file) {
+      file->write(frame.image);
+    } else {
+      write_png((output / frame_name(f, "png")).string(), size.width, size.height, frame.image);
+    }
+    if (!o.layout_dir.empty()) {
+      write_text(std::filesystem::path(o.layout_dir) / frame_name(f, "json"), layout_json(frame));
+    }
+    progress.frame_done(f + 1);
+  }
+  if (file) file->finish();
+  std::printf("wrote %zu frames (%ux%u, %g fps) to %s\n", cameras.size(), size.width, size.height,
+              o.fps, o.output.c_str());
+}
+
+}  // namespace
+
+void add_video_command(CLI::App& app, DeviceOptions& device) {
+  CLI::App* cmd = app.add_subcommand(
+      "video", "Render the labelled scene along a camera path or a turntable, frame by frame");
+  auto o = std::make_shared<VideoOptions>();
+  cmd->add_option("scene", o->scene, "scene file")->required();
+  cmd->add_option("--path", o->path, "camera path: front,left_2,top_3 (docs/scene-format.md)");
+  cmd->add_option("--orbit", o->orbit, "turntable: degrees about the scene's centre");
+  cmd->add_option("--seconds", o->seconds,
+                  "duration of the turntable (default: 30 degrees a second)");
+  cmd->add_option("--camera", o->camera, "named position the turntable starts from");
+  cmd->add_option("--fps", o->fps, "frames per second")->capture_default_str();
+  cmd->add_option("--size", o->size, "image size, N or WxH")->capture_default_str();
+  cmd->add_option("-o,--output", o->output, "NAME.mp4 (H.264), or a folder for PNG frames")
+      ->required();
+  cmd->add_option("--layout-dir", o->layout_dir, "folder for each frame's layout JSON");
+  cmd->add_option("--layers", o->layers, "depth layers, 1 to 8")->capture_default_str();
+  cmd->add_flag("--screen-space", o->screen_space,
+                "labels live on screen (the thesis), not as offsets from their anchors");
+  cmd->add_flag("--no-forces", o->no_forces, "place every frame from scratch (labels jump)");
+  cmd->callback([&device, o] { video(device, *o); });
+}
+
+}  // namespace strata::app
