@@ -92,15 +92,19 @@ glm::vec3 up_axis(const Camera& camera) {
   return out;
 }
 
-bool has_position(const Scene& scene, const std::string& name) {
-  return name == scene_camera_name ||
-         std::any_of(scene.camera_positions.begin(), scene.camera_positions.end(),
+bool scene_names(const Scene& scene, const std::string& name) {
+  return std::any_of(scene.camera_positions.begin(), scene.camera_positions.end(),
                      [&](const CameraPose& pose) { return pose.name == name; });
+}
+
+bool has_position(const Scene& scene, const std::string& name) {
+  return name == scene_camera_name || scene_names(scene, name);
 }
 
 std::string position_names(const Scene& scene) {
   std::string names;
   for (const CameraPose& pose : scene.camera_positions) names += pose.name + ", ";
+  if (scene_names(scene, scene_camera_name)) return names.substr(0, names.size() - 2);
   return names + scene_camera_name + " (the scene's camera)";
 }
 
@@ -116,9 +120,15 @@ bool parse_seconds(const std::string& text, double& seconds) {
   return ec == std::errc() && ptr == end && std::isfinite(seconds) && seconds > 0.0;
 }
 
-// One part of a path, `name` or `name_SECONDS`: its pose and the seconds the move to it takes.
-CameraKey parse_part(const Scene& scene, const std::string& text, const std::string& part,
-                     size_t index) {
+// One part of a path's text: the pose it names and the seconds the move to it takes.
+struct PathPart {
+  Camera camera;
+  double seconds = 0.0;
+};
+
+// `name` or `name_SECONDS`; the whole part is tried as a name first, so `left_side` is a name.
+PathPart parse_part(const Scene& scene, const std::string& text, const std::string& part,
+                    size_t index) {
   if (part.empty()) fail(scene, text, "part " + std::to_string(index + 1) + " is empty");
   const double default_seconds = index == 0 ? 0.0 : 1.0;
   if (has_position(scene, part)) return {camera_position(scene, part), default_seconds};
@@ -130,18 +140,15 @@ CameraKey parse_part(const Scene& scene, const std::string& text, const std::str
              "' (the scene has: " + position_names(scene) + ")");
   }
   if (index == 0) {
-    fail(scene, text,
-         "'" + part +
-             "': the first position is where the path starts; it takes no "
-             "duration");
+    fail(scene, text, "'" + part + "': the first position is where the path starts; no duration");
   }
   const std::string duration = part.substr(cut + 1);
-  CameraKey key{camera_position(scene, name), 0.0};
-  if (!parse_seconds(duration, key.time)) {
+  PathPart out{camera_position(scene, name)};
+  if (!parse_seconds(duration, out.seconds)) {
     fail(scene, text,
          "'" + part + "': '" + duration + "' is not a duration (a positive number of seconds)");
   }
-  return key;
+  return out;
 }
 
 }  // namespace
@@ -163,10 +170,7 @@ Camera CameraPath::at(double seconds) const {
 }
 
 Camera camera_position(const Scene& scene, const std::string& name) {
-  const bool scene_names_it =
-      std::any_of(scene.camera_positions.begin(), scene.camera_positions.end(),
-                  [&](const CameraPose& pose) { return pose.name == name; });
-  if (name == scene_camera_name && !scene_names_it) return scene.camera;
+  if (name == scene_camera_name && !scene_names(scene, name)) return scene.camera;
   return camera_for(scene, name);
 }
 
@@ -196,10 +200,9 @@ CameraPath parse_camera_path(const Scene& scene, const std::string& text) {
   path.up = up_axis(scene.camera);
   double time = 0.0;
   for (size_t i = 0; i < parts.size(); ++i) {
-    CameraKey key = parse_part(scene, text, parts[i], i);
-    time += key.time;
-    key.time = time;
-    path.keys.push_back(key);
+    const PathPart part = parse_part(scene, text, parts[i], i);
+    time += part.seconds;
+    path.keys.push_back({part.camera, time});
   }
   return path;
 }

@@ -126,6 +126,7 @@ TEST_SUITE("cli") {
 
   // A turntable video: the frame count and size ffprobe reads, a layout per frame, and strata
   // eval over the sequence.
+#if STRATA_VIDEO
   TEST_CASE("video_of_a_turntable_has_its_frames_and_layouts") {
     const std::string dir = test::output_dir() + "/turntable";
     std::filesystem::remove_all(dir);
@@ -153,6 +154,8 @@ TEST_SUITE("cli") {
     CHECK(report["frames"] == 7);
     CHECK(report["sequence"]["jumps"] == 0);
   }
+
+#endif
 
   TEST_CASE("video_with_two_paths_or_none_is_one_clear_error") {
     const auto both = run_strata("video " STRATA_SOURCE_DIR

@@ -1,5 +1,8 @@
 #include "engine/core/video_file.h"
 
+#include "engine/core/error.h"
+
+#if STRATA_VIDEO
 extern "C" {
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
@@ -7,8 +10,6 @@ extern "C" {
 #include <libavutil/opt.h>
 #include <libswscale/swscale.h>
 }
-
-#include "engine/core/error.h"
 
 namespace strata {
 
@@ -139,3 +140,21 @@ void VideoFile::finish() {
 }
 
 }  // namespace strata
+
+#else  // built with STRATA_VIDEO=OFF
+
+namespace strata {
+
+struct VideoFile::Codec {};
+
+VideoFile::VideoFile(const std::string& path, uint32_t, uint32_t, double) {
+  throw Error(path + ": this strata was built without MP4 output (STRATA_VIDEO=OFF); write PNG "
+                     "frames to a folder instead");
+}
+VideoFile::~VideoFile() = default;
+void VideoFile::write(std::span<const uint8_t>) {}
+void VideoFile::finish() {}
+
+}  // namespace strata
+
+#endif
