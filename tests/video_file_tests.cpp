@@ -10,6 +10,7 @@
 #include "gpu_fixture.h"
 
 namespace strata {
+#if STRATA_VIDEO  // (a build without FFmpeg writes no MP4)
 namespace {
 
 // What ffprobe says of the file's video stream: "codec,width,height,frames".
@@ -29,7 +30,6 @@ std::string probe(const std::string& file) {
 
 }  // namespace
 
-#if STRATA_VIDEO  // (a build without FFmpeg writes no MP4)
 TEST_SUITE("cpu") {
   TEST_CASE("an_mp4_holds_every_frame_written_at_its_size") {
     const std::string file = test::output_dir() + "/gradient.mp4";
