@@ -32,6 +32,7 @@ struct VideoOptions {
   std::string layout_dir;
   bool screen_space = false;
   bool no_forces = false;
+  float previous_weight = -1.0f;  // eq. 3.1's eta; < 0: the scene's
   uint32_t layers = 4;
 };
 
@@ -82,10 +83,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   const Scene scene = load_scene_reporting(o.scene);
   const std::vector<Camera> cameras = sample(camera_path(scene, o), o.fps);
   const std::filesystem::path output = o.output;
-  const bool mp4 = output.extension() == ".mp4";
-  if (!mp4 && output.has_extension()) {
-    throw Error("-o " + o.output + ": give NAME.mp4, or a folder for a PNG sequence");
-  }
+  const bool mp4 = output.extension() == ".mp4";  // anything else names a folder
   std::unique_ptr<VideoFile> file;
   if (mp4) {
     file = std::make_unique<VideoFile>(o.output, size.width, size.height, o.fps);
@@ -98,6 +96,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   LabellingSettings settings;
   settings.layer_count = o.layers;
   settings.placement.weights = scene.settings.weights;
+  if (o.previous_weight >= 0.0f) settings.placement.weights.previous_position = o.previous_weight;
   settings.forces.anchor_relative = !o.screen_space;
   LabelledRenderer renderer(ctx, scene, cameras.front(), size, settings);
   renderer.run();  // the first frame: the labels settled on their placement
@@ -148,6 +147,9 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--screen-space", o->screen_space,
                 "labels live on screen (the thesis), not as offsets from their anchors");
   cmd->add_flag("--no-forces", o->no_forces, "place every frame from scratch (labels jump)");
+  cmd->add_option("--previous-weight", o->previous_weight,
+                  "weight of eq. 3.1's distance to last frame's position (default: the scene's)")
+      ->check(CLI::Range(0.0f, 1e6f));
   cmd->callback([&device, o] { video(device, *o); });
 }
 
