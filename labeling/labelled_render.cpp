@@ -64,6 +64,7 @@ struct LabelledRenderer::Parts {
 LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camera& camera,
                                    graph::Extent size, const LabellingSettings& settings)
     : ctx_(ctx), scene_(scene), size_(size), settings_(settings) {
+  settings_.placement.previous_relative_to_anchor = settings.forces.anchor_relative;
   labels_.resize(scene.labels.size());
   for (size_t i = 0; i < scene.labels.size(); ++i) labels_[i].size = scene.labels[i].size;
   project_and_layer(camera);

@@ -185,6 +185,7 @@ void Placement::add_previous(graph::Graph& graph, const Buffers& b, ResourceId s
                     if (settings_.weights.previous_position == 0.0f) return;
                     gpu::ForcesParams p{};
                     p.label_count = label_count_;
+                    p.anchor_relative = settings_.previous_relative_to_anchor ? 1u : 0u;
                     pc.dispatch(previous_, p, {label_count_, 1, 1});
                   },
                   "placement"});

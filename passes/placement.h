@@ -31,6 +31,9 @@ struct PlacementSettings {
   float occlusion_weight = 0.5f;  // eq. 3.4 (one layer)
   float single_saliency_weight = 0.5f;  // eq. 3.4 (one layer)
   bool write_constraints = false;       // keep each label's constraint image (tests, debugging)
+  // Eta's previous position (Inputs::previous): last frame's offset from the anchor, kept with
+  // the anchor's move (labels held as offsets), or the drawn pixel itself (labels on screen).
+  bool previous_relative_to_anchor = false;
   // Cost above a label's lowest tile bound that its speculative pass covers (speed only:
   // the positions do not depend on it).
   float bucket_width = 0.0625f;

@@ -215,30 +215,37 @@ TEST_SUITE("gpu") {
   // the reference's positions for those previous positions.
   TEST_CASE_FIXTURE(test::GpuTest, "previous_positions_come_from_the_forces_state") {
     Inputs in = disc_scene(4);
-    PlacementSettings settings;
-    settings.weights.previous_position = 0.2f;
     std::vector<gpu::LabelStateGpu> state(in.labels.size());
     for (size_t i = 0; i < state.size(); ++i) {
       if (i == 3) continue;  // never drawn: its previous position stays the anchor
+      state[i].position = glm::vec2(-16.0f + 8.0f * float(i), -9.0f);  // offset from the anchor
       state[i].drawn = in.labels[i].anchor + glm::vec2(-14.0f + 9.0f * float(i), 11.0f);
       state[i].flags = LABEL_STATE_PLACED;
-      in.labels[i].previous = in.labels[i].anchor;  // what the GPU must replace
     }
-    const GpuPlacement gpu = place_on_gpu(ctx, in, settings, {}, state);
-    Inputs expected = in;
-    for (size_t i = 0; i < 3; ++i) expected.labels[i].previous = state[i].drawn;
-    const ReferencePlacement cpu =
-        place_reference(expected.final_rgba8, expected.layers, expected.layer_count,
-                        expected.labels, expected.order, settings, expected.size);
-    check_placements(gpu, cpu);
-    // The term matters here: with the anchors as previous positions the result differs.
-    const ReferencePlacement anchored = place_reference(in.final_rgba8, in.layers, in.layer_count,
-                                                        in.labels, in.order, settings, in.size);
-    bool differs = false;
-    for (size_t i = 0; i < cpu.placements.size(); ++i) {
-      differs |= cpu.placements[i].position != anchored.placements[i].position;
+    for (const bool relative : {false, true}) {
+      CAPTURE(relative);
+      PlacementSettings settings;
+      settings.weights.previous_position = 0.2f;
+      settings.previous_relative_to_anchor = relative;
+      const GpuPlacement gpu = place_on_gpu(ctx, in, settings, {}, state);
+      Inputs expected = in;
+      for (size_t i = 0; i < 3; ++i) {
+        expected.labels[i].previous =
+            relative ? in.labels[i].anchor + state[i].position : state[i].drawn;
+      }
+      const ReferencePlacement cpu =
+          place_reference(expected.final_rgba8, expected.layers, expected.layer_count,
+                          expected.labels, expected.order, settings, expected.size);
+      check_placements(gpu, cpu);
+      // The term matters here: with the anchors as previous positions the result differs.
+      const ReferencePlacement anchored = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                          in.labels, in.order, settings, in.size);
+      bool differs = false;
+      for (size_t i = 0; i < cpu.placements.size(); ++i) {
+        differs |= cpu.placements[i].position != anchored.placements[i].position;
+      }
+      CHECK(differs);
     }
-    CHECK(differs);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "bucket_width_changes_the_passes_not_the_positions") {
