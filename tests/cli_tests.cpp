@@ -32,6 +32,14 @@ nlohmann::json named(const nlohmann::json& list, const std::string& name) {
   return nlohmann::json();
 }
 
+// A folder of the test output, emptied.
+std::string empty_folder(const std::string& name) {
+  const std::string dir = test::output_dir() + "/" + name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
 }  // namespace
 
 TEST_SUITE("cli") {
@@ -91,9 +99,7 @@ TEST_SUITE("cli") {
 
   // The thesis program's screenshots: one still per named position, named after it.
   TEST_CASE("render_with_several_positions_writes_one_png_per_position") {
-    const std::string dir = test::output_dir() + "/stills";
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
+    const std::string dir = empty_folder("stills");
     const auto r = run_strata("render " STRATA_SOURCE_DIR
                               "/assets/scenes/head.json --size 64 "
                               "--camera front,left -o " +
@@ -111,9 +117,7 @@ TEST_SUITE("cli") {
   }
 
   TEST_CASE("an_unknown_position_in_the_list_is_one_error_naming_it") {
-    const std::string dir = test::output_dir() + "/stills-unknown";
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
+    const std::string dir = empty_folder("stills-unknown");
     const auto r = run_strata("render " STRATA_SOURCE_DIR
                               "/assets/scenes/head.json --size 32 "
                               "--camera front,back -o " +
