@@ -148,8 +148,9 @@ namespace strata {
 struct VideoFile::Codec {};
 
 VideoFile::VideoFile(const std::string& path, uint32_t, uint32_t, double) {
-  throw Error(path + ": this strata was built without MP4 output (STRATA_VIDEO=OFF); write PNG "
-                     "frames to a folder instead");
+  throw Error(path +
+              ": this strata was built without MP4 output (STRATA_VIDEO=OFF); write PNG "
+              "frames to a folder instead");
 }
 VideoFile::~VideoFile() = default;
 void VideoFile::write(std::span<const uint8_t>) {}
