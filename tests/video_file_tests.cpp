@@ -15,9 +15,10 @@ namespace {
 
 // What ffprobe says of the file's video stream: "codec,width,height,frames".
 std::string probe(const std::string& file) {
-  const std::string command = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-                              "stream=codec_name,width,height,nb_read_frames -of csv=p=0 '" +
-                              file + "' 2>&1";
+  const std::string command =
+      "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+      "stream=codec_name,width,height,nb_read_frames -of csv=p=0 '" +
+      file + "' 2>&1";
   std::FILE* pipe = popen(command.c_str(), "r");
   REQUIRE(pipe != nullptr);
   std::string out;
@@ -56,6 +57,5 @@ TEST_SUITE("cpu") {
   }
 }
 #endif
-
 
 }  // namespace strata

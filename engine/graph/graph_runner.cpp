@@ -54,8 +54,8 @@ void PassContext::dispatch_threads(const ComputePipeline& pipeline, glm::uvec3 t
 void PassContext::barrier() {
   const PassInfo& pass = runner_->graph_.passes()[pass_];
   if (pass.kind == PassKind::graphics) {
-    throw GraphError("pass '" + pass.name + "' asks for a barrier between its commands, but it is " +
-                     "a graphics pass");
+    throw GraphError("pass '" + pass.name +
+                     "' asks for a barrier between its commands, but it is " + "a graphics pass");
   }
   VkMemoryBarrier2 memory{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
   if (pass.kind == PassKind::compute) {
