@@ -33,6 +33,7 @@ struct VideoOptions {
   bool screen_space = false;
   bool no_forces = false;
   float previous_weight = -1.0f;  // eq. 3.1's eta; < 0: the scene's
+  float layer_margin = LayerHysteresis{}.margin;
   uint32_t layers = 4;
 };
 
@@ -98,6 +99,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   settings.placement.weights = scene.settings.weights;
   if (o.previous_weight >= 0.0f) settings.placement.weights.previous_position = o.previous_weight;
   settings.forces.anchor_relative = !o.screen_space;
+  settings.hysteresis.margin = o.layer_margin;
   LabelledRenderer renderer(ctx, scene, cameras.front(), size, settings);
   renderer.run();  // the first frame: the labels settled on their placement
   const Progress progress(cameras.size());
@@ -150,6 +152,11 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--previous-weight", o->previous_weight,
                   "weight of eq. 3.1's distance to last frame's position (default: the scene's)")
       ->check(CLI::Range(0.0f, 1e6f));
+  cmd->add_option("--layer-margin", o->layer_margin,
+                  "layer hysteresis: how far past its slab an anchor goes before its label "
+                  "changes layer, as a share of the distance to the next plane")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 100.0f));
   cmd->callback([&device, o] { video(device, *o); });
 }
 
