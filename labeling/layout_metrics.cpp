@@ -29,14 +29,7 @@ uint32_t image_extent(const json& value, const Field& field) {
 }
 
 std::vector<double> numbers(const json& value, const Field& field, size_t count) {
-  const std::string expected = "expected " + std::to_string(count) + " numbers";
-  if (!value.is_array() || value.size() != count) field.fail(expected);
-  std::vector<double> result;
-  for (const json& v : value) {
-    if (!v.is_number() || !std::isfinite(v.get<double>())) field.fail(expected);
-    result.push_back(v.get<double>());
-  }
-  return result;
+  return json_numbers(value, field, count);
 }
 
 int label_id(const json& value, const Field& field) {

@@ -2,7 +2,9 @@
 // expected 16 numbers"), and the key lookups every JSON reader of strata makes.
 #pragma once
 
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -46,6 +48,19 @@ inline const nlohmann::json& required(const nlohmann::json& object, const JsonFi
   const nlohmann::json* value = optional(object, key);
   if (!value) field.fail(std::string("missing key '") + key + "'");
   return *value;
+}
+
+// `count` finite numbers in an array; an error naming the field otherwise.
+inline std::vector<double> json_numbers(const nlohmann::json& value, const JsonField& field,
+                                        size_t count) {
+  const std::string expected = "expected " + std::to_string(count) + " numbers";
+  if (!value.is_array() || value.size() != count) field.fail(expected);
+  std::vector<double> result;
+  for (const nlohmann::json& v : value) {
+    if (!v.is_number() || !std::isfinite(v.get<double>())) field.fail(expected);
+    result.push_back(v.get<double>());
+  }
+  return result;
 }
 
 }  // namespace strata

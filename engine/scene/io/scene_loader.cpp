@@ -58,14 +58,8 @@ std::string string(const json& value, const Field& field) {
 }
 
 std::vector<float> numbers(const json& value, const Field& field, size_t count) {
-  const std::string expected = "expected " + std::to_string(count) + " numbers";
-  if (!value.is_array() || value.size() != count) field.fail(expected);
-  std::vector<float> result;
-  for (const json& v : value) {
-    if (!v.is_number() || !std::isfinite(v.get<double>())) field.fail(expected);
-    result.push_back(v.get<float>());
-  }
-  return result;
+  const std::vector<double> read = json_numbers(value, field, count);
+  return {read.begin(), read.end()};
 }
 
 glm::vec3 vec3(const json& value, const Field& field) {
