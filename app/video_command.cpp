@@ -32,7 +32,8 @@ struct VideoOptions {
   std::string layout_dir;
   bool screen_space = false;
   bool no_forces = false;
-  float previous_weight = -1.0f;  // eq. 3.1's eta; < 0: the scene's
+  bool hard = false;
+  ForceSettings forces;
   float layer_margin = LayerHysteresis{}.margin;
   uint32_t layers = 4;
 };
@@ -97,7 +98,8 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   LabellingSettings settings;
   settings.layer_count = o.layers;
   settings.placement.weights = scene.settings.weights;
-  if (o.previous_weight >= 0.0f) settings.placement.weights.previous_position = o.previous_weight;
+  settings.placement.hard = o.hard;
+  settings.forces = o.forces;
   settings.forces.anchor_relative = !o.screen_space;
   settings.hysteresis.margin = o.layer_margin;
   LabelledRenderer renderer(ctx, scene, cameras.front(), size, settings);
@@ -149,8 +151,25 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--screen-space", o->screen_space,
                 "labels live on screen (the thesis), not as offsets from their anchors");
   cmd->add_flag("--no-forces", o->no_forces, "place every frame from scratch (labels jump)");
-  cmd->add_option("--previous-weight", o->previous_weight,
-                  "weight of eq. 3.1's distance to last frame's position (default: the scene's)")
+  cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
+  cmd->add_option("--speed", o->forces.speed, "forces: pixels per second at full force")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0f, 1e6f));
+  cmd->add_option("--hold", o->forces.hold_share,
+                  "a label keeps its target unless a position costs less by this share of its "
+                  "cost (plus --hold-cost)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 100.0f));
+  cmd->add_option("--hold-cost", o->forces.hold_cost, "the hold's fixed part (eq. 3.1 units)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 1e9f));
+  cmd->add_option("--fade", o->forces.fade_seconds, "seconds a label takes to fade in or out")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0f, 60.0f));
+  cmd->add_option("--previous-weight", o->forces.previous_weight,
+                  "eq. 3.1's eta after the first frame: cost per pixel of distance to a label's "
+                  "last target")
+      ->capture_default_str()
       ->check(CLI::Range(0.0f, 1e6f));
   cmd->add_option("--layer-margin", o->layer_margin,
                   "layer hysteresis: how far past its slab an anchor goes before its label "

@@ -64,7 +64,6 @@ struct LabelledRenderer::Parts {
 LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camera& camera,
                                    graph::Extent size, const LabellingSettings& settings)
     : ctx_(ctx), scene_(scene), size_(size), settings_(settings) {
-  settings_.placement.previous_relative_to_anchor = settings.forces.anchor_relative;
   labels_.resize(scene.labels.size());
   for (size_t i = 0; i < scene.labels.size(); ++i) labels_[i].size = scene.labels[i].size;
   project_and_layer(camera);
@@ -116,10 +115,11 @@ void LabelledRenderer::build_graph() {
   graph::Graph graph;
   const VolumeRenderer::Outputs rendered = p.renderer.add_to(graph);
   const graph::ResourceId state = p.forces.import_state(graph);
-  placed_ = p.placement.add_to(graph, {.final_image = rendered.final,
-                                       .layers = rendered.layers,
-                                       .layer_count = render.layer_count,
-                                       .previous = state});
+  placed_ = p.placement.add_to(
+      graph, {.final_image = rendered.final,
+              .layers = rendered.layers,
+              .layer_count = render.layer_count,
+              .previous = Placement::Previous{.state = state, .params = &p.forces.params()}});
   const LabelForces::Outputs moved = p.forces.add_to(
       graph, {.labels = placed_.labels, .targets = placed_.placements, .state = state});
   layers_id_ = rendered.layers;
@@ -140,6 +140,7 @@ void LabelledRenderer::build_graph() {
 }
 
 void LabelledRenderer::set_order(const std::vector<uint32_t>& within) {
+  within_ = within;
   parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within),
                               settings_.placement);
 }
@@ -153,7 +154,10 @@ void LabelledRenderer::set_camera(const Camera& camera) {
 }
 
 void LabelledRenderer::advance(double seconds) {
-  parts_->forces.set_frame(settings_.forces, seconds);
+  PlacementSettings moving = settings_.placement;
+  moving.weights.previous_position = settings_.forces.previous_weight;
+  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within_), moving);
+  parts_->forces.set_frame(settings_.forces, seconds, settings_.placement.hard);
   run_frame();
 }
 
@@ -189,8 +193,6 @@ std::vector<uint32_t> LabelledRenderer::apollonius_layers_order() {
   return apollonius_order(anchors, occupancy, size_.width, size_.height);
 }
 
-// Eq. 3.2 as the optimised order compares it: the sum of the shown labels' costs, a hidden
-// label counting as much as an anchor-constraint violation.
 double LabelledRenderer::total_cost() const {
   double total = 0.0;
   const auto results = parts_->placement.results();
@@ -207,6 +209,7 @@ void LabelledRenderer::run() {
   // A still: every frame puts the labels on their placement (the forces start afresh).
   const auto run_still = [this] {
     parts_->forces.reset();
+    parts_->forces.set_frame(settings_.forces, 0.0, settings_.placement.hard);
     run_frame();
   };
   set_order(scene_order(uint32_t(labels_.size())));

@@ -87,6 +87,9 @@ class LabelledRenderer {
   std::vector<PipelineReport> placement_pipelines() const;
   // The picture and layout of the last run.
   LabelledFrame result() const;
+  // Eq. 3.2 of the last frame's placement: the sum of the shown labels' costs (without the hold),
+  // a hidden label counting as much as an anchor-constraint violation.
+  double total_cost() const;
 
  private:
   struct Parts;
@@ -101,8 +104,8 @@ class LabelledRenderer {
   void project_and_layer(const Camera& camera);
   void build_graph();
   void set_order(const std::vector<uint32_t>& within);
+  std::vector<uint32_t> within_;  // the order inside each layer set_order() was last given
   std::vector<uint32_t> apollonius_layers_order();
-  double total_cost() const;
 
   RenderStats stats_;
   Placement::Outputs placed_{};

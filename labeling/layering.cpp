@@ -109,10 +109,10 @@ void update_centres(std::span<const float> values, const std::vector<uint32_t>& 
   }
 }
 
-// Renumbers the non-empty clusters by increasing centre and drops the empty ones.
+// Renumbers the clusters by increasing centre and drops the empty ones unless `keep_empty`.
 std::vector<float> renumber_front_to_back(const std::vector<double>& centres,
-                                          std::vector<uint32_t>& cluster) {
-  std::vector<bool> used(centres.size(), false);
+                                          std::vector<uint32_t>& cluster, bool keep_empty) {
+  std::vector<bool> used(centres.size(), keep_empty);
   for (const uint32_t c : cluster) used[c] = true;
   std::vector<uint32_t> order;
   for (uint32_t c = 0; c < centres.size(); ++c) {
@@ -132,13 +132,13 @@ std::vector<float> renumber_front_to_back(const std::vector<double>& centres,
 
 // Lloyd's iterations from `centre`; returns each value's cluster, numbered front to back.
 std::vector<uint32_t> lloyd(std::span<const float> values, std::vector<double> centre,
-                            std::vector<float>* centres) {
+                            std::vector<float>* centres, bool keep_empty = false) {
   std::vector<uint32_t> cluster(values.size(), unassigned);
   for (int iteration = 0; iteration < max_lloyd_iterations; ++iteration) {
     if (!assign(values, centre, cluster)) break;
     update_centres(values, cluster, centre);
   }
-  std::vector<float> sorted_centres = renumber_front_to_back(centre, cluster);
+  std::vector<float> sorted_centres = renumber_front_to_back(centre, cluster, keep_empty);
   if (centres) *centres = std::move(sorted_centres);
   return cluster;
 }
@@ -176,13 +176,21 @@ struct Member {
   auto operator<=>(const Member&) const = default;
 };
 
-// Each cluster's lower-median member in NDC z, as the member's own eye depth.
+// Each cluster's lower-median member in NDC z, as the member's own eye depth; an empty cluster's
+// centre (NDC z) as an eye depth.
 std::vector<float> cluster_medians(const std::vector<Member>& members,
-                                   const std::vector<uint32_t>& cluster, size_t cluster_count) {
-  std::vector<std::vector<Member>> by_cluster(cluster_count);
+                                   const std::vector<uint32_t>& cluster,
+                                   const std::vector<float>& centres, float near_plane,
+                                   float far_plane) {
+  std::vector<std::vector<Member>> by_cluster(centres.size());
   for (size_t i = 0; i < members.size(); ++i) by_cluster[cluster[i]].push_back(members[i]);
   std::vector<float> planes;
-  for (std::vector<Member>& group : by_cluster) {
+  for (size_t c = 0; c < centres.size(); ++c) {
+    std::vector<Member>& group = by_cluster[c];
+    if (group.empty()) {
+      planes.push_back(ndc_z_to_eye_depth(centres[c], near_plane, far_plane));
+      continue;
+    }
     const auto median = group.begin() + static_cast<std::ptrdiff_t>((group.size() - 1) / 2);
     std::nth_element(group.begin(), median, group.end());
     planes.push_back(median->eye_depth);
@@ -205,14 +213,15 @@ std::vector<Member> usable_members(std::span<const float> depths, float near_pla
   return members;
 }
 
-// The layering of clusters `cluster` (numbered front to back, `count` of them): planes at the
-// medians, and each label on the layer whose plane is at or behind its anchor.
+// The layering of clusters `cluster` (numbered front to back, with increasing `centres`): planes
+// at the medians (an empty cluster's at its centre), and each label on the layer whose plane is at
+// or behind its anchor.
 Layering layering_of(const std::vector<Member>& members, const std::vector<uint32_t>& cluster,
-                     size_t count, std::span<const float> anchor_eye_depths, float near_plane,
-                     float far_plane) {
+                     const std::vector<float>& centres, std::span<const float> anchor_eye_depths,
+                     float near_plane, float far_plane) {
   Layering layering;
-  layering.plane_depths = cluster_medians(members, cluster, count);
-  layering.layer_count = std::max<uint32_t>(1, static_cast<uint32_t>(count));
+  layering.plane_depths = cluster_medians(members, cluster, centres, near_plane, far_plane);
+  layering.layer_count = std::max<uint32_t>(1, static_cast<uint32_t>(centres.size()));
   if (!layering.plane_depths.empty()) {
     layering.split_depths.assign(layering.plane_depths.begin(), layering.plane_depths.end() - 1);
   }
@@ -241,7 +250,7 @@ Layering layer_labels(std::span<const float> anchor_eye_depths, uint32_t layer_c
   std::vector<float> centres;
   const std::vector<uint32_t> cluster = kmeans_plus_plus(
       ndc_z_of(members), std::clamp(layer_count, 1u, max_layer_count), seed, &centres);
-  return layering_of(members, cluster, centres.size(), anchor_eye_depths, near_plane, far_plane);
+  return layering_of(members, cluster, centres, anchor_eye_depths, near_plane, far_plane);
 }
 
 Layering follow_layering(const Layering& previous, std::span<const float> anchor_eye_depths,
@@ -260,10 +269,16 @@ Layering follow_layering(const Layering& previous, std::span<const float> anchor
     start.push_back(eye_depth_to_ndc_z(plane, near_plane, far_plane));
   }
   std::vector<float> centres;
-  const std::vector<uint32_t> cluster = lloyd(z, start, &centres);
+  // A cluster the iterations empty keeps its place (at its centre): dropping it, and seeding
+  // again next frame, would move many labels at once.
+  const std::vector<uint32_t> cluster = lloyd(z, start, &centres, true);
   Layering layering =
-      layering_of(members, cluster, centres.size(), anchor_eye_depths, near_plane, far_plane);
-  if (layering.layer_count != previous.layer_count) return layering;
+      layering_of(members, cluster, centres, anchor_eye_depths, near_plane, far_plane);
+  const std::vector<float>& planes = layering.plane_depths;
+  if (std::adjacent_find(planes.begin(), planes.end(), std::greater_equal<float>()) !=
+      planes.end()) {
+    return layer_labels(anchor_eye_depths, layer_count, near_plane, far_plane, seed);
+  }
 
   // A label stays on its previous layer while its anchor is within the margin of that slab.
   std::vector<float> plane_z;

@@ -64,7 +64,7 @@ Layering layer_labels(std::span<const float> anchor_eye_depths, uint32_t layer_c
 struct LayerHysteresis {
   // A label leaves its layer only once its anchor is past the layer's slab by more than this
   // share of the distance (in NDC z) between the two planes on that side.
-  float margin = 0.25f;
+  float margin = 1.5f;
 };
 
 // The next frame's layering, following `previous` (the same labels, the camera moved): Lloyd's

@@ -9,10 +9,14 @@ namespace strata {
 
 using graph::Use;
 
-gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_count,
-                                double seconds) {
+gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_count, double seconds,
+                                bool hard) {
   if (!(settings.speed > 0.0f) || !(settings.epsilon > 0.0f) || !(settings.snap >= 0.0f)) {
     throw Error("forces: speed and epsilon must be > 0 and snap >= 0");
+  }
+  if (!(settings.hold_share >= 0.0f) || !(settings.hold_cost >= 0.0f) ||
+      !(settings.fade_seconds >= 0.0f) || !(settings.appear_padding >= 0.0f)) {
+    throw Error("forces: hold, fade and padding must be >= 0");
   }
   if (!(seconds >= 0.0 && seconds <= 60.0)) {
     throw Error("forces: a frame of " + std::to_string(seconds) + " s");
@@ -27,6 +31,12 @@ gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_co
   p.epsilon = settings.epsilon;
   p.snap = settings.snap;
   p.anchor_relative = settings.anchor_relative ? 1u : 0u;
+  p.fade = seconds > 0.0 && settings.fade_seconds > 0.0f
+               ? static_cast<float>(std::min(1.0, seconds / settings.fade_seconds))
+               : 1.0f;
+  p.hold_share = settings.hold_share;
+  p.hold_cost = settings.hold_cost;
+  p.appear_padding = hard ? settings.appear_padding : 0.0f;
   return p;
 }
 
@@ -49,8 +59,8 @@ void LabelForces::reset() {
   upload(ctx_, state_, as_bytes(empty));
 }
 
-void LabelForces::set_frame(const ForceSettings& settings, double seconds) {
-  params_ = forces_params(settings, label_count_, seconds);
+void LabelForces::set_frame(const ForceSettings& settings, double seconds, bool hard) {
+  params_ = forces_params(settings, label_count_, seconds, hard);
 }
 
 std::vector<gpu::LabelStateGpu> LabelForces::state() const {
@@ -93,6 +103,15 @@ LabelForces::Outputs LabelForces::add_to(graph::Graph& graph, const Inputs& in) 
                     vkCmdCopyBuffer(pc.cmd, pc.buffer(drawn), pc.buffer(readback), 1, &region);
                   }});
   return out;
+}
+
+std::vector<gpu::LabelGpu> previous_reference(std::vector<gpu::LabelGpu> labels,
+                                              const std::vector<gpu::LabelStateGpu>& state,
+                                              const gpu::ForcesParams& params) {
+  for (size_t i = 0; i < labels.size(); ++i) {
+    labels[i] = gpu::forces_previous(labels[i], state[i], params);
+  }
+  return labels;
 }
 
 std::vector<gpu::PlacementGpu> forces_reference(const std::vector<gpu::LabelGpu>& labels,

@@ -22,15 +22,26 @@ struct ForceSettings {
   // with the anchor while the camera turns and the forces act on the offset; or, as in the
   // thesis, as a position on screen.
   bool anchor_relative = true;
-  float speed = 600.0f;   // pixels per second at full force
+  float speed = 90.0f;    // pixels per second at full force (3 px a frame at 30 fps)
   float epsilon = 24.0f;  // pixels: within this the force shrinks toward the target (eq. 3.7)
   float snap = 0.5f;      // pixels: within this the label is put on its target
+  // The hold (eq. 3.1 with hysteresis): a label keeps heading for last frame's target unless
+  // another position costs less by more than this share of the target's cost plus hold_cost.
+  float hold_share = 0.5f;
+  float hold_cost = 2.0f;
+  // Eq. 3.1's eta in the frames of an animation (a still uses the scene's): the distance to the
+  // label's last target costs this much per pixel, so a label that must move goes nearby.
+  float previous_weight = 2.0f;
+  float fade_seconds = 0.3f;  // a label fades in or out over this long (0: it pops)
+  // Hard mode: pixels of extra clear zone a label hidden in the last frame needs to appear.
+  float appear_padding = 8.0f;
 };
 
 // The push constants of one frame of `seconds`: enough sub-steps that none moves a label by more
-// than epsilon, so no step overshoots its target.
-gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_count,
-                                double seconds);
+// than epsilon, so no step overshoots its target. A frame of 0 s is a still: labels fade at once.
+// `hard`: the placement forbids violations (the appear padding applies).
+gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_count, double seconds,
+                                bool hard = false);
 
 class LabelForces {
  public:
@@ -52,7 +63,9 @@ class LabelForces {
   Outputs add_to(graph::Graph& graph, const Inputs& in);
 
   // The next frame's settings and duration (a fixed 1 / fps offline, so videos are repeatable).
-  void set_frame(const ForceSettings& settings, double seconds);
+  void set_frame(const ForceSettings& settings, double seconds, bool hard = false);
+  // The frame's push constants (the placement's previous pass reads them too).
+  const gpu::ForcesParams& params() const { return params_; }
   // Forgets every drawn position: the next frame puts each label on its target.
   void reset();
   // The state after the last completed frame (waits; tests and tools).
@@ -68,6 +81,11 @@ class LabelForces {
   Buffer state_;
   Buffer readback_;
 };
+
+// The CPU reference of the placement's previous pass: what each label takes from the state.
+std::vector<gpu::LabelGpu> previous_reference(std::vector<gpu::LabelGpu> labels,
+                                              const std::vector<gpu::LabelStateGpu>& state,
+                                              const gpu::ForcesParams& params);
 
 // The CPU reference: one frame of forces over every label. `state` is updated in place; returns
 // where each label is drawn.

@@ -174,19 +174,15 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                   "placement"});
 }
 
-// Each label's previous position (eq. 3.1's eta) from where the forces drew it last frame; only
-// recorded while eta has a weight (the thesis's settings give it none).
-void Placement::add_previous(graph::Graph& graph, const Buffers& b, ResourceId state) {
+// What each label takes from last frame's forces state (forces_previous): its previous position
+// (eq. 3.1's eta), its held position and hold, its padding.
+void Placement::add_previous(graph::Graph& graph, const Buffers& b, const Previous& previous) {
   graph.add_pass({"placement.previous",
                   graph::PassKind::compute,
                   {{b.labels, Use::storage_read_write, FORCES_BINDING_LABELS},
-                   {state, Use::storage_read, FORCES_BINDING_STATE}},
-                  [this](graph::PassContext& pc) {
-                    if (settings_.weights.previous_position == 0.0f) return;
-                    gpu::ForcesParams p{};
-                    p.label_count = label_count_;
-                    p.anchor_relative = settings_.previous_relative_to_anchor ? 1u : 0u;
-                    pc.dispatch(previous_, p, {label_count_, 1, 1});
+                   {previous.state, Use::storage_read, FORCES_BINDING_STATE}},
+                  [this, params = previous.params](graph::PassContext& pc) {
+                    pc.dispatch(previous_, *params, {label_count_, 1, 1});
                   },
                   "placement"});
 }

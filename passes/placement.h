@@ -31,9 +31,6 @@ struct PlacementSettings {
   float occlusion_weight = 0.5f;  // eq. 3.4 (one layer)
   float single_saliency_weight = 0.5f;  // eq. 3.4 (one layer)
   bool write_constraints = false;       // keep each label's constraint image (tests, debugging)
-  // Eta's previous position (Inputs::previous): last frame's offset from the anchor, kept with
-  // the anchor's move (labels held as offsets), or the drawn pixel itself (labels on screen).
-  bool previous_relative_to_anchor = false;
   // Cost above a label's lowest tile bound that its speculative pass covers (speed only:
   // the positions do not depend on it).
   float bucket_width = 0.0625f;
@@ -66,13 +63,18 @@ struct PlacementLayout {
 
 class Placement {
  public:
+  struct Previous {
+    graph::ResourceId state;          // LabelStateGpu[]
+    const gpu::ForcesParams* params;  // read when the frame is recorded
+  };
   struct Inputs {
     graph::ResourceId final_image;  // the label-free final image (rgba8)
     graph::ResourceId layers;       // the depth layers (rgba16f array), premultiplied
     uint32_t layer_count = 1;
-    // LabelStateGpu[] (passes/label_forces.h): last frame's drawn positions become the labels'
-    // previous positions (eq. 3.1's eta term); none: the anchors set_frame() gave.
-    std::optional<graph::ResourceId> previous;
+    // Last frame's forces state (passes/label_forces.h): the labels' previous positions (eq.
+    // 3.1's eta term), held positions with their hold, and hard-mode padding (forces_previous in
+    // shaders/shared/forces.h); none: the anchors set_frame() gave, nothing held.
+    std::optional<Previous> previous;
   };
   struct Outputs {
     graph::ResourceId labels, placements, saliency, costs, tables, constraints, results;
@@ -105,7 +107,7 @@ class Placement {
   };
   Buffers add_buffers(graph::Graph& graph) const;
   void add_upload(graph::Graph& graph, const Buffers& b);
-  void add_previous(graph::Graph& graph, const Buffers& b, graph::ResourceId state);
+  void add_previous(graph::Graph& graph, const Buffers& b, const Previous& previous);
   void add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in);
   void add_bounds(graph::Graph& graph, const Buffers& b);
   graph::PassId add_label_loop(graph::Graph& graph, const Buffers& b);

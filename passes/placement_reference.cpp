@@ -134,16 +134,13 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
     const uint64_t r = placer.results[i];
     gpu::PlacementGpu& result = out.placements[i];
     if (r == PLACEMENT_NONE || (labels[i].flags & LABEL_ENABLED) == 0u) {
-      result = {labels[i].anchor, 0.0f, PLACEMENT_HIDDEN};
+      result = gpu::hidden_placement(labels[i]);
       continue;
     }
-    const uint32_t pixel = uint32_t(r & 0xFFFFFFFFu);
     const uint32_t cost_bits = uint32_t(r >> 32);
     float cost;
     std::memcpy(&cost, &cost_bits, 4);
-    result = {
-        gpu::box_origin(glm::uvec2(pixel % w, pixel / w), labels[i].size) + labels[i].size * 0.5f,
-        cost, PLACEMENT_SHOWN};
+    result = gpu::shown_placement(labels[i], uint32_t(r & 0xFFFFFFFFu), cost, w);
   }
   return out;
 }

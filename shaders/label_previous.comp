@@ -2,8 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shared/forces.h"
 
-// Eq. 3.1's previous position (eta): where the forces drew each label last frame, or, for labels
-// held as offsets from their anchors, that offset from the anchor's new position.
+// What each label of this frame takes from the last one (forces_previous): eq. 3.1's previous
+// position, the held position and its hold, and hard mode's padding for a hidden label.
 layout(local_size_x = FORCES_GROUP) in;
 layout(binding = FORCES_BINDING_LABELS, std430) buffer Labels { LabelGpu labels[]; };
 layout(binding = FORCES_BINDING_STATE, std430) readonly buffer States { LabelStateGpu states[]; };
@@ -11,8 +11,6 @@ layout(push_constant) uniform Push { ForcesParams params; };
 
 void main() {
   const uint i = gl_GlobalInvocationID.x;
-  if (i >= params.label_count || (states[i].flags & LABEL_STATE_PLACED) == 0u) return;
-  // Anchored labels: where the label is now if it kept last frame's offset from its anchor.
-  labels[i].previous =
-      params.anchor_relative != 0u ? labels[i].anchor + states[i].position : states[i].drawn;
+  if (i >= params.label_count) return;
+  labels[i] = forces_previous(labels[i], states[i], params);
 }

@@ -158,7 +158,7 @@ void cull(LabelGpu me, uvec2 tile) {
     if ((touch & ~full) != 0u) tile_placed[atomicAdd(tile_placed_count, 1u)] = s;
   }
   // Anchors: a candidate's box (margin included) covering one.
-  const vec2 h = me.size * 0.5 + vec2(params.margin);
+  const vec2 h = constraint_half_size(me, params.margin);
   for (uint k = gl_LocalInvocationIndex; k < params.label_count; k += threads) {
     if ((labels[k].flags & LABEL_ENABLED) == 0u) continue;
     const vec2 d = abs(labels[k].anchor - centre);
@@ -244,7 +244,7 @@ void classify(uint j, uint group, uint first, uint end) {
     }
   }
   // (as cull() and constraint_bits() take the anchors)
-  const vec2 h = me.size * 0.5 + vec2(params.margin);
+  const vec2 h = constraint_half_size(me, params.margin);
   for (uint k = lane; valid && k < params.label_count; k += PLACE_CLASSIFY_LANES) {
     if ((labels[k].flags & LABEL_ENABLED) == 0u) continue;
     const vec2 a = labels[k].anchor;

@@ -53,8 +53,11 @@ float cell_bound(LabelGpu me, uvec2 first, uvec2 last) {
   const vec2 hi_centre = box_origin(last, me.size) + me.size * 0.5;
   const vec2 to_anchor = max(max(lo_centre - me.anchor, me.anchor - hi_centre), vec2(0.0));
   const vec2 to_previous = max(max(lo_centre - me.previous, me.previous - hi_centre), vec2(0.0));
+  // The hold is added unless the held position is one of the cell's candidates' centres.
+  const vec2 to_held = max(max(lo_centre - me.held, me.held - hi_centre), vec2(0.0));
+  const float hold = any(greaterThan(to_held, vec2(0.5))) ? me.hold : 0.0;
   float bound = 0.9999 * (w.distance_to_anchor * length(to_anchor) + w.connector_direction +
-                          w.previous_position * length(to_previous));
+                          w.previous_position * length(to_previous) + hold);
   const vec2 shared_lo = max(box_origin(last, me.size), vec2(0.0));
   const vec2 shared_hi = min(box_origin(first, me.size) + me.size, vec2(params.width, params.height));
   if (all(lessThan(shared_lo, shared_hi))) {

@@ -14,17 +14,8 @@ void main() {
   const uint i = gl_GlobalInvocationID.x;
   if (i >= params.label_count) return;
   const uint64_t r = results[i];
-  PlacementGpu out_placement;
-  if (r == PLACEMENT_NONE || (labels[i].flags & LABEL_ENABLED) == 0u) {
-    out_placement.position = labels[i].anchor;
-    out_placement.cost = 0.0;
-    out_placement.shown = PLACEMENT_HIDDEN;
-  } else {
-    const uint pixel = uint(r & 0xFFFFFFFFul);
-    const vec2 origin = box_origin(uvec2(pixel % params.width, pixel / params.width), labels[i].size);
-    out_placement.position = origin + labels[i].size * 0.5;
-    out_placement.cost = uintBitsToFloat(uint(r >> 32));
-    out_placement.shown = PLACEMENT_SHOWN;
-  }
-  placements[i] = out_placement;
+  const bool shown = r != PLACEMENT_NONE && (labels[i].flags & LABEL_ENABLED) != 0u;
+  placements[i] = shown ? shown_placement(labels[i], uint(r & 0xFFFFFFFFul),
+                                          uintBitsToFloat(uint(r >> 32)), params.width)
+                        : hidden_placement(labels[i]);
 }

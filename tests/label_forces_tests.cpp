@@ -56,7 +56,7 @@ std::vector<T> as(const std::vector<std::byte>& bytes) {
 
 TEST_SUITE("cpu") {
   TEST_CASE("a_frame_is_split_into_steps_that_never_move_a_label_past_epsilon") {
-    const ForceSettings s;  // 600 px/s, epsilon 24 px
+    const ForceSettings s{.speed = 600.0f, .epsilon = 24.0f};
     CHECK(forces_params(s, 1, 1.0 / 30.0).steps == 1);
     const gpu::ForcesParams second = forces_params(s, 1, 1.0);
     CHECK(second.steps == 25);
@@ -66,7 +66,7 @@ TEST_SUITE("cpu") {
 
   TEST_CASE("a_label_converges_to_a_still_target_without_overshoot_and_stays") {
     const glm::vec2 start{100.0f, 100.0f}, goal{400.0f, 500.0f};  // 500 px apart
-    const std::vector<float> d = approach({}, start, goal, 60);
+    const std::vector<float> d = approach({.speed = 600.0f, .epsilon = 24.0f}, start, goal, 60);
     for (size_t f = 1; f < d.size(); ++f) CHECK(d[f] <= d[f - 1]);
     // At 600 px/s the unit force covers 480 px in 24 frames; then the attenuated tail and the snap.
     CHECK(d[23] == doctest::Approx(20.0f).epsilon(1e-3));
@@ -79,7 +79,8 @@ TEST_SUITE("cpu") {
   TEST_CASE("within_epsilon_the_force_shrinks_with_the_distance") {
     // 12 px away with epsilon 24: a step of 20 px at full force would overshoot; the attenuated
     // force moves it 12 * 20 / 24 = 10 px.
-    const std::vector<float> d = approach({}, {0.0f, 0.0f}, {12.0f, 0.0f}, 1);
+    const std::vector<float> d =
+        approach({.speed = 600.0f, .epsilon = 24.0f}, {0.0f, 0.0f}, {12.0f, 0.0f}, 1);
     CHECK(d[0] == doctest::Approx(2.0f).epsilon(1e-5));
   }
 
@@ -107,6 +108,59 @@ TEST_SUITE("cpu") {
     CHECK(state[0].position == glm::vec2(10.0f, 20.0f));
     CHECK(state[1].position == glm::vec2(30.0f, 40.0f));
     CHECK(drawn[0].shown == PLACEMENT_HIDDEN);
+  }
+
+  TEST_CASE("labels_fade_out_where_they_were_and_fade_in_over_the_fade_time") {
+    // 0.3 s at 30 frames per second: 1/9 of the way each frame.
+    const ForceSettings settings{.anchor_relative = true, .fade_seconds = 0.3f};
+    const gpu::ForcesParams p = forces_params(settings, 1, 1.0 / 30.0);
+    CHECK(p.fade == doctest::Approx(1.0f / 9.0f));
+    CHECK(forces_params(settings, 1, 0.0).fade == 1.0f);  // a still: at once
+    std::vector<gpu::LabelStateGpu> state(1);
+    const glm::vec2 offset{50.0f, -20.0f};
+    // Shown in a still: fully drawn at once.
+    glm::vec2 anchor{100.0f, 100.0f};
+    auto drawn = forces_reference({label_at(anchor)}, {target_at(anchor + offset)}, state,
+                                  forces_params(settings, 1, 0.0));
+    CHECK(drawn[0].opacity == 1.0f);
+    // Hidden by the placement: fades out over 9 frames, drawn at its offset from the moving anchor.
+    for (int f = 1; f <= 10; ++f) {
+      CAPTURE(f);
+      anchor.x += 3.0f;
+      drawn = forces_reference({label_at(anchor)}, {target_at(anchor, false)}, state, p);
+      const float expected = std::max(0.0f, 1.0f - float(f) / 9.0f);
+      CHECK(drawn[0].opacity == doctest::Approx(expected).epsilon(1e-5));
+      CHECK(drawn[0].shown == (f < 9 ? PLACEMENT_SHOWN : PLACEMENT_HIDDEN));
+      if (f < 9) CHECK(drawn[0].position == anchor + offset);
+    }
+    // Shown again: fades in, never more than 1.
+    for (int f = 1; f <= 10; ++f) {
+      drawn = forces_reference({label_at(anchor)}, {target_at(anchor + offset)}, state, p);
+      CHECK(drawn[0].opacity == doctest::Approx(std::min(1.0f, float(f) / 9.0f)).epsilon(1e-5));
+    }
+  }
+
+  TEST_CASE("a_kept_target_keeps_its_exact_offset_a_new_target_is_the_placements") {
+    // The placement rounds to its candidate pixels; a label it keeps on the held position keeps
+    // the exact offset it had, so it does not drift by that rounding from frame to frame.
+    const gpu::ForcesParams p = forces_params({.anchor_relative = true}, 1, 1.0 / 30.0);
+    gpu::LabelStateGpu s{};
+    s.position = s.target = {40.3f, -12.7f};
+    s.flags = LABEL_STATE_PLACED | LABEL_STATE_SHOWN | LABEL_STATE_SEEN;
+    s.cost = 10.0f;
+    std::vector<gpu::LabelStateGpu> state{s};
+    const glm::vec2 anchor{200.25f, 150.5f};
+    const gpu::LabelGpu held = previous_reference({label_at(anchor)}, state, p)[0];
+    CHECK(held.held == anchor + s.target);
+    CHECK(held.hold == doctest::Approx(p.hold_cost + p.hold_share * 10.0f));
+    // Kept: the placement's pixel is within half a pixel of the held position.
+    auto drawn = forces_reference({held}, {target_at(glm::round(held.held))}, state, p);
+    CHECK(state[0].target == s.target);
+    CHECK(drawn[0].position == anchor + s.target);
+    // Moved elsewhere: the new target is the placement's.
+    const glm::vec2 elsewhere = anchor + glm::vec2(-80.0f, 30.0f);
+    forces_reference({held}, {target_at(elsewhere)}, state, p);
+    CHECK(state[0].target == elsewhere - anchor);
   }
 }
 
@@ -140,6 +194,10 @@ TEST_SUITE("gpu") {
         for (uint32_t i = 0; i < count; ++i) {
           labels[i] = label_at({pixel(rng), pixel(rng)}, i % 7 != 0);
           targets[i] = target_at({pixel(rng), pixel(rng)}, i % 5 != 0);
+          if (i % 3 == 0) {  // the placement kept the held position
+            labels[i].held = targets[i].position + glm::vec2(0.25f, -0.5f);
+            labels[i].hold = 5.0f;
+          }
         }
         upload(ctx, label_buffer, as_bytes(labels));
         upload(ctx, target_buffer, as_bytes(targets));
@@ -161,11 +219,14 @@ TEST_SUITE("gpu") {
         };
         int mismatches = 0;
         for (uint32_t i = 0; i < count; ++i) {
-          const bool same = close(drawn[i].position, expected[i].position) &&
-                            drawn[i].shown == expected[i].shown &&
-                            close(gpu_state[i].position, state[i].position) &&
-                            close(gpu_state[i].drawn, state[i].drawn) &&
-                            gpu_state[i].flags == state[i].flags;
+          const bool same =
+              close(drawn[i].position, expected[i].position) &&
+              drawn[i].shown == expected[i].shown &&
+              close(gpu_state[i].position, state[i].position) &&
+              close(gpu_state[i].drawn, state[i].drawn) &&
+              close(gpu_state[i].target, state[i].target) && gpu_state[i].cost == state[i].cost &&
+              gpu_state[i].opacity == state[i].opacity && drawn[i].opacity == expected[i].opacity &&
+              gpu_state[i].flags == state[i].flags;
           if (!same && mismatches++ < 3) {
             MESSAGE("label " << i << ": gpu " << drawn[i].position.x << "," << drawn[i].position.y
                              << " cpu " << expected[i].position.x << "," << expected[i].position.y);

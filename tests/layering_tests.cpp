@@ -199,6 +199,23 @@ TEST_SUITE("cpu") {
     const Layering no_margin = follow_layering(previous, small, 2, 1.0f, 1000.0f, {.margin = 0.0f});
     CHECK(no_margin.label_layer[2] == 1);
   }
+
+  TEST_CASE("a_cluster_that_a_move_empties_keeps_its_layer_and_nobody_is_reclustered") {
+    // Three clusters; then the middle one's two anchors move next to the back cluster, so Lloyd's
+    // iterations from the previous planes empty it. The layer count stays three (the empty
+    // cluster's plane at its centre), and the labels of the other clusters keep their layers.
+    const std::vector<float> before{100, 101, 102, 300, 301, 600, 601, 602};
+    const Layering previous = layer_labels(before, 3, 1.0f, 1000.0f);
+    REQUIRE(previous.layer_count == 3);
+    std::vector<float> after = before;
+    after[3] = 590.0f;
+    after[4] = 592.0f;
+    const Layering followed = follow_layering(previous, after, 3, 1.0f, 1000.0f, {});
+    CHECK(followed.layer_count == 3);
+    CHECK(std::is_sorted(followed.plane_depths.begin(), followed.plane_depths.end()));
+    for (const size_t i : {0, 1, 2, 5, 6, 7})
+      CHECK(followed.label_layer[i] == previous.label_layer[i]);
+  }
 }
 
 }  // namespace strata

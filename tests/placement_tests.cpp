@@ -91,10 +91,12 @@ std::vector<T> as(const std::vector<std::byte>& bytes) {
   return out;
 }
 
-// `previous`: the forces' state whose drawn positions become the labels' previous positions.
+// `previous`: the forces' state that the labels take their previous and held positions and
+// their padding from, with the forces' `params`.
 GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSettings& settings,
                           const PlacementLayout& layout = {},
-                          const std::vector<gpu::LabelStateGpu>& previous = {}) {
+                          const std::vector<gpu::LabelStateGpu>& previous = {},
+                          const gpu::ForcesParams& params = {}) {
   Image final_image(ctx, {VK_FORMAT_R8G8B8A8_UNORM,
                           {in.size.width, in.size.height, 1},
                           VK_IMAGE_TYPE_2D,
@@ -124,9 +126,11 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
   Buffer state(ctx, std::max<size_t>(1, previous.size()) * sizeof(gpu::LabelStateGpu),
                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
   if (!previous.empty()) upload(ctx, state, as_bytes(previous));
-  std::optional<graph::ResourceId> state_id;
+  std::optional<Placement::Previous> state_id;
   if (!previous.empty()) {
-    state_id = g.import_buffer("state", {.buffer = state.handle(), .has_content = true});
+    state_id = Placement::Previous{
+        .state = g.import_buffer("state", {.buffer = state.handle(), .has_content = true}),
+        .params = &params};
   }
   const Placement::Outputs r = placement.add_to(g, {.final_image = general("final", final_image),
                                                     .layers = general("layers", layers),
@@ -220,22 +224,24 @@ TEST_SUITE("gpu") {
       if (i == 3) continue;  // never drawn: its previous position stays the anchor
       state[i].position = glm::vec2(-16.0f + 8.0f * float(i), -9.0f);  // offset from the anchor
       state[i].drawn = in.labels[i].anchor + glm::vec2(-14.0f + 9.0f * float(i), 11.0f);
-      state[i].flags = LABEL_STATE_PLACED;
+      state[i].flags = LABEL_STATE_PLACED | LABEL_STATE_SEEN;  // (not shown: nothing held)
     }
     for (const bool relative : {false, true}) {
       CAPTURE(relative);
       PlacementSettings settings;
       settings.weights.previous_position = 0.2f;
-      settings.previous_relative_to_anchor = relative;
-      const GpuPlacement gpu = place_on_gpu(ctx, in, settings, {}, state);
-      Inputs expected = in;
+      const gpu::ForcesParams params =
+          forces_params({.anchor_relative = relative}, uint32_t(in.labels.size()), 1.0 / 30.0);
+      const GpuPlacement gpu = place_on_gpu(ctx, in, settings, {}, state, params);
+      const std::vector<gpu::LabelGpu> expected = previous_reference(in.labels, state, params);
       for (size_t i = 0; i < 3; ++i) {
-        expected.labels[i].previous =
-            relative ? in.labels[i].anchor + state[i].position : state[i].drawn;
+        CHECK(expected[i].previous ==
+              (relative ? in.labels[i].anchor + state[i].position : state[i].drawn));
+        CHECK(expected[i].hold == 0.0f);
       }
-      const ReferencePlacement cpu =
-          place_reference(expected.final_rgba8, expected.layers, expected.layer_count,
-                          expected.labels, expected.order, settings, expected.size);
+      CHECK(expected[3].previous == in.labels[3].anchor);
+      const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                     expected, in.order, settings, in.size);
       check_placements(gpu, cpu);
       // The term matters here: with the anchors as previous positions the result differs.
       const ReferencePlacement anchored = place_reference(in.final_rgba8, in.layers, in.layer_count,
@@ -246,6 +252,72 @@ TEST_SUITE("gpu") {
       }
       CHECK(differs);
     }
+  }
+
+  // The hold: a label shown last frame keeps its target unless a position beats it by the hold.
+  // With a large hold every held label stays (the held positions are free); with none they go
+  // back to the fresh placement; GPU and reference agree either way.
+  TEST_CASE_FIXTURE(test::GpuTest, "a_held_label_keeps_its_target_unless_a_move_wins_the_hold") {
+    const Inputs in = disc_scene(4);
+    const ReferencePlacement fresh = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                     in.labels, in.order, {}, in.size);
+    // Last frame's targets: the fresh ones moved by a few pixels, each its own way.
+    std::vector<gpu::LabelStateGpu> state(in.labels.size());
+    for (size_t i = 0; i < state.size(); ++i) {
+      const glm::vec2 moved =
+          fresh.placements[i].position + glm::vec2(i % 2 == 0 ? 3.0f : -3.0f, i < 2 ? 2.0f : -2.0f);
+      state[i].position = state[i].target = moved - in.labels[i].anchor;
+      state[i].drawn = moved;
+      state[i].cost = fresh.placements[i].cost;
+      state[i].flags = LABEL_STATE_PLACED | LABEL_STATE_SHOWN | LABEL_STATE_SEEN;
+    }
+    for (const float hold : {0.0f, 1e3f}) {
+      CAPTURE(hold);
+      const gpu::ForcesParams params = forces_params({.hold_share = 0.0f, .hold_cost = hold},
+                                                     uint32_t(in.labels.size()), 1.0 / 30.0);
+      const std::vector<gpu::LabelGpu> labels = previous_reference(in.labels, state, params);
+      const ReferencePlacement cpu =
+          place_reference(in.final_rgba8, in.layers, in.layer_count, labels, in.order, {}, in.size);
+      check_placements(place_on_gpu(ctx, in, {}, {}, state, params), cpu);
+      for (size_t i = 0; i < in.labels.size(); ++i) {
+        CAPTURE(i);
+        CHECK(labels[i].hold == hold);
+        CHECK(labels[i].held == state[i].drawn);
+        const glm::vec2 expected = hold > 0.0f ? state[i].drawn : fresh.placements[i].position;
+        CHECK(glm::all(
+            glm::lessThanEqual(glm::abs(cpu.placements[i].position - expected), glm::vec2(0.5f))));
+        // The reported cost is the position's own, the hold not included.
+        CHECK(cpu.placements[i].cost < 1e3f);
+      }
+    }
+  }
+
+  // Hard mode's asymmetric clear zone: labels hidden last frame need `appear_padding` more room,
+  // so in a crowded scene fewer of them appear than labels shown last frame keep their place.
+  TEST_CASE_FIXTURE(test::GpuTest, "in_hard_mode_a_label_needs_more_room_to_appear_than_to_stay") {
+    const Inputs in = disc_scene(12, 2.5f);
+    PlacementSettings settings;
+    settings.hard = true;
+    const auto shown_count = [](const std::vector<gpu::PlacementGpu>& placements) {
+      size_t n = 0;
+      for (const auto& p : placements) n += p.shown == PLACEMENT_SHOWN;
+      return n;
+    };
+    size_t shown[2] = {};
+    for (const uint32_t flags : {LABEL_STATE_SEEN | LABEL_STATE_SHOWN, LABEL_STATE_SEEN}) {
+      CAPTURE(flags);
+      const std::vector<gpu::LabelStateGpu> state(in.labels.size(), {.flags = flags});
+      const gpu::ForcesParams params =
+          forces_params({.appear_padding = 12.0f}, uint32_t(in.labels.size()), 1.0 / 30.0, true);
+      const std::vector<gpu::LabelGpu> labels = previous_reference(in.labels, state, params);
+      CHECK(labels[0].padding == (flags & LABEL_STATE_SHOWN ? 0.0f : 12.0f));
+      const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                     labels, in.order, settings, in.size);
+      check_placements(place_on_gpu(ctx, in, settings, {}, state, params), cpu);
+      shown[flags & LABEL_STATE_SHOWN ? 0 : 1] = shown_count(cpu.placements);
+    }
+    MESSAGE("labels shown: staying " << shown[0] << ", appearing " << shown[1]);
+    CHECK(shown[1] < shown[0]);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "bucket_width_changes_the_passes_not_the_positions") {

@@ -48,10 +48,13 @@ using glm::unpackUnorm4x8;
 // A function defined in a shared header is inline in C++, so that every file may include it;
 // GLSL has no such keyword.
 #define STRATA_INLINE inline
+// A member's value in a C++ aggregate initialised without it; GLSL structs have none.
+#define STRATA_DEFAULT(value) = value
 #else
 #define STRATA_BEGIN
 #define STRATA_END
 #define STRATA_INLINE
+#define STRATA_DEFAULT(value)
 #endif
 
 #endif

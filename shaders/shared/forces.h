@@ -5,7 +5,7 @@
 #ifndef STRATA_SHARED_FORCES_H
 #define STRATA_SHARED_FORCES_H
 
-#include "labels.h"
+#include "placement.h"
 
 #define FORCES_GROUP 64
 #define FORCES_BINDING_LABELS 0   // LabelGpu[]: this frame's anchors and flags
@@ -15,18 +15,20 @@
 
 // LabelStateGpu.flags
 #define LABEL_STATE_PLACED 1u  // the label has a drawn position (it was shown before)
+#define LABEL_STATE_SHOWN 2u   // the placement showed the label in the last frame
+#define LABEL_STATE_SEEN 4u    // the label has been through a frame since the last reset
 
 STRATA_BEGIN
 
 // What persists of a label between frames.
 struct LabelStateGpu {
   vec2 position;  // drawn box centre: an offset from the anchor, or pixels (ForcesParams)
-  vec2 drawn;     // where the box centre was drawn (pixels; the anchor while never placed):
-                  // the next frame's previous position (eq. 3.1's eta term)
+  vec2 drawn;     // where the box centre was drawn (pixels; the anchor while never placed)
   uint flags;     // LABEL_STATE_*
-  uint pad0;
-  uint pad1;
-  uint pad2;
+  float cost;     // eq. 3.1 at the target, without the hold (sizes the next frame's hold)
+  vec2 target;    // where the label is heading: the placement's position, held as `position` is
+  float opacity;  // 0: invisible, 1: fully drawn; fades toward 1 while shown, toward 0 when not
+  uint pad;
 };
 
 struct ForcesParams {
@@ -37,8 +39,19 @@ struct ForcesParams {
   float epsilon;         // pixels: closer than this the force shrinks with the distance
   float snap;            // pixels: closer than this the label is put on its target
   uint anchor_relative;  // 1: positions are offsets from the anchor, 0: pixels on screen
+  float fade;            // opacity change this frame (1: at once)
+  float hold_share;      // the hold: this share of the target's cost ...
+  float hold_cost;       // ... plus this
+  float appear_padding;  // pixels of padding for a label hidden in the last frame (hard mode)
   uint pad;
 };
+
+// An opacity moved by `change`, kept in [0, 1]; within 1/512 of either end (less than a step of
+// an 8-bit image) it is that end, so a fade ends after whole frames despite rounding.
+STRATA_INLINE float faded(float opacity, float change) {
+  float o = clamp(opacity + change, 0.0f, 1.0f);
+  return o < 1.0f / 512.0f ? 0.0f : (o > 1.0f - 1.0f / 512.0f ? 1.0f : o);
+}
 
 // Eq. 3.6-3.8 for one sub-step: the label at l moves toward p by the unit force (attenuated as
 // d / epsilon within epsilon of p) times the time step.
@@ -49,13 +62,54 @@ STRATA_INLINE vec2 force_step(vec2 l, vec2 p, float seconds, float speed, float 
   return l + (seconds * speed) * force;
 }
 
+// A position of the state (offset or pixels) as pixels on screen for the label's anchor now.
+STRATA_INLINE vec2 state_to_screen(LabelGpu label, vec2 p, ForcesParams params) {
+  return params.anchor_relative != 0u ? label.anchor + p : p;
+}
+
+// What the placement of the next frame takes from the last one. A label shown in the last frame
+// is held: its target (as an offset from its anchor's new position, or on screen) is eq. 3.1's
+// previous position, and the held position that a move away from must win the hold; where it is
+// drawn, maybe still on its way there, does not matter (the target would otherwise be pulled back
+// toward the label in transit, and chase it). A label hidden since it was drawn has its last
+// drawn position (or offset) as its previous position, and in hard mode a padding.
+STRATA_INLINE LabelGpu forces_previous(LabelGpu label, LabelStateGpu state, ForcesParams params) {
+  if ((state.flags & LABEL_STATE_SEEN) != 0u && (state.flags & LABEL_STATE_SHOWN) == 0u) {
+    label.padding = params.appear_padding;
+  }
+  if ((state.flags & LABEL_STATE_PLACED) == 0u) return label;
+  if ((state.flags & LABEL_STATE_SHOWN) != 0u) {
+    label.held = state_to_screen(label, state.target, params);
+    label.hold = params.hold_cost + params.hold_share * max(state.cost, 0.0f);
+    label.previous = label.held;
+  } else {
+    label.previous = params.anchor_relative != 0u ? label.anchor + state.position : state.drawn;
+  }
+  return label;
+}
+
 // The label's state after this frame. A label seen for the first time starts on its target; a
-// hidden or disabled one keeps where it was.
+// hidden or disabled one keeps where it was (an anchored one stays on its anchor) and fades out.
+// The placement's position is the held one when the placement kept it: the exact held offset
+// is kept then, not the candidate pixel nearest to it, so a held label does not drift.
 STRATA_INLINE LabelStateGpu forces_update(LabelGpu label, PlacementGpu target, LabelStateGpu state,
                                           ForcesParams params) {
   if ((state.flags & LABEL_STATE_PLACED) == 0u) state.drawn = label.anchor;
-  if ((label.flags & LABEL_ENABLED) == 0u || target.shown != PLACEMENT_SHOWN) return state;
-  vec2 goal = params.anchor_relative != 0u ? target.position - label.anchor : target.position;
+  state.flags |= LABEL_STATE_SEEN;
+  bool shown = (label.flags & LABEL_ENABLED) != 0u && target.shown == PLACEMENT_SHOWN;
+  if (!shown) {
+    state.flags &= ~LABEL_STATE_SHOWN;
+    state.opacity = faded(state.opacity, -params.fade);
+    if ((label.flags & LABEL_ENABLED) != 0u && (state.flags & LABEL_STATE_PLACED) != 0u) {
+      state.drawn = state_to_screen(label, state.position, params);
+    }
+    return state;
+  }
+  bool kept =
+      (state.flags & LABEL_STATE_SHOWN) != 0u && label.hold > 0.0f && holds(label, target.position);
+  vec2 goal =
+      kept ? state.target
+           : (params.anchor_relative != 0u ? target.position - label.anchor : target.position);
   vec2 l = goal;
   if ((state.flags & LABEL_STATE_PLACED) != 0u) {
     l = state.position;
@@ -65,15 +119,21 @@ STRATA_INLINE LabelStateGpu forces_update(LabelGpu label, PlacementGpu target, L
     }
   }
   state.position = l;
-  state.flags |= LABEL_STATE_PLACED;
-  state.drawn = params.anchor_relative != 0u ? label.anchor + l : l;
+  state.target = goal;
+  state.cost = target.cost;
+  state.flags |= LABEL_STATE_PLACED | LABEL_STATE_SHOWN;
+  state.opacity = faded(state.opacity, params.fade);
+  state.drawn = state_to_screen(label, l, params);
   return state;
 }
 
-// Where the label is drawn this frame: its state's position, shown when the placement shows it.
+// Where the label is drawn this frame, and how opaque: its state's position while it is shown or
+// still fading out.
 STRATA_INLINE PlacementGpu forces_drawn(PlacementGpu target, LabelStateGpu state) {
   PlacementGpu drawn = target;
   if ((state.flags & LABEL_STATE_PLACED) != 0u) drawn.position = state.drawn;
+  drawn.opacity = state.opacity;
+  drawn.shown = state.opacity > 0.0f ? PLACEMENT_SHOWN : PLACEMENT_HIDDEN;
   return drawn;
 }
 

@@ -24,9 +24,10 @@ float text_coverage(vec2 p, vec2 top_left, LabelGpu label) {
   return coverage;
 }
 
-// Every shown label of `layer` drawn over `content` (premultiplied) at pixel centre p, in label
-// order: a later label covers an earlier one. External labels: connector, box, text, then the
-// anchor marker on top. Internal labels: the box centred on the anchor, no connector or marker.
+// Every shown label of `layer` drawn over `content` (premultiplied) at pixel centre p, as opaque
+// as its placement says, in label order: a later label covers an earlier one. External labels:
+// connector, box, text, then the anchor marker on top. Internal labels: the box centred on the
+// anchor, no connector or marker.
 vec4 draw_labels_at(vec2 p, uint layer, vec4 content) {
   for (uint i = 0u; i < label_count(); ++i) {
     LabelGpu label = label_at(i);
@@ -40,7 +41,7 @@ vec4 draw_labels_at(vec2 p, uint layer, vec4 content) {
     float text = text_coverage(p, centre - 0.5f * label.size, label);
     color = label_over(label_premultiplied(LABEL_TEXT_COLOR, text), color);
     if (!is_internal) color = label_over(label_anchor_marker(p, label.anchor), color);
-    content = label_over(color, content);
+    content = label_over(color * placement.opacity, content);  // (premultiplied: a fade)
   }
   return content;
 }

@@ -26,14 +26,22 @@ struct LabelGpu {
   uint flags;          // LABEL_*
   uint glyph_first;    // the label's glyphs in the glyph buffer
   uint glyph_count;
+  float hold;     // eq. 3.1 adds this to every position but `held`: a label moves only for
+                  // a position better by more (0: no held position)
+  vec2 held;      // the position the label was heading for in the previous frame (box
+                  // centre, pixels)
+  float padding;  // pixels added to the constraint margin around this label's box (hard
+                  // mode: a label needs a larger clear zone to appear than to stay)
   uint pad;
 };
 
 // The result for one label: written by the placement, read by drawing and by the host.
 struct PlacementGpu {
-  vec2 position;  // box centre, pixels
-  float cost;     // eq. 3.1 at that position
-  uint shown;     // PLACEMENT_*
+  vec2 position;                       // box centre, pixels
+  float cost;                          // eq. 3.1 at that position
+  uint shown;                          // PLACEMENT_*
+  float opacity STRATA_DEFAULT(1.0f);  // 1 when shown; between 0 and 1 while fading in or out
+  uint pad STRATA_DEFAULT(0u);
 };
 
 struct GlyphGpu {

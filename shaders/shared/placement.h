@@ -138,6 +138,39 @@ STRATA_INLINE vec2 box_origin(uvec2 p, vec2 size) {
   return vec2(p) - floor(size * 0.5f);
 }
 
+// Half the box that the constraints test around label `me`: its size, the margin and its own
+// padding.
+STRATA_INLINE vec2 constraint_half_size(LabelGpu me, float margin) {
+  return me.size * 0.5f + vec2(margin + me.padding);
+}
+
+// Is box centre c the label's held position? (The candidates nearest to it: within half a pixel.)
+STRATA_INLINE bool holds(LabelGpu me, vec2 c) {
+  return all(lessThanEqual(abs(c - me.held), vec2(0.5f)));
+}
+
+// A label's placement at candidate pixel (`pixel`, in an image `width` wide) of eq. 3.1 cost
+// `cost`: its box centre, and the cost without the hold (what the position itself costs).
+STRATA_INLINE PlacementGpu shown_placement(LabelGpu me, uint pixel, float cost, uint width) {
+  PlacementGpu p;
+  p.position = box_origin(uvec2(pixel % width, pixel / width), me.size) + me.size * 0.5f;
+  p.cost = holds(me, p.position) ? cost : cost - me.hold;
+  p.shown = PLACEMENT_SHOWN;
+  p.opacity = 1.0f;
+  p.pad = 0u;
+  return p;
+}
+
+STRATA_INLINE PlacementGpu hidden_placement(LabelGpu me) {
+  PlacementGpu p;
+  p.position = me.anchor;
+  p.cost = 0.0f;
+  p.shown = PLACEMENT_HIDDEN;
+  p.opacity = 0.0f;
+  p.pad = 0u;
+  return p;
+}
+
 // The classifying workgroups of a label whose tile list has `beyond` entries past bucket 0.
 STRATA_INLINE uint placement_classify_groups(uint beyond) {
   return (beyond + PLACEMENT_CLASSIFY_TILES - 1u) / PLACEMENT_CLASSIFY_TILES;

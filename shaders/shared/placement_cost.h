@@ -91,7 +91,7 @@ PairBoxRegion pair_box_region(LabelGpu k, LabelGpu j, vec3 placed_j, float margi
   for (int i = 0; i < 4; ++i) r.box[i] = vec4(0.0f);
   r.info = uvec4(0u);
   if (placed_j.z < 0.5f) return r;
-  vec2 h = k.size * 0.5f + vec2(margin);
+  vec2 h = constraint_half_size(k, margin);
   vec2 centre = vec2(placed_j);
   vec2 lo = centre - j.size * 0.5f, hi = centre + j.size * 0.5f;
   ShadowPlanes planes =
@@ -110,7 +110,7 @@ ShadowPlanes pair_connector_region(LabelGpu k, LabelGpu j, vec3 placed_j, float 
   ShadowPlanes c;
   for (int i = 0; i < 6; ++i) c.p[i] = vec4(0.0f);
   if (placed_j.z < 0.5f || (j.flags & LABEL_INTERNAL) != 0u) return c;
-  vec2 h = k.size * 0.5f + vec2(margin);
+  vec2 h = constraint_half_size(k, margin);
   vec2 centre = vec2(placed_j);
   return shadow_planes(k.anchor, h, j.anchor, centre, centre, centre, true);
 }
@@ -161,7 +161,7 @@ float constraint_weight(uint bits) {
 // the bits found weigh more than `budget` (the GPU's candidates that cannot win any more; the
 // CPU reference passes infinity and always gets every bit).
 uint constraint_bits(LabelGpu me, vec2 c, uint known, float budget) {
-  vec2 h = me.size * 0.5f + vec2(params.margin);
+  vec2 h = constraint_half_size(me, params.margin);
   const uint shadows = CONSTRAINT_LABEL | CONSTRAINT_CONNECTOR;
   uint bits = known;
   for (uint k = 0u; k < placed_count() && (bits & shadows) != shadows; ++k) {
@@ -204,6 +204,7 @@ float free_cost(LabelGpu me, vec2 origin, vec2 c) {
   float cost = w.distance_to_anchor * distance + w.connector_direction * direction;
   cost += w.integral_costs * max(box_integral(me.layer, origin, me.size), 0.0f);
   cost += w.previous_position * length(c - me.previous);
+  if (!holds(me, c)) cost += me.hold;
   return cost;
 }
 
