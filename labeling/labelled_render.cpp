@@ -141,8 +141,14 @@ void LabelledRenderer::build_graph() {
 
 void LabelledRenderer::set_order(const std::vector<uint32_t>& within) {
   within_ = within;
-  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within),
-                              settings_.placement);
+}
+
+// The labels and order of the next frame for the placement: a still with the scene's eta, a frame
+// of an animation with the forces' (toward the last targets).
+void LabelledRenderer::set_placement_frame(bool moving) {
+  PlacementSettings settings = settings_.placement;
+  if (moving) settings.weights.previous_position = settings_.forces.previous_weight;
+  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within_), settings);
 }
 
 void LabelledRenderer::set_camera(const Camera& camera) {
@@ -154,9 +160,7 @@ void LabelledRenderer::set_camera(const Camera& camera) {
 }
 
 void LabelledRenderer::advance(double seconds) {
-  PlacementSettings moving = settings_.placement;
-  moving.weights.previous_position = settings_.forces.previous_weight;
-  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within_), moving);
+  set_placement_frame(true);
   parts_->forces.set_frame(settings_.forces, seconds, settings_.placement.hard);
   run_frame();
 }
@@ -208,6 +212,7 @@ double LabelledRenderer::total_cost() const {
 void LabelledRenderer::run() {
   // A still: every frame puts the labels on their placement (the forces start afresh).
   const auto run_still = [this] {
+    set_placement_frame(false);
     parts_->forces.reset();
     parts_->forces.set_frame(settings_.forces, 0.0, settings_.placement.hard);
     run_frame();

@@ -104,6 +104,7 @@ class LabelledRenderer {
   void project_and_layer(const Camera& camera);
   void build_graph();
   void set_order(const std::vector<uint32_t>& within);
+  void set_placement_frame(bool moving);
   std::vector<uint32_t> within_;  // the order inside each layer set_order() was last given
   std::vector<uint32_t> apollonius_layers_order();
 
