@@ -11,10 +11,12 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/viewer.h"
 #include "engine/gpu/resources.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
+#include "labeling/camera_path.h"
 #include "labeling/labelled_render.h"
 #include "passes/summed_area_table.h"
 #include "passes/volume_renderer.h"
@@ -334,6 +336,68 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint
   print_json(ctx, setup, runs, t, results);
 }
 
+struct ViewBenchOptions {
+  std::string scene = "assets/scenes/head.json";
+  std::string size = "1024";
+  uint32_t frames = 120;
+  double degrees = 90.0;
+};
+
+// The viewer's whole frame (labelled scene, forces, label drawing, the panel), headless, with two
+// frames in flight, along a turntable at 30 frames a second of animation time.
+void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
+  const graph::Extent size = parse_size(o.size, "--size");
+  Scene scene = load_scene_reporting(o.scene);
+  Context ctx(device.context());
+  LabellingSettings settings;
+  settings.placement.weights = scene.settings.weights;
+  const double fps = 30.0;
+  const std::vector<Camera> cameras =
+      sample(orbit_path(scene, scene.camera, o.degrees, double(o.frames) / fps), fps);
+  HeadlessOutput output(ctx, size, 2);
+  ViewerOptions options;
+  options.scene_path = o.scene;
+  options.optimize_on_idle = false;
+  Viewer viewer(ctx, scene, cameras.front(), settings, options, output, nullptr);
+  for (int i = 0; i < 10; ++i) viewer.frame(1.0 / fps);  // warm up: the HA-Buffer grows
+  output.wait_idle();
+  const ViewerSummary before = viewer.summary();
+  const auto start = std::chrono::steady_clock::now();
+  for (const Camera& camera : cameras) {
+    viewer.set_camera(camera);
+    viewer.frame(1.0 / fps);
+  }
+  output.wait_idle();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const ViewerSummary& after = viewer.summary();
+  // (the frames read back during the path; the last ones are still in their slots)
+  const uint64_t timed = after.timed_frames - before.timed_frames;
+  std::vector<double> gpu(after.gpu_frame_ms.begin() + long(before.gpu_frame_ms.size()),
+                          after.gpu_frame_ms.end());
+  std::sort(gpu.begin(), gpu.end());
+  const auto at = [&](double q) {
+    return gpu.empty() ? 0.0 : gpu[std::min(gpu.size() - 1, size_t(q * double(gpu.size())))];
+  };
+  nlohmann::ordered_json out;
+  out["device"] = ctx.report().name;
+  out["scene"] = o.scene;
+  out["size"] = {size.width, size.height};
+  out["labels"] = scene.labels.size();
+  out["frames"] = cameras.size();
+  out["frames_in_flight"] = output.frames_in_flight();
+  out["frames_per_second"] = double(cameras.size()) / seconds;
+  out["gpu_frame_ms"] = {{"median", at(0.5)}, {"p95", at(0.95)}, {"max", at(1.0)}};
+  nlohmann::ordered_json passes;
+  for (const auto& [name, ms] : after.gpu_ms) {
+    const auto was = before.gpu_ms.find(name);
+    const double sum = ms - (was == before.gpu_ms.end() ? 0.0 : was->second);
+    passes[name] = timed ? sum / double(timed) : 0.0;
+  }
+  out["mean_pass_ms"] = passes;
+  std::printf("%s\n", out.dump(2).c_str());
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app, DeviceOptions& device) {
@@ -380,6 +444,18 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       ->check(CLI::Range(1u, 100000u));
   place_cmd->callback(
       [&device, place, options] { bench_placement(device, *place, options->runs); });
+
+  auto view = std::make_shared<ViewBenchOptions>();
+  CLI::App* view_cmd = cmd->add_subcommand(
+      "view", "the viewer's whole frame (labels, forces, drawing, UI) along a turntable");
+  view_cmd->add_option("scene", view->scene, "scene file")->capture_default_str();
+  view_cmd->add_option("--size", view->size, "N or WxH")->capture_default_str();
+  view_cmd->add_option("--frames", view->frames, "frames timed along the path")
+      ->capture_default_str()
+      ->check(CLI::Range(1u, 100000u));
+  view_cmd->add_option("--degrees", view->degrees, "how far the turntable turns")
+      ->capture_default_str();
+  view_cmd->callback([&device, view] { bench_view(device, *view); });
 }
 
 }  // namespace strata::app

@@ -5,6 +5,7 @@
 
 #include "app/commands.h"
 #include "engine/core/png.h"
+#include "engine/core/text_file.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
 #include "engine/scene/io/scene_loader.h"
@@ -122,11 +123,7 @@ LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene)
 }
 
 void write_layout(const std::string& path, const LabelledFrame& frame) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) throw Error(path + ": cannot write the layout file");
-  const std::string json = layout_json(frame);
-  const bool ok = std::fwrite(json.data(), 1, json.size(), f) == json.size();
-  if (std::fclose(f) != 0 || !ok) throw Error(path + ": cannot write the layout file");
+  write_text_file(path, layout_json(frame));
   std::printf("wrote %s\n", path.c_str());
 }
 

@@ -13,6 +13,7 @@
 
 #include "app/commands.h"
 #include "engine/core/png.h"
+#include "engine/core/text_file.h"
 #include "engine/core/video_file.h"
 #include "labeling/camera_path.h"
 #include "labeling/labelled_render.h"
@@ -67,12 +68,6 @@ class Progress {
   Clock::time_point start_ = Clock::now();
 };
 
-void write_text(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary);
-  out << text;
-  if (!out.flush()) throw Error(file.string() + ": cannot write");
-}
-
 std::string frame_name(size_t frame, const char* extension) {
   char name[32];
   std::snprintf(name, sizeof name, "frame-%05zu.%s", frame, extension);
@@ -121,7 +116,8 @@ void video(DeviceOptions& device, const VideoOptions& o) {
       write_png((output / frame_name(f, "png")).string(), size.width, size.height, frame.image);
     }
     if (!o.layout_dir.empty()) {
-      write_text(std::filesystem::path(o.layout_dir) / frame_name(f, "json"), layout_json(frame));
+      write_text_file(std::filesystem::path(o.layout_dir) / frame_name(f, "json"),
+                      layout_json(frame));
     }
     progress.frame_done(f + 1);
   }

@@ -1,12 +1,15 @@
 #include "labeling/labelled_render.h"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 #include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
+#include "engine/gpu/context.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
 #include "engine/scene/io/transfer_function_loader.h"
@@ -44,44 +47,122 @@ std::vector<ProjectedPoint> project_anchors(const Scene& scene, const Camera& ca
 }
 
 struct LabelledRenderer::Parts {
-  Parts(Context& ctx, const Scene& scene, const RenderSettings& render, uint32_t label_count,
-        const FontAtlas& font, size_t glyph_count)
+  Parts(Context& ctx, const Scene& scene, const RenderSettings& render, uint32_t label_count)
       : renderer(ctx, scene, render),
         placement(ctx, label_count),
         forces(ctx, label_count),
-        drawing(ctx, font),
-        target(ctx),
-        glyphs(ctx, std::max<size_t>(1, glyph_count) * sizeof(gpu::GlyphGpu),
-               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local) {}
+        target(ctx) {}
   VolumeRenderer renderer;
   Placement placement;
   LabelForces forces;
-  LabelDrawing drawing;
+  std::optional<LabelDrawing> drawing;  // with the font of its size
   HeadlessTarget target;
   Buffer glyphs;
 };
 
 LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camera& camera,
                                    graph::Extent size, const LabellingSettings& settings)
-    : ctx_(ctx), scene_(scene), size_(size), settings_(settings) {
+    : ctx_(ctx), scene_(scene), size_(size), camera_(camera), settings_(settings) {
   labels_.resize(scene.labels.size());
+  hidden_.assign(scene.labels.size(), false);
   for (size_t i = 0; i < scene.labels.size(); ++i) labels_[i].size = scene.labels[i].size;
   project_and_layer(camera);
-
-  // Boxes from the texts: sizes and glyph ranges stay; anchors and layers follow the camera.
-  const FontAtlas font = load_font_atlas(settings.font_pixels);
-  std::vector<std::string> texts;
-  for (const Label& label : scene.labels) texts.push_back(label.text);
-  const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, texts, labels_);
-
-  parts_ = std::make_unique<Parts>(ctx, scene, settings.render, uint32_t(labels_.size()), font,
-                                   glyphs.size());
-  Parts& p = *parts_;
-  p.renderer.set_camera(camera);
-  p.drawing.set_label_count(uint32_t(labels_.size()));
-  if (!glyphs.empty()) upload(ctx, p.glyphs, as_bytes(glyphs));
+  parts_ = std::make_unique<Parts>(ctx, scene, settings.render, uint32_t(labels_.size()));
+  parts_->renderer.set_camera(camera);
+  build_labels();
   set_order(scene_order(uint32_t(labels_.size())));
   build_graph();
+}
+
+// Boxes from the texts: sizes and glyph ranges stay; anchors and layers follow the camera.
+void LabelledRenderer::build_labels() {
+  const FontAtlas font = load_font_atlas(settings_.font_pixels);
+  std::vector<std::string> texts;
+  for (const Label& label : scene_.labels) texts.push_back(label.text);
+  const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, texts, labels_);
+  Parts& p = *parts_;
+  p.glyphs = Buffer(ctx_, std::max<size_t>(1, glyphs.size()) * sizeof(gpu::GlyphGpu),
+                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
+  if (!glyphs.empty()) upload(ctx_, p.glyphs, as_bytes(glyphs));
+  p.drawing.emplace(ctx_, font);
+  p.drawing->set_label_count(uint32_t(labels_.size()));
+}
+
+void LabelledRenderer::set_font_pixels(float pixels) {
+  if (!(pixels >= 4.0f && pixels <= 128.0f)) throw Error("label font size must be 4 to 128 px");
+  vkDeviceWaitIdle(ctx_.device());  // the glyphs and the drawing's atlas are replaced
+  settings_.font_pixels = pixels;
+  for (size_t i = 0; i < labels_.size(); ++i) labels_[i].size = scene_.labels[i].size;
+  runner_.reset();
+  build_labels();
+  build_graph();
+}
+
+void LabelledRenderer::set_size(graph::Extent size) {
+  if (size == size_) return;
+  size_ = size;
+  runner_->set_viewport(size);
+  set_camera(camera_);
+}
+
+std::span<const gpu::PlacementGpu> LabelledRenderer::placement_results() const {
+  return parts_->placement.results();
+}
+
+std::span<const gpu::PlacementGpu> LabelledRenderer::drawn() const {
+  return parts_->forces.drawn();
+}
+
+size_t LabelledRenderer::placement_order_count() const {
+  return size_t(std::count_if(labels_.begin(), labels_.end(), [](const gpu::LabelGpu& l) {
+    return (l.flags & LABEL_ENABLED) != 0u;
+  }));
+}
+
+VolumeRenderer& LabelledRenderer::renderer() {
+  return parts_->renderer;
+}
+
+void LabelledRenderer::set_label_hidden(size_t index, bool hidden) {
+  hidden_.at(index) = hidden;
+}
+
+void LabelledRenderer::set_extension(Extension extend) {
+  extension_ = std::move(extend);
+  runner_.reset();
+  build_graph();
+}
+
+void LabelledRenderer::set_frames_in_flight(uint32_t frames) {
+  frames_in_flight_ = frames;
+  runner_->set_frames_in_flight(frames);
+  parts_->renderer.readback().set_slots(frames);
+  parts_->placement.readback().set_slots(frames);
+  parts_->forces.readback().set_slots(frames);
+  use_slot(0);
+}
+
+void LabelledRenderer::use_slot(uint32_t slot) {
+  parts_->renderer.readback().use_slot(*runner_, slot);
+  parts_->placement.readback().use_slot(*runner_, slot);
+  parts_->forces.readback().use_slot(*runner_, slot);
+  stats_ = parts_->renderer.collect(*runner_);
+}
+
+void LabelledRenderer::prepare_frame(double seconds, bool trial) {
+  if (trial && trial_within_.size() == labels_.size()) {
+    const std::vector<uint32_t> kept = within_;
+    set_order(trial_within_);
+    set_placement_frame(true);
+    set_order(kept);
+  } else {
+    set_placement_frame(true);
+  }
+  ForceSettings forces = settings_.forces;
+  if (afresh_) forces.hold_share = forces.hold_cost = 0.0f;
+  parts_->forces.set_frame(forces, seconds, settings_.placement.hard);
+  parts_->forces.set_trial(trial);
+  afresh_ = false;
 }
 
 // Layering on the CPU, from the camera alone: k-means++ on the visible anchors' depths, after the
@@ -89,7 +170,9 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
 void LabelledRenderer::project_and_layer(const Camera& camera) {
   const std::vector<ProjectedPoint> anchors = project_anchors(scene_, camera, size_);
   std::vector<float> depths;
-  for (const auto& a : anchors) depths.push_back(a.visible ? a.eye_depth : std::nanf(""));
+  for (size_t i = 0; i < anchors.size(); ++i) {
+    depths.push_back(anchors[i].visible && !hidden_[i] ? anchors[i].eye_depth : std::nanf(""));
+  }
   layering_ = follow_layering(layering_, depths, settings_.layer_count, camera.near_plane,
                               camera.far_plane, settings_.hysteresis, settings_.seed);
   for (size_t i = 0; i < labels_.size(); ++i) {
@@ -98,8 +181,8 @@ void LabelledRenderer::project_and_layer(const Camera& camera) {
     l.previous = anchors[i].pixel;  // (the GPU's forces state replaces it once drawn)
     l.anchor_depth = anchors[i].eye_depth;
     l.layer = layering_.label_layer[i];
-    l.flags =
-        (anchors[i].visible ? LABEL_ENABLED : 0u) | (settings_.internal ? LABEL_INTERNAL : 0u);
+    l.flags = (anchors[i].visible && !hidden_[i] ? LABEL_ENABLED : 0u) |
+              (settings_.internal ? LABEL_INTERNAL : 0u);
   }
 }
 
@@ -126,17 +209,24 @@ void LabelledRenderer::build_graph() {
   const graph::ResourceId glyph_buffer =
       graph.import_buffer("labels.glyphs", {.buffer = p.glyphs.handle(), .has_content = true});
   const graph::ResourceId labelled = graph.add_image("labels.final", {VK_FORMAT_R8G8B8A8_UNORM});
-  p.drawing.add_to(graph, {.layers = rendered.layers,
-                           .layer_count = render.layer_count,
-                           .labels = placed_.labels,
-                           .placements = moved.drawn,
-                           .glyphs = glyph_buffer,
-                           .output = labelled,
-                           .background = render.background});
-  p.target.add_output(graph, labelled);
+  labelled_id_ = labelled;
+  p.drawing->add_to(graph, {.layers = rendered.layers,
+                            .layer_count = render.layer_count,
+                            .labels = placed_.labels,
+                            .placements = moved.drawn,
+                            .glyphs = glyph_buffer,
+                            .output = labelled,
+                            .background = render.background});
+  if (extension_) {
+    extension_(graph, {labelled, rendered, placed_, moved.drawn, render.layer_count});
+  } else {
+    p.target.add_output(graph, labelled);
+  }
+  runner_.reset();  // (waits for its frames in flight)
   runner_ = std::make_unique<graph::GraphRunner>(ctx_, std::move(graph));
   runner_->set_viewport(size_);
-  p.target.bind(*runner_);
+  if (!extension_) p.target.bind(*runner_);
+  if (frames_in_flight_ > 1) runner_->set_frames_in_flight(frames_in_flight_);
 }
 
 void LabelledRenderer::set_order(const std::vector<uint32_t>& within) {
@@ -147,11 +237,12 @@ void LabelledRenderer::set_order(const std::vector<uint32_t>& within) {
 // of an animation with the forces' (toward the last targets).
 void LabelledRenderer::set_placement_frame(bool moving) {
   PlacementSettings settings = settings_.placement;
-  if (moving) settings.weights.previous_position = settings_.forces.previous_weight;
+  if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
   parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within_), settings);
 }
 
 void LabelledRenderer::set_camera(const Camera& camera) {
+  camera_ = camera;
   project_and_layer(camera);
   parts_->renderer.set_camera(camera);
   parts_->renderer.settings().splits = layering_.split_depths;
@@ -247,8 +338,10 @@ LabelledFrame LabelledRenderer::result() const {
   frame.layering = layering_;
   frame.render_stats = stats_;
   frame.timings = runner_->timings();
-  const auto pixels = parts_->target.pixels();
-  frame.image.assign(pixels.begin(), pixels.end());
+  if (!extension_) {
+    const auto pixels = parts_->target.pixels();
+    frame.image.assign(pixels.begin(), pixels.end());
+  }
   const auto results = parts_->placement.results();
   const auto drawn = parts_->forces.drawn();
   for (size_t i = 0; i < labels_.size(); ++i) {

@@ -4,6 +4,7 @@
 // inside it; the placements come back after the frame.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,6 +66,16 @@ std::vector<ProjectedPoint> project_anchors(const Scene& scene, const Camera& ca
 // Everything one labelled frame needs, set up once: renderer, placement, drawing, their graph.
 class LabelledRenderer {
  public:
+  // What the frame's graph made, for passes that an extension adds after the label drawing.
+  struct GraphIds {
+    graph::ResourceId labelled;  // rgba8: the labelled picture
+    VolumeRenderer::Outputs rendered;
+    Placement::Outputs placed;
+    graph::ResourceId drawn;  // PlacementGpu[]: where the labels are drawn
+    uint32_t layer_count = 1;
+  };
+  using Extension = std::function<void(graph::Graph&, const GraphIds&)>;
+
   LabelledRenderer(Context& ctx, const Scene& scene, const Camera& camera, graph::Extent size,
                    const LabellingSettings& settings);
   ~LabelledRenderer();
@@ -80,12 +91,62 @@ class LabelledRenderer {
   // drawn positions toward it (a label seen for the first time starts on its placement).
   void advance(double seconds);
   graph::GraphRunner& runner() { return *runner_; }
+
+  // The interactive viewer's frames (app/view_command.cpp). `extend` ends the graph instead of
+  // the headless readback of the picture (the viewer adds its UI and presents); it is called
+  // again whenever the graph is rebuilt (the layer count changed). result() then has no image.
+  void set_extension(Extension extend);
+  // A new image size (a resized window): the anchors are projected again.
+  void set_size(graph::Extent size);
+  graph::Extent size() const { return size_; }
+  const Camera& camera() const { return camera_; }
+  // Frames recorded before the earlier ones finished: a readback per frame slot.
+  void set_frames_in_flight(uint32_t frames);
+  // Frame slot `slot` is free (its last frame finished): the results read from now on are that
+  // frame's (a frame or two old), the next frame writes its own into the slot. Reads the
+  // renderer's counters (and grows its table when it overflowed).
+  void use_slot(uint32_t slot);
+  // Sets the next frame up, `seconds` after the last, without running it (the caller records
+  // runner() into its own command buffer). A trial frame places the labels (in the order given
+  // to set_trial_order) but leaves the forces' state as it was (optimisation on idle).
+  void prepare_frame(double seconds, bool trial = false);
+  // Trial frames place labels in `within` (a permutation of the label indices); the other frames
+  // in the order last kept with keep_order (the scene's after set_camera).
+  void set_trial_order(const std::vector<uint32_t>& within) { trial_within_ = within; }
+  void keep_order(const std::vector<uint32_t>& within) { set_order(within); }
+  // The next frame places the labels afresh: no hold, no eta toward the last targets (after a
+  // change of the settings); the forces still move them there.
+  void place_afresh() { afresh_ = true; }
+  const std::vector<uint32_t>& order() const { return within_; }
+
+  // Live settings: placement weights, forces, internal labelling and the layer count take effect
+  // with the next set_camera(); the renderer's own settings through renderer().
+  LabellingSettings& settings() { return settings_; }
+  VolumeRenderer& renderer();
+  // Hides label `index` (of the scene's labels) from the layering, placement and drawing.
+  void set_label_hidden(size_t index, bool hidden);
+  bool label_hidden(size_t index) const { return hidden_.at(index); }
+  // The label font's size in pixels: rebuilds the glyphs, box sizes and the graph.
+  void set_font_pixels(float pixels);
+  const Layering& layering() const { return layering_; }
+  const std::vector<gpu::LabelGpu>& labels() const { return labels_; }
+  const RenderStats& stats() const { return stats_; }
+  graph::ResourceId labelled_image() const { return labelled_id_; }
+  // The last completed frame's (of the current slot) placements and drawn positions, per label.
+  std::span<const gpu::PlacementGpu> placement_results() const;
+  std::span<const gpu::PlacementGpu> drawn() const;
+  // Stein & Decoret's order inside each layer, from the last frame's layers (downloads them:
+  // nothing may be in flight).
+  std::vector<uint32_t> apollonius_layers_order();
+  // Labels the next frame places (the enabled ones).
+  size_t placement_order_count() const;
+
   // The placement's resources and its label loop's pass: the baseline benchmark reads the
   // per-label results after each label, and the buckets give its tile statistics.
   const Placement::Outputs& placement() const { return placed_; }
   // The placement's pipelines and what the driver reports of each (benchmark output).
   std::vector<PipelineReport> placement_pipelines() const;
-  // The picture and layout of the last run.
+  // The picture (none with an extension) and layout of the last run.
   LabelledFrame result() const;
   // Eq. 3.2 of the last frame's placement: the sum of the shown labels' costs (without the hold),
   // a hidden label counting as much as an anchor-constraint violation.
@@ -106,7 +167,14 @@ class LabelledRenderer {
   void set_order(const std::vector<uint32_t>& within);
   void set_placement_frame(bool moving);
   std::vector<uint32_t> within_;  // the order inside each layer set_order() was last given
-  std::vector<uint32_t> apollonius_layers_order();
+  std::vector<uint32_t> trial_within_;
+  bool afresh_ = false;
+  void build_labels();  // glyphs and box sizes from the texts at settings_.font_pixels
+  Extension extension_;
+  uint32_t frames_in_flight_ = 1;
+  std::vector<bool> hidden_;
+  Camera camera_;
+  graph::ResourceId labelled_id_ = 0;
 
   RenderStats stats_;
   Placement::Outputs placed_{};

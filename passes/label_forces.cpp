@@ -49,8 +49,7 @@ LabelForces::LabelForces(Context& ctx, uint32_t label_count)
              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                  VK_BUFFER_USAGE_TRANSFER_DST_BIT,
              MemoryKind::device_local),
-      readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu),
-                VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback) {
+      readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu)) {
   reset();
 }
 
@@ -70,7 +69,7 @@ std::vector<gpu::LabelStateGpu> LabelForces::state() const {
 }
 
 std::span<const gpu::PlacementGpu> LabelForces::drawn() const {
-  return {reinterpret_cast<const gpu::PlacementGpu*>(readback_.mapped()), label_count_};
+  return {reinterpret_cast<const gpu::PlacementGpu*>(readback_.data().data()), label_count_};
 }
 
 graph::ResourceId LabelForces::import_state(graph::Graph& graph) const {
@@ -92,8 +91,7 @@ LabelForces::Outputs LabelForces::add_to(graph::Graph& graph, const Inputs& in) 
                     pc.dispatch(forces_, params_, {label_count_, 1, 1});
                   },
                   "labels"});
-  const graph::ResourceId readback = graph.import_buffer(
-      "forces.readback", {.buffer = readback_.handle(), .final_use = Use::host_read});
+  const graph::ResourceId readback = readback_.import(graph, "forces.readback");
   const graph::ResourceId drawn = out.drawn;
   graph.add_pass({"forces.readback",
                   graph::PassKind::transfer,
@@ -120,7 +118,7 @@ std::vector<gpu::PlacementGpu> forces_reference(const std::vector<gpu::LabelGpu>
                                                 const gpu::ForcesParams& params) {
   std::vector<gpu::PlacementGpu> drawn(labels.size());
   for (size_t i = 0; i < labels.size(); ++i) {
-    state[i] = gpu::forces_update(labels[i], targets[i], state[i], params);
+    if (params.trial == 0u) state[i] = gpu::forces_update(labels[i], targets[i], state[i], params);
     drawn[i] = gpu::forces_drawn(targets[i], state[i]);
   }
   return drawn;

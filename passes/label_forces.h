@@ -12,6 +12,7 @@
 #include "engine/gpu/resources.h"
 #include "engine/gpu/shader_library.h"
 #include "engine/graph/graph_runner.h"
+#include "engine/graph/readback.h"
 #include "engine/graph/render_graph.h"
 #include "shared/forces.h"
 
@@ -64,6 +65,9 @@ class LabelForces {
 
   // The next frame's settings and duration (a fixed 1 / fps offline, so videos are repeatable).
   void set_frame(const ForceSettings& settings, double seconds, bool hard = false);
+  // Marks the frame set last as a trial (ForcesParams::trial): labels are drawn where they were
+  // and the state is not written, so several trial placements start from the same state.
+  void set_trial(bool trial) { params_.trial = trial ? 1u : 0u; }
   // The frame's push constants (the placement's previous pass reads them too).
   const gpu::ForcesParams& params() const { return params_; }
   // Forgets every drawn position: the next frame puts each label on its target.
@@ -72,6 +76,7 @@ class LabelForces {
   std::vector<gpu::LabelStateGpu> state() const;
   // Where the labels were drawn in the last completed frame.
   std::span<const gpu::PlacementGpu> drawn() const;
+  graph::Readback& readback() { return readback_; }
 
  private:
   Context& ctx_;
@@ -79,7 +84,7 @@ class LabelForces {
   gpu::ForcesParams params_{};
   ComputePipeline forces_;
   Buffer state_;
-  Buffer readback_;
+  graph::Readback readback_;
 };
 
 // The CPU reference of the placement's previous pass: what each label takes from the state.
@@ -87,8 +92,8 @@ std::vector<gpu::LabelGpu> previous_reference(std::vector<gpu::LabelGpu> labels,
                                               const std::vector<gpu::LabelStateGpu>& state,
                                               const gpu::ForcesParams& params);
 
-// The CPU reference: one frame of forces over every label. `state` is updated in place; returns
-// where each label is drawn.
+// The CPU reference: one frame of forces over every label. `state` is updated in place (kept in a
+// trial frame); returns where each label is drawn.
 std::vector<gpu::PlacementGpu> forces_reference(const std::vector<gpu::LabelGpu>& labels,
                                                 const std::vector<gpu::PlacementGpu>& targets,
                                                 std::vector<gpu::LabelStateGpu>& state,

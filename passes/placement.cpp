@@ -45,14 +45,12 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
       place_(ctx, "place_label.comp"),
       finalize_(ctx, "placement_finalize.comp"),
       previous_(ctx, "label_previous.comp"),
-      tables_(ctx) {
+      tables_(ctx),
+      readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu)) {
   if (label_count > LABEL_MAX) {
     throw Error("placement: " + std::to_string(label_count) + " labels; strata places at most " +
                 std::to_string(LABEL_MAX));
   }
-  readback_ = Buffer(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu),
-                     VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback);
-  std::memset(readback_.mapped(), 0, readback_.size());
 }
 
 gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) const {
@@ -105,11 +103,11 @@ Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
   add_bounds(graph, b);
   const graph::PassId loop = add_label_loop(graph, b);
   add_finalize(graph, b);
-  return {b.labels,      b.placements, b.saliency, b.costs, b.tables,
-          b.constraints, b.results,    b.buckets,  loop};
+  return {b.labels,  b.placements, b.saliency, b.costs, b.tables, b.constraints,
+          b.results, b.buckets,    b.order,    loop};
 }
 
-Placement::Buffers Placement::add_buffers(graph::Graph& graph) const {
+Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
   const uint32_t n = std::max(label_count_, 1u);
   const uint32_t layers = layer_count_;
   Buffers b;
@@ -132,8 +130,7 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) const {
   b.samples = graph.add_buffer("placement.samples", per_tile(sizeof(uint64_t)));
   b.regions = graph.add_buffer("placement.regions",
                                fixed(VkDeviceSize{n} * n * sizeof(gpu::PairRegionsGpu)));
-  b.readback = graph.import_buffer("placement.readback",
-                                   {.buffer = readback_.handle(), .final_use = Use::host_read});
+  b.readback = readback_.import(graph, "placement.readback");
   return b;
 }
 
@@ -320,7 +317,7 @@ std::vector<PipelineReport> Placement::pipeline_statistics() const {
 }
 
 std::span<const gpu::PlacementGpu> Placement::results() const {
-  return {reinterpret_cast<const gpu::PlacementGpu*>(readback_.mapped()), label_count_};
+  return {reinterpret_cast<const gpu::PlacementGpu*>(readback_.data().data()), label_count_};
 }
 
 }  // namespace strata

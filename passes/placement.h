@@ -16,6 +16,7 @@
 #include "engine/gpu/resources.h"
 #include "engine/gpu/shader_library.h"
 #include "engine/graph/graph_runner.h"
+#include "engine/graph/readback.h"
 #include "engine/scene/scene.h"
 #include "passes/summed_area_table.h"
 #include "shared/forces.h"
@@ -79,6 +80,7 @@ class Placement {
   struct Outputs {
     graph::ResourceId labels, placements, saliency, costs, tables, constraints, results;
     graph::ResourceId buckets;  // PlacementBucketsGpu per order position (benchmark statistics)
+    graph::ResourceId order;    // uint[]: the frame's insertion order (label indices)
     graph::PassId label_loop;   // the pass that places the labels one by one
   };
 
@@ -93,8 +95,9 @@ class Placement {
   void set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_t> order,
                  const PlacementSettings& settings);
 
-  // The placements of the last completed frame.
+  // The placements of the last completed frame (of the readback's current slot).
   std::span<const gpu::PlacementGpu> results() const;
+  graph::Readback& readback() { return readback_; }
 
   // The placement's compute pipelines (shader name and what the driver reports of each).
   std::vector<PipelineReport> pipeline_statistics() const;
@@ -105,7 +108,7 @@ class Placement {
     graph::ResourceId bounds, tiles, buckets, lower, args, speculative, samples, regions;
     graph::ResourceId readback;
   };
-  Buffers add_buffers(graph::Graph& graph) const;
+  Buffers add_buffers(graph::Graph& graph);
   void add_upload(graph::Graph& graph, const Buffers& b);
   void add_previous(graph::Graph& graph, const Buffers& b, const Previous& previous);
   void add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in);
@@ -125,7 +128,7 @@ class Placement {
   PlacementSettings settings_;
   ComputePipeline saliency_, integral_costs_, bounds_, place_, finalize_, previous_;
   SummedAreaTable tables_;
-  Buffer readback_;
+  graph::Readback readback_;
 };
 
 }  // namespace strata

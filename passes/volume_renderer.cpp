@@ -280,6 +280,7 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
       settings_(std::move(settings)),
       camera_(camera_for(scene, "")),
       inputs_(prepare_render_inputs(scene, ctx.properties().limits.maxImageDimension3D)),
+      counters_readback_(ctx, VR_COUNTER_COUNT * sizeof(uint32_t)),
       build_(ctx, "habuffer_build.vert", "habuffer_build.frag", {}),
       resolve_(ctx, "habuffer_resolve.comp") {
   frame_data(inputs_, camera_, settings_, {1, 1}, 1);  // checks the settings early
@@ -298,9 +299,6 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
   volumes_ = filled(inputs_.volumes);
   occupancy_ = Buffer(ctx, at_least(inputs_.occupancy.size() * sizeof(uint32_t)), storage,
                       MemoryKind::device_local);
-  counters_readback_ = Buffer(ctx, VR_COUNTER_COUNT * sizeof(uint32_t),
-                              VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryKind::host_readback);
-  std::memset(counters_readback_.mapped(), 0, VR_COUNTER_COUNT * sizeof(uint32_t));
   transfer_table_ = Buffer(ctx, inputs_.transfer_table.size() * sizeof(glm::vec4), storage,
                            MemoryKind::device_local);
   upload_transfer();
@@ -342,6 +340,8 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                                {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count, true});
   out.final = graph.add_image("render.final", {VK_FORMAT_R8G8B8A8_UNORM});
   out.depth = graph.add_image("render.depth", {VK_FORMAT_R32_SFLOAT});
+  out.frame = frame;
+  out.keys = keys;
   const auto uploaded = [&graph](const char* name, const Buffer& buffer) {
     return graph.import_buffer(name, {.buffer = buffer.handle(), .has_content = true});
   };
@@ -356,9 +356,7 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
   ids_.occupancy = uploaded("render.occupancy", occupancy_);
   ids_.vertices = uploaded("render.vertices", vertices_);
   ids_.indices = uploaded("render.indices", indices_);
-  ids_.readback =
-      graph.import_buffer("render.counters_readback",
-                          {.buffer = counters_readback_.handle(), .final_use = Use::host_read});
+  ids_.readback = counters_readback_.import(graph, "render.counters_readback");
 
   graph.add_pass(
       {"render.clear",
@@ -437,7 +435,7 @@ void VolumeRenderer::record_build(graph::PassContext& pc) const {
 
 RenderStats VolumeRenderer::collect(graph::GraphRunner& runner) {
   uint32_t c[VR_COUNTER_COUNT];
-  std::memcpy(c, counters_readback_.mapped(), sizeof c);
+  std::memcpy(c, counters_readback_.data().data(), sizeof c);
   RenderStats stats;
   stats.overflow = c[VR_COUNTER_OVERFLOW];
   stats.fragments = c[VR_COUNTER_FRAGMENTS];

@@ -10,6 +10,7 @@
 #include "engine/gpu/resources.h"
 #include "engine/gpu/shader_library.h"
 #include "engine/graph/graph_runner.h"
+#include "engine/graph/readback.h"
 #include "engine/graph/render_graph.h"
 #include "engine/scene/scene.h"
 #include "shared/volume_render.h"
@@ -82,6 +83,8 @@ class VolumeRenderer {
     graph::ResourceId layers;  // rgba16f array, one layer per depth layer, premultiplied
     graph::ResourceId final;   // rgba8, layers over the background
     graph::ResourceId depth;   // r32f eye depth, 0 where nothing is opaque enough
+    graph::ResourceId frame;   // FrameGpu (uniform): camera, layers, the HA-Buffer's size
+    graph::ResourceId keys;    // the HA-Buffer: uint64_t per slot (debug views)
   };
 
   // Uploads the scene once: volumes into the atlas, transfer functions into their table, the
@@ -105,6 +108,8 @@ class VolumeRenderer {
   RenderStats collect(graph::GraphRunner& runner);
 
   const RenderInputs& inputs() const { return inputs_; }
+  // The counters' readback, one per frame in flight (collect() reads its current slot).
+  graph::Readback& readback() { return counters_readback_; }
   const Camera& camera() const { return camera_; }
 
  private:
@@ -118,7 +123,8 @@ class VolumeRenderer {
   RenderInputs inputs_;
 
   Image atlas_;
-  Buffer transfer_table_, volumes_, occupancy_, vertices_, indices_, counters_readback_;
+  Buffer transfer_table_, volumes_, occupancy_, vertices_, indices_;
+  graph::Readback counters_readback_;
   uint32_t forced_slots_ = 0;  // 0: sized from the viewport
 
   GraphicsPipeline build_;

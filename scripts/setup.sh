@@ -18,7 +18,7 @@ packages=(
   # videos: H.264 in MP4 through FFmpeg's libraries; ffprobe checks them in the tests
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
   # window tests without a display
-  xvfb xauth
+  xvfb xauth xdotool
 )
 
 cd "$(dirname "$0")/.."

@@ -13,7 +13,10 @@ layout(push_constant) uniform Push { ForcesParams params; };
 void main() {
   const uint i = gl_GlobalInvocationID.x;
   if (i >= params.label_count) return;
-  const LabelStateGpu state = forces_update(labels[i], targets[i], states[i], params);
-  states[i] = state;
+  LabelStateGpu state = states[i];
+  if (params.trial == 0u) {
+    state = forces_update(labels[i], targets[i], state, params);
+    states[i] = state;
+  }
   drawn[i] = forces_drawn(targets[i], state);
 }

@@ -30,6 +30,7 @@ TEST_SUITE("window") {
       graph::Graph g;
       target.add_output(g, pattern.add_to(g, 4));
       graph::GraphRunner runner(ctx, std::move(g));
+      runner.set_frames_in_flight(target.frames_in_flight());
       for (int i = 0; i < 3; ++i) CHECK(target.draw(runner));
       CHECK(target.extent() == graph::Extent{160, 120});
       CHECK(runner.viewport() == graph::Extent{160, 120});

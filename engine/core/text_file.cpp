@@ -19,6 +19,12 @@ std::string read_text_file(const std::filesystem::path& path) {
   return std::move(text).str();
 }
 
+void write_text_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  if (!out.flush()) throw Error(path.string() + ": cannot write the file");
+}
+
 std::string text_position(const std::string& text, std::ptrdiff_t offset) {
   const auto upto =
       text.begin() + std::clamp<std::ptrdiff_t>(offset, 0, std::ptrdiff_t(text.size()));

@@ -106,10 +106,7 @@ GraphRunner::GraphRunner(Context& ctx, Graph graph)
                                    r.imported_image.format}
                            : Bound{r.imported_buffer.buffer};
   }
-  VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-  info.queryType = VK_QUERY_TYPE_TIMESTAMP;
-  info.queryCount = static_cast<uint32_t>(2 * std::max<size_t>(1, graph_.passes().size()));
-  STRATA_VK(vkCreateQueryPool(ctx_.device(), &info, nullptr, &queries_));
+  set_frames_in_flight(1);
   VkSamplerCreateInfo sampler{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   sampler.magFilter = sampler.minFilter = VK_FILTER_LINEAR;
   sampler.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
@@ -119,13 +116,30 @@ GraphRunner::GraphRunner(Context& ctx, Graph graph)
 }
 
 GraphRunner::~GraphRunner() {
+  if (frames_in_flight() > 1) vkDeviceWaitIdle(ctx_.device());  // frames may still run
   vkDestroySampler(ctx_.device(), linear_sampler_, nullptr);
-  vkDestroyQueryPool(ctx_.device(), queries_, nullptr);
+  for (VkQueryPool pool : queries_) vkDestroyQueryPool(ctx_.device(), pool, nullptr);
+}
+
+void GraphRunner::set_frames_in_flight(uint32_t frames) {
+  if (frames == 0) throw Error("render graph: no frames in flight");
+  if (!queries_.empty()) vkDeviceWaitIdle(ctx_.device());
+  for (VkQueryPool pool : queries_) vkDestroyQueryPool(ctx_.device(), pool, nullptr);
+  queries_.assign(frames, VK_NULL_HANDLE);
+  VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  info.queryCount = static_cast<uint32_t>(2 * std::max<size_t>(1, graph_.passes().size()));
+  for (VkQueryPool& pool : queries_) {
+    STRATA_VK(vkCreateQueryPool(ctx_.device(), &info, nullptr, &pool));
+  }
+  slot_ = 0;
 }
 
 void GraphRunner::set_viewport(Extent viewport) {
   if (viewport == viewport_) return;
   if (viewport.width == 0 || viewport.height == 0) throw Error("render graph: empty viewport");
+  // (resources of frames still in flight are replaced: those frames finish first)
+  if (viewport_.width != 0 && frames_in_flight() > 1) vkDeviceWaitIdle(ctx_.device());
   viewport_ = viewport;
   for (size_t i = 0; i < graph_.resources().size(); ++i) {
     const ResourceInfo& r = graph_.resources()[i];
@@ -147,6 +161,8 @@ void GraphRunner::set_viewport(Extent viewport) {
 
 void GraphRunner::reallocate() {
   const Extent viewport = viewport_;
+  // (resources of frames still in flight are replaced: those frames finish first)
+  if (frames_in_flight() > 1) vkDeviceWaitIdle(ctx_.device());
   viewport_ = {};
   set_viewport(viewport);
 }
@@ -240,7 +256,7 @@ bool GraphRunner::stamps_end(uint32_t p) const {
 VkCommandBuffer GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
   emit(cmd, compiled_.pass_barriers[p]);
   if (stamps_begin(p)) {
-    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p);
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_[slot_], 2 * p);
   }
   PassContext pc;
   pc.cmd = cmd;
@@ -249,15 +265,33 @@ VkCommandBuffer GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
   pc.pass_ = p;
   graph_.passes()[p].record(pc);
   if (stamps_end(p)) {
-    vkCmdWriteTimestamp2(pc.cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_, 2 * p + 1);
+    vkCmdWriteTimestamp2(pc.cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_[slot_], 2 * p + 1);
   }
   return pc.cmd;
 }
 
-void GraphRunner::record(VkCommandBuffer cmd) {
+void GraphRunner::record(VkCommandBuffer cmd, uint32_t slot) {
   check_bound();
+  if (slot >= queries_.size()) {
+    throw Error("render graph: frame slot " + std::to_string(slot) + " of " +
+                std::to_string(queries_.size()) + " frames in flight");
+  }
+  slot_ = slot;
   const auto passes = static_cast<uint32_t>(graph_.passes().size());
-  vkCmdResetQueryPool(cmd, queries_, 0, 2 * passes);
+  if (frames_in_flight() > 1) {
+    // Frames share the transient resources and follow each other on the queue: everything the
+    // earlier frames did is done and visible before this one starts (compile() orders the passes
+    // inside one frame only).
+    VkMemoryBarrier2 all{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+    all.srcStageMask = all.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    all.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
+    all.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.memoryBarrierCount = 1;
+    dep.pMemoryBarriers = &all;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  }
+  vkCmdResetQueryPool(cmd, queries_[slot_], 0, 2 * passes);
   for (uint32_t p = 0; p < passes; ++p) record_pass(cmd, p);
   emit(cmd, compiled_.final_barriers);
 }
@@ -277,7 +311,8 @@ void GraphRunner::run_split(const std::function<bool(const SplitPoint&)>& split_
   after_split_ = &after;
   const auto passes = static_cast<uint32_t>(graph_.passes().size());
   VkCommandBuffer cmd = ctx_.begin_commands();
-  vkCmdResetQueryPool(cmd, queries_, 0, 2 * passes);
+  slot_ = 0;
+  vkCmdResetQueryPool(cmd, queries_[slot_], 0, 2 * passes);
   for (uint32_t p = 0; p < passes; ++p) {
     cmd = record_pass(cmd, p);
     if (p + 1 < passes) split(cmd, {p});
@@ -293,20 +328,21 @@ void GraphRunner::run_now() {
   ctx_.run_now([&](VkCommandBuffer cmd) { record(cmd); });
 }
 
-std::vector<PassTiming> GraphRunner::timings() const {
+std::vector<PassTiming> GraphRunner::timings(uint32_t slot) const {
+  const VkQueryPool pool = queries_.at(slot);
   const auto& passes = graph_.passes();
   std::vector<uint64_t> stamps(2 * passes.size());
   // (stamps that were not written must not be waited for: read those that were, one by one)
   const auto read = [&](uint32_t query) {
-    STRATA_VK(vkGetQueryPoolResults(ctx_.device(), queries_, query, 1, sizeof(uint64_t),
-                                    &stamps[query], sizeof(uint64_t),
+    STRATA_VK(vkGetQueryPoolResults(ctx_.device(), pool, query, 1, sizeof(uint64_t), &stamps[query],
+                                    sizeof(uint64_t),
                                     VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   };
   if (per_pass_stamps_ && !passes.empty()) {
-    STRATA_VK(
-        vkGetQueryPoolResults(ctx_.device(), queries_, 0, static_cast<uint32_t>(stamps.size()),
-                              stamps.size() * sizeof(uint64_t), stamps.data(), sizeof(uint64_t),
-                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    STRATA_VK(vkGetQueryPoolResults(ctx_.device(), pool, 0, static_cast<uint32_t>(stamps.size()),
+                                    stamps.size() * sizeof(uint64_t), stamps.data(),
+                                    sizeof(uint64_t),
+                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   } else {
     for (uint32_t p = 0; p < passes.size(); ++p) {
       if (stamps_begin(p)) read(2 * p);

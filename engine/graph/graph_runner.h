@@ -112,7 +112,14 @@ class GraphRunner {
   void bind_buffer(ResourceId id, VkBuffer buffer);
   void bind_image(ResourceId id, VkImage image, VkImageView view, VkFormat format);
 
-  void record(VkCommandBuffer cmd);
+  // Frames recorded before the earlier ones finished (the viewer keeps two in flight): each
+  // frame slot has its own timestamps, and a frame first waits on the queue for everything the
+  // frames before it did. Waits for the device when it changes.
+  void set_frames_in_flight(uint32_t frames);
+  uint32_t frames_in_flight() const { return static_cast<uint32_t>(queries_.size()); }
+
+  // Records one frame into `cmd`, its timestamps into frame slot `slot`.
+  void record(VkCommandBuffer cmd, uint32_t slot = 0);
   // Records into a fresh command buffer, submits and waits (headless runs, benchmarks, tests).
   void run_now();
   // The same work split into several submissions: at every point (after a pass, or at a pass's
@@ -133,8 +140,8 @@ class GraphRunner {
   // ends: a group's time without the cost of stamping each of its passes (benchmarks).
   void set_timestamps_per_pass(bool per_pass) { per_pass_stamps_ = per_pass; }
   // GPU time of each pass of the last completed run; with group stamps only, one entry per
-  // group (named after it) instead.
-  std::vector<PassTiming> timings() const;
+  // group (named after it) instead. With frames in flight: of the last completed frame of `slot`.
+  std::vector<PassTiming> timings(uint32_t slot = 0) const;
 
   const Graph& graph() const { return graph_; }
   // Mutable so that a test can drop a barrier and show that validation catches it.
@@ -168,7 +175,8 @@ class GraphRunner {
   Extent viewport_{};
   std::vector<std::variant<std::monostate, Buffer, Image>> owned_;
   std::vector<Bound> bound_;
-  VkQueryPool queries_ = VK_NULL_HANDLE;
+  std::vector<VkQueryPool> queries_;  // one per frame slot
+  uint32_t slot_ = 0;                 // the slot being recorded
   VkSampler linear_sampler_ = VK_NULL_HANDLE;
   const std::function<bool(const SplitPoint&)>* split_at_ = nullptr;  // inside run_split only
   const std::function<void(const SplitPoint&)>* after_split_ = nullptr;

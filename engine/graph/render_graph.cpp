@@ -13,8 +13,8 @@ constexpr VkPipelineStageFlags2 kShaderStages[] = {
 };
 
 bool image_only(Use use) {
-  return use == Use::sampled || use == Use::color_attachment || use == Use::depth_attachment ||
-         use == Use::present;
+  return use == Use::sampled || use == Use::color_attachment || use == Use::color_blend ||
+         use == Use::depth_attachment || use == Use::present;
 }
 
 bool buffer_only(Use use) {
@@ -35,6 +35,7 @@ VkFlags usage_flag(Use use, bool is_image) {
     case Use::indirect:
       return VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
     case Use::color_attachment:
+    case Use::color_blend:
       return VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
     case Use::depth_attachment:
       return VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
@@ -169,6 +170,8 @@ const char* to_string(Use use) {
       return "indirect";
     case Use::color_attachment:
       return "color_attachment";
+    case Use::color_blend:
+      return "color_blend";
     case Use::depth_attachment:
       return "depth_attachment";
     case Use::transfer_src:
@@ -206,6 +209,10 @@ Access access_of(Use use, PassKind kind, bool is_image) {
       return {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
               VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
               VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, false, true};
+    case Use::color_blend:
+      return {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+              VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+              VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, true, true};
     case Use::depth_attachment:
       return {VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
                   VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,

@@ -35,7 +35,8 @@ struct Extent {
 enum class PassKind { compute, graphics, transfer };
 
 // How a pass touches a resource. Writes that are not also reads (storage_write, transfer_dst,
-// color_attachment) need no earlier content; every read needs a writer or imported content.
+// color_attachment) need no earlier content; every read (color_blend too) needs a writer or
+// imported content.
 enum class Use {
   sampled,             // image read through a sampler
   storage_read,        // storage buffer or image, read
@@ -44,6 +45,7 @@ enum class Use {
   uniform,             // uniform buffer
   indirect,            // indirect dispatch or draw arguments
   color_attachment,    // rendered to (cleared or overwritten)
+  color_blend,         // rendered onto: loaded, blended over, stored (a UI over the picture)
   depth_attachment,    // depth test and write
   transfer_src,
   transfer_dst,

@@ -55,27 +55,16 @@ std::vector<const char*> Glfw::instance_extensions() const {
   return {names, names + count};
 }
 
-WindowTarget::WindowTarget(Context& ctx, GLFWwindow* window) : ctx_(ctx), window_(window) {
+WindowTarget::WindowTarget(Context& ctx, GLFWwindow* window, uint32_t frames_in_flight)
+    : ctx_(ctx), window_(window), slots_(ctx, frames_in_flight) {
   STRATA_VK(glfwCreateWindowSurface(ctx.instance(), window, nullptr, &surface_));
   VkBool32 supported = VK_FALSE;
   vkGetPhysicalDeviceSurfaceSupportKHR(ctx.physical_device(), ctx.queue_family(), surface_,
                                        &supported);
   if (!supported) throw Error("device '" + ctx.report().name + "' cannot present to this window");
-
+  acquired_.resize(frames_in_flight);
   VkSemaphoreCreateInfo sem{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-  STRATA_VK(vkCreateSemaphore(ctx.device(), &sem, nullptr, &acquired_));
-  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  fence.flags = VK_FENCE_CREATE_SIGNALED_BIT;
-  STRATA_VK(vkCreateFence(ctx.device(), &fence, nullptr, &frame_done_));
-  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pool.queueFamilyIndex = ctx.queue_family();
-  STRATA_VK(vkCreateCommandPool(ctx.device(), &pool, nullptr, &pool_));
-  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  alloc.commandPool = pool_;
-  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  alloc.commandBufferCount = 1;
-  STRATA_VK(vkAllocateCommandBuffers(ctx.device(), &alloc, &cmd_));
+  for (VkSemaphore& s : acquired_) STRATA_VK(vkCreateSemaphore(ctx.device(), &sem, nullptr, &s));
 }
 
 WindowTarget::~WindowTarget() {
@@ -83,9 +72,7 @@ WindowTarget::~WindowTarget() {
   vkDeviceWaitIdle(device);
   destroy_swapchain_images();
   vkDestroySwapchainKHR(device, swapchain_, nullptr);
-  vkDestroyCommandPool(device, pool_, nullptr);
-  vkDestroyFence(device, frame_done_, nullptr);
-  vkDestroySemaphore(device, acquired_, nullptr);
+  for (VkSemaphore s : acquired_) vkDestroySemaphore(device, s, nullptr);
   vkDestroySurfaceKHR(ctx_.instance(), surface_, nullptr);
 }
 
@@ -164,52 +151,47 @@ void WindowTarget::create_swapchain(graph::Extent framebuffer) {
   for (VkSemaphore& s : rendered_) STRATA_VK(vkCreateSemaphore(device, &sem, nullptr, &s));
 }
 
-void WindowTarget::wait_for_last_frame() {
-  STRATA_VK(vkWaitForFences(ctx_.device(), 1, &frame_done_, VK_TRUE, UINT64_MAX));
+void WindowTarget::wait_idle() {
+  slots_.wait_all();
 }
 
 bool WindowTarget::draw(graph::GraphRunner& runner) {
+  return draw([&runner](uint32_t, graph::Extent) -> graph::GraphRunner& { return runner; });
+}
+
+bool WindowTarget::draw(const Prepare& prepare) {
   const graph::Extent framebuffer = framebuffer_size(window_);
   if (framebuffer.width == 0 || framebuffer.height == 0) return false;  // minimised
   if (!swapchain_ || out_of_date_ || !(framebuffer == extent_)) create_swapchain(framebuffer);
-  runner.set_viewport(extent_);
 
+  const uint32_t slot = slots_.next();
   VkDevice device = ctx_.device();
-  STRATA_VK(vkWaitForFences(device, 1, &frame_done_, VK_TRUE, UINT64_MAX));
   uint32_t index = 0;
-  const VkResult acquired =
-      vkAcquireNextImageKHR(device, swapchain_, UINT64_MAX, acquired_, VK_NULL_HANDLE, &index);
+  const VkResult acquired = vkAcquireNextImageKHR(device, swapchain_, UINT64_MAX, acquired_[slot],
+                                                  VK_NULL_HANDLE, &index);
   if (acquired == VK_ERROR_OUT_OF_DATE_KHR) {
     out_of_date_ = true;
     return false;
   }
   if (acquired != VK_SUBOPTIMAL_KHR) check_vk(acquired, "vkAcquireNextImageKHR");
-  STRATA_VK(vkResetFences(device, 1, &frame_done_));
 
+  graph::GraphRunner& runner = prepare(slot, extent_);
+  if (runner.frames_in_flight() < slots_.count()) {
+    throw Error("window: the render graph keeps " + std::to_string(runner.frames_in_flight()) +
+                " frames in flight, the window " + std::to_string(slots_.count()));
+  }
+  runner.set_viewport(extent_);
   runner.bind_image(swapchain_id_, images_[index], VK_NULL_HANDLE, format_);
-  STRATA_VK(vkResetCommandBuffer(cmd_, 0));
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  STRATA_VK(vkBeginCommandBuffer(cmd_, &begin));
-  runner.record(cmd_);
-  STRATA_VK(vkEndCommandBuffer(cmd_));
+  const VkCommandBuffer cmd = slots_.begin(slot);
+  runner.record(cmd, slot);
 
   VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-  wait.semaphore = acquired_;
+  wait.semaphore = acquired_[slot];
   wait.stageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;  // the blit; matches initial_stage
   VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
   signal.semaphore = rendered_[index];
   signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-  VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-  cmd_info.commandBuffer = cmd_;
-  VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-  submit.waitSemaphoreInfoCount = 1;
-  submit.pWaitSemaphoreInfos = &wait;
-  submit.commandBufferInfoCount = 1;
-  submit.pCommandBufferInfos = &cmd_info;
-  submit.signalSemaphoreInfoCount = 1;
-  submit.pSignalSemaphoreInfos = &signal;
-  STRATA_VK(vkQueueSubmit2(ctx_.queue(), 1, &submit, frame_done_));
+  slots_.submit(slot, {&wait, 1}, {&signal, 1});
 
   VkPresentInfoKHR present{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
   present.waitSemaphoreCount = 1;

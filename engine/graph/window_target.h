@@ -1,10 +1,13 @@
 // Rendering to a GLFW window: a surface, a swapchain that follows the framebuffer (resize, HiDPI
-// scale, minimise), and one frame in flight. The graph's final rgba8 image is blitted to the
-// acquired swapchain image by a transfer pass, so the same graph feeds this and HeadlessTarget.
+// scale, minimise), and frames in flight (FrameSlots: two by default). The graph's final rgba8
+// image is blitted to the acquired swapchain image by a transfer pass, so the same graph feeds this
+// and HeadlessTarget.
 #pragma once
 
+#include <functional>
 #include <vector>
 
+#include "engine/graph/frame_slots.h"
 #include "engine/graph/graph_runner.h"
 
 struct GLFWwindow;
@@ -26,7 +29,7 @@ class Glfw {
 
 class WindowTarget {
  public:
-  WindowTarget(Context& ctx, GLFWwindow* window);
+  WindowTarget(Context& ctx, GLFWwindow* window, uint32_t frames_in_flight = 2);
   ~WindowTarget();
   WindowTarget(const WindowTarget&) = delete;
   WindowTarget& operator=(const WindowTarget&) = delete;
@@ -36,10 +39,15 @@ class WindowTarget {
   // Draws and presents one frame, sizing the runner's viewport to the framebuffer. Returns false,
   // drawing nothing, while the window is minimised (framebuffer of zero size).
   bool draw(graph::GraphRunner& runner);
+  // The same, with the frame prepared in between: once the frame slot is free (its last frame
+  // finished: read its results now), `prepare(slot, extent)` sets the frame up and returns the
+  // runner to record (it may build a new one); the runner has frames_in_flight() slots.
+  using Prepare = std::function<graph::GraphRunner&(uint32_t slot, graph::Extent extent)>;
+  bool draw(const Prepare& prepare);
 
-  // Waits until the last submitted frame has finished (its counters can then be read, its
-  // resources reallocated): with one frame in flight, draw() waits for this anyway.
-  void wait_for_last_frame();
+  // Waits until every submitted frame has finished.
+  void wait_idle();
+  uint32_t frames_in_flight() const { return slots_.count(); }
 
   graph::Extent extent() const { return extent_; }
   uint32_t swapchain_recreations() const { return recreations_; }
@@ -56,10 +64,8 @@ class WindowTarget {
   graph::Extent extent_{};
   std::vector<VkImage> images_;
   std::vector<VkSemaphore> rendered_;  // one per swapchain image
-  VkSemaphore acquired_ = VK_NULL_HANDLE;
-  VkFence frame_done_ = VK_NULL_HANDLE;
-  VkCommandPool pool_ = VK_NULL_HANDLE;
-  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+  std::vector<VkSemaphore> acquired_;  // one per frame slot
+  FrameSlots slots_;
   graph::ResourceId swapchain_id_ = 0;
   bool out_of_date_ = false;
   uint32_t recreations_ = 0;

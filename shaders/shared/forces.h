@@ -43,7 +43,7 @@ struct ForcesParams {
   float hold_share;      // the hold: this share of the target's cost ...
   float hold_cost;       // ... plus this
   float appear_padding;  // pixels of padding for a label hidden in the last frame (hard mode)
-  uint pad;
+  uint trial;  // 1: a trial frame (the viewer's optimisation on idle): the state stays as it was
 };
 
 // An opacity moved by `change`, kept in [0, 1]; within 1/512 of either end (less than a step of

@@ -1,0 +1,618 @@
+#include "app/viewer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#define GLFW_INCLUDE_VULKAN
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+
+#include "engine/core/error.h"
+#include "engine/core/png.h"
+#include "engine/core/text_file.h"
+#include "engine/gpu/context.h"
+#include "engine/scene/io/scene_loader.h"
+#include "labeling/camera_path.h"
+#include "labeling/insertion_order.h"
+
+namespace strata::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+constexpr double kMaxStep = 0.1;           // a frame's time step at most (slow devices)
+constexpr double kPlotSeconds = 5.0;       // the timing plots' span
+constexpr double kAnimationSeconds = 1.0;  // moves to named positions and anatomical views
+
+bool same_view(const Camera& a, const Camera& b) {
+  return a.view == b.view;
+}
+
+// A transfer function seen through a window of intensities: the function's [0, 1] spread over
+// [level - window / 2, level + window / 2], its opacity times `opacity`.
+TransferFunction windowed(const TransferFunction& tf, float level, float window, float opacity) {
+  TransferFunction out = tf;
+  for (auto& stop : out.stops) {
+    stop.position = level - 0.5f * window + stop.position * window;
+    stop.color.a = std::clamp(stop.color.a * opacity, 0.0f, 1.0f);
+  }
+  return out;
+}
+
+float parse_float(const std::string& name, const std::string& value) {
+  try {
+    size_t used = 0;
+    const float v = std::stof(value, &used);
+    if (used == value.size() && std::isfinite(v)) return v;
+  } catch (const std::exception&) {
+  }
+  throw Error("parameter " + name + ": '" + value + "' is not a number");
+}
+
+bool parse_bool(const std::string& name, const std::string& value) {
+  if (value == "1" || value == "true" || value == "on") return true;
+  if (value == "0" || value == "false" || value == "off") return false;
+  throw Error("parameter " + name + ": '" + value + "' is not on or off");
+}
+
+}  // namespace
+
+bool HeadlessOutput::draw(const WindowTarget::Prepare& prepare) {
+  const uint32_t slot = slots_.next();
+  graph::GraphRunner& runner = prepare(slot, size_);
+  runner.set_viewport(size_);
+  const VkCommandBuffer cmd = slots_.begin(slot);
+  runner.record(cmd, slot);
+  slots_.submit(slot);
+  return true;
+}
+
+graph::Extent WindowOutput::extent() const {
+  int w = 0, h = 0;
+  glfwGetFramebufferSize(window_, &w, &h);
+  return {uint32_t(std::max(w, 0)), uint32_t(std::max(h, 0))};
+}
+
+std::vector<std::pair<std::string, std::string>> viewer_parameters() {
+  return {
+      {"weights.label_shadow", "eq. 3.1: a box over an earlier box or its leader"},
+      {"weights.anchor_constraint", "eq. 3.1: a box or leader over an anchor"},
+      {"weights.connector_shadow", "eq. 3.1: a leader over an earlier box or leader"},
+      {"weights.integral_costs", "eq. 3.1: the occlusion and saliency under the box"},
+      {"weights.distance_to_anchor", "eq. 3.1: leader length"},
+      {"weights.connector_direction", "eq. 3.1: leader direction change from the last frame"},
+      {"weights.previous_position", "eq. 3.1 eta: distance to the last target (per pixel)"},
+      {"integral.saliency", "eq. 3.3: how much saliency modulates occlusion"},
+      {"integral.occlusion", "eq. 3.4: occlusion weight with one layer"},
+      {"integral.single_saliency", "eq. 3.4: saliency weight with one layer"},
+      {"margin", "pixels around boxes in the constraints"},
+      {"layers", "depth layers asked for, 1 to 8"},
+      {"hard", "on: no constraint violations (labels may be hidden)"},
+      {"internal", "on: each label on its anchor"},
+      {"font", "label font size in pixels"},
+      {"forces.speed", "pixels per second at full force"},
+      {"forces.epsilon", "pixels: nearer than this the force shrinks"},
+      {"forces.snap", "pixels: nearer than this a label lands on its target"},
+      {"forces.hold_share", "hold: this share of the target's cost ..."},
+      {"forces.hold_cost", "... plus this"},
+      {"forces.fade", "seconds a label takes to fade in or out"},
+      {"forces.anchor_relative", "on: labels held as offsets from their anchors"},
+      {"optimize", "on: try random insertion orders when the camera rests"},
+      {"render.step", "world units between ray samples (0: half the finest voxel)"},
+      {"render.skip_empty", "on: empty-space skipping"},
+  };
+}
+
+Viewer::Viewer(Context& ctx, Scene& scene, const Camera& camera, const LabellingSettings& settings,
+               const ViewerOptions& options, ViewerOutput& output, GLFWwindow* window)
+    : ctx_(ctx),
+      scene_(scene),
+      options_(options),
+      output_(output),
+      ui_(ctx, window, options.ui_scale, output.frames_in_flight()),
+      control_(scene, camera),
+      debug_(ctx),
+      applied_camera_(camera),
+      last_change_(Clock::now()),
+      last_frame_(Clock::now()),
+      slots_(output.frames_in_flight()) {
+  graph::Extent size = output.extent();
+  if (size.width == 0 || size.height == 0) size = {64, 64};  // (a minimised window: resized later)
+  labelled_ = std::make_unique<LabelledRenderer>(ctx, scene, camera, size, settings);
+  labelled_->set_extension([this](graph::Graph& graph, const LabelledRenderer::GraphIds& ids) {
+    extend_graph(graph, ids);
+  });
+  labelled_->set_frames_in_flight(output.frames_in_flight());
+  for (const Volume& v : scene.volumes) {
+    original_tfs_.push_back(v.transfer_function >= 0 ? scene.transfer_functions[v.transfer_function]
+                                                     : TransferFunction{});
+  }
+  looks_.resize(scene.volumes.size());
+}
+
+Viewer::~Viewer() {
+  output_.wait_idle();
+  if (video_) stop_recording();
+}
+
+// The viewer's end of the frame's graph: the picture (or a debug view) copied into the display
+// image, the UI drawn onto it, then the output (the window's present).
+void Viewer::extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds& ids) {
+  ++generation_;
+  const graph::ResourceId debug_image =
+      debug_.add_to(graph, {.saliency = ids.placed.saliency,
+                            .costs = ids.placed.costs,
+                            .labels = ids.placed.labels,
+                            .placements = ids.placed.placements,
+                            .order = ids.placed.order,
+                            .layers = ids.rendered.layers,
+                            .frame = ids.rendered.frame,
+                            .keys = ids.rendered.keys,
+                            .layer_count = ids.layer_count,
+                            .label_count = uint32_t(scene_.labels.size())});
+  display_id_ = graph.add_image("view.display", {VK_FORMAT_R8G8B8A8_UNORM});
+  const graph::ResourceId labelled = ids.labelled, display = display_id_;
+  graph.add_pass({"view.copy",
+                  graph::PassKind::transfer,
+                  {{labelled, graph::Use::transfer_src},
+                   {debug_image, graph::Use::transfer_src},
+                   {display, graph::Use::transfer_dst}},
+                  [this, labelled, debug_image, display](graph::PassContext& pc) {
+                    VkImageCopy region{};
+                    region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                    region.dstSubresource = region.srcSubresource;
+                    region.extent = {pc.viewport.width, pc.viewport.height, 1};
+                    const graph::ResourceId from = debug_choice_ ? debug_image : labelled;
+                    vkCmdCopyImage(pc.cmd, pc.image(from), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                   pc.image(display), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                                   &region);
+                  },
+                  "ui"});
+  ui_.add_to(graph, display);
+  output_.add_to(graph, display);
+}
+
+// --- input -------------------------------------------------------------------------------------
+
+void Viewer::mouse_button(int button, int action, int mods) {
+  if (action == GLFW_PRESS && drag_button_ < 0) {
+    drag_button_ = button;
+    drag_pan_ = button == GLFW_MOUSE_BUTTON_MIDDLE ||
+                (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_SHIFT));
+  } else if (action == GLFW_RELEASE && button == drag_button_) {
+    drag_button_ = -1;
+  }
+}
+
+void Viewer::cursor(glm::vec2 position) {
+  const glm::vec2 delta = position - mouse_;
+  mouse_ = position;
+  if (drag_button_ < 0 || delta == glm::vec2(0.0f)) return;
+  const graph::Extent e = output_.extent();
+  const glm::uvec2 viewport{std::max(1u, e.width), std::max(1u, e.height)};
+  if (drag_pan_) {
+    control_.pan(delta, viewport);
+  } else if (drag_button_ == GLFW_MOUSE_BUTTON_LEFT) {
+    control_.rotate(delta, viewport);
+  } else if (drag_button_ == GLFW_MOUSE_BUTTON_RIGHT) {
+    control_.zoom_drag(delta.y, viewport);
+  }
+}
+
+void Viewer::scroll(double ticks) {
+  control_.zoom_wheel(ticks);
+}
+
+void Viewer::key(int key, int mods) {
+  (void)mods;
+  switch (key) {
+    case GLFW_KEY_Q:
+    case GLFW_KEY_ESCAPE:
+      quit_ = true;
+      break;
+    case GLFW_KEY_LEFT:
+      control_.rotate_step(-1, 0);
+      break;
+    case GLFW_KEY_RIGHT:
+      control_.rotate_step(1, 0);
+      break;
+    case GLFW_KEY_UP:
+      control_.rotate_step(0, 1);
+      break;
+    case GLFW_KEY_DOWN:
+      control_.rotate_step(0, -1);
+      break;
+    case GLFW_KEY_R:
+      reset_camera();
+      break;
+    case GLFW_KEY_F12:
+      screenshot();
+      break;
+    case GLFW_KEY_H:
+      options_.show_panel = !options_.show_panel;
+      ui_event();
+      break;
+    default:
+      if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9) jump_to_position(size_t(key - GLFW_KEY_1));
+      break;
+  }
+}
+
+// --- actions -----------------------------------------------------------------------------------
+
+void Viewer::jump_to_position(size_t index) {
+  const std::optional<Camera> goal = numbered_position(scene_, index);
+  if (!goal) {
+    message_ = "the scene has no position " + std::to_string(index + 1);
+    ui_event();
+    return;
+  }
+  control_.animate_to(*goal, kAnimationSeconds);
+}
+
+void Viewer::view_from(AnatomicalView view) {
+  control_.animate_to(control_.view_from(view), kAnimationSeconds);
+}
+
+void Viewer::reset_camera() {
+  control_.reset();
+}
+
+std::filesystem::path Viewer::screenshot(const std::filesystem::path& path) {
+  std::filesystem::path out = path;
+  if (out.empty()) {
+    const std::string stem = scene_.source.empty() ? "strata" : scene_.source.stem().string();
+    do {
+      char name[64];
+      std::snprintf(name, sizeof name, "-%03u.png", ++screenshots_);
+      out = options_.screenshot_dir / (stem + name);
+    } while (std::filesystem::exists(out));
+  }
+  output_.wait_idle();
+  const graph::Extent e = labelled_->size();
+  const std::vector<std::byte> pixels =
+      labelled_->runner().download_image(labelled_->labelled_image());
+  write_png(out.string(), e.width, e.height,
+            {reinterpret_cast<const uint8_t*>(pixels.data()), pixels.size()});
+  message_ = "wrote " + out.string();
+  std::printf("view: screenshot %s\n", out.string().c_str());
+  std::fflush(stdout);
+  ui_event();
+  return out;
+}
+
+void Viewer::capture(const std::filesystem::path& path) {
+  output_.wait_idle();
+  const graph::Extent e = labelled_->size();
+  const std::vector<std::byte> pixels = labelled_->runner().download_image(display_id_);
+  write_png(path.string(), e.width, e.height,
+            {reinterpret_cast<const uint8_t*>(pixels.data()), pixels.size()});
+}
+
+// After the frames in flight finished: the results of the last one.
+void Viewer::read_latest() {
+  output_.wait_idle();
+  labelled_->use_slot(last_slot_);
+}
+
+void Viewer::write_layout(const std::filesystem::path& path) {
+  read_latest();
+  write_text_file(path, layout_json(labelled_->result()));
+}
+
+void Viewer::start_recording(const std::filesystem::path& path) {
+  if (video_) stop_recording();
+  const graph::Extent e = labelled_->size();
+  video_ = std::make_unique<VideoFile>(path.string(), e.width & ~1u, e.height & ~1u,
+                                       options_.record_fps);
+  video_path_ = path;
+  video_frames_ = 0;
+  message_ = "recording " + path.string();
+}
+
+void Viewer::stop_recording() {
+  if (!video_) return;
+  video_->finish();
+  video_.reset();
+  message_ = "wrote " + video_path_.string() + " (" + std::to_string(video_frames_) + " frames)";
+  std::printf("view: video %s, %llu frames\n", video_path_.string().c_str(),
+              static_cast<unsigned long long>(video_frames_));
+  std::fflush(stdout);
+}
+
+void Viewer::set_label_hidden(int id, bool hidden) {
+  for (size_t i = 0; i < scene_.labels.size(); ++i) {
+    if (scene_.labels[i].id != id) continue;
+    labelled_->set_label_hidden(i, hidden);
+    labelled_->set_camera(control_.camera());  // (the labels' flags are set there)
+    changed();
+    return;
+  }
+  throw Error("the scene has no label " + std::to_string(id));
+}
+
+void Viewer::save_position(const std::string& name) {
+  const std::string chosen = name.empty() ? new_position_name(scene_) : name;
+  for (const CameraPose& p : scene_.camera_positions) {
+    if (p.name == chosen) throw Error("the scene already has a position '" + chosen + "'");
+  }
+  scene_.camera_positions.push_back(control_.pose(chosen));
+  std::filesystem::path path = options_.scene_path;
+  if (path.extension() != ".json") path.replace_extension(".json");  // (a thesis .xml scene)
+  save_scene_json(path, scene_);
+  message_ = "saved position '" + chosen + "' in " + path.string();
+  std::printf("view: %s\n", message_.c_str());
+  ui_event();
+}
+
+void Viewer::set_parameter(const std::string& name, const std::string& value) {
+  LabellingSettings& s = labelled_->settings();
+  CostWeights& w = s.placement.weights;
+  const auto number = [&] { return parse_float(name, value); };
+  const auto flag = [&] { return parse_bool(name, value); };
+  bool reproject = false;
+  if (name == "weights.label_shadow") {
+    w.label_shadow = number();
+  } else if (name == "weights.anchor_constraint") {
+    w.anchor_constraint = number();
+  } else if (name == "weights.connector_shadow") {
+    w.connector_shadow = number();
+  } else if (name == "weights.integral_costs") {
+    w.integral_costs = number();
+  } else if (name == "weights.distance_to_anchor") {
+    w.distance_to_anchor = number();
+  } else if (name == "weights.connector_direction") {
+    w.connector_direction = number();
+  } else if (name == "weights.previous_position") {
+    s.forces.previous_weight = number();
+  } else if (name == "integral.saliency") {
+    s.placement.saliency_weight = number();
+  } else if (name == "integral.occlusion") {
+    s.placement.occlusion_weight = number();
+  } else if (name == "integral.single_saliency") {
+    s.placement.single_saliency_weight = number();
+  } else if (name == "margin") {
+    s.placement.margin = number();
+  } else if (name == "layers") {
+    const float layers = number();
+    if (!(layers >= 1.0f && layers <= 8.0f)) throw Error("parameter layers: 1 to 8");
+    s.layer_count = uint32_t(layers);
+    reproject = true;
+  } else if (name == "hard") {
+    s.placement.hard = flag();
+  } else if (name == "internal") {
+    s.internal = flag();
+    reproject = true;
+  } else if (name == "font") {
+    labelled_->set_font_pixels(number());
+  } else if (name == "forces.speed") {
+    s.forces.speed = number();
+  } else if (name == "forces.epsilon") {
+    s.forces.epsilon = number();
+  } else if (name == "forces.snap") {
+    s.forces.snap = number();
+  } else if (name == "forces.hold_share") {
+    s.forces.hold_share = number();
+  } else if (name == "forces.hold_cost") {
+    s.forces.hold_cost = number();
+  } else if (name == "forces.fade") {
+    s.forces.fade_seconds = number();
+  } else if (name == "forces.anchor_relative") {
+    s.forces.anchor_relative = flag();
+  } else if (name == "optimize") {
+    options_.optimize_on_idle = flag();
+  } else if (name == "render.step") {
+    labelled_->renderer().settings().step = number();
+  } else if (name == "render.skip_empty") {
+    labelled_->renderer().settings().skip_empty = flag();
+  } else {
+    std::string names;
+    for (const auto& p : viewer_parameters()) names += (names.empty() ? "" : ", ") + p.first;
+    throw Error("no parameter '" + name + "' (parameters: " + names + ")");
+  }
+  // (the forces check their settings when the next frame is set up)
+  forces_params(s.forces, 1, 0.0, s.placement.hard);
+  if (reproject) labelled_->set_camera(control_.camera());
+  labelled_->place_afresh();  // the new settings' layout, reached smoothly
+  changed();
+}
+
+void Viewer::set_transfer(uint32_t volume) {
+  const VolumeLook& look = looks_[volume];
+  output_.wait_idle();  // the table and grids are rewritten
+  labelled_->renderer().set_transfer_function(
+      volume, windowed(original_tfs_[volume], look.level, look.window, look.opacity));
+  labelled_->place_afresh();
+  changed();
+}
+
+// --- frames ------------------------------------------------------------------------------------
+
+void Viewer::changed(bool camera_moved) {
+  ++serial_;
+  settled_ = false;
+  last_change_ = Clock::now();
+  if (camera_moved || optimisation_.serial != serial_) optimisation_ = {};
+}
+
+void Viewer::apply_camera() {
+  const Camera& camera = control_.camera();
+  if (same_view(camera, applied_camera_)) return;
+  applied_camera_ = camera;
+  labelled_->set_camera(camera);  // (the order goes back to the scene's)
+  changed(true);
+}
+
+bool Viewer::busy() const {
+  if (quit_) return false;
+  if (ui_frames_ > 0 || !settled_ || control_.animating()) return true;
+  if (!same_view(control_.camera(), applied_camera_)) return true;  // moved since the last frame
+  if (drag_button_ >= 0) return false;  // a still mouse button: nothing moves
+  // Trials under way: their results come back with the next frames.
+  const Optimisation& o = optimisation_;
+  return o.serial == serial_ && !o.done && !o.orders.empty();
+}
+
+std::optional<double> Viewer::wake_in() const {
+  if (!options_.optimize_on_idle || optimisation_.done || scene_.labels.size() < 2) return {};
+  return std::max(0.0, options_.idle_seconds - seconds_between(last_change_, Clock::now()));
+}
+
+int Viewer::next_trial() {
+  Optimisation& o = optimisation_;
+  const size_t n = scene_.labels.size();
+  if (!options_.optimize_on_idle || n < 2 || o.done || drag_button_ >= 0 || control_.animating() ||
+      video_) {
+    return -1;
+  }
+  if (seconds_between(last_change_, Clock::now()) < options_.idle_seconds) return -1;
+  if (o.baseline < 0.0) return -1;  // no settled normal frame yet
+  if (o.orders.empty()) {
+    o.serial = serial_;
+    for (uint32_t t = 0; t < options_.optimize_tries; ++t) {
+      o.orders.push_back(random_order(uint32_t(n), serial_ * 131 + t + 1));
+    }
+    o.costs.assign(o.orders.size(), std::nan(""));
+  }
+  if (o.submitted >= o.orders.size()) return -1;
+  return int(o.submitted++);
+}
+
+// The results of the frame that last used `slot` (it has finished).
+void Viewer::read_slot(uint32_t slot) {
+  const SlotFrame done = slots_[slot];
+  if (done.generation != generation_) return;  // never used, or another graph's
+  labelled_->use_slot(slot);
+  last_timings_ = labelled_->runner().timings(slot);
+  double gpu = 0.0;
+  for (const graph::PassTiming& t : last_timings_) {
+    summary_.gpu_ms[t.name] += t.ms;
+    gpu += t.ms;
+  }
+  ++summary_.timed_frames;
+  summary_.gpu_frame_ms.push_back(gpu);
+  gpu_times_.push_back(float(gpu));
+  if (done.serial != serial_) return;  // made before the last change
+
+  Optimisation& o = optimisation_;
+  if (done.trial >= 0) {
+    if (o.serial == serial_ && size_t(done.trial) < o.costs.size()) {
+      o.costs[size_t(done.trial)] = labelled_->total_cost();
+      const bool all =
+          std::none_of(o.costs.begin(), o.costs.end(), [](double c) { return std::isnan(c); });
+      if (all && !o.done) {
+        const size_t best =
+            size_t(std::min_element(o.costs.begin(), o.costs.end()) - o.costs.begin());
+        o.done = true;
+        if (o.costs[best] < o.baseline * (1.0 - 1e-4)) {
+          labelled_->keep_order(o.orders[best]);
+          ++optimisations_;
+          settled_ = false;  // the labels move to the cheaper layout
+          message_ = "optimised on idle: cost " + std::to_string(o.baseline) + " -> " +
+                     std::to_string(o.costs[best]);
+        }
+      }
+    }
+    return;
+  }
+  // A normal frame: settled when every label is on its target and fully faded in or out.
+  const auto targets = labelled_->placement_results();
+  const auto drawn = labelled_->drawn();
+  bool still = true;
+  const auto& labels = labelled_->labels();
+  for (size_t i = 0; i < drawn.size() && still; ++i) {
+    if ((labels[i].flags & LABEL_ENABLED) == 0u && drawn[i].opacity == 0.0f) continue;
+    // (a held label keeps its exact offset from its anchor: within half a pixel per axis of
+    // the placement's pixel-centred position)
+    const bool on_target = glm::length(drawn[i].position - targets[i].position) < 0.75f ||
+                           (drawn[i].opacity == 0.0f && targets[i].shown != PLACEMENT_SHOWN);
+    still = on_target && (drawn[i].opacity == 0.0f || drawn[i].opacity == 1.0f);
+  }
+  if (still) {
+    settled_ = true;
+    if (o.serial != serial_ || o.orders.empty()) o.baseline = labelled_->total_cost();
+  }
+}
+
+graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double seconds) {
+  if (!(extent == labelled_->size())) {
+    labelled_->set_size(extent);
+    changed(true);
+  }
+  read_slot(slot);
+  // Stein & Decoret's order needs the picture: computed once the camera rests (a wait for the
+  // frames in flight, once per rest).
+  if (insertion_order_ == 1 && settled_ && apollonius_serial_ != serial_ && !control_.animating()) {
+    output_.wait_idle();
+    labelled_->keep_order(labelled_->apollonius_layers_order());
+    apollonius_serial_ = serial_;
+    settled_ = false;
+  }
+  const int trial = next_trial();
+  if (trial >= 0) labelled_->set_trial_order(optimisation_.orders[size_t(trial)]);
+  labelled_->prepare_frame(seconds, trial >= 0);
+  debug_.set_enabled(debug_choice_.has_value());
+  if (debug_choice_) {
+    debug_.set(*debug_choice_);
+    debug_.set_placement(uint32_t(labelled_->placement_order_count()),
+                         labelled_->settings().placement.margin);
+  }
+  slots_[slot] = {generation_, serial_, trial};
+  last_slot_ = slot;
+  return labelled_->runner();
+}
+
+void Viewer::frame(std::optional<double> step) {
+  const Clock::time_point now = Clock::now();
+  double seconds = std::min(seconds_between(last_frame_, now), kMaxStep);
+  if (video_) seconds = 1.0 / options_.record_fps;
+  if (step) seconds = *step;
+  summary_.frame_ms.push_back(seconds_between(last_frame_, now) * 1e3);
+  frame_times_.push_back(float(seconds_between(last_frame_, now) * 1e3));
+  last_frame_ = now;
+  const size_t plot = size_t(kPlotSeconds * 60.0);
+  while (frame_times_.size() > plot) frame_times_.pop_front();
+  while (gpu_times_.size() > plot) gpu_times_.pop_front();
+
+  // The UI first: what it changes applies to this frame.
+  graph::Extent extent = output_.extent();
+  if (extent.width == 0 || extent.height == 0) return;  // minimised
+  ui_.begin_frame(extent, seconds);
+  if (options_.show_panel) build_panel();
+  ui_.end_frame();
+  if (ui_frames_ > 0) --ui_frames_;
+
+  control_.update(seconds);
+  apply_camera();
+  const bool drawn =
+      output_.draw([this, seconds](uint32_t slot, graph::Extent e) -> graph::GraphRunner& {
+        return prepare(slot, e, seconds);
+      });
+  if (!drawn) return;
+  ++summary_.frames;
+  summary_.busy_seconds += seconds_between(now, Clock::now());
+  if (video_) {
+    output_.wait_idle();
+    const std::vector<std::byte> pixels =
+        labelled_->runner().download_image(labelled_->labelled_image());
+    const graph::Extent e = labelled_->size();
+    // (the encoder takes even sizes: the last row and column of an odd size are left out)
+    std::vector<uint8_t> even;
+    const uint32_t w = e.width & ~1u, h = e.height & ~1u;
+    even.reserve(size_t(w) * h * 4);
+    const auto* p = reinterpret_cast<const uint8_t*>(pixels.data());
+    for (uint32_t y = 0; y < h; ++y) {
+      even.insert(even.end(), p + size_t(y) * e.width * 4, p + (size_t(y) * e.width + w) * 4);
+    }
+    video_->write(even);
+    ++video_frames_;
+  }
+}
+
+}  // namespace strata::app

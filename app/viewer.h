@@ -1,0 +1,246 @@
+// The interactive viewer's state and frame (`strata view`, `strata bench view`): the labelled
+// scene every frame with the forces moving the labels, the camera by mouse and keys (3D Slicer's
+// conventions), the Dear ImGui panel over it, screenshots, recording and optimisation on idle.
+// Frames are recorded while earlier ones still run; what the GPU reports (layouts, costs,
+// counters, timings) is read when a frame slot comes round again, a frame or two later. With
+// nothing to do (camera still, labels settled, no input) the viewer asks for no frames.
+#pragma once
+
+#include <chrono>
+#include <deque>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "app/ui_layer.h"
+#include "engine/core/video_file.h"
+#include "engine/graph/frame_slots.h"
+#include "engine/graph/window_target.h"
+#include "labeling/camera_control.h"
+#include "labeling/labelled_render.h"
+#include "passes/debug_view.h"
+
+namespace strata::app {
+
+// Where the viewer's frames go: a window (presented) or nowhere (the benchmark).
+class ViewerOutput {
+ public:
+  virtual ~ViewerOutput() = default;
+  // Ends the graph after the UI was drawn onto `display`.
+  virtual void add_to(graph::Graph& graph, graph::ResourceId display) = 0;
+  // Records and submits one frame, prepared by `prepare` once its slot is free; false when
+  // nothing was drawn (a minimised window).
+  virtual bool draw(const WindowTarget::Prepare& prepare) = 0;
+  virtual void wait_idle() = 0;
+  // The picture's size now (the window's framebuffer).
+  virtual graph::Extent extent() const = 0;
+  virtual uint32_t frames_in_flight() const = 0;
+};
+
+// Frames without a window: submitted in turn over the frame slots, never presented.
+class HeadlessOutput : public ViewerOutput {
+ public:
+  HeadlessOutput(Context& ctx, graph::Extent size, uint32_t frames_in_flight)
+      : slots_(ctx, frames_in_flight), size_(size) {}
+  void add_to(graph::Graph&, graph::ResourceId) override {}
+  bool draw(const WindowTarget::Prepare& prepare) override;
+  void wait_idle() override { slots_.wait_all(); }
+  graph::Extent extent() const override { return size_; }
+  uint32_t frames_in_flight() const override { return slots_.count(); }
+
+ private:
+  FrameSlots slots_;
+  graph::Extent size_;
+};
+
+// Frames presented to a GLFW window.
+class WindowOutput : public ViewerOutput {
+ public:
+  WindowOutput(Context& ctx, GLFWwindow* window, uint32_t frames_in_flight)
+      : target_(ctx, window, frames_in_flight), window_(window) {}
+  void add_to(graph::Graph& graph, graph::ResourceId display) override {
+    target_.add_output(graph, display);
+  }
+  bool draw(const WindowTarget::Prepare& prepare) override { return target_.draw(prepare); }
+  void wait_idle() override { target_.wait_idle(); }
+  graph::Extent extent() const override;
+  uint32_t frames_in_flight() const override { return target_.frames_in_flight(); }
+
+ private:
+  WindowTarget target_;
+  GLFWwindow* window_;
+};
+
+struct ViewerOptions {
+  std::filesystem::path scene_path;  // where "save position" writes the scene back
+  std::filesystem::path screenshot_dir = ".";
+  bool optimize_on_idle = true;  // the thesis program's option
+  uint32_t optimize_tries = 8;   // random insertion orders tried each time the camera rests
+  double idle_seconds = 0.5;     // how long the camera rests before they are tried
+  double record_fps = 30.0;
+  float ui_scale = 1.0f;
+  bool show_panel = true;
+};
+
+// Totals over a run, printed when the viewer closes and by `strata bench view`.
+struct ViewerSummary {
+  uint64_t frames = 0;
+  double busy_seconds = 0.0;             // wall-clock time spent in frames
+  std::map<std::string, double> gpu_ms;  // per pass: summed over the frames read back
+  uint64_t timed_frames = 0;             // frames whose timings were read
+  std::vector<double> gpu_frame_ms;      // per frame read: the whole frame's GPU time
+  std::vector<double> frame_ms;          // per frame: wall-clock time from the last
+};
+
+class Viewer {
+ public:
+  Viewer(Context& ctx, Scene& scene, const Camera& camera, const LabellingSettings& settings,
+         const ViewerOptions& options, ViewerOutput& output, GLFWwindow* window);
+  ~Viewer();
+
+  // Input, from the window's callbacks or an input script; positions in framebuffer pixels.
+  // GLFW's codes: GLFW_MOUSE_BUTTON_*, GLFW_PRESS / GLFW_RELEASE, GLFW_MOD_*, GLFW_KEY_*.
+  void mouse_button(int button, int action, int mods);
+  void cursor(glm::vec2 position);
+  void scroll(double ticks);
+  void key(int key, int mods);
+  // Any event the UI took (it needs a frame or two to show its answer).
+  void ui_event() { ui_frames_ = 3; }
+  bool ui_wants_mouse() const { return ui_.wants_mouse(); }
+  bool ui_wants_keyboard() const { return ui_.wants_keyboard(); }
+
+  // Whether a frame is due: the camera moves, labels move or fade, trials run, the UI answers.
+  // False: the viewer may sleep until the next event (or wake_in()); a recording draws anyway.
+  bool busy() const;
+  // Seconds until something happens without input (the optimisation on idle), if anything will.
+  std::optional<double> wake_in() const;
+  // One frame: UI, camera, labels, drawn and handed to the output. `seconds`: the time step
+  // (default: the wall clock since the last frame, at most 0.1 s; a recording's 1 / fps).
+  void frame(std::optional<double> seconds = {});
+  bool quit_requested() const { return quit_; }
+  void request_quit() { quit_ = true; }
+
+  // Actions (panel buttons, keys and scripts).
+  void jump_to_position(size_t index);  // the scene's named position (keys 1-9), animated
+  void view_from(AnatomicalView view);
+  void reset_camera();
+  // The labelled picture without the UI (PNG); the path written.
+  std::filesystem::path screenshot(const std::filesystem::path& path = {});
+  // The window's picture, UI included (PNG).
+  void capture(const std::filesystem::path& path);
+  // The layout of the last finished frame (layout JSON of `strata render --layout`).
+  void write_layout(const std::filesystem::path& path);
+  // Records every frame from now on into an MP4 (through `strata video`'s encoder) at a fixed
+  // time step of 1 / fps, until stop_recording().
+  void start_recording(const std::filesystem::path& path);
+  void stop_recording();
+  bool recording() const { return video_ != nullptr; }
+  // Sets a parameter by the name the panel and input scripts use (`viewer_parameters()`).
+  void set_parameter(const std::string& name, const std::string& value);
+  void set_label_hidden(int id, bool hidden);
+  void save_position(const std::string& name);
+  // The current camera (input scripts, tests), and a jump to another (benchmark paths).
+  const Camera& camera() const { return control_.camera(); }
+  void set_camera(const Camera& camera) { control_.set_camera(camera); }
+  const ViewerSummary& summary() const { return summary_; }
+  // The renderer's counters of the last frame read back.
+  const RenderStats& render_stats() const { return labelled_->stats(); }
+  bool settled() const { return settled_; }
+  // The picture's size now.
+  graph::Extent extent() const { return output_.extent(); }
+
+ private:
+  struct SlotFrame {
+    uint64_t generation = 0;  // LabelledRenderer's graph when recorded (0: never used)
+    uint64_t serial = 0;      // the change serial the frame was made for
+    int trial = -1;           // a trial frame's index, or -1
+  };
+  void changed(bool camera_moved = false);
+  void apply_camera();
+  graph::GraphRunner& prepare(uint32_t slot, graph::Extent extent, double seconds);
+  void read_slot(uint32_t slot);
+  int next_trial();
+  void build_panel();
+  void panel_labelling();
+  void panel_forces();
+  void panel_labels();
+  void panel_rendering();
+  void panel_camera();
+  void panel_statistics();
+  void panel_debug();
+  void set_transfer(uint32_t volume);
+  void extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds& ids);
+  void read_latest();
+
+  Context& ctx_;
+  Scene& scene_;
+  ViewerOptions options_;
+  ViewerOutput& output_;
+  UiLayer ui_;
+  CameraControl control_;
+  std::unique_ptr<LabelledRenderer> labelled_;
+  DebugView debug_;
+  std::optional<DebugViewChoice> debug_choice_;
+  graph::ResourceId display_id_ = 0;
+  uint64_t generation_ = 0;  // bumped whenever the graph is rebuilt
+
+  // Input.
+  int drag_button_ = -1;  // GLFW button of the drag in progress
+  bool drag_pan_ = false;
+  glm::vec2 mouse_{0.0f};
+  bool quit_ = false;
+  int ui_frames_ = 3;  // frames the UI still needs
+
+  // Change tracking and idle.
+  uint64_t serial_ = 1;
+  Camera applied_camera_;
+  std::chrono::steady_clock::time_point last_change_;
+  std::chrono::steady_clock::time_point last_frame_;
+  bool settled_ = false;
+  std::vector<SlotFrame> slots_;
+  uint32_t last_slot_ = 0;
+
+  // Optimisation on idle: random orders tried in trial frames, the cheapest kept.
+  struct Optimisation {
+    uint64_t serial = 0;  // the change it was made for
+    std::vector<std::vector<uint32_t>> orders;
+    std::vector<double> costs;  // NaN until read back
+    uint32_t submitted = 0;
+    double baseline = -1.0;  // the kept order's cost (a normal frame's)
+    bool done = false;
+  } optimisation_;
+  uint64_t optimisations_ = 0;  // orders adopted
+
+  // Panel state.
+  std::vector<TransferFunction> original_tfs_;  // per volume
+  struct VolumeLook {
+    float level = 0.5f, window = 1.0f, opacity = 1.0f;
+  };
+  std::vector<VolumeLook> looks_;
+  char label_filter_[64] = "";
+  char position_name_[64] = "";
+  std::string message_;
+  int picked_label_ = 0;
+  int insertion_order_ = 0;  // 0 scene, 1 Apollonius (on rest)
+  uint64_t apollonius_serial_ = 0;
+  std::deque<float> frame_times_, gpu_times_;
+  std::vector<graph::PassTiming> last_timings_;
+
+  // Output.
+  std::unique_ptr<VideoFile> video_;
+  std::filesystem::path video_path_;
+  uint64_t video_frames_ = 0;
+  uint32_t screenshots_ = 0;
+  ViewerSummary summary_;
+};
+
+// The names set_parameter() takes, with what each sets.
+std::vector<std::pair<std::string, std::string>> viewer_parameters();
+
+}  // namespace strata::app

@@ -1,0 +1,287 @@
+// The interactive viewer end to end, under Xvfb on lavapipe with validation on: input scripts
+// drive it with the events a user makes and the screenshots and layouts show each effect; one
+// test sends real X events with xdotool.
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <thread>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "engine/core/png.h"
+#include "gpu_fixture.h"
+#include "test_files.h"
+
+namespace strata {
+namespace {
+
+using test::run_strata;
+
+const std::string kScene = STRATA_SOURCE_DIR "/assets/scenes/head.json";
+constexpr int kWidth = 160, kHeight = 120;
+
+struct LabelBox {
+  int id = 0;
+  bool shown = false;
+  glm::vec2 anchor{0.0f};
+  glm::vec4 box{0.0f};  // x, y, width, height
+};
+
+std::vector<LabelBox> read_layout(const std::filesystem::path& path) {
+  const auto json = nlohmann::json::parse(test::read_file(path));
+  std::vector<LabelBox> out;
+  for (const auto& l : json.at("labels")) {
+    out.push_back({l.at("id").get<int>(),
+                   l.at("shown").get<bool>(),
+                   {l.at("anchor")[0].get<float>(), l.at("anchor")[1].get<float>()},
+                   {l.at("box")[0].get<float>(), l.at("box")[1].get<float>(),
+                    l.at("box")[2].get<float>(), l.at("box")[3].get<float>()}});
+  }
+  return out;
+}
+
+bool inside(glm::vec2 p) {
+  return p.x >= 0.0f && p.y >= 0.0f && p.x < float(kWidth) && p.y < float(kHeight);
+}
+
+// Mean distance of the anchors in the image from their centroid (a zoom scales it).
+float spread(const std::vector<LabelBox>& labels) {
+  glm::vec2 centre{0.0f};
+  int n = 0;
+  for (const auto& l : labels) {
+    if (!inside(l.anchor)) continue;
+    centre += l.anchor;
+    ++n;
+  }
+  centre /= float(std::max(n, 1));
+  float sum = 0.0f;
+  for (const auto& l : labels) {
+    if (inside(l.anchor)) sum += glm::length(l.anchor - centre);
+  }
+  return sum / float(std::max(n, 1));
+}
+
+float mean_leader(const std::vector<LabelBox>& labels) {
+  float sum = 0.0f;
+  int n = 0;
+  for (const auto& l : labels) {
+    if (!l.shown) continue;
+    const glm::vec2 centre{l.box.x + 0.5f * l.box.z, l.box.y + 0.5f * l.box.w};
+    sum += glm::length(centre - l.anchor);
+    ++n;
+  }
+  return sum / float(std::max(n, 1));
+}
+
+// Pixels that differ by more than 8 in some channel, inside `region` (x, y, w, h) or anywhere.
+size_t changed_pixels(const Rgba8Image& a, const Rgba8Image& b,
+                      std::optional<glm::vec4> region = {}) {
+  REQUIRE(a.width == b.width);
+  REQUIRE(a.height == b.height);
+  size_t n = 0;
+  for (uint32_t y = 0; y < a.height; ++y) {
+    for (uint32_t x = 0; x < a.width; ++x) {
+      if (region && (float(x) < region->x || float(y) < region->y ||
+                     float(x) >= region->x + region->z || float(y) >= region->y + region->w)) {
+        continue;
+      }
+      const size_t i = (size_t(y) * a.width + x) * 4;
+      for (int c = 0; c < 3; ++c) {
+        if (std::abs(int(a.pixels[i + c]) - int(b.pixels[i + c])) > 8) {
+          ++n;
+          break;
+        }
+      }
+    }
+  }
+  return n;
+}
+
+// Runs `strata view` on the test scene with `script` (written into `dir`).
+test::CommandResult view(const std::filesystem::path& dir, const std::string& script,
+                         const std::string& options = "--no-optimize --no-panel") {
+  const auto path = test::write_file(dir / "script.txt", script);
+  return run_strata("--validate view " + kScene + " --size " + std::to_string(kWidth) + "x" +
+                    std::to_string(kHeight) + " " + options + " --screenshot-dir " + dir.string() +
+                    " --script " + path.string());
+}
+
+}  // namespace
+
+TEST_SUITE("window") {
+  TEST_CASE("viewer_script_rotates_zooms_pans_jumps_reweights_and_hides") {
+    const auto dir = test::fresh_folder("viewer", "script");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto r = view(
+        dir, "layout " + d("base.json") + "\nscreenshot " + d("base.png") +
+                 "\ndrag left 80 60 110 60\nlayout " + d("rotated.json") + "\nscreenshot " +
+                 d("rotated.png") + "\nscroll -2\nlayout " + d("zoomed.json") +
+                 "\ndrag middle 80 60 92 52\nlayout " + d("panned.json") + "\nkey 2\nlayout " +
+                 d("left.json") + "\nscreenshot " + d("left.png") + "\nhide 3\nlayout " +
+                 d("hidden.json") + "\nscreenshot " + d("hidden.png") +
+                 "\nhide 60\nhide 52\nhide 81\nhide 29\nhide 31\nhide 37\nlayout " + d("few.json") +
+                 "\nset weights.anchor_constraint 0\nset weights.distance_to_anchor 1\nlayout " +
+                 d("weighted.json") + "\nquit\n");
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    CHECK(r.output.find("validation") == std::string::npos);
+
+    // Left drag: the scene turns (anchors move, the picture changes).
+    const auto base = read_layout(d("base.json")), rotated = read_layout(d("rotated.json"));
+    float moved = 0.0f;
+    for (size_t i = 0; i < base.size(); ++i)
+      moved += glm::length(rotated[i].anchor - base[i].anchor);
+    CHECK(moved / float(base.size()) > 5.0f);
+    CHECK(changed_pixels(read_png(d("base.png")), read_png(d("rotated.png"))) > 2000);
+
+    // The wheel toward the user zooms in: the anchors spread out.
+    const auto zoomed = read_layout(d("zoomed.json"));
+    CHECK(spread(zoomed) > 1.3f * spread(rotated));
+
+    // Middle drag: the content follows the mouse (anchors near the target's depth exactly).
+    const auto panned = read_layout(d("panned.json"));
+    for (size_t i = 0; i < zoomed.size(); ++i) {
+      if (!inside(zoomed[i].anchor)) continue;
+      const glm::vec2 delta = panned[i].anchor - zoomed[i].anchor;
+      CHECK(delta.x == doctest::Approx(12.0f).epsilon(0.25));
+      CHECK(delta.y == doctest::Approx(-8.0f).epsilon(0.25));
+    }
+
+    // Key 2: the scene's second position ("left"), where `strata render --camera left` has the
+    // same anchors.
+    const auto still = d("render-left.json");
+    const auto rendered =
+        run_strata("render " + kScene + " --camera left --size " + std::to_string(kWidth) + "x" +
+                   std::to_string(kHeight) + " -o " + d("render-left.png") + " --layout " + still);
+    REQUIRE(rendered.exit_code == 0);
+    const auto left = read_layout(d("left.json")), expected = read_layout(still);
+    for (size_t i = 0; i < left.size(); ++i) {
+      CHECK(left[i].anchor.x == doctest::Approx(expected[i].anchor.x).epsilon(1e-3));
+      CHECK(left[i].anchor.y == doctest::Approx(expected[i].anchor.y).epsilon(1e-3));
+    }
+
+    // Hiding label 3: gone from the layout, and its box's pixels change where the layout had it.
+    const auto find = [](const std::vector<LabelBox>& ls, int id) {
+      for (const auto& l : ls) {
+        if (l.id == id) return l;
+      }
+      FAIL("no label " << id);
+      return LabelBox{};
+    };
+    const auto hidden = read_layout(d("hidden.json"));
+    const LabelBox before = find(left, 3);
+    REQUIRE(before.shown);
+    CHECK_FALSE(find(hidden, 3).shown);
+    const Rgba8Image was = read_png(d("left.png")), now = read_png(d("hidden.png"));
+    const size_t in_box = changed_pixels(was, now, before.box);
+    CHECK(double(in_box) > 0.35 * double(before.box.z * before.box.w));
+
+    // Without the anchor constraint's weight and with a heavier leader length, the four labels
+    // left move toward their anchors.
+    const auto few = read_layout(d("few.json")), weighted = read_layout(d("weighted.json"));
+    CHECK(std::count_if(few.begin(), few.end(), [](const LabelBox& l) { return l.shown; }) == 4);
+    CHECK(mean_leader(weighted) < 0.8f * mean_leader(few));
+  }
+
+  TEST_CASE("viewer_panel_screenshot_key_recording_and_idle") {
+    const auto dir = test::fresh_folder("viewer", "panel");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto r = view(dir,
+                        "screenshot " + d("picture.png") + "\ncapture " + d("window.png") +
+                            "\nkey f12\nreport " + d("still-1.json") + "\nsleep 1.5\nreport " +
+                            d("still-2.json") + "\nrecord start " + d("clip.mp4") +
+                            "\ndrag left 80 60 100 60\nframes 4\nrecord stop\nreport " +
+                            d("recorded.json") + "\nquit\n",
+                        "--no-optimize");
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+
+    // The panel is in the window's picture, not in the screenshot.
+    const Rgba8Image picture = read_png(d("picture.png")), window = read_png(d("window.png"));
+    CHECK(changed_pixels(picture, window, glm::vec4(0, 0, 80, 40)) > 1000);
+
+    // F12 wrote a screenshot into --screenshot-dir.
+    size_t pngs = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+      if (e.path().filename().string().rfind("head-", 0) == 0) ++pngs;
+    }
+    CHECK(pngs == 1);
+
+    // Still camera, settled labels: no frames while the script slept.
+    const auto frames = [&](const char* name) {
+      return nlohmann::json::parse(test::read_file(d(name))).at("frames").get<int>();
+    };
+    CHECK(nlohmann::json::parse(test::read_file(d("still-1.json"))).at("settled") == true);
+    CHECK(frames("still-2.json") == frames("still-1.json"));
+
+    // Every frame drawn while recording is in the video.
+    const int recorded = frames("recorded.json") - frames("still-2.json");
+    CHECK(recorded >= 4);
+#if STRATA_VIDEO
+    std::FILE* pipe = popen(("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                             "stream=nb_read_frames -of csv=p=0 '" +
+                             d("clip.mp4") + "'")
+                                .c_str(),
+                            "r");
+    REQUIRE(pipe != nullptr);
+    char line[64] = {};
+    const bool read = std::fgets(line, sizeof line, pipe) != nullptr;
+    pclose(pipe);
+    REQUIRE(read);
+    CHECK(std::atoi(line) == recorded);
+#endif
+  }
+
+  TEST_CASE("viewer_answers_real_x_events") {
+    // The wiring from X to the viewer: xdotool's key and mouse events (XTEST), as a user's.
+    const auto dir = test::fresh_folder("viewer", "xdotool");
+    const std::string log = (dir / "log.txt").string();
+    const std::string command = std::string(STRATA_BINARY) + " --validate view " + kScene +
+                                " --size 160x120 --no-optimize --no-panel --screenshot-dir " +
+                                dir.string() + " > " + log + " 2>&1 &";
+    REQUIRE(std::system(command.c_str()) == 0);
+    const auto sh = [](const std::string& c) { return std::system(c.c_str()); };
+    REQUIRE(sh("xdotool search --sync --name 'strata - head.json' > /dev/null") == 0);
+    const auto wait_for = [&](const std::function<bool()>& done) {
+      for (int i = 0; i < 1200 && !done(); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      }
+      return done();
+    };
+    const auto screenshots = [&] {
+      size_t n = 0;
+      for (const auto& e : std::filesystem::directory_iterator(dir)) {
+        if (e.path().extension() == ".png") ++n;
+      }
+      return n;
+    };
+    const std::string window = "$(xdotool search --name 'strata - head.json' | head -1)";
+    // (settled first: the first frames take a while on lavapipe)
+    std::this_thread::sleep_for(std::chrono::seconds(3));
+    CHECK(sh("xdotool key --window " + window + " F12") == 0);
+    REQUIRE(wait_for([&] { return screenshots() == 1; }));
+    // A left drag across the window turns the scene.
+    CHECK(sh("xdotool mousemove --window " + window + " 60 60 mousedown 1 mousemove --window " +
+             window + " 80 60 mousemove --window " + window + " 110 60 mouseup 1") == 0);
+    std::this_thread::sleep_for(std::chrono::seconds(4));
+    CHECK(sh("xdotool key --window " + window + " F12") == 0);
+    REQUIRE(wait_for([&] { return screenshots() == 2; }));
+    CHECK(sh("xdotool key --window " + window + " q") == 0);
+    REQUIRE(wait_for([&] { return test::read_file(log).find("frames at") != std::string::npos; }));
+    const std::string out = test::read_file(log);
+    INFO(out);
+    CHECK(out.find("validation") == std::string::npos);
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+      if (e.path().extension() == ".png") files.push_back(e.path());
+    }
+    std::sort(files.begin(), files.end());
+    REQUIRE(files.size() == 2);
+    CHECK(changed_pixels(read_png(files[0].string()), read_png(files[1].string())) > 1000);
+  }
+}
+
+}  // namespace strata
