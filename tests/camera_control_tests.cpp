@@ -10,24 +10,16 @@
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/scene_bounds.h"
 #include "labeling/camera_control.h"
+#include "test_scenes.h"
 
 namespace strata {
 namespace {
 
 const glm::uvec2 viewport{640, 480};
 
-// A 20 mm box around (10, 20, 30), seen obliquely from the front left and above.
+// test::box_scene(), seen obliquely from the front left and above.
 Scene box_scene() {
-  Scene scene;
-  Mesh box;
-  for (int corner = 0; corner < 8; ++corner) {
-    box.positions.push_back(glm::vec3(10, 20, 30) + 10.0f * glm::vec3((corner & 1) ? 1 : -1,
-                                                                      (corner & 2) ? 1 : -1,
-                                                                      (corner & 4) ? 1 : -1));
-  }
-  scene.meshes.push_back(box);
-  scene.camera = {glm::lookAt(glm::vec3(-60, -60, 80), glm::vec3(10, 20, 30), glm::vec3(0, 0, 1)),
-                  30.0f, 1.0f, 500.0f};
+  Scene scene = test::box_scene();
   scene.camera_positions = {
       {"front", glm::lookAt(glm::vec3(10, -80, 30), glm::vec3(10, 20, 30), glm::vec3(0, 0, 1))}};
   return scene;

@@ -11,6 +11,7 @@
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/scene_bounds.h"
 #include "labeling/camera_path.h"
+#include "test_scenes.h"
 
 namespace strata {
 namespace {
@@ -19,18 +20,9 @@ CameraPose look_at(const std::string& name, glm::vec3 eye, glm::vec3 target, glm
   return {name, glm::lookAt(eye, target, up)};
 }
 
-// A 20 mm box around (10, 20, 30) seen from the front, the left and the top.
+// test::box_scene() seen from the front, the left and the top.
 Scene box_scene() {
-  Scene scene;
-  Mesh box;
-  for (int corner = 0; corner < 8; ++corner) {
-    box.positions.push_back(glm::vec3(10, 20, 30) + 10.0f * glm::vec3((corner & 1) ? 1 : -1,
-                                                                      (corner & 2) ? 1 : -1,
-                                                                      (corner & 4) ? 1 : -1));
-  }
-  scene.meshes.push_back(box);
-  scene.camera = {glm::lookAt(glm::vec3(-60, -60, 80), glm::vec3(10, 20, 30), glm::vec3(0, 0, 1)),
-                  30.0f, 1.0f, 500.0f};
+  Scene scene = test::box_scene();
   scene.camera_positions = {look_at("front", {10, -80, 30}, {10, 20, 30}, {0, 0, 1}),
                             look_at("left", {110, 20, 30}, {10, 20, 30}, {0, 0, 1}),
                             look_at("top", {10, 20, 130}, {10, 20, 30}, {0, -1, 0})};

@@ -23,9 +23,12 @@
 #include "passes/debug_view.h"
 #include "passes/placement.h"
 #include "passes/volume_renderer.h"
+#include "test_scenes.h"
 
 namespace strata {
 namespace {
+
+using test::quad;
 
 template <typename T>
 std::vector<T> as(const std::vector<std::byte>& bytes) {
@@ -220,19 +223,6 @@ size_t count_colour(const std::vector<uint8_t>& view, glm::u8vec3 colour) {
     n += view[i] == colour.r && view[i + 1] == colour.g && view[i + 2] == colour.b;
   }
   return n;
-}
-
-Mesh quad(float z, glm::vec4 color, float half, glm::vec2 centre) {
-  Mesh m;
-  m.name = "quad";
-  m.positions = {{centre.x - half, centre.y - half, z},
-                 {centre.x + half, centre.y - half, z},
-                 {centre.x + half, centre.y + half, z},
-                 {centre.x - half, centre.y + half, z}};
-  m.normals.assign(4, glm::vec3(0.0f, 0.0f, 1.0f));
-  m.indices = {0, 1, 2, 0, 2, 3};
-  m.color = color;
-  return m;
 }
 
 // A cube of voxels whose value falls off from the centre, under a ramp transfer function.

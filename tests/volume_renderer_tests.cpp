@@ -18,22 +18,12 @@
 #include "gpu_fixture.h"
 #include "passes/volume_render_reference.h"
 #include "passes/volume_renderer.h"
+#include "test_scenes.h"
 
 namespace strata {
 namespace {
 
-Mesh quad(float z, glm::vec4 color, float half = 10.0f, glm::vec2 centre = glm::vec2(0.0f)) {
-  Mesh m;
-  m.name = "quad";
-  m.positions = {{centre.x - half, centre.y - half, z},
-                 {centre.x + half, centre.y - half, z},
-                 {centre.x + half, centre.y + half, z},
-                 {centre.x - half, centre.y + half, z}};
-  m.normals.assign(4, glm::vec3(0.0f, 0.0f, 1.0f));
-  m.indices = {0, 1, 2, 0, 2, 3};
-  m.color = color;
-  return m;
-}
+using test::quad;
 
 // A ball of radius `radius` voxels whose value falls off linearly from the centre.
 Volume ball(glm::uvec3 dims, glm::vec3 origin, float radius) {
