@@ -497,6 +497,9 @@ void Viewer::read_slot(uint32_t slot) {
   }
   ++summary_.timed_frames;
   summary_.gpu_frame_ms.push_back(gpu);
+  if (!last_timings_.empty()) {
+    summary_.gpu_span_ms.push_back(last_timings_.back().end_ms - last_timings_.front().begin_ms);
+  }
   gpu_times_.push_back(float(gpu));
   if (done.serial != serial_) return;  // made before the last change
 

@@ -94,7 +94,8 @@ struct ViewerSummary {
   double busy_seconds = 0.0;             // wall-clock time spent in frames
   std::map<std::string, double> gpu_ms;  // per pass: summed over the frames read back
   uint64_t timed_frames = 0;             // frames whose timings were read
-  std::vector<double> gpu_frame_ms;      // per frame read: the whole frame's GPU time
+  std::vector<double> gpu_frame_ms;      // per frame read: the sum of its passes' GPU times
+  std::vector<double> gpu_span_ms;       // per frame read: first pass's start to last pass's end
   std::vector<double> frame_ms;          // per frame: wall-clock time from the last
 };
 
@@ -148,6 +149,10 @@ class Viewer {
   // The current camera (input scripts, tests), and a jump to another (benchmark paths).
   const Camera& camera() const { return control_.camera(); }
   void set_camera(const Camera& camera) { control_.set_camera(camera); }
+  // Timestamps around every pass (the default) or only where pass groups begin and end.
+  void set_timestamps_per_pass(bool per_pass) {
+    labelled_->runner().set_timestamps_per_pass(per_pass);
+  }
   const ViewerSummary& summary() const { return summary_; }
   // The renderer's counters of the last frame read back.
   const RenderStats& render_stats() const { return labelled_->stats(); }
