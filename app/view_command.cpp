@@ -219,7 +219,8 @@ void Script::run(Viewer& viewer, const std::vector<std::string>& w) {
     write_text_file(w[1], "{\"frames\": " + std::to_string(s.frames) +
                               ", \"settled\": " + (viewer.settled() ? "true" : "false") +
                               ", \"busy\": " + (viewer.busy() ? "true" : "false") +
-                              ", \"view\": [" + view + "]}\n");
+                              ", \"trials\": " + std::to_string(s.trials) + ", \"view\": [" + view +
+                              "]}\n");
   } else if (c == "quit") {
     viewer.request_quit();
   } else {

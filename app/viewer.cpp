@@ -454,9 +454,10 @@ bool Viewer::busy() const {
   if (ui_frames_ > 0 || !settled_ || control_.animating()) return true;
   if (!same_view(control_.camera(), applied_camera_)) return true;  // moved since the last frame
   if (drag_button_ >= 0) return false;  // a still mouse button: nothing moves
-  // Trials under way: their results come back with the next frames.
+  // Optimisation on idle: due once the view has rested, until every trial has come back.
   const Optimisation& o = optimisation_;
-  return o.serial == serial_ && !o.done && !o.orders.empty();
+  return options_.optimize_on_idle && !o.done && scene_.labels.size() >= 2 && o.baseline >= 0.0 &&
+         seconds_between(last_change_, Clock::now()) >= options_.idle_seconds;
 }
 
 std::optional<double> Viewer::wake_in() const {
@@ -481,6 +482,7 @@ int Viewer::next_trial() {
     o.costs.assign(o.orders.size(), std::nan(""));
   }
   if (o.submitted >= o.orders.size()) return -1;
+  ++summary_.trials;
   return int(o.submitted++);
 }
 
@@ -515,7 +517,7 @@ void Viewer::read_slot(uint32_t slot) {
         o.done = true;
         if (o.costs[best] < o.baseline * (1.0 - 1e-4)) {
           labelled_->keep_order(o.orders[best]);
-          ++optimisations_;
+          ++summary_.adopted;
           settled_ = false;  // the labels move to the cheaper layout
           message_ = "optimised on idle: cost " + std::to_string(o.baseline) + " -> " +
                      std::to_string(o.costs[best]);

@@ -97,6 +97,8 @@ struct ViewerSummary {
   std::vector<double> gpu_frame_ms;      // per frame read: the sum of its passes' GPU times
   std::vector<double> gpu_span_ms;       // per frame read: first pass's start to last pass's end
   std::vector<double> frame_ms;          // per frame: wall-clock time from the last
+  uint64_t trials = 0;                   // optimisation on idle: orders tried ...
+  uint64_t adopted = 0;                  // ... and kept
 };
 
 class Viewer {
@@ -220,7 +222,6 @@ class Viewer {
     double baseline = -1.0;  // the kept order's cost (a normal frame's)
     bool done = false;
   } optimisation_;
-  uint64_t optimisations_ = 0;  // orders adopted
 
   // Panel state.
   std::vector<TransferFunction> original_tfs_;  // per volume

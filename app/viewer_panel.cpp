@@ -133,7 +133,8 @@ void Viewer::panel_labelling() {
     changed();
   }
   checkbox(*this, "optimise on idle (random orders)", "optimize", options_.optimize_on_idle);
-  ImGui::Text("orders adopted: %llu", static_cast<unsigned long long>(optimisations_));
+  ImGui::Text("orders tried %llu, adopted %llu", static_cast<unsigned long long>(summary_.trials),
+              static_cast<unsigned long long>(summary_.adopted));
   checkbox(*this, "hard constraints", "hard", s.placement.hard);
   checkbox(*this, "internal labelling", "internal", s.internal);
   // (applied when the slider is let go: the glyphs and the graph are rebuilt)

@@ -235,6 +235,27 @@ TEST_SUITE("window") {
 #endif
   }
 
+  TEST_CASE("viewer_tries_insertion_orders_when_the_camera_rests") {
+    // Optimisation on idle: once the view has rested, trial frames try random orders (labels
+    // stay where they are meanwhile); a camera move starts it again; then nothing is drawn.
+    const auto dir = test::fresh_folder("viewer", "optimize");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto r = view(dir,
+                        "report " + d("opened.json") + "\ndrag left 80 60 90 60\nreport " +
+                            d("moved.json") + "\nsleep 1.5\nreport " + d("still.json") + "\nquit\n",
+                        "--no-panel");
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    const auto field = [&](const char* name, const char* key) {
+      return nlohmann::json::parse(test::read_file(d(name))).at(key).get<int>();
+    };
+    // (each command waits for the view to settle: the trials have all come back)
+    CHECK(field("opened.json", "trials") == 8);
+    CHECK(field("moved.json", "trials") == 16);
+    CHECK(field("moved.json", "frames") >= field("opened.json", "frames") + 8);
+    CHECK(field("still.json", "frames") == field("moved.json", "frames"));
+  }
+
   TEST_CASE("viewer_answers_real_x_events") {
     // The wiring from X to the viewer: xdotool's key and mouse events (XTEST), as a user's.
     const auto dir = test::fresh_folder("viewer", "xdotool");
