@@ -151,10 +151,9 @@ class Viewer {
   // The current camera (input scripts, tests), and a jump to another (benchmark paths).
   const Camera& camera() const { return control_.camera(); }
   void set_camera(const Camera& camera) { control_.set_camera(camera); }
-  // Timestamps around every pass (the default) or only where pass groups begin and end.
-  void set_timestamps_per_pass(bool per_pass) {
-    labelled_->runner().set_timestamps_per_pass(per_pass);
-  }
+  // Timestamps around every pass (the default), only where pass groups begin and end, or only
+  // where the frame begins and ends (GraphRunner).
+  graph::GraphRunner& runner() { return labelled_->runner(); }
   const ViewerSummary& summary() const { return summary_; }
   // The renderer's counters of the last frame read back.
   const RenderStats& render_stats() const { return labelled_->stats(); }

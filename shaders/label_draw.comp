@@ -24,11 +24,43 @@ float atlas_coverage(vec2 uv) { return textureLod(atlas, uv, 0.0).r; }
 
 #include "shared/label_draw_pixel.h"
 
+// The labels that can touch this workgroup's tile (bit i: label i), so that each pixel visits
+// only those, still in label order.
+shared uint tile_labels[LABEL_MAX / 32u];
+
 void main() {
   const uvec3 id = gl_GlobalInvocationID;
+  const uint lane = gl_LocalInvocationIndex;
+  const uint lanes = LABEL_DRAW_GROUP * LABEL_DRAW_GROUP;
+  for (uint w = lane; w < LABEL_MAX / 32u; w += lanes) tile_labels[w] = 0u;
+  barrier();
+  const vec2 tile_lo = vec2(gl_WorkGroupID.xy * LABEL_DRAW_GROUP) + 0.5f;
+  const vec2 tile_hi = tile_lo + float(LABEL_DRAW_GROUP - 1u);
+  const uint count = min(label_count(), LABEL_MAX);
+  for (uint i = lane; i < count; i += lanes) {
+    const LabelGpu label = labels[i];
+    if ((label.flags & LABEL_ENABLED) == 0u || label.layer != gl_WorkGroupID.z) continue;
+    const PlacementGpu placement = placements[i];
+    if (placement.shown != PLACEMENT_SHOWN) continue;
+    const vec2 centre = (label.flags & LABEL_INTERNAL) != 0u ? label.anchor : placement.position;
+    if (!label_far_from_tile(tile_lo, tile_hi, label.anchor, centre, label.size)) {
+      atomicOr(tile_labels[i / 32u], 1u << (i % 32u));
+    }
+  }
+  barrier();
+
   if (id.x >= params.width || id.y >= params.height || id.z >= params.layer_count) return;
   const ivec3 texel = ivec3(id);
   const vec4 content = imageLoad(layers, texel);
-  const vec4 drawn = draw_labels_at(vec2(id.xy) + 0.5, id.z, content);
+  const vec2 p = vec2(id.xy) + 0.5;
+  vec4 drawn = content;
+  for (uint w = 0u; w < LABEL_MAX / 32u; ++w) {
+    uint bits = tile_labels[w];
+    while (bits != 0u) {
+      const uint b = uint(findLSB(bits));
+      bits &= bits - 1u;
+      drawn = draw_label_at(w * 32u + b, p, id.z, drawn);
+    }
+  }
   if (drawn != content) imageStore(layers, texel, drawn);
 }

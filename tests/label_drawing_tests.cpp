@@ -336,6 +336,34 @@ TEST_SUITE("gpu") {
     }
   }
 
+  TEST_CASE_FIXTURE(test::GpuTest, "many_overlapping_labels_match_the_cpu_reference") {
+    // 100 labels over the image on every layer, some internal, some hidden, some fading: each
+    // workgroup keeps the labels that can touch its tile (several words of its bit set), and
+    // the picture is still the reference's, label order included.
+    LabelScene s = make_scene();
+    s.labels.clear();
+    s.placements.clear();
+    std::vector<std::string> texts;
+    for (uint32_t i = 0; i < 100; ++i) {
+      const glm::vec2 anchor{float((i * 37) % 112), float((i * 53) % 96)};
+      const uint32_t flags = LABEL_ENABLED | (i % 9 == 4 ? LABEL_INTERNAL : 0u);
+      s.labels.push_back(label_on(i % 3, anchor, i % 11 == 7 ? 0u : flags));
+      gpu::PlacementGpu p{{float((i * 29 + 13) % 112), float((i * 17 + 5) % 96)},
+                          0.0f,
+                          i % 13 == 6 ? PLACEMENT_HIDDEN : PLACEMENT_SHOWN};
+      p.opacity = i % 5 == 2 ? 0.5f : 1.0f;
+      s.placements.push_back(p);
+      texts.push_back(i % 2 ? "Cortex" : "Pons");
+    }
+    s.glyphs = build_glyph_buffer(test_font(), texts, s.labels);
+    const DrawnLabels gpu = draw_on_gpu(ctx, s);
+    size_t where = 0;
+    const float worst = worst_difference(gpu.layers, reference_layers(s), where);
+    CHECK_MESSAGE(worst <= kTolerance,
+                  "layer pixel " << where << " differs by " << worst * 255.0f << "/255");
+    CHECK(gpu.layers != s.layers);
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "label_on_a_rear_layer_is_partly_covered_by_the_front_layer") {
     const LabelScene s = make_scene();
     const DrawnLabels gpu = draw_on_gpu(ctx, s);

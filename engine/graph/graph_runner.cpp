@@ -245,11 +245,13 @@ void GraphRunner::check_bound() const {
 
 bool GraphRunner::stamps_begin(uint32_t p) const {
   const auto& passes = graph_.passes();
+  if (frame_stamps_) return p == 0;
   return per_pass_stamps_ || p == 0 || passes[p - 1].group != passes[p].group;
 }
 
 bool GraphRunner::stamps_end(uint32_t p) const {
   const auto& passes = graph_.passes();
+  if (frame_stamps_) return p + 1 == passes.size();
   return per_pass_stamps_ || p + 1 == passes.size() || passes[p + 1].group != passes[p].group;
 }
 
@@ -364,7 +366,8 @@ std::vector<PassTiming> GraphRunner::timings(uint32_t slot) const {
     if (stamps_begin(p)) group_first = p;
     if (stamps_end(p)) {
       const double begin = since_start(2 * group_first), end = since_start(2 * p + 1);
-      out.push_back({passes[p].group, passes[p].group, end - begin, begin, end});
+      const std::string name = frame_stamps_ ? "frame" : passes[p].group;
+      out.push_back({name, name, end - begin, begin, end});
     }
   }
   return out;

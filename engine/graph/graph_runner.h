@@ -138,7 +138,15 @@ class GraphRunner {
 
   // Timestamps around every pass (the default), or only where a group of passes begins and
   // ends: a group's time without the cost of stamping each of its passes (benchmarks).
-  void set_timestamps_per_pass(bool per_pass) { per_pass_stamps_ = per_pass; }
+  void set_timestamps_per_pass(bool per_pass) {
+    per_pass_stamps_ = per_pass;
+    frame_stamps_ = false;
+  }
+  // Only where the frame begins and ends: one entry, "frame" (the least disturbed whole time).
+  void set_timestamps_per_frame() {
+    per_pass_stamps_ = false;
+    frame_stamps_ = true;
+  }
   // GPU time of each pass of the last completed run; with group stamps only, one entry per
   // group (named after it) instead. With frames in flight: of the last completed frame of `slot`.
   std::vector<PassTiming> timings(uint32_t slot = 0) const;
@@ -170,6 +178,7 @@ class GraphRunner {
 
   Context& ctx_;
   bool per_pass_stamps_ = true;
+  bool frame_stamps_ = false;
   Graph graph_;
   CompiledGraph compiled_;
   Extent viewport_{};

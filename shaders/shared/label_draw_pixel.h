@@ -24,24 +24,26 @@ float text_coverage(vec2 p, vec2 top_left, LabelGpu label) {
   return coverage;
 }
 
-// Every shown label of `layer` drawn over `content` (premultiplied) at pixel centre p, as opaque
-// as its placement says, in label order: a later label covers an earlier one. External labels:
-// connector, box, text, then the anchor marker on top. Internal labels: the box centred on the
-// anchor, no connector or marker.
+// Label i drawn over `content` (premultiplied) at pixel centre p if it is shown on `layer`, as
+// opaque as its placement says. External labels: connector, box, text, then the anchor marker on
+// top. Internal labels: the box centred on the anchor, no connector or marker.
+vec4 draw_label_at(uint i, vec2 p, uint layer, vec4 content) {
+  LabelGpu label = label_at(i);
+  if ((label.flags & LABEL_ENABLED) == 0u || label.layer != layer) return content;
+  PlacementGpu placement = placement_at(i);
+  if (placement.shown != PLACEMENT_SHOWN) return content;
+  bool is_internal = (label.flags & LABEL_INTERNAL) != 0u;
+  vec2 centre = is_internal ? label.anchor : placement.position;
+  if (label_far_from(p, label.anchor, centre, label.size)) return content;
+  vec4 color = label_frame(p, label.anchor, centre, label.size, !is_internal);
+  float text = text_coverage(p, centre - 0.5f * label.size, label);
+  color = label_over(label_premultiplied(LABEL_TEXT_COLOR, text), color);
+  if (!is_internal) color = label_over(label_anchor_marker(p, label.anchor), color);
+  return label_over(color * placement.opacity, content);  // (premultiplied: a fade)
+}
+
+// Every label in label order: a later label covers an earlier one.
 vec4 draw_labels_at(vec2 p, uint layer, vec4 content) {
-  for (uint i = 0u; i < label_count(); ++i) {
-    LabelGpu label = label_at(i);
-    if ((label.flags & LABEL_ENABLED) == 0u || label.layer != layer) continue;
-    PlacementGpu placement = placement_at(i);
-    if (placement.shown != PLACEMENT_SHOWN) continue;
-    bool is_internal = (label.flags & LABEL_INTERNAL) != 0u;
-    vec2 centre = is_internal ? label.anchor : placement.position;
-    if (label_far_from(p, label.anchor, centre, label.size)) continue;
-    vec4 color = label_frame(p, label.anchor, centre, label.size, !is_internal);
-    float text = text_coverage(p, centre - 0.5f * label.size, label);
-    color = label_over(label_premultiplied(LABEL_TEXT_COLOR, text), color);
-    if (!is_internal) color = label_over(label_anchor_marker(p, label.anchor), color);
-    content = label_over(color * placement.opacity, content);  // (premultiplied: a fade)
-  }
+  for (uint i = 0u; i < label_count(); ++i) content = draw_label_at(i, p, layer, content);
   return content;
 }

@@ -104,6 +104,16 @@ STRATA_INLINE bool label_far_from(vec2 p, vec2 anchor, vec2 centre, vec2 size) {
   return p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y;
 }
 
+// Whether label_far_from holds for every pixel centre in [tile_lo, tile_hi] (a workgroup's tile
+// can leave the label out).
+STRATA_INLINE bool label_far_from_tile(vec2 tile_lo, vec2 tile_hi, vec2 anchor, vec2 centre,
+                                       vec2 size) {
+  float margin = LABEL_MARKER_RADIUS + 1.0f;
+  vec2 lo = min(centre - 0.5f * size, anchor) - margin;
+  vec2 hi = max(centre + 0.5f * size, anchor) + margin;
+  return tile_hi.x < lo.x || tile_hi.y < lo.y || tile_lo.x > hi.x || tile_lo.y > hi.y;
+}
+
 // The final pixel: the layers' front-to-back composite over the background, opaque.
 STRATA_INLINE vec4 label_over_background(vec4 layers, vec3 background) {
   return vec4(vec3(layers) + (1.0f - layers.a) * background, 1.0f);
