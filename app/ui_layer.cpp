@@ -18,12 +18,6 @@ void check_imgui_vk(VkResult result) {
   if (result < 0) check_vk(result, "Dear ImGui's Vulkan backend");
 }
 
-// The font file the labels use (STRATA_FONT replaces Debian's DejaVu Sans).
-std::string ui_font_path() {
-  const char* env = std::getenv("STRATA_FONT");
-  return env && *env ? env : kDefaultFontPath;
-}
-
 }  // namespace
 
 UiLayer::UiLayer(Context& ctx, GLFWwindow* window, float scale, uint32_t frames_in_flight)
@@ -36,9 +30,10 @@ UiLayer::UiLayer(Context& ctx, GLFWwindow* window, float scale, uint32_t frames_
   ImGui::GetStyle().ScaleAllSizes(scale);
   ImFontConfig config;
   config.OversampleH = 2;
-  if (!io.Fonts->AddFontFromFileTTF(ui_font_path().c_str(), 15.0f * scale, &config)) {
+  const std::string font = font_file();  // the labels' font
+  if (!io.Fonts->AddFontFromFileTTF(font.c_str(), 15.0f * scale, &config)) {
     ImGui::DestroyContext();
-    throw Error("cannot load the UI font " + ui_font_path());
+    throw Error("cannot load the UI font " + font);
   }
   if (window_) ImGui_ImplGlfw_InitForVulkan(window_, false);  // the viewer forwards events
 

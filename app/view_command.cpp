@@ -9,6 +9,7 @@
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
 #include <imgui.h>
+#include <nlohmann/json.hpp>
 
 #include <backends/imgui_impl_glfw.h>
 
@@ -209,18 +210,16 @@ void Script::run(Viewer& viewer, const std::vector<std::string>& w) {
     viewer.save_position(w[1]);
   } else if (c == "report") {
     need(2, "report FILE.json");
-    const ViewerSummary& s = viewer.summary();
-    std::string view;
+    nlohmann::json view = nlohmann::json::array();
     for (int col = 0; col < 4; ++col) {
-      for (int row = 0; row < 4; ++row) {
-        view += (view.empty() ? "" : ", ") + std::to_string(viewer.camera().view[col][row]);
-      }
+      for (int row = 0; row < 4; ++row) view.push_back(viewer.camera().view[col][row]);
     }
-    write_text_file(w[1], "{\"frames\": " + std::to_string(s.frames) +
-                              ", \"settled\": " + (viewer.settled() ? "true" : "false") +
-                              ", \"busy\": " + (viewer.busy() ? "true" : "false") +
-                              ", \"trials\": " + std::to_string(s.trials) + ", \"view\": [" + view +
-                              "]}\n");
+    const nlohmann::json report = {{"frames", viewer.summary().frames},
+                                   {"settled", viewer.settled()},
+                                   {"busy", viewer.busy()},
+                                   {"trials", viewer.summary().trials},
+                                   {"view", view}};
+    write_text_file(w[1], report.dump() + "\n");
   } else if (c == "quit") {
     viewer.request_quit();
   } else {

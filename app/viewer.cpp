@@ -61,6 +61,86 @@ bool parse_bool(const std::string& name, const std::string& value) {
   throw Error("parameter " + name + ": '" + value + "' is not on or off");
 }
 
+// Where a panel or script parameter lives: a number or a flag of the labelling, rendering or
+// viewer settings. `layers` (a count) and `font` (a font rebuild) are set by hand.
+struct SettingsRef {
+  LabellingSettings& labels;
+  RenderSettings& render;
+  ViewerOptions& viewer;
+};
+
+struct Parameter {
+  const char* name;
+  const char* what;
+  float* (*number)(const SettingsRef&) = nullptr;
+  bool* (*flag)(const SettingsRef&) = nullptr;
+  bool reproject = false;  // the anchors are projected and layered again
+};
+
+const std::vector<Parameter>& parameters() {
+  using S = const SettingsRef&;
+  static const std::vector<Parameter> all = {
+      {"weights.label_shadow", "eq. 3.1: a box over an earlier box or its leader",
+       [](S s) { return &s.labels.placement.weights.label_shadow; }},
+      {"weights.anchor_constraint", "eq. 3.1: a box or leader over an anchor",
+       [](S s) { return &s.labels.placement.weights.anchor_constraint; }},
+      {"weights.connector_shadow", "eq. 3.1: a leader over an earlier box or leader",
+       [](S s) { return &s.labels.placement.weights.connector_shadow; }},
+      {"weights.integral_costs", "eq. 3.1: the occlusion and saliency under the box",
+       [](S s) { return &s.labels.placement.weights.integral_costs; }},
+      {"weights.distance_to_anchor", "eq. 3.1: leader length",
+       [](S s) { return &s.labels.placement.weights.distance_to_anchor; }},
+      {"weights.connector_direction", "eq. 3.1: connector direction",
+       [](S s) { return &s.labels.placement.weights.connector_direction; }},
+      {"weights.previous_position", "eq. 3.1 eta: per pixel of distance to the last target",
+       [](S s) { return &s.labels.forces.previous_weight; }},
+      {"integral.saliency", "eq. 3.3: how much saliency modulates occlusion",
+       [](S s) { return &s.labels.placement.saliency_weight; }},
+      {"integral.occlusion", "eq. 3.4: occlusion weight with one layer",
+       [](S s) { return &s.labels.placement.occlusion_weight; }},
+      {"integral.single_saliency", "eq. 3.4: saliency weight with one layer",
+       [](S s) { return &s.labels.placement.single_saliency_weight; }},
+      {"margin", "pixels around boxes in the constraints",
+       [](S s) { return &s.labels.placement.margin; }},
+      {"layers", "depth layers asked for, 1 to 8"},
+      {"hard", "on: no constraint violations (labels may be hidden)", nullptr,
+       [](S s) { return &s.labels.placement.hard; }},
+      {"internal", "on: each label on its anchor", nullptr, [](S s) { return &s.labels.internal; },
+       true},
+      {"font", "label font size in pixels"},
+      {"forces.speed", "pixels per second at full force",
+       [](S s) { return &s.labels.forces.speed; }},
+      {"forces.epsilon", "pixels: nearer than this the force shrinks",
+       [](S s) { return &s.labels.forces.epsilon; }},
+      {"forces.snap", "pixels: nearer than this a label lands on its target",
+       [](S s) { return &s.labels.forces.snap; }},
+      {"forces.hold_share", "hold: this share of the target's cost ...",
+       [](S s) { return &s.labels.forces.hold_share; }},
+      {"forces.hold_cost", "... plus this", [](S s) { return &s.labels.forces.hold_cost; }},
+      {"forces.fade", "seconds a label takes to fade in or out",
+       [](S s) { return &s.labels.forces.fade_seconds; }},
+      {"forces.anchor_relative", "on: labels held as offsets from their anchors", nullptr,
+       [](S s) { return &s.labels.forces.anchor_relative; }},
+      {"optimize", "on: try random insertion orders when the camera rests", nullptr,
+       [](S s) { return &s.viewer.optimize_on_idle; }},
+      {"render.step", "world units between ray samples (0: half the finest voxel)",
+       [](S s) { return &s.render.step; }},
+      {"render.skip_empty", "on: empty-space skipping", nullptr,
+       [](S s) { return &s.render.skip_empty; }},
+  };
+  return all;
+}
+
+const Parameter& parameter(const std::string& name) {
+  for (const Parameter& p : parameters()) {
+    if (name == p.name) return p;
+  }
+  std::string names;
+  for (const Parameter& p : parameters())
+    names += (names.empty() ? "" : ", ") + std::string(p.name);
+  throw Error("no parameter '" + name + "' (parameters: " + names + ")");
+}
+
 }  // namespace
 
 bool HeadlessOutput::draw(const WindowTarget::Prepare& prepare) {
@@ -80,33 +160,9 @@ graph::Extent WindowOutput::extent() const {
 }
 
 std::vector<std::pair<std::string, std::string>> viewer_parameters() {
-  return {
-      {"weights.label_shadow", "eq. 3.1: a box over an earlier box or its leader"},
-      {"weights.anchor_constraint", "eq. 3.1: a box or leader over an anchor"},
-      {"weights.connector_shadow", "eq. 3.1: a leader over an earlier box or leader"},
-      {"weights.integral_costs", "eq. 3.1: the occlusion and saliency under the box"},
-      {"weights.distance_to_anchor", "eq. 3.1: leader length"},
-      {"weights.connector_direction", "eq. 3.1: leader direction change from the last frame"},
-      {"weights.previous_position", "eq. 3.1 eta: distance to the last target (per pixel)"},
-      {"integral.saliency", "eq. 3.3: how much saliency modulates occlusion"},
-      {"integral.occlusion", "eq. 3.4: occlusion weight with one layer"},
-      {"integral.single_saliency", "eq. 3.4: saliency weight with one layer"},
-      {"margin", "pixels around boxes in the constraints"},
-      {"layers", "depth layers asked for, 1 to 8"},
-      {"hard", "on: no constraint violations (labels may be hidden)"},
-      {"internal", "on: each label on its anchor"},
-      {"font", "label font size in pixels"},
-      {"forces.speed", "pixels per second at full force"},
-      {"forces.epsilon", "pixels: nearer than this the force shrinks"},
-      {"forces.snap", "pixels: nearer than this a label lands on its target"},
-      {"forces.hold_share", "hold: this share of the target's cost ..."},
-      {"forces.hold_cost", "... plus this"},
-      {"forces.fade", "seconds a label takes to fade in or out"},
-      {"forces.anchor_relative", "on: labels held as offsets from their anchors"},
-      {"optimize", "on: try random insertion orders when the camera rests"},
-      {"render.step", "world units between ray samples (0: half the finest voxel)"},
-      {"render.skip_empty", "on: empty-space skipping"},
-  };
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const Parameter& p : parameters()) out.emplace_back(p.name, p.what);
+  return out;
 }
 
 Viewer::Viewer(Context& ctx, Scene& scene, const Camera& camera, const LabellingSettings& settings,
@@ -274,12 +330,8 @@ std::filesystem::path Viewer::screenshot(const std::filesystem::path& path) {
       out = options_.screenshot_dir / (stem + name);
     } while (std::filesystem::exists(out));
   }
-  output_.wait_idle();
-  const graph::Extent e = labelled_->size();
-  const std::vector<std::byte> pixels =
-      labelled_->runner().download_image(labelled_->labelled_image());
-  write_png(out.string(), e.width, e.height,
-            {reinterpret_cast<const uint8_t*>(pixels.data()), pixels.size()});
+  const std::vector<uint8_t> pixels = download(labelled_->labelled_image());
+  write_png(out.string(), labelled_->size().width, labelled_->size().height, pixels);
   message_ = "wrote " + out.string();
   std::printf("view: screenshot %s\n", out.string().c_str());
   std::fflush(stdout);
@@ -288,11 +340,16 @@ std::filesystem::path Viewer::screenshot(const std::filesystem::path& path) {
 }
 
 void Viewer::capture(const std::filesystem::path& path) {
+  write_png(path.string(), labelled_->size().width, labelled_->size().height,
+            download(display_id_));
+}
+
+// An rgba8 image of the last frame, once the frames in flight have finished.
+std::vector<uint8_t> Viewer::download(graph::ResourceId image) {
   output_.wait_idle();
-  const graph::Extent e = labelled_->size();
-  const std::vector<std::byte> pixels = labelled_->runner().download_image(display_id_);
-  write_png(path.string(), e.width, e.height,
-            {reinterpret_cast<const uint8_t*>(pixels.data()), pixels.size()});
+  const std::vector<std::byte> bytes = labelled_->runner().download_image(image);
+  const auto* p = reinterpret_cast<const uint8_t*>(bytes.data());
+  return {p, p + bytes.size()};
 }
 
 // After the frames in flight finished: the results of the last one.
@@ -330,7 +387,6 @@ void Viewer::set_label_hidden(int id, bool hidden) {
   for (size_t i = 0; i < scene_.labels.size(); ++i) {
     if (scene_.labels[i].id != id) continue;
     labelled_->set_label_hidden(i, hidden);
-    labelled_->set_camera(control_.camera());  // (the labels' flags are set there)
     changed();
     return;
   }
@@ -352,72 +408,54 @@ void Viewer::save_position(const std::string& name) {
 }
 
 void Viewer::set_parameter(const std::string& name, const std::string& value) {
-  LabellingSettings& s = labelled_->settings();
-  CostWeights& w = s.placement.weights;
-  const auto number = [&] { return parse_float(name, value); };
-  const auto flag = [&] { return parse_bool(name, value); };
-  bool reproject = false;
-  if (name == "weights.label_shadow") {
-    w.label_shadow = number();
-  } else if (name == "weights.anchor_constraint") {
-    w.anchor_constraint = number();
-  } else if (name == "weights.connector_shadow") {
-    w.connector_shadow = number();
-  } else if (name == "weights.integral_costs") {
-    w.integral_costs = number();
-  } else if (name == "weights.distance_to_anchor") {
-    w.distance_to_anchor = number();
-  } else if (name == "weights.connector_direction") {
-    w.connector_direction = number();
-  } else if (name == "weights.previous_position") {
-    s.forces.previous_weight = number();
-  } else if (name == "integral.saliency") {
-    s.placement.saliency_weight = number();
-  } else if (name == "integral.occlusion") {
-    s.placement.occlusion_weight = number();
-  } else if (name == "integral.single_saliency") {
-    s.placement.single_saliency_weight = number();
-  } else if (name == "margin") {
-    s.placement.margin = number();
-  } else if (name == "layers") {
-    const float layers = number();
-    if (!(layers >= 1.0f && layers <= 8.0f)) throw Error("parameter layers: 1 to 8");
-    s.layer_count = uint32_t(layers);
-    reproject = true;
-  } else if (name == "hard") {
-    s.placement.hard = flag();
-  } else if (name == "internal") {
-    s.internal = flag();
-    reproject = true;
-  } else if (name == "font") {
-    labelled_->set_font_pixels(number());
-  } else if (name == "forces.speed") {
-    s.forces.speed = number();
-  } else if (name == "forces.epsilon") {
-    s.forces.epsilon = number();
-  } else if (name == "forces.snap") {
-    s.forces.snap = number();
-  } else if (name == "forces.hold_share") {
-    s.forces.hold_share = number();
-  } else if (name == "forces.hold_cost") {
-    s.forces.hold_cost = number();
-  } else if (name == "forces.fade") {
-    s.forces.fade_seconds = number();
-  } else if (name == "forces.anchor_relative") {
-    s.forces.anchor_relative = flag();
-  } else if (name == "optimize") {
-    options_.optimize_on_idle = flag();
-  } else if (name == "render.step") {
-    labelled_->renderer().settings().step = number();
-  } else if (name == "render.skip_empty") {
-    labelled_->renderer().settings().skip_empty = flag();
+  if (parameter(name).flag) {
+    set_flag(name, parse_bool(name, value));
   } else {
-    std::string names;
-    for (const auto& p : viewer_parameters()) names += (names.empty() ? "" : ", ") + p.first;
-    throw Error("no parameter '" + name + "' (parameters: " + names + ")");
+    set_number(name, parse_float(name, value));
   }
-  // (the forces check their settings when the next frame is set up)
-  forces_params(s.forces, 1, 0.0, s.placement.hard);
+}
+
+void Viewer::set_number(const std::string& name, float value) {
+  const Parameter& p = parameter(name);
+  if (p.flag) throw Error("parameter " + name + " is on or off, not a number");
+  if (name == "font") {
+    labelled_->set_font_pixels(value);  // (checks the size)
+    settings_changed(false);
+    return;
+  }
+  // Copies first: a value that the checks refuse changes nothing.
+  LabellingSettings labels = labelled_->settings();
+  RenderSettings render = labelled_->renderer().settings();
+  ViewerOptions viewer = options_;
+  if (name == "layers") {
+    if (!(value >= 1.0f && value <= 8.0f)) throw Error("parameter layers: 1 to 8");
+    labels.layer_count = uint32_t(value);
+  } else {
+    *p.number({labels, render, viewer}) = value;
+  }
+  commit_settings(labels, render, viewer, p.reproject || name == "layers");
+}
+
+void Viewer::set_flag(const std::string& name, bool value) {
+  const Parameter& p = parameter(name);
+  if (!p.flag) throw Error("parameter " + name + " is a number, not on or off");
+  LabellingSettings labels = labelled_->settings();
+  RenderSettings render = labelled_->renderer().settings();
+  ViewerOptions viewer = options_;
+  *p.flag({labels, render, viewer}) = value;
+  commit_settings(labels, render, viewer, p.reproject);
+}
+
+void Viewer::commit_settings(const LabellingSettings& labels, const RenderSettings& render,
+                             const ViewerOptions& viewer, bool reproject) {
+  forces_params(labels.forces, 1, 0.0, labels.placement.hard);  // (throws on a bad force)
+  labelled_->settings() = labels;
+  labelled_->renderer().settings() = render;
+  options_ = viewer;
+  settings_changed(reproject);
+}
+
+void Viewer::settings_changed(bool reproject) {
   if (reproject) labelled_->set_camera(control_.camera());
   labelled_->place_afresh();  // the new settings' layout, reached smoothly
   changed();
@@ -428,17 +466,16 @@ void Viewer::set_transfer(uint32_t volume) {
   output_.wait_idle();  // the table and grids are rewritten
   labelled_->renderer().set_transfer_function(
       volume, windowed(original_tfs_[volume], look.level, look.window, look.opacity));
-  labelled_->place_afresh();
-  changed();
+  settings_changed(false);
 }
 
 // --- frames ------------------------------------------------------------------------------------
 
-void Viewer::changed(bool camera_moved) {
+void Viewer::changed() {
   ++serial_;
   settled_ = false;
   last_change_ = Clock::now();
-  if (camera_moved || optimisation_.serial != serial_) optimisation_ = {};
+  optimisation_ = {};  // (trials of an earlier serial are ignored when they come back)
 }
 
 void Viewer::apply_camera() {
@@ -446,7 +483,7 @@ void Viewer::apply_camera() {
   if (same_view(camera, applied_camera_)) return;
   applied_camera_ = camera;
   labelled_->set_camera(camera);  // (the order goes back to the scene's)
-  changed(true);
+  changed();
 }
 
 bool Viewer::busy() const {
@@ -475,7 +512,6 @@ int Viewer::next_trial() {
   if (seconds_between(last_change_, Clock::now()) < options_.idle_seconds) return -1;
   if (o.baseline < 0.0) return -1;  // no settled normal frame yet
   if (o.orders.empty()) {
-    o.serial = serial_;
     for (uint32_t t = 0; t < options_.optimize_tries; ++t) {
       o.orders.push_back(random_order(uint32_t(n), serial_ * 131 + t + 1));
     }
@@ -498,7 +534,6 @@ void Viewer::read_slot(uint32_t slot) {
     gpu += t.ms;
   }
   ++summary_.timed_frames;
-  summary_.gpu_frame_ms.push_back(gpu);
   if (!last_timings_.empty()) {
     summary_.gpu_span_ms.push_back(last_timings_.back().end_ms - last_timings_.front().begin_ms);
   }
@@ -507,7 +542,7 @@ void Viewer::read_slot(uint32_t slot) {
 
   Optimisation& o = optimisation_;
   if (done.trial >= 0) {
-    if (o.serial == serial_ && size_t(done.trial) < o.costs.size()) {
+    if (size_t(done.trial) < o.costs.size()) {
       o.costs[size_t(done.trial)] = labelled_->total_cost();
       const bool all =
           std::none_of(o.costs.begin(), o.costs.end(), [](double c) { return std::isnan(c); });
@@ -516,7 +551,7 @@ void Viewer::read_slot(uint32_t slot) {
             size_t(std::min_element(o.costs.begin(), o.costs.end()) - o.costs.begin());
         o.done = true;
         if (o.costs[best] < o.baseline * (1.0 - 1e-4)) {
-          labelled_->keep_order(o.orders[best]);
+          labelled_->set_order(o.orders[best]);
           ++summary_.adopted;
           settled_ = false;  // the labels move to the cheaper layout
           message_ = "optimised on idle: cost " + std::to_string(o.baseline) + " -> " +
@@ -541,21 +576,21 @@ void Viewer::read_slot(uint32_t slot) {
   }
   if (still) {
     settled_ = true;
-    if (o.serial != serial_ || o.orders.empty()) o.baseline = labelled_->total_cost();
+    if (o.orders.empty()) o.baseline = labelled_->total_cost();  // the kept order's cost
   }
 }
 
 graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double seconds) {
   if (!(extent == labelled_->size())) {
     labelled_->set_size(extent);
-    changed(true);
+    changed();
   }
   read_slot(slot);
   // Stein & Decoret's order needs the picture: computed once the camera rests (a wait for the
   // frames in flight, once per rest).
   if (insertion_order_ == 1 && settled_ && apollonius_serial_ != serial_ && !control_.animating()) {
     output_.wait_idle();
-    labelled_->keep_order(labelled_->apollonius_layers_order());
+    labelled_->set_order(labelled_->apollonius_layers_order());
     apollonius_serial_ = serial_;
     settled_ = false;
   }
@@ -578,7 +613,6 @@ void Viewer::frame(std::optional<double> step) {
   double seconds = std::min(seconds_between(last_frame_, now), kMaxStep);
   if (video_) seconds = 1.0 / options_.record_fps;
   if (step) seconds = *step;
-  summary_.frame_ms.push_back(seconds_between(last_frame_, now) * 1e3);
   frame_times_.push_back(float(seconds_between(last_frame_, now) * 1e3));
   last_frame_ = now;
   const size_t plot = size_t(kPlotSeconds * 60.0);
@@ -603,17 +637,15 @@ void Viewer::frame(std::optional<double> step) {
   ++summary_.frames;
   summary_.busy_seconds += seconds_between(now, Clock::now());
   if (video_) {
-    output_.wait_idle();
-    const std::vector<std::byte> pixels =
-        labelled_->runner().download_image(labelled_->labelled_image());
+    const std::vector<uint8_t> pixels = download(labelled_->labelled_image());
     const graph::Extent e = labelled_->size();
     // (the encoder takes even sizes: the last row and column of an odd size are left out)
     std::vector<uint8_t> even;
     const uint32_t w = e.width & ~1u, h = e.height & ~1u;
     even.reserve(size_t(w) * h * 4);
-    const auto* p = reinterpret_cast<const uint8_t*>(pixels.data());
     for (uint32_t y = 0; y < h; ++y) {
-      even.insert(even.end(), p + size_t(y) * e.width * 4, p + (size_t(y) * e.width + w) * 4);
+      const auto row = pixels.begin() + long(size_t(y) * e.width * 4);
+      even.insert(even.end(), row, row + long(w) * 4);
     }
     video_->write(even);
     ++video_frames_;

@@ -94,9 +94,7 @@ struct ViewerSummary {
   double busy_seconds = 0.0;             // wall-clock time spent in frames
   std::map<std::string, double> gpu_ms;  // per pass: summed over the frames read back
   uint64_t timed_frames = 0;             // frames whose timings were read
-  std::vector<double> gpu_frame_ms;      // per frame read: the sum of its passes' GPU times
   std::vector<double> gpu_span_ms;       // per frame read: first pass's start to last pass's end
-  std::vector<double> frame_ms;          // per frame: wall-clock time from the last
   uint64_t trials = 0;                   // optimisation on idle: orders tried ...
   uint64_t adopted = 0;                  // ... and kept
 };
@@ -144,8 +142,11 @@ class Viewer {
   void start_recording(const std::filesystem::path& path);
   void stop_recording();
   bool recording() const { return video_ != nullptr; }
-  // Sets a parameter by the name the panel and input scripts use (`viewer_parameters()`).
+  // Sets a parameter by the name the panel and input scripts use (`viewer_parameters()`): from
+  // text (scripts), a number or a flag (the panel). A bad name or value changes nothing.
   void set_parameter(const std::string& name, const std::string& value);
+  void set_number(const std::string& name, float value);
+  void set_flag(const std::string& name, bool value);
   void set_label_hidden(int id, bool hidden);
   void save_position(const std::string& name);
   // The current camera (input scripts, tests), and a jump to another (benchmark paths).
@@ -167,7 +168,7 @@ class Viewer {
     uint64_t serial = 0;      // the change serial the frame was made for
     int trial = -1;           // a trial frame's index, or -1
   };
-  void changed(bool camera_moved = false);
+  void changed();
   void apply_camera();
   graph::GraphRunner& prepare(uint32_t slot, graph::Extent extent, double seconds);
   void read_slot(uint32_t slot);
@@ -181,8 +182,13 @@ class Viewer {
   void panel_statistics();
   void panel_debug();
   void set_transfer(uint32_t volume);
+  void commit_settings(const LabellingSettings& labels, const RenderSettings& render,
+                       const ViewerOptions& viewer, bool reproject);
+  // After a setting changed: anchors again if asked, the labels placed afresh, a new serial.
+  void settings_changed(bool reproject);
   void extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds& ids);
   void read_latest();
+  std::vector<uint8_t> download(graph::ResourceId image);
 
   Context& ctx_;
   Scene& scene_;
@@ -214,7 +220,6 @@ class Viewer {
 
   // Optimisation on idle: random orders tried in trial frames, the cheapest kept.
   struct Optimisation {
-    uint64_t serial = 0;  // the change it was made for
     std::vector<std::vector<uint32_t>> orders;
     std::vector<double> costs;  // NaN until read back
     uint32_t submitted = 0;

@@ -13,18 +13,18 @@
 namespace strata::app {
 namespace {
 
-// A float slider whose change is applied through set_parameter (one path for the panel and for
+// A float slider whose change is applied through set_number (one path for the panel and for
 // input scripts).
 bool slider(Viewer& viewer, const char* label, const char* parameter, float value, float lo,
             float hi, const char* format = "%.3g", ImGuiSliderFlags flags = 0) {
   if (!ImGui::SliderFloat(label, &value, lo, hi, format, flags)) return false;
-  viewer.set_parameter(parameter, std::to_string(value));
+  viewer.set_number(parameter, value);
   return true;
 }
 
 bool checkbox(Viewer& viewer, const char* label, const char* parameter, bool value) {
   if (!ImGui::Checkbox(label, &value)) return false;
-  viewer.set_parameter(parameter, value ? "on" : "off");
+  viewer.set_flag(parameter, value);
   return true;
 }
 
@@ -125,11 +125,11 @@ void Viewer::panel_labelling() {
   ImGui::Separator();
   slider(*this, "margin (px)", "margin", s.placement.margin, 0.0f, 32.0f, "%.1f");
   int layers = int(s.layer_count);
-  if (ImGui::SliderInt("layers", &layers, 1, 8)) set_parameter("layers", std::to_string(layers));
+  if (ImGui::SliderInt("layers", &layers, 1, 8)) set_number("layers", float(layers));
   ImGui::Text("layers used: %u", labelled_->layering().layer_count);
   const char* orders[] = {"scene", "Apollonius (when the camera rests)"};
   if (ImGui::Combo("insertion order", &insertion_order_, orders, 2)) {
-    labelled_->keep_order(scene_order(uint32_t(scene_.labels.size())));
+    labelled_->set_order(scene_order(uint32_t(scene_.labels.size())));
     changed();
   }
   checkbox(*this, "optimise on idle (random orders)", "optimize", options_.optimize_on_idle);
@@ -140,7 +140,7 @@ void Viewer::panel_labelling() {
   // (applied when the slider is let go: the glyphs and the graph are rebuilt)
   float font = s.font_pixels;
   ImGui::SliderFloat("font size (px)", &font, 8.0f, 40.0f, "%.0f");
-  if (ImGui::IsItemDeactivatedAfterEdit()) set_parameter("font", std::to_string(font));
+  if (ImGui::IsItemDeactivatedAfterEdit()) set_number("font", font);
 }
 
 void Viewer::panel_forces() {

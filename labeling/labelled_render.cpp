@@ -125,11 +125,11 @@ VolumeRenderer& LabelledRenderer::renderer() {
 
 void LabelledRenderer::set_label_hidden(size_t index, bool hidden) {
   hidden_.at(index) = hidden;
+  set_camera(camera_);  // (layering and flags from the anchors again)
 }
 
 void LabelledRenderer::set_extension(Extension extend) {
   extension_ = std::move(extend);
-  runner_.reset();
   build_graph();
 }
 
@@ -150,14 +150,8 @@ void LabelledRenderer::use_slot(uint32_t slot) {
 }
 
 void LabelledRenderer::prepare_frame(double seconds, bool trial) {
-  if (trial && trial_within_.size() == labels_.size()) {
-    const std::vector<uint32_t> kept = within_;
-    set_order(trial_within_);
-    set_placement_frame(true);
-    set_order(kept);
-  } else {
-    set_placement_frame(true);
-  }
+  const bool trial_order = trial && trial_within_.size() == labels_.size();
+  set_placement_frame(true, trial_order ? trial_within_ : within_);
   ForceSettings forces = settings_.forces;
   if (afresh_) forces.hold_share = forces.hold_cost = 0.0f;
   parts_->forces.set_frame(forces, seconds, settings_.placement.hard);
@@ -229,16 +223,12 @@ void LabelledRenderer::build_graph() {
   if (frames_in_flight_ > 1) runner_->set_frames_in_flight(frames_in_flight_);
 }
 
-void LabelledRenderer::set_order(const std::vector<uint32_t>& within) {
-  within_ = within;
-}
-
 // The labels and order of the next frame for the placement: a still with the scene's eta, a frame
 // of an animation with the forces' (toward the last targets).
-void LabelledRenderer::set_placement_frame(bool moving) {
+void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32_t>& within) {
   PlacementSettings settings = settings_.placement;
   if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
-  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within_), settings);
+  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within), settings);
 }
 
 void LabelledRenderer::set_camera(const Camera& camera) {
@@ -251,8 +241,7 @@ void LabelledRenderer::set_camera(const Camera& camera) {
 }
 
 void LabelledRenderer::advance(double seconds) {
-  set_placement_frame(true);
-  parts_->forces.set_frame(settings_.forces, seconds, settings_.placement.hard);
+  prepare_frame(seconds);
   run_frame();
 }
 
@@ -303,7 +292,7 @@ double LabelledRenderer::total_cost() const {
 void LabelledRenderer::run() {
   // A still: every frame puts the labels on their placement (the forces start afresh).
   const auto run_still = [this] {
-    set_placement_frame(false);
+    set_placement_frame(false, within_);
     parts_->forces.reset();
     parts_->forces.set_frame(settings_.forces, 0.0, settings_.placement.hard);
     run_frame();

@@ -110,20 +110,21 @@ class LabelledRenderer {
   // runner() into its own command buffer). A trial frame places the labels (in the order given
   // to set_trial_order) but leaves the forces' state as it was (optimisation on idle).
   void prepare_frame(double seconds, bool trial = false);
-  // Trial frames place labels in `within` (a permutation of the label indices); the other frames
-  // in the order last kept with keep_order (the scene's after set_camera).
+  // The order inside each layer (a permutation of the label indices): trial frames place the
+  // labels in the trial order, the other frames in the one set last (the scene's after
+  // set_camera).
   void set_trial_order(const std::vector<uint32_t>& within) { trial_within_ = within; }
-  void keep_order(const std::vector<uint32_t>& within) { set_order(within); }
+  void set_order(const std::vector<uint32_t>& within) { within_ = within; }
   // The next frame places the labels afresh: no hold, no eta toward the last targets (after a
   // change of the settings); the forces still move them there.
   void place_afresh() { afresh_ = true; }
-  const std::vector<uint32_t>& order() const { return within_; }
 
   // Live settings: placement weights, forces, internal labelling and the layer count take effect
   // with the next set_camera(); the renderer's own settings through renderer().
   LabellingSettings& settings() { return settings_; }
   VolumeRenderer& renderer();
-  // Hides label `index` (of the scene's labels) from the layering, placement and drawing.
+  // Hides label `index` (of the scene's labels) from the layering, placement and drawing (the
+  // anchors are layered again, as by set_camera).
   void set_label_hidden(size_t index, bool hidden);
   bool label_hidden(size_t index) const { return hidden_.at(index); }
   // The label font's size in pixels: rebuilds the glyphs, box sizes and the graph.
@@ -164,8 +165,7 @@ class LabelledRenderer {
   void run_frame();
   void project_and_layer(const Camera& camera);
   void build_graph();
-  void set_order(const std::vector<uint32_t>& within);
-  void set_placement_frame(bool moving);
+  void set_placement_frame(bool moving, const std::vector<uint32_t>& within);
   std::vector<uint32_t> within_;  // the order inside each layer set_order() was last given
   std::vector<uint32_t> trial_within_;
   bool afresh_ = false;

@@ -63,14 +63,16 @@ const GlyphMetrics& FontAtlas::glyph(char c) const {
   return glyphs[static_cast<size_t>(c - kFirstFontChar)];
 }
 
+std::string font_file(const std::string& path) {
+  const char* env = std::getenv("STRATA_FONT");
+  return path == kDefaultFontPath && env && *env ? std::string(env) : path;
+}
+
 FontAtlas load_font_atlas(float pixel_height, const std::string& path) {
   if (!(pixel_height >= 4.0f && pixel_height <= 128.0f)) {
     throw Error("font: pixel height " + std::to_string(pixel_height) + " is not in 4..128");
   }
-  // STRATA_FONT replaces the default font (hosts without fonts-dejavu-core).
-  const char* env = std::getenv("STRATA_FONT");
-  const std::string& file = (path == kDefaultFontPath && env && *env) ? std::string(env) : path;
-  const std::vector<unsigned char> data = read_font_file(file);
+  const std::vector<unsigned char> data = read_font_file(font_file(path));
   // stb_truetype trusts its input: refuse what cannot even hold a font's table directory.
   if (data.size() < 12) throw Error(path + ": not a TrueType font");
   stbtt_fontinfo font{};

@@ -41,6 +41,10 @@ struct FontAtlas {
   const GlyphMetrics& glyph(char c) const;
 };
 
+// The font file to read for `path`: STRATA_FONT, when set, replaces the default font (hosts
+// without fonts-dejavu-core).
+std::string font_file(const std::string& path = kDefaultFontPath);
+
 // Bakes printable ASCII of the font at `path` at `pixel_height` (ascent to descent). Throws
 // Error naming the path (and, for the default font, the Debian package) when it is missing or
 // not a font.
