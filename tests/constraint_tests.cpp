@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "passes/placement_reference.h"
+#include "test_scenes.h"
 
 namespace strata {
 namespace {
@@ -66,12 +67,7 @@ bool touches(glm::dvec2 anchor, glm::dvec2 centre, glm::dvec2 half, const Polygo
 }
 
 gpu::LabelGpu label(glm::vec2 anchor, glm::vec2 size) {
-  gpu::LabelGpu l{};
-  l.anchor = anchor;
-  l.size = size;
-  l.previous = anchor;
-  l.flags = LABEL_ENABLED;
-  return l;
+  return test::label_at(anchor, size);
 }
 
 }  // namespace

@@ -44,12 +44,7 @@ std::vector<glm::vec4> from_halves(const std::vector<std::byte>& bytes) {
 }
 
 gpu::LabelGpu label(glm::vec2 anchor, glm::vec2 size, uint32_t flags = LABEL_ENABLED) {
-  gpu::LabelGpu l{};
-  l.anchor = anchor;
-  l.size = size;
-  l.previous = anchor;
-  l.flags = flags;
-  return l;
+  return test::label_at(anchor, size, 0, flags);
 }
 
 // Inserts a fragment as the HA-Buffer build does: the first free slot of the pixel's probes.
@@ -150,15 +145,7 @@ std::vector<std::vector<uint8_t>> views_on_gpu(Context& ctx, const ViewInputs& i
   frame.table_size = static_cast<uint32_t>(in.keys.size());
   const Buffer frame_buffer =
       filled_buffer(ctx, std::as_bytes(std::span(&frame, 1)), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-  Image layers(ctx, {VK_FORMAT_R16G16B16A16_SFLOAT,
-                     {in.size.width, in.size.height, 1},
-                     VK_IMAGE_TYPE_2D,
-                     VK_IMAGE_USAGE_STORAGE_BIT,
-                     in.layer_count,
-                     true});
-  std::vector<uint64_t> halves;
-  for (const glm::vec4& c : in.layers) halves.push_back(glm::packHalf4x16(c));
-  upload(ctx, layers, as_bytes(halves), VK_IMAGE_LAYOUT_GENERAL);
+  const Image layers = test::layer_image(ctx, in.size, in.layer_count, in.layers);
 
   graph::Graph g;
   const auto filled = [&g](const char* name, const Buffer& buffer) {

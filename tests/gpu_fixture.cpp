@@ -7,6 +7,8 @@
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 
+#include <glm/gtc/packing.hpp>
+
 namespace strata::test {
 
 Context& gpu() {
@@ -40,6 +42,20 @@ CommandResult run_strata(const std::string& args, const std::string& env) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+Image layer_image(Context& ctx, graph::Extent size, uint32_t layer_count,
+                  const std::vector<glm::vec4>& layers) {
+  Image image(ctx, {VK_FORMAT_R16G16B16A16_SFLOAT,
+                    {size.width, size.height, 1},
+                    VK_IMAGE_TYPE_2D,
+                    VK_IMAGE_USAGE_STORAGE_BIT,
+                    layer_count,
+                    true});
+  std::vector<uint64_t> halves;
+  for (const glm::vec4& c : layers) halves.push_back(glm::packHalf4x16(c));
+  upload(ctx, image, as_bytes(halves), VK_IMAGE_LAYOUT_GENERAL);
+  return image;
 }
 
 std::string output_dir() {

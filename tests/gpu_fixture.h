@@ -5,7 +5,11 @@
 
 #include <string>
 
+#include <glm/glm.hpp>
+
 #include "engine/gpu/context.h"
+#include "engine/gpu/resources.h"
+#include "engine/graph/render_graph.h"
 
 namespace strata::test {
 
@@ -24,6 +28,12 @@ struct CommandResult {
 
 // Runs the strata binary built with these tests, with `args` (shell syntax), and captures it.
 CommandResult run_strata(const std::string& args, const std::string& env = "");
+
+// Depth layers as the renderer leaves them: an rgba16f 2D-array storage image of `layer_count`
+// layers of `size`, from premultiplied colours (layer after layer, rows top to bottom), in the
+// general layout.
+Image layer_image(Context& ctx, graph::Extent size, uint32_t layer_count,
+                  const std::vector<glm::vec4>& layers);
 
 // A folder for files the tests write (created on first use).
 std::string output_dir();

@@ -18,6 +18,7 @@
 #include "passes/label_forces.h"
 #include "passes/placement.h"
 #include "passes/placement_reference.h"
+#include "test_scenes.h"
 
 namespace strata {
 namespace {
@@ -32,13 +33,7 @@ struct Inputs {
 };
 
 gpu::LabelGpu label(glm::vec2 anchor, glm::vec2 size, uint32_t layer) {
-  gpu::LabelGpu l{};
-  l.anchor = anchor;
-  l.size = size;
-  l.previous = anchor;
-  l.layer = layer;
-  l.flags = LABEL_ENABLED;
-  return l;
+  return test::label_at(anchor, size, layer);
 }
 
 // A bright disc (the "object") on a dark background, half of it in the front layer, half in the
@@ -102,17 +97,7 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
                           VK_IMAGE_TYPE_2D,
                           VK_IMAGE_USAGE_STORAGE_BIT});
   upload(ctx, final_image, as_bytes(in.final_rgba8), VK_IMAGE_LAYOUT_GENERAL);
-  std::vector<uint16_t> halves;
-  for (const glm::vec4& c : in.layers) {
-    for (int ch = 0; ch < 4; ++ch) halves.push_back(glm::packHalf1x16(c[ch]));
-  }
-  Image layers(ctx, {VK_FORMAT_R16G16B16A16_SFLOAT,
-                     {in.size.width, in.size.height, 1},
-                     VK_IMAGE_TYPE_2D,
-                     VK_IMAGE_USAGE_STORAGE_BIT,
-                     in.layer_count,
-                     true});
-  upload(ctx, layers, as_bytes(halves), VK_IMAGE_LAYOUT_GENERAL);
+  const Image layers = test::layer_image(ctx, in.size, in.layer_count, in.layers);
 
   Placement placement(ctx, uint32_t(in.labels.size()), layout);
   graph::Graph g;

@@ -5,6 +5,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "engine/scene/scene.h"
+#include "shared/labels.h"
 
 namespace strata::test {
 
@@ -35,6 +36,18 @@ inline Mesh quad(float z, glm::vec4 color, float half = 10.0f, glm::vec2 centre 
   m.indices = {0, 1, 2, 0, 2, 3};
   m.color = color;
   return m;
+}
+
+// An enabled label of `size` at `anchor` on `layer` (its previous position the anchor).
+inline gpu::LabelGpu label_at(glm::vec2 anchor, glm::vec2 size, uint32_t layer = 0,
+                              uint32_t flags = LABEL_ENABLED) {
+  gpu::LabelGpu l{};
+  l.anchor = anchor;
+  l.size = size;
+  l.previous = anchor;
+  l.layer = layer;
+  l.flags = flags;
+  return l;
 }
 
 }  // namespace strata::test
