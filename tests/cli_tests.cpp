@@ -141,17 +141,7 @@ TEST_SUITE("cli") {
     CHECK(r.exit_code == 0);
     CHECK(r.output.find("validation:") == std::string::npos);
     CHECK(r.output.find("wrote 7 frames (64x64, 30 fps)") != std::string::npos);
-    std::FILE* pipe = popen(("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-                             "stream=width,height,nb_read_frames -of csv=p=0 " +
-                             dir + ".mp4")
-                                .c_str(),
-                            "r");
-    REQUIRE(pipe != nullptr);
-    char line[128] = {};
-    const bool read = std::fgets(line, sizeof line, pipe) != nullptr;
-    pclose(pipe);
-    CHECK(read);
-    CHECK(std::string(line).starts_with("64,64,7"));
+    CHECK(test::probe_video(dir + ".mp4", "width,height,nb_read_frames") == "64,64,7");
     const auto eval = run_strata("eval " + dir + "/frame-0000*.json");
     CHECK(eval.exit_code == 0);
     const nlohmann::json report = bench_report(eval.output);

@@ -58,6 +58,20 @@ Image layer_image(Context& ctx, graph::Extent size, uint32_t layer_count,
   return image;
 }
 
+std::string probe_video(const std::string& file, const std::string& entries) {
+  const std::string command =
+      "ffprobe -v error -count_frames -select_streams v:0 -show_entries stream=" + entries +
+      " -of csv=p=0 '" + file + "' 2>&1";
+  std::FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::string out;
+  char buffer[256];
+  while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
+  pclose(pipe);
+  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
+  return out;
+}
+
 std::string output_dir() {
   const std::string dir = STRATA_TEST_OUTPUT;
   std::filesystem::create_directories(dir);

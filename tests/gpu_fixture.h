@@ -35,6 +35,10 @@ CommandResult run_strata(const std::string& args, const std::string& env = "");
 Image layer_image(Context& ctx, graph::Extent size, uint32_t layer_count,
                   const std::vector<glm::vec4>& layers);
 
+// What ffprobe (Debian's ffmpeg) says of a video file's first video stream: `entries` (e.g.
+// "codec_name,width,height,nb_read_frames") as comma-separated values, frames counted.
+std::string probe_video(const std::string& file, const std::string& entries);
+
 // A folder for files the tests write (created on first use).
 std::string output_dir();
 

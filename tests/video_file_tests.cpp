@@ -15,18 +15,7 @@ namespace {
 
 // What ffprobe says of the file's video stream: "codec,width,height,frames".
 std::string probe(const std::string& file) {
-  const std::string command =
-      "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-      "stream=codec_name,width,height,nb_read_frames -of csv=p=0 '" +
-      file + "' 2>&1";
-  std::FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::string out;
-  char buffer[256];
-  while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
-  pclose(pipe);
-  while (!out.empty() && (out.back() == '\n' || out.back() == '\r')) out.pop_back();
-  return out;
+  return test::probe_video(file, "codec_name,width,height,nb_read_frames");
 }
 
 }  // namespace

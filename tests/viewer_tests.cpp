@@ -221,17 +221,7 @@ TEST_SUITE("window") {
     const int recorded = frames("recorded.json") - frames("still-2.json");
     CHECK(recorded >= 4);
 #if STRATA_VIDEO
-    std::FILE* pipe = popen(("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-                             "stream=nb_read_frames -of csv=p=0 '" +
-                             d("clip.mp4") + "'")
-                                .c_str(),
-                            "r");
-    REQUIRE(pipe != nullptr);
-    char line[64] = {};
-    const bool read = std::fgets(line, sizeof line, pipe) != nullptr;
-    pclose(pipe);
-    REQUIRE(read);
-    CHECK(std::atoi(line) == recorded);
+    CHECK(test::probe_video(d("clip.mp4"), "nb_read_frames") == std::to_string(recorded));
 #endif
   }
 
