@@ -149,6 +149,17 @@ struct RenderBenchOptions {
   float step = 0.0f;
 };
 
+// What the driver reports per pipeline (registers, ...), if anything: {pipeline: {name: value}}.
+ordered_json pipelines_json(const std::vector<PipelineReport>& reports) {
+  ordered_json out = ordered_json::object();
+  for (const auto& [name, statistics] : reports) {
+    if (statistics.empty()) continue;
+    ordered_json& entry = out[name];
+    for (const auto& s : statistics) entry[s.name] = s.value;
+  }
+  return out;
+}
+
 void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t runs) {
   const graph::Extent size = parse_size(o.size, "--size");
   const Scene scene = load_scene_reporting(o.scene);
@@ -170,7 +181,7 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
     if (name == "render.resolve") resolve_ms = stat.median;
   }
   // Texture fetches: one trilinear atlas fetch per live volume per sample (the transfer tables
-  // are in shared memory).
+  // are storage buffers, not textures).
   const double rays = double(size.width) * size.height;
   const double fetches = double(last.fetches);
   // The sampling distance the frame used (--step 0 asks for half a voxel).
@@ -183,7 +194,7 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
                               {"layers", o.layers},
                               {"empty_space_skipping", !o.no_skipping},
                               {"step", shortest_double(step)}};
-  const ordered_json results = {{"samples_per_ray", double(last.samples) / rays},
+  ordered_json results = {{"samples_per_ray", double(last.samples) / rays},
                                 {"shaded_samples_per_ray", double(last.shaded) / rays},
                                 {"habuffer_fragments", last.fragments},
                                 {"habuffer_slots", last.table_size},
@@ -193,6 +204,8 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
                                 {"texture_fetches_per_frame", last.fetches},
                                 {"resolve_fetch_rate_gtexel_per_s",
                                  resolve_ms > 0.0 ? fetches / (resolve_ms * 1e-3) * 1e-9 : 0.0}};
+  const ordered_json pipelines = pipelines_json(renderer.pipeline_statistics());
+  if (!pipelines.empty()) results["pipelines"] = pipelines;
   print_json(ctx, setup, runs, t, results);
 }
 
@@ -216,17 +229,6 @@ void resize_labels(Scene& scene, uint32_t count) {
     l.id = int(i) + 1;
     scene.labels.push_back(l);
   }
-}
-
-// What the driver reports per pipeline (registers, ...), if anything: {pipeline: {name: value}}.
-ordered_json pipelines_json(const std::vector<PipelineReport>& reports) {
-  ordered_json out = ordered_json::object();
-  for (const auto& [name, statistics] : reports) {
-    if (statistics.empty()) continue;
-    ordered_json& entry = out[name];
-    for (const auto& s : statistics) entry[s.name] = s.value;
-  }
-  return out;
 }
 
 void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint32_t runs) {

@@ -7,7 +7,7 @@
 //   constraints  label i's constraint image (thesis 4.1.1), recomputed from the labels placed
 //                before it in the order (see shaders/shared/debug_view.h)
 //   layer        depth layer L (premultiplied) over a grey checkerboard
-//   fragments    the HA-Buffer's fragments per pixel times scale, black-body ramp
+//   fragments    the HA-Buffer's mesh fragments per pixel times scale, black-body ramp
 // The per-pixel code is shared with the CPU reference below.
 #pragma once
 

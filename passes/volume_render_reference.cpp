@@ -73,7 +73,7 @@ bool intersect(const vec3& o, const vec3& d, const vec3& a, const vec3& b, const
   return u >= 0.0f && v >= 0.0f && u + v <= 1.0f;
 }
 
-std::vector<Fragment> fragments(const RenderInputs& in, const FrameGpu& frame, const vec3& origin,
+std::vector<Fragment> mesh_fragments(const RenderInputs& in, const FrameGpu& frame, const vec3& origin,
                                 const vec3& direction) {
   std::vector<Fragment> out;
   const auto visible = [&](float t) { return t >= frame.near_depth && t <= frame.far_depth; };
@@ -95,24 +95,6 @@ std::vector<Fragment> fragments(const RenderInputs& in, const FrameGpu& frame, c
       out.push_back({t, uvec2(mesh_payload_color(draw.color, normal, -normalize(view_position)),
                               m | (VR_KIND_MESH << 8u))});
     }
-  }
-  for (uint v = 0; v < in.volumes.size(); ++v) {
-    const mat4& w2t = in.volumes[v].world_to_texture;
-    const vec3 o = vec3(w2t * vec4(origin, 1.0f)), d = mat3(w2t) * direction;
-    float enter = -3.4e38f, leave = 3.4e38f;
-    for (int axis = 0; axis < 3; ++axis) {
-      if (std::abs(d[axis]) < 1e-20f) {
-        if (o[axis] < 0.0f || o[axis] > 1.0f) enter = 3.4e38f;
-        continue;
-      }
-      const float t0 = (0.0f - o[axis]) / d[axis], t1 = (1.0f - o[axis]) / d[axis];
-      enter = std::max(enter, std::min(t0, t1));
-      leave = std::min(leave, std::max(t0, t1));
-    }
-    if (enter > leave) continue;
-    const uint face = v | (VR_KIND_VOLUME_FACE << 8u);
-    if (visible(enter)) out.push_back({enter, uvec2(0u, face | (1u << 10u))});
-    if (visible(leave)) out.push_back({leave, uvec2(0u, face)});
   }
   std::stable_sort(out.begin(), out.end(),
                    [](const Fragment& a, const Fragment& b) { return a.depth < b.depth; });
@@ -137,10 +119,10 @@ ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera
       const glm::vec2 centre(float(x) + 0.5f, float(y) + 0.5f);
       const auto ray = ref.pixel_ray(centre);
       const std::vector<gpu::Fragment> found =
-          gpu::fragments(inputs, ref.frame, ray.origin, ray.direction);
+          gpu::mesh_fragments(inputs, ref.frame, ray.origin, ray.direction);
       float depths[VR_MAX_FRAGMENTS];
       glm::uvec2 payloads[VR_MAX_FRAGMENTS];
-      const uint32_t count = uint32_t(std::min<size_t>(found.size(), VR_MAX_FRAGMENTS));
+      const uint32_t count = uint32_t(std::min<size_t>(found.size(), VR_MAX_MESH_FRAGMENTS));
       for (uint32_t i = 0; i < count; ++i) {
         depths[i] = found[i].depth;
         payloads[i] = found[i].payload;

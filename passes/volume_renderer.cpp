@@ -146,13 +146,19 @@ RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimens
       }
     }
     gpu::VolumeGpu info{};
-    info.texture_to_world = texture_to_world(v);
-    info.world_to_texture = glm::inverse(info.texture_to_world);
+    const glm::mat4 to_world = texture_to_world(v);
+    info.world_to_texture = glm::inverse(to_world);
+    // Per voxel to per texture unit (× dims), then world: gradients transform with the transpose
+    // of the world-to-texture map.
+    const glm::mat3 gradient =
+        glm::transpose(glm::mat3(info.world_to_texture)) *
+        glm::mat3(glm::vec3(v.dims.x, 0, 0), glm::vec3(0, v.dims.y, 0), glm::vec3(0, 0, v.dims.z));
+    info.gradient_to_world = glm::mat4(gradient);
     const glm::vec3 atlas_size(dims);
     info.atlas_offset =
         glm::vec4(glm::vec3(VR_ATLAS_BORDER, VR_ATLAS_BORDER, z0 + VR_ATLAS_BORDER) / atlas_size,
                   (float(index) + 0.5f) / float(scene.volumes.size()));
-    const float spacing = finest_world_spacing(info.texture_to_world, v.dims);
+    const float spacing = finest_world_spacing(to_world, v.dims);
     info.atlas_scale = glm::vec4(glm::vec3(v.dims) / atlas_size, spacing);
     info.texel = glm::vec4(1.0f / glm::vec3(v.dims), 0.0f);
     const glm::uvec3 bricks = (v.dims + uint32_t(VR_BRICK - 1)) / uint32_t(VR_BRICK);
@@ -162,7 +168,7 @@ RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimens
     in.volumes.push_back(info);
     in.finest_spacing = std::min(in.finest_spacing, spacing);
     for (int c = 0; c < 8; ++c) {
-      extend(glm::vec3(info.texture_to_world * glm::vec4(c & 1, (c >> 1) & 1, (c >> 2) & 1, 1.0f)));
+      extend(glm::vec3(to_world * glm::vec4(c & 1, (c >> 1) & 1, (c >> 2) & 1, 1.0f)));
     }
     in.transfer_functions.push_back(v.transfer_function >= 0
                                         ? scene.transfer_functions.at(size_t(v.transfer_function))
@@ -267,6 +273,7 @@ gpu::FrameGpu frame_data(const RenderInputs& in, const Camera& camera,
   f.volume_count = static_cast<uint32_t>(in.volumes.size());
   f.table_size = table_size;
   f.skip_empty = settings.skip_empty ? 1u : 0u;
+  f.mesh_count = static_cast<uint32_t>(in.meshes.size());
   f.near_depth = camera.near_plane;
   f.far_depth = camera.far_plane;
   f.step = settings.step > 0.0f ? settings.step : 0.5f * in.finest_spacing;
@@ -321,6 +328,7 @@ void VolumeRenderer::set_table_size(uint32_t slots) {
 
 uint32_t VolumeRenderer::slots_for(graph::Extent e) const {
   if (forced_slots_) return forced_slots_;
+  if (inputs_.meshes.empty()) return 1;  // volume boxes need no slots; the resolve skips the table
   const double wanted =
       double(e.width) * e.height * settings_.expected_depth_complexity / settings_.load_factor;
   return static_cast<uint32_t>(std::min(std::ceil(wanted), 4.0e9));
@@ -409,6 +417,7 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
 }
 
 void VolumeRenderer::record_build(graph::PassContext& pc) const {
+  if (inputs_.meshes.empty()) return;  // volume boxes are the resolve's ray-box tests
   VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
   rendering.renderArea = {{0, 0}, {pc.viewport.width, pc.viewport.height}};
   rendering.layerCount = 1;
@@ -420,17 +429,15 @@ void VolumeRenderer::record_build(graph::PassContext& pc) const {
   pc.bind(build_);
   for (uint32_t m = 0; m < inputs_.meshes.size(); ++m) {
     const RenderInputs::MeshDraw& draw = inputs_.meshes[m];
-    const gpu::DrawGpu push{draw.transform, draw.color, draw.first_index, m, VR_KIND_MESH, 0};
+    const gpu::DrawGpu push{draw.transform, draw.color, draw.first_index, m, 0, 0};
     build_.push_constants(pc.cmd, push);
     vkCmdDraw(pc.cmd, draw.index_count, 1, 0, 0);
   }
-  for (uint32_t v = 0; v < inputs_.volumes.size(); ++v) {
-    const gpu::DrawGpu push{
-        inputs_.volumes[v].texture_to_world, glm::vec4(0.0f), 0, v, VR_KIND_VOLUME_FACE, 0};
-    build_.push_constants(pc.cmd, push);
-    vkCmdDraw(pc.cmd, 36, 1, 0, 0);
-  }
   vkCmdEndRendering(pc.cmd);
+}
+
+std::vector<PipelineReport> VolumeRenderer::pipeline_statistics() const {
+  return {{resolve_.name(), resolve_.statistics()}};
 }
 
 RenderStats VolumeRenderer::collect(graph::GraphRunner& runner) {

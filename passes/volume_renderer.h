@@ -1,6 +1,6 @@
-// The renderer: transparent meshes and volume proxy boxes hashed into the HA-Buffer by one thin
-// graphics pass, then one compute pass that sorts each pixel's fragments, ray-casts the volumes
-// live between them from the volume atlas, and writes one premultiplied image per depth layer,
+// The renderer: transparent meshes hashed into the HA-Buffer by one thin graphics pass, then one
+// compute pass that sorts each pixel's mesh fragments, adds the volumes' boxes by a ray-box test,
+// ray-casts the volumes live between them from the volume atlas, and writes one premultiplied image per depth layer,
 // the label-free final image and a depth image. docs/ARCHITECTURE.md, "Rendering", says why.
 #pragma once
 
@@ -25,15 +25,15 @@ struct RenderSettings {
   float termination_alpha = 0.99f;
   float depth_alpha = 0.5f;
   glm::vec3 background{0.0f};
-  float expected_depth_complexity = 4.0f;  // HA-Buffer sizing: fragments per pixel expected
+  float expected_depth_complexity = 4.0f;  // HA-Buffer sizing: mesh fragments per pixel expected
   float load_factor = 0.5f;                // ... and the share of slots they should fill
 };
 
 // What the GPU counted during the last completed frame.
 struct RenderStats {
   uint32_t overflow = 0;          // fragments that found no slot (the table grows)
-  uint32_t fragments = 0;         // fragments in the table
-  uint32_t resolve_overflow = 0;  // fragments beyond the resolve's per-pixel capacity
+  uint32_t fragments = 0;         // mesh fragments in the table
+  uint32_t resolve_overflow = 0;  // mesh fragments beyond the resolve's per-pixel capacity
   uint64_t samples = 0;           // ray positions sampled
   uint64_t shaded = 0;            // volume samples shaded
   uint64_t fetches = 0;           // atlas texture fetches (trilinear, 4 x 16-bit)
@@ -99,6 +99,9 @@ class VolumeRenderer {
   RenderSettings& settings() { return settings_; }
   // Rebuilds volume v's empty-space grid and its transfer-function row.
   void set_transfer_function(uint32_t volume, const TransferFunction& tf);
+  // What the driver reports about the resolve's compiled shader (registers, ...), if anything.
+  std::vector<PipelineReport> pipeline_statistics() const;
+
   // Forces the HA-Buffer's slot count (tests force overflow with a tiny table); collect() grows it.
   void set_table_size(uint32_t slots);
   uint32_t table_slots(graph::Extent viewport) const { return slots_for(viewport); }

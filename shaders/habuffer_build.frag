@@ -3,26 +3,20 @@
 #include "shared/volume_shading.h"
 #include "habuffer.glsl"
 
-// Thin: every fragment of every mesh and volume box goes into the hash table; nothing is drawn.
+// Thin: every fragment of every mesh goes into the hash table; nothing is drawn.
 layout(early_fragment_tests) in;
 layout(binding = VR_BINDING_FRAME) uniform Frame { FrameGpu frame; };
 layout(push_constant) uniform Push { DrawGpu draw; };
 
 layout(location = 0) in vec3 view_position;
 layout(location = 1) in vec3 view_normal;
-layout(location = 2) flat in vec3 face_normal_view;
 
 void main() {
   const uvec2 px = uvec2(gl_FragCoord.xy);
   const uint pixel = px.y * frame.width + px.x;
   const vec3 to_eye = -normalize(view_position);
-  uvec2 data;
-  if (draw.kind == VR_KIND_MESH) {
-    data = uvec2(mesh_payload_color(draw.color, view_normal, to_eye), draw.object);
-  } else {
-    const uint enters = dot(face_normal_view, to_eye) > 0.0 ? 1u : 0u;
-    data = uvec2(0u, draw.object | (VR_KIND_VOLUME_FACE << 8) | (enters << 10));
-  }
+  const uvec2 data = uvec2(mesh_payload_color(draw.color, view_normal, to_eye),
+                           draw.object | (VR_KIND_MESH << 8));
   const float depth = -view_position.z;
   for (uint age = 1u; age <= VR_MAX_AGE; ++age) {
     const uint slot = habuffer_slot(pixel, age, frame.table_size);

@@ -33,16 +33,16 @@ void main() {
   uint count = 0u, dropped = 0u;
   float depths[VR_MAX_FRAGMENTS];
   uvec2 payloads[VR_MAX_FRAGMENTS];
-  if (inside) {
-    // Gather this pixel's fragments along its probe sequence up to the first empty slot, then
-    // sort them by depth.
+  if (inside && frame.mesh_count > 0u) {
+    // Gather this pixel's mesh fragments along its probe sequence up to the first empty slot,
+    // then sort them by depth.
     const uint pixel = px.y * frame.width + px.x;
     for (uint age = 1u; age <= VR_MAX_AGE; ++age) {
       const uint slot = habuffer_slot(pixel, age, frame.table_size);
       const uint64_t key = keys[slot];
       if (key == uint64_t(0)) break;
       if (uint(key & 0xFFFFFFul) != pixel || uint((key >> 24) & 0xFFul) != age) continue;
-      if (count == VR_MAX_FRAGMENTS) {
+      if (count == VR_MAX_MESH_FRAGMENTS) {
         ++dropped;
         continue;
       }

@@ -28,6 +28,7 @@ using glm::clamp;
 using glm::dot;
 using glm::floor;
 using glm::greaterThanEqual;
+using glm::inversesqrt;
 using glm::length;
 using glm::lessThanEqual;
 using glm::max;

@@ -6,7 +6,8 @@
 //                                          voxel), w the normalised intensity
 //   vec4 table_entry(uint v, int i)        transfer table entry i of volume v
 //   bool brick_empty(uint v, vec3 tc)      transfer function is transparent in tc's brick
-// and the fragments of the pixel sorted front to back: their eye depths and payloads.
+// and the pixel's mesh fragments sorted front to back: their eye depths and payloads. The
+// volumes' boxes are added here, by a ray-box test.
 //
 // The ray is parametrised by eye depth z: point(z) = origin + direction * z. Samples lie on one
 // grid for the whole ray (near + (k + 0.5) * dz), so segments between fragments join seamlessly.
@@ -58,13 +59,14 @@ vec4 sample_volumes(uint live, vec3 p, vec3 to_eye, float step_world) {
     atlas_fetches += 1u;
     vec4 c = transfer(v, s.w);
     if (c.a <= 0.0f) continue;
-    // Per voxel to per texture unit, then world: gradients transform with the transpose of the
-    // world-to-texture map.
-    vec3 normal = transpose(mat3(vol.world_to_texture)) * (vec3(s) / vec3(vol.texel));
+    vec3 normal = mat3(vol.gradient_to_world) * vec3(s);
     float alpha = corrected_alpha(c.a, step_world, vol.atlas_scale.w);
     shaded_samples += 1u;
-    vec4 shaded = length(normal) > 1e-6f ? shade_blinn_phong(vec4(vec3(c), 1.0f), -normal, to_eye)
-                                         : vec4(vec3(c), 1.0f);
+    // One reciprocal square root for both the zero test and the normalisation.
+    float length2 = dot(normal, normal);
+    vec4 shaded = length2 > 1e-12f ? shade_unit_normal(vec4(vec3(c), 1.0f),
+                                                       normal * inversesqrt(length2), to_eye)
+                                   : vec4(vec3(c), 1.0f);
     sum += vec4(vec3(shaded) * alpha, alpha);
   }
   if (sum.a > 1.0f) sum /= sum.a;
@@ -118,6 +120,25 @@ Ray pixel_ray(vec2 pixel) {
 float grid_depth(float k, float dz) {
   return frame.near_depth + (k + 0.5f) * dz;
 }
+// Where the ray enters and leaves volume v's box (eye depths; enter > leave: it misses). The
+// slab test in texture space, where the box is [0,1]^3.
+vec2 box_interval(uint v, vec3 origin, vec3 direction) {
+  mat4 w2t = volume_info(v).world_to_texture;
+  vec3 o = vec3(w2t * vec4(origin, 1.0f));
+  vec3 d = mat3(w2t) * direction;
+  float enter = -3.4e38f, leave = 3.4e38f;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (abs(d[axis]) < 1e-20f) {
+      if (o[axis] < 0.0f || o[axis] > 1.0f) enter = 3.4e38f;
+      continue;
+    }
+    float t0 = (0.0f - o[axis]) / d[axis], t1 = (1.0f - o[axis]) / d[axis];
+    enter = max(enter, min(t0, t1));
+    leave = min(leave, max(t0, t1));
+  }
+  return vec2(enter, leave);
+}
+
 float grid_index_at_or_after(float z, float dz) {
   return max(ceil((z - frame.near_depth) / dz - 0.5f), 0.0f);
 }
@@ -137,12 +158,26 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   vec3 to_eye = -normalize(direction);
   float dz = frame.step / length(direction);
 
-  // Volumes the near plane cuts: their rays start at the near plane.
+  // Each box's faces between the near and far planes join the mesh fragments, in depth order
+  // (after fragments at the same depth); a box the near plane cuts is live from the start.
   uint live = 0u;
   for (uint v = 0u; v < frame.volume_count; ++v) {
     vec3 tc =
         vec3(volume_info(v).world_to_texture * vec4(origin + direction * frame.near_depth, 1.0f));
     if (inside_unit_box(tc)) live |= 1u << v;
+    vec2 box = box_interval(v, origin, direction);
+    if (box.x > box.y) continue;
+    for (uint face = 0u; face < 2u; ++face) {
+      float d = face == 0u ? box.x : box.y;
+      if (d < frame.near_depth || d > frame.far_depth) continue;
+      uint j = count++;
+      for (; j > 0u && depths[j - 1u] > d; --j) {
+        depths[j] = depths[j - 1u];
+        payloads[j] = payloads[j - 1u];
+      }
+      depths[j] = d;
+      payloads[j] = uvec2(0u, v | (VR_KIND_VOLUME_FACE << 8u) | ((1u - face) << 10u));
+    }
   }
 
   float total = 0.0f;

@@ -1,6 +1,6 @@
-// Rendering of transparent meshes and volumes through the HA-Buffer (a hashed A-buffer) and its
-// resolve, which ray-casts every volume active between consecutive fragments and writes one image
-// per depth layer. Constants, bindings and GPU structs are written once here for C++ and GLSL.
+// Rendering of transparent meshes and volumes through the HA-Buffer (a hashed A-buffer of mesh
+// fragments) and its resolve, which adds each volume's box by a ray-box test, ray-casts every
+// volume active between consecutive fragments and writes one image per depth layer. Constants, bindings and GPU structs are written once here for C++ and GLSL.
 #ifndef STRATA_SHARED_VOLUME_RENDER_H
 #define STRATA_SHARED_VOLUME_RENDER_H
 
@@ -8,7 +8,8 @@
 
 #define VR_MAX_VOLUMES 8
 #define VR_MAX_LAYERS 8
-#define VR_MAX_FRAGMENTS 16  // per pixel in the resolve; more are counted, not drawn
+#define VR_MAX_MESH_FRAGMENTS 16  // per pixel in the resolve; more are counted, not drawn
+#define VR_MAX_FRAGMENTS (VR_MAX_MESH_FRAGMENTS + 2 * VR_MAX_VOLUMES)  // with the boxes' faces
 #define VR_MAX_AGE 255       // probes per insertion before a fragment counts as overflow
 #define VR_TF_SIZE 256       // entries per transfer-function row
 #define VR_BRICK 8           // voxels per brick edge for empty-space skipping
@@ -20,8 +21,8 @@
 
 // Counters written on the GPU, read back a frame later.
 #define VR_COUNTER_OVERFLOW 0          // fragments that found no free slot
-#define VR_COUNTER_FRAGMENTS 1         // fragments the resolve found
-#define VR_COUNTER_RESOLVE_OVERFLOW 2  // fragments beyond VR_MAX_FRAGMENTS in one pixel
+#define VR_COUNTER_FRAGMENTS 1         // mesh fragments the resolve found in the table
+#define VR_COUNTER_RESOLVE_OVERFLOW 2  // mesh fragments beyond VR_MAX_MESH_FRAGMENTS in a pixel
 #define VR_COUNTER_SAMPLES 3           // ray positions sampled
 #define VR_COUNTER_SHADED 4            // volume samples shaded (alpha > 0)
 #define VR_COUNTER_FETCHES 5           // atlas fetches (one per live volume per sample)
@@ -45,8 +46,9 @@
 STRATA_BEGIN
 
 struct VolumeGpu {
-  mat4 world_to_texture;  // world -> [0,1]^3 (voxel centres at (i + 0.5) / dims)
-  mat4 texture_to_world;
+  mat4 world_to_texture;   // world -> [0,1]^3 (voxel centres at (i + 0.5) / dims)
+  mat4 gradient_to_world;  // 3x3 part: a gradient per voxel to world units (transpose of the
+                           // world-to-texture map times dims; a normal's direction)
   vec4
       atlas_offset;  // xyz: atlas coordinate of texture coordinate 0; w: transfer row centre (0..1)
   vec4 atlas_scale;  // xyz: atlas units per texture unit; w: reference step in world units
@@ -68,7 +70,7 @@ struct FrameGpu {
   uint volume_count;
   uint table_size;  // HA-Buffer slots
   uint skip_empty;  // 1: empty-space skipping
-  uint pad0;
+  uint mesh_count;  // 0: the table is empty and the resolve does not read it
   uint pad1;
   float near_depth;  // eye depth of the near and far planes
   float far_depth;
@@ -80,14 +82,14 @@ struct FrameGpu {
   float pad4;
 };
 
-// Push constants of one draw in the HA-Buffer build.
+// Push constants of one mesh's draw in the HA-Buffer build.
 struct DrawGpu {
-  mat4 model;        // mesh: model to world; volume box: texture to world
-  vec4 color;        // straight RGBA (meshes)
-  uint first_index;  // meshes: first index in the index buffer
-  uint object;       // mesh index, or volume index for boxes
-  uint kind;         // VR_KIND_MESH or VR_KIND_VOLUME_FACE
-  uint pad;
+  mat4 model;        // model to world
+  vec4 color;        // straight RGBA
+  uint first_index;  // first index in the index buffer
+  uint object;       // mesh index
+  uint pad0;
+  uint pad1;
 };
 STRATA_END
 

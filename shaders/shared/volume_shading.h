@@ -13,14 +13,22 @@ STRATA_BEGIN
 
 // Two-sided Blinn-Phong with a headlight (light and eye in the same direction, so the half vector
 // is the light): straight RGBA in, premultiplied RGBA out.
-STRATA_INLINE vec4 shade_blinn_phong(vec4 color, vec3 normal, vec3 to_eye) {
-  vec3 n = normalize(normal);
-  if (dot(n, to_eye) < 0.0f) n = -n;
-  float diffuse = max(dot(n, to_eye), 0.0f);
-  float specular = pow(diffuse, 32.0f);
+// `unit_normal` has length 1; the specular power 32 is five squarings (no pow on the GPU's
+// special-function units, which bound the resolve's shading).
+STRATA_INLINE vec4 shade_unit_normal(vec4 color, vec3 unit_normal, vec3 to_eye) {
+  float diffuse = abs(dot(unit_normal, to_eye));
+  float specular = diffuse * diffuse;
+  specular *= specular;
+  specular *= specular;
+  specular *= specular;
+  specular *= specular;
   vec3 rgb = vec3(color) * (0.3f + 0.7f * diffuse) + vec3(0.2f * specular);
   rgb = min(rgb, vec3(1.0f));
   return vec4(rgb * color.a, color.a);
+}
+
+STRATA_INLINE vec4 shade_blinn_phong(vec4 color, vec3 normal, vec3 to_eye) {
+  return shade_unit_normal(color, normalize(normal), to_eye);
 }
 
 // Eq. 3.9, front to back: `back` (premultiplied) seen through what `front` has accumulated.
