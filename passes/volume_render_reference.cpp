@@ -17,7 +17,8 @@ struct Reference {
   FrameGpu frame;
   const RenderInputs& in;
 
-  VolumeGpu volume_info(uint v) const { return in.volumes[v]; }
+  // (the walk loads the first volume's data whatever the count, as the GPU's one-entry buffer)
+  VolumeGpu volume_info(uint v) const { return v < in.volumes.size() ? in.volumes[v] : VolumeGpu{}; }
 
   // Linear filtering with clamp-to-edge addressing, as the GPU's sampler does.
   vec4 volume_sample(uint v, vec3 tc) const {

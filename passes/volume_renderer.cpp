@@ -303,7 +303,10 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
   };
   vertices_ = filled(inputs_.vertices);
   indices_ = filled(inputs_.indices);
-  volumes_ = filled(inputs_.volumes);
+  // (one entry at least: the resolve loads the first volume's data whatever the count)
+  std::vector<gpu::VolumeGpu> volume_data = inputs_.volumes;
+  if (volume_data.empty()) volume_data.emplace_back();
+  volumes_ = filled(volume_data);
   occupancy_ = Buffer(ctx, at_least(inputs_.occupancy.size() * sizeof(uint32_t)), storage,
                       MemoryKind::device_local);
   transfer_table_ = Buffer(ctx, inputs_.transfer_table.size() * sizeof(glm::vec4), storage,

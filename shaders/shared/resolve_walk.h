@@ -46,28 +46,32 @@ bool inside_unit_box(vec3 tc) {
          tc.z <= 1.0f;
 }
 
-// The sum of every live (entered, not yet left) volume's shaded, opacity-corrected sample at p
-// (premultiplied).
+// Volume v's shaded, opacity-corrected sample at texture coordinate tc (premultiplied; zero
+// outside its box or where its transfer function is transparent).
+vec4 sample_volume(uint v, VolumeGpu vol, vec3 tc, vec3 to_eye, float step_world) {
+  if (!inside_unit_box(tc)) return vec4(0.0f);
+  vec4 s = volume_sample(v, tc);
+  atlas_fetches += 1u;
+  vec4 c = transfer(v, s.w);
+  if (c.a <= 0.0f) return vec4(0.0f);
+  vec3 normal = mat3(vol.gradient_to_world) * vec3(s);
+  float alpha = corrected_alpha(c.a, step_world, vol.atlas_scale.w);
+  shaded_samples += 1u;
+  // One reciprocal square root for both the zero test and the normalisation.
+  float length2 = dot(normal, normal);
+  vec4 shaded = length2 > 1e-12f ? shade_unit_normal(vec4(vec3(c), 1.0f),
+                                                     normal * inversesqrt(length2), to_eye)
+                                 : vec4(vec3(c), 1.0f);
+  return vec4(vec3(shaded) * alpha, alpha);
+}
+
+// The sum of every live (entered, not yet left) volume's sample at p (premultiplied).
 vec4 sample_volumes(uint live, vec3 p, vec3 to_eye, float step_world) {
   vec4 sum = vec4(0.0f);
   for (uint v = 0u; v < frame.volume_count; ++v) {
     if ((live & (1u << v)) == 0u) continue;
     VolumeGpu vol = volume_info(v);
-    vec3 tc = vec3(vol.world_to_texture * vec4(p, 1.0f));
-    if (!inside_unit_box(tc)) continue;
-    vec4 s = volume_sample(v, tc);
-    atlas_fetches += 1u;
-    vec4 c = transfer(v, s.w);
-    if (c.a <= 0.0f) continue;
-    vec3 normal = mat3(vol.gradient_to_world) * vec3(s);
-    float alpha = corrected_alpha(c.a, step_world, vol.atlas_scale.w);
-    shaded_samples += 1u;
-    // One reciprocal square root for both the zero test and the normalisation.
-    float length2 = dot(normal, normal);
-    vec4 shaded = length2 > 1e-12f ? shade_unit_normal(vec4(vec3(c), 1.0f),
-                                                       normal * inversesqrt(length2), to_eye)
-                                   : vec4(vec3(c), 1.0f);
-    sum += vec4(vec3(shaded) * alpha, alpha);
+    sum += sample_volume(v, vol, vec3(vol.world_to_texture * vec4(p, 1.0f)), to_eye, step_world);
   }
   if (sum.a > 1.0f) sum /= sum.a;
   return sum;
@@ -180,6 +184,13 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
     }
   }
 
+  // One volume (the common case): its data stay in registers and the ray is stepped in its
+  // texture space.
+  const bool one_volume = frame.volume_count == 1u;
+  VolumeGpu first = volume_info(0u);
+  vec3 first_origin = vec3(first.world_to_texture * vec4(origin, 1.0f));
+  vec3 first_direction = mat3(first.world_to_texture) * direction;
+
   float total = 0.0f;
   float z = frame.near_depth;
   float checked_until = -1.0f;  // samples before this depth lie in bricks known to be occupied
@@ -215,7 +226,9 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
         }
         checked_until = bricks.x;
       }
-      vec4 c = sample_volumes(live, origin + direction * zs, to_eye, frame.step);
+      vec4 c = one_volume ? sample_volume(0u, first, first_origin + first_direction * zs, to_eye,
+                                          frame.step)
+                          : sample_volumes(live, origin + direction * zs, to_eye, frame.step);
       r.samples += 1u;
       acc = over(acc, c);
       float before = total;
