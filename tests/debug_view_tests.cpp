@@ -184,7 +184,24 @@ const char* name_of(DebugBuffer buffer) {
   return names[static_cast<uint32_t>(buffer)];
 }
 
+// Whether a pixel of the reference within one pixel of p has exactly `gpu`'s colour at p.
+bool colour_next_to(const std::vector<uint8_t>& gpu, const std::vector<uint8_t>& cpu,
+                    graph::Extent size, size_t p) {
+  const int x = int(p % size.width), y = int(p / size.width);
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int nx = x + dx, ny = y + dy;
+      if (nx < 0 || ny < 0 || nx >= int(size.width) || ny >= int(size.height)) continue;
+      const size_t n = size_t(ny) * size.width + size_t(nx);
+      if (std::equal(&gpu[4 * p], &gpu[4 * p + 4], &cpu[4 * n])) return true;
+    }
+  }
+  return false;
+}
+
 // GPU and reference agree within 1/255 per channel; reports the first few pixels that do not.
+// Constraint images are bits of plane tests: a GPU may fuse a multiply-add that the CPU rounds
+// twice, so a pixel on a region's edge may take its neighbour's side; elsewhere they agree.
 void check_view(const std::vector<uint8_t>& gpu, const std::vector<uint8_t>& cpu,
                 graph::Extent size, const DebugViewChoice& choice) {
   const std::string mode = name_of(choice.buffer);
@@ -192,15 +209,21 @@ void check_view(const std::vector<uint8_t>& gpu, const std::vector<uint8_t>& cpu
   CAPTURE(choice.layer);
   CAPTURE(choice.label);
   REQUIRE(gpu.size() == cpu.size());
-  size_t bad = 0;
+  size_t bad = 0, edge = 0;
   for (size_t i = 0; i < cpu.size(); ++i) {
-    if (std::abs(int(gpu[i]) - int(cpu[i])) > 1 && bad++ < 3) {
-      const size_t p = i / 4;
+    if (std::abs(int(gpu[i]) - int(cpu[i])) <= 1) continue;
+    const size_t p = i / 4;
+    if (choice.buffer == DebugBuffer::constraints && colour_next_to(gpu, cpu, size, p)) {
+      ++edge;
+      continue;
+    }
+    if (bad++ < 3) {
       MESSAGE("pixel " << p % size.width << "," << p / size.width << " channel " << i % 4
                        << ": gpu " << int(gpu[i]) << " cpu " << int(cpu[i]));
     }
   }
   CHECK_MESSAGE(bad == 0, bad << " channels differ by more than 1/255");
+  CHECK(edge * 200 <= cpu.size());  // a few edge pixels at most (0.5%)
 }
 
 // How many pixels of an rgba8 view have exactly this colour.
