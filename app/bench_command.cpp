@@ -195,15 +195,15 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
                               {"empty_space_skipping", !o.no_skipping},
                               {"step", shortest_double(step)}};
   ordered_json results = {{"samples_per_ray", double(last.samples) / rays},
-                                {"shaded_samples_per_ray", double(last.shaded) / rays},
-                                {"habuffer_fragments", last.fragments},
-                                {"habuffer_slots", last.table_size},
-                                {"habuffer_load_factor", last.load_factor()},
-                                {"habuffer_overflow", last.overflow},
-                                {"resolve_overflow", last.resolve_overflow},
-                                {"texture_fetches_per_frame", last.fetches},
-                                {"resolve_fetch_rate_gtexel_per_s",
-                                 resolve_ms > 0.0 ? fetches / (resolve_ms * 1e-3) * 1e-9 : 0.0}};
+                          {"shaded_samples_per_ray", double(last.shaded) / rays},
+                          {"habuffer_fragments", last.fragments},
+                          {"habuffer_slots", last.table_size},
+                          {"habuffer_load_factor", last.load_factor()},
+                          {"habuffer_overflow", last.overflow},
+                          {"resolve_overflow", last.resolve_overflow},
+                          {"texture_fetches_per_frame", last.fetches},
+                          {"resolve_fetch_rate_gtexel_per_s",
+                           resolve_ms > 0.0 ? fetches / (resolve_ms * 1e-3) * 1e-9 : 0.0}};
   const ordered_json pipelines = pipelines_json(renderer.pipeline_statistics());
   if (!pipelines.empty()) results["pipelines"] = pipelines;
   print_json(ctx, setup, runs, t, results);

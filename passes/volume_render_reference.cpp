@@ -18,7 +18,9 @@ struct Reference {
   const RenderInputs& in;
 
   // (the walk loads the first volume's data whatever the count, as the GPU's one-entry buffer)
-  VolumeGpu volume_info(uint v) const { return v < in.volumes.size() ? in.volumes[v] : VolumeGpu{}; }
+  VolumeGpu volume_info(uint v) const {
+    return v < in.volumes.size() ? in.volumes[v] : VolumeGpu{};
+  }
 
   // Linear filtering with clamp-to-edge addressing, as the GPU's sampler does.
   vec4 volume_sample(uint v, vec3 tc) const {
@@ -74,8 +76,8 @@ bool intersect(const vec3& o, const vec3& d, const vec3& a, const vec3& b, const
   return u >= 0.0f && v >= 0.0f && u + v <= 1.0f;
 }
 
-std::vector<Fragment> mesh_fragments(const RenderInputs& in, const FrameGpu& frame, const vec3& origin,
-                                const vec3& direction) {
+std::vector<Fragment> mesh_fragments(const RenderInputs& in, const FrameGpu& frame,
+                                     const vec3& origin, const vec3& direction) {
   std::vector<Fragment> out;
   const auto visible = [&](float t) { return t >= frame.near_depth && t <= frame.far_depth; };
   for (uint m = 0; m < in.meshes.size(); ++m) {
