@@ -51,6 +51,10 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
     throw Error("placement: " + std::to_string(label_count) + " labels; strata places at most " +
                 std::to_string(LABEL_MAX));
   }
+  const uint32_t c = layout.classify_tiles;
+  if (c != 0 && c != 4 && c != 8 && c != 16) {
+    throw Error("placement: classify_tiles " + std::to_string(c) + " is not 0, 4, 8 or 16");
+  }
 }
 
 gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) const {
@@ -60,6 +64,10 @@ gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) co
   p.label = step > 0 && step <= order_.size() ? order_[step - 1] : 0;
   p.spec_label = step < order_.size() ? order_[step] : 0;
   p.finish_lanes = layout_.finish_lanes;
+  const glm::uvec2 across = gpu::placement_tiles(viewport.width, viewport.height);
+  p.classify_tiles = layout_.classify_tiles != 0
+                         ? layout_.classify_tiles
+                         : gpu::placement_classify_tiles(across.x * across.y);
   return p;
 }
 
@@ -103,8 +111,8 @@ Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
   add_bounds(graph, b);
   const graph::PassId loop = add_label_loop(graph, b);
   add_finalize(graph, b);
-  return {b.labels,  b.placements, b.saliency, b.costs, b.tables, b.constraints,
-          b.results, b.buckets,    b.order,    loop};
+  return {b.labels,      b.placements, b.saliency, b.costs, b.tables,
+          b.constraints, b.results,    b.buckets,  b.order, loop};
 }
 
 Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
@@ -284,7 +292,9 @@ glm::uvec3 Placement::direct_groups(graph::Extent viewport) const {
   const glm::uvec2 across = gpu::placement_tiles(viewport.width, viewport.height);
   const uint32_t tile_count = across.x * across.y;
   const uint32_t tiles = std::min(2 * tile_count, std::max(layout_.direct_groups, 1u));
-  return gpu::placement_dispatch_size(gpu::placement_classify_groups(tile_count) + tiles + 1);
+  const uint32_t per_group = params(viewport, 0).classify_tiles;
+  return gpu::placement_dispatch_size(gpu::placement_classify_groups(tile_count, per_group) +
+                                      tiles + 1);
 }
 
 // Each label's position and whether it is shown, copied to the host after the frame.

@@ -60,6 +60,8 @@ struct PlacementLayout {
   // label's last workgroup that take its tile list (0: all; fewer make more chunks).
   uint32_t direct_groups = PLACEMENT_DIRECT_GROUPS;
   uint32_t finish_lanes = 0;
+  // List entries per classifying workgroup: 4, 8 or 16 (0: placement_classify_tiles()).
+  uint32_t classify_tiles = 0;
 };
 
 class Placement {

@@ -175,10 +175,9 @@ void cull(LabelGpu me, uvec2 tile) {
 // and the cheapest of four sampled candidates with their bits (into samples: the dispatch's last
 // workgroup bounds the label's best by them, as by the speculative winners). The plane tests
 // lean the safe way by a rounding margin: a bit every candidate has is never claimed wrongly, and
-// a sample is never cheaper than it is. PLACE_CLASSIFY_LANES invocations per entry, each taking
+// a sample is never cheaper than it is. 256 / classify_tiles invocations per entry, each taking
 // every so many placed labels and anchors.
-#define PLACE_CLASSIFY_LANES (PLACE_GROUP_X * PLACE_GROUP_Y / PLACEMENT_CLASSIFY_TILES)
-shared uint class_bits[PLACEMENT_CLASSIFY_TILES];  // bits 0-2: every candidate's; 3q + 3..5: sample q's
+shared uint class_bits[PLACEMENT_CLASSIFY_TILES_MAX];  // bits 0-2: every candidate's; 3q + 3..5: sample q's
 
 // Sample q of a tile: the candidate in the middle of its quarter q.
 uvec2 sample_pixel(uvec2 tile, uint q) {
@@ -206,15 +205,16 @@ uint classify_region(uint pair, bool connector, vec2 c, vec2 e, vec2 sample_cent
 
 void classify(uint j, uint group, uint first, uint end) {
   const uint t = gl_LocalInvocationIndex;
-  const uint local = t / PLACE_CLASSIFY_LANES, lane = t % PLACE_CLASSIFY_LANES;
-  const uint index = first + group * PLACEMENT_CLASSIFY_TILES + local;
+  const uint lanes = PLACE_GROUP_X * PLACE_GROUP_Y / params.classify_tiles;
+  const uint local = t / lanes, lane = t % lanes;
+  const uint index = first + group * params.classify_tiles + local;
   const bool valid = index < end;
   const uvec2 tiles_xy = placement_tiles(params.width, params.height);
   const uint tiles = tiles_xy.x * tiles_xy.y;
   const uint list = j * tiles + min(index, tiles - 1u);
   const uvec2 entry = tile_list[list];
   const LabelGpu me = labels[params.spec_label];
-  if (t < PLACEMENT_CLASSIFY_TILES) class_bits[t] = 0u;
+  if (t < params.classify_tiles) class_bits[t] = 0u;
   barrier();
   const uint tile_index = entry.x & PLACEMENT_TILE_INDEX_MASK;
   const uvec2 tile = uvec2(tile_index % tiles_xy.x, tile_index / tiles_xy.x);
@@ -226,7 +226,7 @@ void classify(uint j, uint group, uint first, uint end) {
   }
   uint bits = 0u;
   // (the labels placed up to j - 2, as for the speculative pass)
-  for (uint s = lane; valid && s + 2u <= j; s += PLACE_CLASSIFY_LANES) {
+  for (uint s = lane; valid && s + 2u <= j; s += lanes) {
     const uint pair = j * params.label_count + s;
     // (both halves are tested before their presence is known: no load waits for another)
     const uint info = regions[pair].info.x;
@@ -245,7 +245,7 @@ void classify(uint j, uint group, uint first, uint end) {
   }
   // (as cull() and constraint_bits() take the anchors)
   const vec2 h = constraint_half_size(me, params.margin);
-  for (uint k = lane; valid && k < params.label_count; k += PLACE_CLASSIFY_LANES) {
+  for (uint k = lane; valid && k < params.label_count; k += lanes) {
     if ((labels[k].flags & LABEL_ENABLED) == 0u) continue;
     const vec2 a = labels[k].anchor;
     if (anchor_covers_rectangle(a, centre, extent, h)) bits |= CONSTRAINT_ANCHOR;
@@ -399,7 +399,7 @@ void finish(uint j) {
   // The next dispatch's size, when indirect: this main pass, the next label's speculative pass and
   // classification, and the region writer.
   const uvec3 size =
-      placement_dispatch_size(placement_label_groups(count0 + kept, next_count0, next_total));
+      placement_dispatch_size(placement_label_groups(count0 + kept, next_count0, next_total, params.classify_tiles));
   args[3u * j + 3u] = size.x;
   args[3u * j + 4u] = size.y;
   args[3u * j + 5u] = size.z;
@@ -412,6 +412,54 @@ shared uint64_t tile_best;  // the label's best when this workgroup started
 // width or height apart (neighbouring invocations read neighbouring table entries).
 uvec2 candidate_pixel(uvec2 base, uint q) {
   return base + uvec2(q % PLACE_SPAN_X, q / PLACE_SPAN_X) * uvec2(PLACE_GROUP_X, PLACE_GROUP_Y);
+}
+
+// constraint_bits() for the invocation's candidates (bit q of `wanted`) at once: one pass over
+// the tile's culled labels and anchors, each region loaded once for all of them (four passes
+// made a chain of four times as many dependent loads). A candidate leaves the pass when it has
+// both shadow bits or weighs more than its budget, as constraint_bits() returns there; the bits
+// that decide (rejected, or the cost's weight) are the same, and with an infinite budget all.
+void candidate_bits(LabelGpu me, vec2 centres[PLACE_SPAN_X * PLACE_SPAN_Y], uint wanted,
+                    float budgets[PLACE_SPAN_X * PLACE_SPAN_Y],
+                    out uint bits[PLACE_SPAN_X * PLACE_SPAN_Y]) {
+  const uint shadows = CONSTRAINT_LABEL | CONSTRAINT_CONNECTOR;
+  uint open = 0u;  // candidates still taking the placed labels
+  [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
+    bits[q] = tile_bits;
+    if ((wanted & (1u << q)) != 0u && (tile_bits & shadows) != shadows) open |= 1u << q;
+  }
+  uint rejected = 0u;
+  for (uint k = 0u; k < placed_count() && open != 0u; ++k) {
+    const PairRegionsGpu r = placed_regions(k);
+    [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
+      if ((open & (1u << q)) == 0u) continue;
+      bits[q] |= region_bits(r, centres[q], bits[q]);
+      if (constraint_weight(bits[q]) > budgets[q]) {
+        rejected |= 1u << q;
+        open &= ~(1u << q);
+      } else if ((bits[q] & shadows) == shadows) {
+        open &= ~(1u << q);
+      }
+    }
+  }
+  if ((me.flags & LABEL_INTERNAL) != 0u) return;
+  const vec2 h = constraint_half_size(me, params.margin);
+  uint seeking = 0u;  // candidates that may still cover an anchor
+  [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
+    if ((wanted & ~rejected & (1u << q)) != 0u && (bits[q] & CONSTRAINT_ANCHOR) == 0u) {
+      seeking |= 1u << q;
+    }
+  }
+  for (uint k = 0u; k < anchor_count() && seeking != 0u; ++k) {
+    const vec2 a = anchor_at(k);
+    [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
+      const vec2 d = abs(a - centres[q]);
+      if ((seeking & (1u << q)) != 0u && d.x <= h.x && d.y <= h.y) {
+        bits[q] |= CONSTRAINT_ANCHOR;
+        seeking &= ~(1u << q);
+      }
+    }
+  }
 }
 
 // The tile's lowest (cost, pixel): every candidate for a speculative pass; for the main pass,
@@ -454,18 +502,25 @@ uint64_t evaluate_tile(uint label, uvec2 tile, uint known, float bound, bool pru
              (prune && (0.9999 * (bound + constraint_weight(tile_bits)) > best ||
                         (params.hard != 0u && tile_bits != 0u)));
   uint64_t key = PLACEMENT_NONE;
+  // Bits weighing more than best - cost without them lose (strictly: 0.999), so the search
+  // stops there (hard mode: at the first); all of them otherwise.
+  vec2 centres[PLACE_SPAN_X * PLACE_SPAN_Y];
+  float budgets[PLACE_SPAN_X * PLACE_SPAN_Y];
+  [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
+    const vec2 origin = box_origin(candidate_pixel(base, q), me.size);
+    centres[q] = origin + me.size * 0.5;
+    budgets[q] = !prune              ? 1.0 / 0.0
+                 : params.hard != 0u ? 0.0
+                                     : (best - free_costs[q]) / 0.999;
+  }
+  uint all_bits[PLACE_SPAN_X * PLACE_SPAN_Y];
+  candidate_bits(me, centres, hopeless ? 0u : candidates, budgets, all_bits);
   [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
     if (hopeless) break;
     if ((candidates & (1u << q)) == 0u) continue;
     const uvec2 p = candidate_pixel(base, q);
-    const vec2 origin = box_origin(p, me.size);
-    const vec2 centre = origin + me.size * 0.5;
-    // Bits weighing more than best - cost without them lose (strictly: 0.999), so the search
-    // stops there (hard mode: at the first); all of them otherwise.
-    const float budget = !prune              ? 1.0 / 0.0
-                         : params.hard != 0u ? 0.0
-                                             : (best - free_costs[q]) / 0.999;
-    const uint bits = constraint_bits(me, centre, tile_bits, budget);
+    const float budget = budgets[q];
+    const uint bits = all_bits[q];
     const uint pixel = p.y * params.width + p.x;
     if (write) constraints[pixel] = bits;
     if (constraint_weight(bits) > budget) continue;
@@ -505,7 +560,7 @@ void main() {
   barrier();
   const uint main_count = dispatch_main, spec_count = dispatch_spec, listed = dispatch_listed;
   const float best_bound = dispatch_bound;
-  const uint classify_count = placement_classify_groups(listed - spec_count);
+  const uint classify_count = placement_classify_groups(listed - spec_count, params.classify_tiles);
   // The workgroups: the classification's (first, so that they start at once), the passes', and
   // a region writer: the label at position j - 2, final since the last dispatch, against the
   // labels from j + 1 on (the ones up to j have them from that dispatch's last workgroup). The

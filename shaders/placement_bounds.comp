@@ -116,7 +116,7 @@ void main() {
     uint listed = 0u;
     for (uint b = 0u; b < PLACEMENT_BUCKETS; ++b) listed += buckets[0].counts[b];
     const uint count0 = buckets[0].counts[0];
-    const uvec3 size = placement_dispatch_size(placement_label_groups(0u, count0, listed));
+    const uvec3 size = placement_dispatch_size(placement_label_groups(0u, count0, listed, params.classify_tiles));
     args[0] = size.x;
     args[1] = size.y;
     args[2] = size.z;

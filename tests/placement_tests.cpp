@@ -325,13 +325,17 @@ TEST_SUITE("gpu") {
     const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                    in.labels, in.order, {}, in.size);
     // (also direct with 3 workgroups for the passes' tiles, each taking many, and with two
-    // invocations of a label's last workgroup taking its list, in chunks of eight entries)
+    // invocations of a label's last workgroup taking its list, in chunks of eight entries, and
+    // with 16 or 8 entries per classifying workgroup instead of 4)
     for (const PlacementLayout& layout :
          {PlacementLayout{.dispatch = LabelDispatch::direct},
           PlacementLayout{.dispatch = LabelDispatch::direct, .direct_groups = 3},
           PlacementLayout{.dispatch = LabelDispatch::indirect},
-          PlacementLayout{.dispatch = LabelDispatch::indirect, .finish_lanes = 2}}) {
+          PlacementLayout{.dispatch = LabelDispatch::indirect, .finish_lanes = 2},
+          PlacementLayout{.dispatch = LabelDispatch::direct, .classify_tiles = 16},
+          PlacementLayout{.dispatch = LabelDispatch::indirect, .classify_tiles = 8}}) {
       CAPTURE(int(layout.dispatch));
+      CAPTURE(layout.classify_tiles);
       CAPTURE(layout.direct_groups);
       CAPTURE(layout.finish_lanes);
       const GpuPlacement gpu = place_on_gpu(ctx, in, {}, layout);

@@ -59,8 +59,9 @@
 // A direct place_label dispatch has at most this many workgroups for the passes' tiles by
 // default (about what a large GPU holds at once; past that they take several each), ...
 #define PLACEMENT_DIRECT_GROUPS 512u
-// ... and classifying workgroups take this many list entries each.
-#define PLACEMENT_CLASSIFY_TILES 4u
+// ... and classifying workgroups take 4, 8 or 16 list entries each (PlacementParams::
+// classify_tiles: as many as keep a label's classification within 256 workgroups).
+#define PLACEMENT_CLASSIFY_TILES_MAX 16u
 
 // Tiles are sorted per label into buckets by how far their lower cost bound lies above the
 // label's smallest one: bucket 0 below bucket_width, bucket b (1..) below bucket_width * 4^b,
@@ -111,6 +112,7 @@ struct PlacementParams {
   uint spec_label;    // ... and at step (speculative pass)
   uint finish_lanes;  // place_label: invocations of the last workgroup taking list entries
                       // (0: all; fewer make more chunks, for tests)
+  uint classify_tiles;  // place_label: list entries per classifying workgroup (4, 8 or 16)
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,
@@ -172,15 +174,23 @@ STRATA_INLINE PlacementGpu hidden_placement(LabelGpu me) {
 }
 
 // The classifying workgroups of a label whose tile list has `beyond` entries past bucket 0.
-STRATA_INLINE uint placement_classify_groups(uint beyond) {
-  return (beyond + PLACEMENT_CLASSIFY_TILES - 1u) / PLACEMENT_CLASSIFY_TILES;
+STRATA_INLINE uint placement_classify_groups(uint beyond, uint per_group) {
+  return (beyond + per_group - 1u) / per_group;
+}
+
+// List entries per classifying workgroup for `tiles` tiles: 4, or 8 or 16 where that keeps the
+// classification within 256 workgroups (fewer resident at once make a label's dispatch longer;
+// smaller groups finish sooner: on an H100 4 was fastest at 1024 tiles, 16 at 2040).
+STRATA_INLINE uint placement_classify_tiles(uint tiles) {
+  return tiles <= 1024u ? 4u : tiles <= 2048u ? 8u : 16u;
 }
 
 // The workgroups of a place_label dispatch sized to its passes: a main pass of `main_tiles`, the
 // next label's speculative pass and classification (its list: `listed` entries, `spec_tiles` of
 // them in bucket 0), and the region writer.
-STRATA_INLINE uint placement_label_groups(uint main_tiles, uint spec_tiles, uint listed) {
-  return main_tiles + spec_tiles + placement_classify_groups(listed - spec_tiles) + 1u;
+STRATA_INLINE uint placement_label_groups(uint main_tiles, uint spec_tiles, uint listed,
+                                          uint per_group) {
+  return main_tiles + spec_tiles + placement_classify_groups(listed - spec_tiles, per_group) + 1u;
 }
 
 // The workgroup counts of an indirect dispatch over `count` tiles (x is limited to 65535).
