@@ -241,9 +241,11 @@ void Placement::add_bounds(graph::Graph& graph, const Buffers& b) {
            p.phase = phase;
            const glm::uvec2 across = gpu::placement_tiles(pc.viewport.width, pc.viewport.height);
            const uint32_t tile_count = across.x * across.y;
-           // Bounds: a workgroup of 64 per tile (its cells); then 64 tiles per group.
-           const uint32_t groups =
-               phase == PLACEMENT_PHASE_BOUNDS ? tile_count : group_count(tile_count, 64);
+           // Bounds: PLACEMENT_BOUNDS_TILES tiles per workgroup, a cell per invocation; then a
+           // tile per invocation.
+           const uint32_t groups = phase == PLACEMENT_PHASE_BOUNDS
+                                       ? group_count(tile_count, PLACEMENT_BOUNDS_TILES)
+                                       : group_count(tile_count, PLACEMENT_BOUNDS_GROUP);
            pc.dispatch_groups(bounds_, p, {groups, uint32_t(order_.size()), 1});
          },
          "placement"});

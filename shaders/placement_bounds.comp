@@ -5,10 +5,10 @@
 #include "shared/placement.h"
 
 // Before the label loop, for every label at once: a lower bound of eq. 3.1 over each 32x32 tile
-// of candidates (phase BOUNDS: a workgroup per tile and label), how many tiles fall in each bucket above the label's lowest bound
+// of candidates (phase BOUNDS: a workgroup per PLACEMENT_BOUNDS_TILES tiles of a label), how many tiles fall in each bucket above the label's lowest bound
 // (COUNT), and the tiles sorted by bucket with the first label dispatch's size (SORT). None of it
 // depends on where earlier labels went, so it is one dispatch per phase, not one per label.
-layout(local_size_x = 64) in;
+layout(local_size_x = PLACEMENT_BOUNDS_GROUP) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
 layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
 layout(binding = PLACEMENT_BINDING_ORDER, std430) readonly buffer Order { uint order[]; };
@@ -75,34 +75,37 @@ uint tile_count() {
   return tiles.x * tiles.y;
 }
 
-shared uint tile_lowest;
-
 // A tile's bound: the lowest of its cells' of 4 x 4 candidates (the integral part needs cells
-// smaller than the label boxes: what all boxes of a whole tile share is often nothing). One
-// workgroup per tile and label; each invocation takes every 64th cell.
-void tile_bound(uint tile, uint s) {
-  if (gl_LocalInvocationIndex == 0u) tile_lowest = floatBitsToUint(INFINITY);
+// smaller than the label boxes: what all boxes of a whole tile share is often nothing). A
+// workgroup takes PLACEMENT_BOUNDS_TILES tiles of one label, an invocation a cell.
+shared uint tile_lowest[PLACEMENT_BOUNDS_TILES];
+void tile_bounds(uint group, uint s) {
+  const uint cells = (PLACEMENT_TILE / PLACEMENT_CELL) * (PLACEMENT_TILE / PLACEMENT_CELL);
+  const uint local_tile = gl_LocalInvocationIndex / cells, c = gl_LocalInvocationIndex % cells;
+  const uint tile = group * PLACEMENT_BOUNDS_TILES + local_tile;
+  if (c == 0u) tile_lowest[local_tile] = floatBitsToUint(INFINITY);
   barrier();
+  const bool in_range = tile < tile_count();
   const uint tiles_x = placement_tiles(params.width, params.height).x;
   const uint cells_x = PLACEMENT_TILE / PLACEMENT_CELL;
   const LabelGpu me = labels[order[s]];
   float bound = INFINITY;
-  for (uint c = gl_LocalInvocationIndex; c < cells_x * cells_x; c += 64u) {
+  if (in_range) {
     const uvec2 first = uvec2(tile % tiles_x, tile / tiles_x) * PLACEMENT_TILE +
                         uvec2(c % cells_x, c / cells_x) * PLACEMENT_CELL;
-    bound = min(bound, cell_bound(me, first, first + uvec2(PLACEMENT_CELL - 1u)));
+    bound = cell_bound(me, first, first + uvec2(PLACEMENT_CELL - 1u));
   }
-  atomicMin(tile_lowest, floatBitsToUint(bound));  // bounds are >= 0: their bits order as they do
+  atomicMin(tile_lowest[local_tile], floatBitsToUint(bound));  // bounds >= 0: bits order too
   barrier();
-  if (gl_LocalInvocationIndex == 0u) {
-    bounds[s * tile_count() + tile] = uintBitsToFloat(tile_lowest);
-    atomicMin(lower[s], tile_lowest);
+  if (in_range && c == 0u) {
+    bounds[s * tile_count() + tile] = uintBitsToFloat(tile_lowest[local_tile]);
+    atomicMin(lower[s], tile_lowest[local_tile]);
   }
 }
 
 void main() {
   if (params.phase == PLACEMENT_PHASE_BOUNDS) {
-    tile_bound(gl_WorkGroupID.x, gl_WorkGroupID.y);
+    tile_bounds(gl_WorkGroupID.x, gl_WorkGroupID.y);
     return;
   }
   const uint tiles = tile_count();

@@ -12,7 +12,9 @@
 #define PLACE_GROUP_Y 16    // H200, 16 x 8 and 8 x 8 ran slower, 32 x 16 no faster)
 #define PLACE_SPAN_X (PLACEMENT_TILE / PLACE_GROUP_X)  // candidates per invocation across ...
 #define PLACE_SPAN_Y (PLACEMENT_TILE / PLACE_GROUP_Y)  // ... and down
-#define PLACEMENT_CELL 4               // placement_bounds: 4 x 4 candidates per cell
+#define PLACEMENT_CELL 4               // placement_bounds: 4 x 4 candidates per cell, ...
+#define PLACEMENT_BOUNDS_GROUP 256     // ... a workgroup of 256 invocations, ...
+#define PLACEMENT_BOUNDS_TILES 4       // ... one cell each: 4 tiles
 #define VR_MAX_LAYERS_FOR_PLACEMENT 8  // as VR_MAX_LAYERS
 #define SALIENCY_SCALE 100.0f          // |CIELAB gradient| of this size counts as saliency 1
 
