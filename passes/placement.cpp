@@ -6,6 +6,11 @@
 #include "engine/core/error.h"
 #include "engine/gpu/context.h"
 
+static_assert(PLACEMENT_BOUNDS_TILES * (PLACEMENT_TILE / PLACEMENT_CELL) *
+                      (PLACEMENT_TILE / PLACEMENT_CELL) ==
+                  PLACEMENT_BOUNDS_GROUP,
+              "placement_bounds.comp: a cell per invocation");
+
 namespace strata {
 
 using graph::ResourceId;
@@ -64,11 +69,14 @@ gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) co
   p.label = step > 0 && step <= order_.size() ? order_[step - 1] : 0;
   p.spec_label = step < order_.size() ? order_[step] : 0;
   p.finish_lanes = layout_.finish_lanes;
-  const glm::uvec2 across = gpu::placement_tiles(viewport.width, viewport.height);
-  p.classify_tiles = layout_.classify_tiles != 0
-                         ? layout_.classify_tiles
-                         : gpu::placement_classify_tiles(across.x * across.y);
+  p.classify_tiles = classify_tiles(viewport);
   return p;
+}
+
+uint32_t Placement::classify_tiles(graph::Extent viewport) const {
+  const glm::uvec2 across = gpu::placement_tiles(viewport.width, viewport.height);
+  return layout_.classify_tiles != 0 ? layout_.classify_tiles
+                                     : gpu::placement_classify_tiles(across.x * across.y);
 }
 
 void Placement::set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_t> order,
@@ -294,9 +302,8 @@ glm::uvec3 Placement::direct_groups(graph::Extent viewport) const {
   const glm::uvec2 across = gpu::placement_tiles(viewport.width, viewport.height);
   const uint32_t tile_count = across.x * across.y;
   const uint32_t tiles = std::min(2 * tile_count, std::max(layout_.direct_groups, 1u));
-  const uint32_t per_group = params(viewport, 0).classify_tiles;
-  return gpu::placement_dispatch_size(gpu::placement_classify_groups(tile_count, per_group) +
-                                      tiles + 1);
+  return gpu::placement_dispatch_size(
+      gpu::placement_classify_groups(tile_count, classify_tiles(viewport)) + tiles + 1);
 }
 
 // Each label's position and whether it is shown, copied to the host after the frame.

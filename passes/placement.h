@@ -118,6 +118,8 @@ class Placement {
   graph::PassId add_label_loop(graph::Graph& graph, const Buffers& b);
   void add_finalize(graph::Graph& graph, const Buffers& b);
   glm::uvec3 direct_groups(graph::Extent viewport) const;
+  // List entries per classifying workgroup at this viewport (the layout's, or by tile count).
+  uint32_t classify_tiles(graph::Extent viewport) const;
   gpu::PlacementParams params(graph::Extent viewport, uint32_t step) const;
 
   Context& ctx_;
