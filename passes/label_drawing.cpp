@@ -76,18 +76,18 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
                             .format = VK_FORMAT_R8_UNORM,
                             .has_content = true,
                             .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
-  graph.add_pass({"labels.draw",
-                  graph::PassKind::compute,
-                  {{in.layers, Use::storage_read_write, LABEL_DRAW_BINDING_LAYERS},
-                   {in.labels, Use::storage_read, LABEL_DRAW_BINDING_LABELS},
-                   {in.placements, Use::storage_read, LABEL_DRAW_BINDING_PLACEMENTS},
-                   {in.glyphs, Use::storage_read, LABEL_DRAW_BINDING_GLYPHS},
-                   {atlas, Use::sampled, LABEL_DRAW_BINDING_ATLAS}},
-                  [this](graph::PassContext& pc) {
-                    pc.dispatch(draw_, params(pc.viewport),
-                                {pc.viewport.width, pc.viewport.height, layer_count_});
-                  },
-                  "labels"});
+  graph.add_pass(
+      {"labels.draw",
+       graph::PassKind::compute,
+       {{in.layers, Use::storage_read_write, LABEL_DRAW_BINDING_LAYERS},
+        {in.labels, Use::storage_read, LABEL_DRAW_BINDING_LABELS},
+        {in.placements, Use::storage_read, LABEL_DRAW_BINDING_PLACEMENTS},
+        {in.glyphs, Use::storage_read, LABEL_DRAW_BINDING_GLYPHS},
+        {atlas, Use::sampled, LABEL_DRAW_BINDING_ATLAS}},
+       [this](graph::PassContext& pc) {
+         pc.dispatch(draw_, params(pc.viewport), {pc.viewport.width, pc.viewport.height, 1});
+       },
+       "labels"});
   graph.add_pass(
       {"labels.composite",
        graph::PassKind::compute,

@@ -44,7 +44,6 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
                 (layout.dispatch == LabelDispatch::automatic &&
                  ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)),
       layout_(layout),
-      saliency_(ctx, "saliency.comp"),
       integral_costs_(ctx, "integral_costs.comp"),
       bounds_(ctx, "placement_bounds.comp"),
       place_(ctx, "place_label.comp"),
@@ -200,24 +199,20 @@ void Placement::add_previous(graph::Graph& graph, const Buffers& b, const Previo
                   "placement"});
 }
 
-// Saliency (eq. 3.5), integral costs per layer (eq. 3.3/3.4) and their summed-area tables.
+// Saliency (eq. 3.5) and integral costs per layer (eq. 3.3/3.4) in one pass, then their
+// summed-area tables.
 void Placement::add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in) {
-  const auto per_pixel_pass = [this, &graph](const char* name, const ComputePipeline& pipeline,
-                                             std::vector<graph::ResourceUse> uses) {
-    graph.add_pass({name, graph::PassKind::compute, std::move(uses),
-                    [this, &pipeline](graph::PassContext& pc) {
-                      pc.dispatch(pipeline, params(pc.viewport, 0),
-                                  {pc.viewport.width, pc.viewport.height, 1});
-                    },
-                    "placement"});
-  };
-  per_pixel_pass("placement.saliency", saliency_,
-                 {{in.final_image, Use::storage_read, PLACEMENT_BINDING_FINAL},
-                  {b.saliency, Use::storage_write, PLACEMENT_BINDING_SALIENCY}});
-  per_pixel_pass("placement.integral_costs", integral_costs_,
-                 {{b.saliency, Use::storage_read, PLACEMENT_BINDING_SALIENCY},
-                  {in.layers, Use::storage_read, PLACEMENT_BINDING_LAYERS},
-                  {b.costs, Use::storage_write, PLACEMENT_BINDING_COSTS}});
+  graph.add_pass({"placement.integral_costs",
+                  graph::PassKind::compute,
+                  {{in.final_image, Use::storage_read, PLACEMENT_BINDING_FINAL},
+                   {b.saliency, Use::storage_write, PLACEMENT_BINDING_SALIENCY},
+                   {in.layers, Use::storage_read, PLACEMENT_BINDING_LAYERS},
+                   {b.costs, Use::storage_write, PLACEMENT_BINDING_COSTS}},
+                  [this](graph::PassContext& pc) {
+                    pc.dispatch(integral_costs_, params(pc.viewport, 0),
+                                {pc.viewport.width, pc.viewport.height, 1});
+                  },
+                  "placement"});
   tables_.add_to(graph, b.costs, b.tables, "placement.sat", in.layer_count);
 }
 
@@ -329,7 +324,7 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
 
 std::vector<PipelineReport> Placement::pipeline_statistics() const {
   std::vector<PipelineReport> out;
-  for (const ComputePipeline* p : {&saliency_, &integral_costs_, &bounds_, &place_, &finalize_}) {
+  for (const ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &finalize_}) {
     out.push_back({p->name(), p->statistics()});
   }
   return out;

@@ -130,7 +130,7 @@ class Placement {
   std::vector<gpu::LabelGpu> labels_;
   std::vector<uint32_t> order_;
   PlacementSettings settings_;
-  ComputePipeline saliency_, integral_costs_, bounds_, place_, finalize_, previous_;
+  ComputePipeline integral_costs_, bounds_, place_, finalize_, previous_;
   SummedAreaTable tables_;
   graph::Readback readback_;
 };

@@ -16,6 +16,7 @@ using glm::ivec3;  // the software sampler's voxel coordinates, by their GLSL na
 struct Reference {
   FrameGpu frame;
   const RenderInputs& in;
+  std::vector<vec4> table;  // corrected_transfer for the frame's step
 
   // (the walk loads the first volume's data whatever the count, as the GPU's one-entry buffer)
   VolumeGpu volume_info(uint v) const {
@@ -44,9 +45,7 @@ struct Reference {
     return sum / 32767.0f;
   }
 
-  vec4 table_entry(uint v, int i) const {
-    return in.transfer_table[size_t(v) * VR_TF_SIZE + size_t(i)];
-  }
+  vec4 table_entry(uint v, int i) const { return table[size_t(v) * VR_TF_SIZE + size_t(i)]; }
 
   bool brick_empty(uint v, vec3 tc) const {
     const VolumeGpu& vol = in.volumes[v];
@@ -54,6 +53,11 @@ struct Reference {
     const uvec3 b = min(uvec3(tc / (vec3(vol.texel) * float(VR_BRICK))), bricks - 1u);
     return in.occupancy[vol.bricks.w + (b.z * bricks.y + b.y) * bricks.x + b.x] == 0u;
   }
+
+  // The pixel's layers (layer l at layers[l * stride]) as the walk emits them.
+  glm::vec4* layers = nullptr;
+  size_t stride = 0;
+  void emit_layer(uint l, vec4 colour) const { layers[l * stride] = colour; }
 
 #include "shared/resolve_walk.h"
 };
@@ -109,7 +113,8 @@ std::vector<Fragment> mesh_fragments(const RenderInputs& in, const FrameGpu& fra
 
 ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera,
                                 const RenderSettings& settings, graph::Extent size) {
-  gpu::Reference ref{frame_data(inputs, camera, settings, size, 1), inputs};
+  const gpu::FrameGpu frame = frame_data(inputs, camera, settings, size, 1);
+  gpu::Reference ref{frame, inputs, corrected_transfer(inputs, frame.step)};
   ReferenceImage image;
   image.size = size;
   image.layer_count = settings.layer_count;
@@ -130,13 +135,13 @@ ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera
         depths[i] = found[i].depth;
         payloads[i] = found[i].payload;
       }
-      const auto r = ref.resolve_pixel(centre, count, depths, payloads);
       const size_t p = size_t{y} * size.width + x;
+      ref.layers = &image.layers[p];
+      ref.stride = pixels;
+      const auto r = ref.resolve_pixel(centre, count, depths, payloads);
       glm::vec4 all(0.0f);
-      for (uint32_t l = 0; l < settings.layer_count; ++l) {
-        image.layers[l * pixels + p] = r.layers[l];
-        all = gpu::over(all, r.layers[l]);
-      }
+      for (uint32_t l = 0; l < settings.layer_count; ++l)
+        all = gpu::over(all, image.layers[l * pixels + p]);
       image.final[p] = glm::vec4(glm::vec3(all) + (1.0f - all.a) * settings.background, 1.0f);
       image.depth[p] = r.depth;
       image.samples += r.samples;

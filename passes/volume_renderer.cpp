@@ -10,6 +10,7 @@
 #include "engine/gpu/context.h"
 #include "engine/graph/graph_runner.h"
 #include "shared/volume_render.h"
+#include "shared/volume_shading.h"
 
 namespace strata {
 
@@ -220,6 +221,17 @@ void RenderInputs::update_transfer() {
   }
 }
 
+std::vector<glm::vec4> corrected_transfer(const RenderInputs& inputs, float step) {
+  std::vector<glm::vec4> table = inputs.transfer_table;
+  for (size_t v = 0; v < inputs.volumes.size() && (v + 1) * VR_TF_SIZE <= table.size(); ++v) {
+    const float reference = inputs.volumes[v].atlas_scale.w;
+    for (size_t i = v * VR_TF_SIZE; i < (v + 1) * VR_TF_SIZE; ++i) {
+      table[i].a = gpu::corrected_alpha(table[i].a, step, reference);
+    }
+  }
+  return table;
+}
+
 std::vector<float> split_depths(const RenderInputs& in, const Camera& camera,
                                 const RenderSettings& settings) {
   const uint32_t layers = settings.layer_count;
@@ -309,13 +321,10 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
   volumes_ = filled(volume_data);
   occupancy_ = Buffer(ctx, at_least(inputs_.occupancy.size() * sizeof(uint32_t)), storage,
                       MemoryKind::device_local);
-  transfer_table_ = Buffer(ctx, inputs_.transfer_table.size() * sizeof(glm::vec4), storage,
-                           MemoryKind::device_local);
   upload_transfer();
 }
 
 void VolumeRenderer::upload_transfer() {
-  upload(ctx_, transfer_table_, as_bytes(inputs_.transfer_table));
   if (!inputs_.occupancy.empty()) upload(ctx_, occupancy_, as_bytes(inputs_.occupancy));
 }
 
@@ -343,6 +352,10 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
       "render.frame", {[](graph::Extent) { return VkDeviceSize{sizeof(gpu::FrameGpu)}; }});
   const ResourceId keys = graph.add_buffer("render.keys", {slots});
   const ResourceId payload = graph.add_buffer("render.payload", {slots});
+  // (written each frame: corrected for the frame's step, which the viewer may change any time)
+  const VkDeviceSize table_bytes = inputs_.transfer_table.size() * sizeof(glm::vec4);
+  const ResourceId transfer =
+      graph.add_buffer("render.transfer", {[table_bytes](graph::Extent) { return table_bytes; }});
   const ResourceId counters = graph.add_buffer(
       "render.counters",
       {[](graph::Extent) { return VkDeviceSize{VR_COUNTER_COUNT * sizeof(uint32_t)}; }});
@@ -362,25 +375,29 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                                    .format = kAtlasFormat,
                                    .has_content = true,
                                    .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
-  ids_.transfer = uploaded("render.transfer_table", transfer_table_);
   ids_.volumes = uploaded("render.volumes", volumes_);
   ids_.occupancy = uploaded("render.occupancy", occupancy_);
   ids_.vertices = uploaded("render.vertices", vertices_);
   ids_.indices = uploaded("render.indices", indices_);
   ids_.readback = counters_readback_.import(graph, "render.counters_readback");
 
-  graph.add_pass(
-      {"render.clear",
-       graph::PassKind::transfer,
-       {{frame, Use::transfer_dst}, {keys, Use::transfer_dst}, {counters, Use::transfer_dst}},
-       [this, frame, keys, counters](graph::PassContext& pc) {
-         const gpu::FrameGpu data =
-             frame_data(inputs_, camera_, settings_, pc.viewport, slots_for(pc.viewport));
-         vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
-         vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
-         vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
-       },
-       "render"});
+  graph.add_pass({"render.clear",
+                  graph::PassKind::transfer,
+                  {{frame, Use::transfer_dst},
+                   {transfer, Use::transfer_dst},
+                   {keys, Use::transfer_dst},
+                   {counters, Use::transfer_dst}},
+                  [this, frame, transfer, keys, counters](graph::PassContext& pc) {
+                    const gpu::FrameGpu data = frame_data(inputs_, camera_, settings_, pc.viewport,
+                                                          slots_for(pc.viewport));
+                    vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
+                    const std::vector<glm::vec4> table = corrected_transfer(inputs_, data.step);
+                    vkCmdUpdateBuffer(pc.cmd, pc.buffer(transfer), 0,
+                                      table.size() * sizeof(glm::vec4), table.data());
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
+                  },
+                  "render"});
   graph.add_pass({"render.habuffer_build",
                   graph::PassKind::graphics,
                   {{frame, Use::uniform, VR_BINDING_FRAME},
@@ -399,7 +416,7 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {payload, Use::storage_read, VR_BINDING_PAYLOAD},
                    {counters, Use::storage_read_write, VR_BINDING_COUNTERS},
                    {ids_.atlas, Use::sampled, VR_BINDING_ATLAS},
-                   {ids_.transfer, Use::storage_read, VR_BINDING_TRANSFER},
+                   {transfer, Use::storage_read, VR_BINDING_TRANSFER},
                    {ids_.occupancy, Use::storage_read, VR_BINDING_OCCUPANCY},
                    {out.layers, Use::storage_write, VR_BINDING_LAYERS},
                    {out.final, Use::storage_write, VR_BINDING_FINAL},

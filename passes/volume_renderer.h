@@ -50,7 +50,8 @@ struct RenderInputs {
                                // 16-bit SNORM; volumes stacked along z
   std::vector<gpu::VolumeGpu> volumes;
   std::vector<TransferFunction> transfer_functions;  // one per volume
-  std::vector<glm::vec4> transfer_table;             // VR_TF_SIZE x max(1, volumes)
+  std::vector<glm::vec4> transfer_table;             // VR_TF_SIZE x max(1, volumes); alpha per the
+                                                     // volume's reference distance (atlas_scale.w)
   std::vector<glm::vec2> brick_ranges;  // per brick: min and max normalised value (dilated)
   std::vector<uint32_t> occupancy;      // per brick: 1 if the transfer function can show it
   struct MeshDraw {
@@ -69,6 +70,10 @@ struct RenderInputs {
 };
 
 RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d);
+
+// The transfer table as the resolve reads it: each entry's alpha corrected for samples `step`
+// world units apart (corrected_alpha with the volume's reference distance), once per frame.
+std::vector<glm::vec4> corrected_transfer(const RenderInputs& inputs, float step);
 
 // The layer boundaries (eye depths): settings.splits, or even over the scene's depth range.
 std::vector<float> split_depths(const RenderInputs& inputs, const Camera& camera,
@@ -98,7 +103,8 @@ class VolumeRenderer {
 
   void set_camera(const Camera& camera) { camera_ = camera; }
   RenderSettings& settings() { return settings_; }
-  // Rebuilds volume v's empty-space grid and its transfer-function row.
+  // Rebuilds volume v's empty-space grid and its transfer-function row (the frames recorded
+  // from now on use them).
   void set_transfer_function(uint32_t volume, const TransferFunction& tf);
   // What the driver reports about the resolve's compiled shader (registers, ...), if anything.
   std::vector<PipelineReport> pipeline_statistics() const;
@@ -127,14 +133,14 @@ class VolumeRenderer {
   RenderInputs inputs_;
 
   Image atlas_;
-  Buffer transfer_table_, volumes_, occupancy_, vertices_, indices_;
+  Buffer volumes_, occupancy_, vertices_, indices_;
   graph::Readback counters_readback_;
   uint32_t forced_slots_ = 0;  // 0: sized from the viewport
 
   GraphicsPipeline build_;
   ComputePipeline resolve_;
   struct Ids {
-    graph::ResourceId atlas, transfer, volumes, occupancy, vertices, indices, readback;
+    graph::ResourceId atlas, volumes, occupancy, vertices, indices, readback;
   } ids_{};
 };
 

@@ -25,6 +25,14 @@ bool brick_empty(uint v, vec3 tc) {
   return occupancy[g.w + (b.z * g.y + b.y) * g.x + b.x] == 0u;
 }
 
+// The pixel's layers go to the images as the walk leaves them; the final image composites them.
+ivec2 pixel_coord;
+vec4 all_layers = vec4(0.0);
+void emit_layer(uint l, vec4 colour) {
+  imageStore(layers, ivec3(pixel_coord, l), colour);
+  all_layers = over(all_layers, colour);
+}
+
 #include "shared/resolve_walk.h"
 
 void main() {
@@ -58,6 +66,7 @@ void main() {
     }
   }
   PixelResult r;
+  pixel_coord = ivec2(px);
   if (inside) r = resolve_pixel(vec2(px) + 0.5, count, depths, payloads);
   const uint found = subgroupAdd(count + dropped);
   const uint lost = subgroupAdd(dropped);
@@ -72,11 +81,7 @@ void main() {
     atomicAdd(counters[VR_COUNTER_FETCHES], fetches);
   }
   if (!inside) return;
-  vec4 all = vec4(0.0);
-  for (uint l = 0u; l < frame.layer_count; ++l) {
-    imageStore(layers, ivec3(px, l), r.layers[l]);
-    all = over(all, r.layers[l]);
-  }
-  imageStore(final_image, ivec2(px), vec4(all.rgb + (1.0 - all.a) * frame.background.rgb, 1.0));
+  imageStore(final_image, ivec2(px),
+             vec4(all_layers.rgb + (1.0 - all_layers.a) * frame.background.rgb, 1.0));
   imageStore(depth_image, ivec2(px), vec4(r.depth));
 }

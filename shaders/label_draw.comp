@@ -1,8 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "shared/label_drawing.h"
+#include "shared/volume_render.h"  // VR_MAX_LAYERS
 
-// One invocation per pixel of one depth layer: the layer's labels drawn over its content in place.
+// One invocation per pixel, for every depth layer: each layer's labels drawn over its content in
+// place.
 layout(local_size_x = LABEL_DRAW_GROUP, local_size_y = LABEL_DRAW_GROUP) in;
 layout(binding = LABEL_DRAW_BINDING_LAYERS, rgba16f) uniform image2DArray layers;
 layout(binding = LABEL_DRAW_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
@@ -24,43 +26,52 @@ float atlas_coverage(vec2 uv) { return textureLod(atlas, uv, 0.0).r; }
 
 #include "shared/label_draw_pixel.h"
 
-// The labels that can touch this workgroup's tile (bit i: label i), so that each pixel visits
-// only those, still in label order.
-shared uint tile_labels[LABEL_MAX / 32u];
+// The labels that can touch this workgroup's tile, per layer (bit i of a row: label i), so that
+// each pixel visits only those, still in label order. A workgroup takes its tile in every layer:
+// the labels are culled once, and the layers without any are not read.
+shared uint tile_labels[VR_MAX_LAYERS][LABEL_MAX / 32u];
 
 void main() {
-  const uvec3 id = gl_GlobalInvocationID;
   const uint lane = gl_LocalInvocationIndex;
   const uint lanes = LABEL_DRAW_GROUP * LABEL_DRAW_GROUP;
-  for (uint w = lane; w < LABEL_MAX / 32u; w += lanes) tile_labels[w] = 0u;
+  const uint layer_count = min(params.layer_count, uint(VR_MAX_LAYERS));
+  for (uint w = lane; w < VR_MAX_LAYERS * (LABEL_MAX / 32u); w += lanes) {
+    tile_labels[w / (LABEL_MAX / 32u)][w % (LABEL_MAX / 32u)] = 0u;
+  }
   barrier();
   const vec2 tile_lo = vec2(gl_WorkGroupID.xy * LABEL_DRAW_GROUP) + 0.5f;
   const vec2 tile_hi = tile_lo + float(LABEL_DRAW_GROUP - 1u);
   const uint count = min(label_count(), LABEL_MAX);
   for (uint i = lane; i < count; i += lanes) {
     const LabelGpu label = labels[i];
-    if ((label.flags & LABEL_ENABLED) == 0u || label.layer != gl_WorkGroupID.z) continue;
+    if ((label.flags & LABEL_ENABLED) == 0u || label.layer >= layer_count) continue;
     const PlacementGpu placement = placements[i];
     if (placement.shown != PLACEMENT_SHOWN) continue;
     const vec2 centre = (label.flags & LABEL_INTERNAL) != 0u ? label.anchor : placement.position;
     if (!label_far_from_tile(tile_lo, tile_hi, label.anchor, centre, label.size)) {
-      atomicOr(tile_labels[i / 32u], 1u << (i % 32u));
+      atomicOr(tile_labels[label.layer][i / 32u], 1u << (i % 32u));
     }
   }
   barrier();
 
-  if (id.x >= params.width || id.y >= params.height || id.z >= params.layer_count) return;
-  const ivec3 texel = ivec3(id);
-  const vec4 content = imageLoad(layers, texel);
-  const vec2 p = vec2(id.xy) + 0.5;
-  vec4 drawn = content;
-  for (uint w = 0u; w < LABEL_MAX / 32u; ++w) {
-    uint bits = tile_labels[w];
-    while (bits != 0u) {
-      const uint b = uint(findLSB(bits));
-      bits &= bits - 1u;
-      drawn = draw_label_at(w * 32u + b, p, id.z, drawn);
+  const uvec2 id = gl_GlobalInvocationID.xy;
+  if (id.x >= params.width || id.y >= params.height) return;
+  const vec2 p = vec2(id) + 0.5;
+  for (uint layer = 0u; layer < layer_count; ++layer) {
+    uint any_label = 0u;
+    for (uint w = 0u; w < LABEL_MAX / 32u; ++w) any_label |= tile_labels[layer][w];
+    if (any_label == 0u) continue;  // (most tiles of a layer hold no label: left unread)
+    const ivec3 texel = ivec3(id, layer);
+    const vec4 content = imageLoad(layers, texel);
+    vec4 drawn = content;
+    for (uint w = 0u; w < LABEL_MAX / 32u; ++w) {
+      uint bits = tile_labels[layer][w];
+      while (bits != 0u) {
+        const uint b = uint(findLSB(bits));
+        bits &= bits - 1u;
+        drawn = draw_label_at(w * 32u + b, p, layer, drawn);
+      }
     }
+    if (drawn != content) imageStore(layers, texel, drawn);
   }
-  if (drawn != content) imageStore(layers, texel, drawn);
 }

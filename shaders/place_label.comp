@@ -303,6 +303,8 @@ void write_regions(uint s, uint first, uint last, LabelGpu placed_label, vec3 pl
 shared uint finishing;  // 1: this workgroup is the dispatch's last
 shared uint bound_bits;  // the bound candidates' smallest true cost (bits)
 shared uint kept;  // entries past bucket 0 the main pass takes
+shared float finish_lowest;  // the label's lowest tile bound
+shared uint finish_ends[PLACEMENT_BUCKETS];  // where each bucket's entries end in its list
 
 // The dispatch's last workgroup. Label j - 1 is final: its constraint regions for labels j and
 // j + 1 (the next dispatch's region writer does the rest). Label j's speculative pass and
@@ -333,6 +335,17 @@ void finish(uint j) {
     keys[c] = i >= total ? PLACEMENT_NONE : i < count0 ? speculative[(p & 1u) * tiles + i] : samples[i];
     entries[c] = i < total ? tile_list[p * tiles + i] : uvec2(0u);
   }
+  // The label's lowest tile bound and where its buckets end in the list: the main pass only looks
+  // at the buckets whose entries can still be cheap enough (below). (One invocation reads them
+  // for the workgroup.)
+  if (t == 0u) {
+    finish_lowest = buckets[p].lowest;
+    uint end = 0u;
+    [[unroll]] for (uint b = 0u; b < PLACEMENT_BUCKETS; ++b) {
+      end += buckets[p].counts[b];
+      finish_ends[b] = end;
+    }
+  }
   uint next_count0 = 0u, next_total = 0u;
   if (t == 0u && p + 1u < params.order_count) {
     next_count0 = buckets[p + 1u].counts[0];
@@ -347,12 +360,15 @@ void finish(uint j) {
   if (j > 0u) write_regions(j - 1u, j, min(j + 2u, params.order_count), placed_label, placed);
   if (!sizing) return;
   const PairRegionsGpu r = pair_regions(me, placed_label, placed, params.margin);
+  // (the first 4 x 256 entries' candidates only: the bound need not be the smallest, and the list
+  // begins with the lowest buckets; with all invocations taking entries, the chunk loaded above)
   float bound = uintBitsToFloat(0x7F800000u);
-  for (uint chunk = 0u; chunk < total; chunk += chunk_size) {
+  const uint bound_end = min(total, 4u * threads);
+  for (uint chunk = 0u; chunk < bound_end; chunk += chunk_size) {
     [[unroll]] for (uint c = 0u; c < 4u; ++c) {
-      const uint i = t < lanes ? chunk + c * lanes + t : total;
+      const uint i = t < lanes ? chunk + c * lanes + t : bound_end;
       const uint64_t key = chunk == 0u ? keys[c]
-                           : i >= total ? PLACEMENT_NONE
+                           : i >= bound_end ? PLACEMENT_NONE
                            : i < count0 ? speculative[(p & 1u) * tiles + i]
                                         : samples[i];
       if (key == PLACEMENT_NONE) continue;
@@ -369,16 +385,25 @@ void finish(uint j) {
   // (rounding: the true cost is the free cost plus the weight of all bits, summed in another
   // order; an infinite bound stays infinite)
   const float best = uintBitsToFloat(bound_bits) * 1.0001;
+  // An entry of bucket b has (bound - lowest) >= its edge, rounded; one that is kept has bound <=
+  // best, so (best - lowest) >= the edge too (rounding is monotonic): the buckets past the first
+  // whose edge is above best - lowest hold nothing to keep, and are not read.
+  const float reach = best - finish_lowest;
+  uint end = count0;
+  for (uint b = 1u; b < PLACEMENT_BUCKETS && placement_bucket_edge(b, params.bucket_width) <= reach; ++b) {
+    end = finish_ends[b];
+  }
+  end = min(end, total);
   // The main pass: bucket 0, then the other entries whose bound with the bits all their
   // candidates have is not above that, moved up in place (a chunk is read before any of it is
   // written, and writes never pass the reads).
-  for (uint chunk = 0u; chunk < total; chunk += chunk_size) {
+  for (uint chunk = 0u; chunk < end; chunk += chunk_size) {
     bool keep[4];
     [[unroll]] for (uint c = 0u; c < 4u; ++c) {
-      const uint i = t < lanes ? chunk + c * lanes + t : total;
-      if (chunk > 0u) entries[c] = i < total ? tile_list[p * tiles + i] : uvec2(0u);
+      const uint i = t < lanes ? chunk + c * lanes + t : end;
+      if (chunk > 0u) entries[c] = i < end ? tile_list[p * tiles + i] : uvec2(0u);
       const uint known = (entries[c].x >> PLACEMENT_TILE_CLASS_SHIFT) & 7u;
-      keep[c] = i >= count0 && i < total &&
+      keep[c] = i >= count0 && i < end &&
                 !(uintBitsToFloat(entries[c].y) + constraint_weight(known) > best) &&
                 !(params.hard != 0u && known != 0u);
     }

@@ -124,6 +124,7 @@ void main() {
     args[1] = size.y;
     args[2] = size.z;
   }
+  if (params.phase == PLACEMENT_PHASE_SORT && tile == 0u) buckets[s].lowest = uintBitsToFloat(lower[s]);
   const float bound = bounds[s * tiles + tile];
   if (isinf(bound)) return;  // no candidate here may hold the label
   // Everything in bucket 0 when the constraint image is kept: every candidate is evaluated.

@@ -60,7 +60,7 @@ TEST_SUITE("gpu") {
       const Scene scene = load_scene(std::string(STRATA_SOURCE_DIR "/assets/scenes/") + file);
       LabelledRenderer renderer(ctx, scene, camera_for(scene, "front"), {64, 64}, {});
       const graph::GraphRunner& runner = renderer.runner();
-      CHECK(runner.graph().passes().size() == 22);
+      CHECK(runner.graph().passes().size() == 21);
       CHECK(graph::barrier_count(runner.compiled()) == 55);
       const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
       CHECK(loop.name == "placement.labels");

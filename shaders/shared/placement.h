@@ -135,6 +135,7 @@ struct PlacementBucketsGpu {
   float bound;  // the main pass's bound on the label's best cost (speculative winners', samples')
   uint counts[PLACEMENT_BUCKETS];
   uint cursors[PLACEMENT_BUCKETS];
+  float lowest;  // the smallest of the label's tile bounds (the buckets' reference)
 };
 
 // The top-left pixel of a label box of `size` whose candidate pixel is p.

@@ -37,7 +37,7 @@
 #define VR_BINDING_INDICES 7
 #define VR_BINDING_ATLAS 8       // sampler3D: every volume, normalised, with borders
 #define VR_ATLAS_BORDER 2        // voxels of replicated edge around each volume in the atlas
-#define VR_BINDING_TRANSFER 9    // vec4[VR_TF_SIZE] per volume, straight RGBA
+#define VR_BINDING_TRANSFER 9    // vec4[VR_TF_SIZE] per volume, straight RGBA, alpha per step
 #define VR_BINDING_OCCUPANCY 10  // one uint per brick, all volumes one after the other
 #define VR_BINDING_LAYERS 11     // image2DArray rgba16f, premultiplied
 #define VR_BINDING_FINAL 12      // image2D rgba8, layers over the background

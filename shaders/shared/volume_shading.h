@@ -37,7 +37,8 @@ STRATA_INLINE vec4 over(vec4 front, vec4 back) {
 }
 
 // Transfer-function alpha is defined per `reference` distance; a step of `step` absorbs more or
-// less (the usual opacity correction).
+// less (the usual opacity correction). Applied to the transfer table's entries once per frame
+// (corrected_transfer in passes/volume_renderer.h), not per sample.
 STRATA_INLINE float corrected_alpha(float alpha, float step, float reference) {
   return 1.0f - pow(max(1.0f - alpha, 0.0f), step / reference);
 }
