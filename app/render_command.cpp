@@ -29,6 +29,7 @@ struct RenderOptions {
   bool no_labels = false;
   bool hard = false;
   bool internal = false;
+  float label_scale = 1.0f;
   bool decoret = false;
   std::string order = "scene";
   std::string layout;
@@ -112,6 +113,7 @@ LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene)
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
   settings.internal = o.internal;
+  settings.label_scale = o.label_scale;
   if (o.order == "apollonius") settings.order = InsertionOrder::apollonius;
   if (o.order == "optimized") settings.order = InsertionOrder::optimized;
   if (o.decoret) {  // Stein & Decoret's setting, as the thesis compares against it
@@ -227,6 +229,9 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--no-labels", o->no_labels, "render the scene without its labels");
   cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
   cmd->add_flag("--internal", o->internal, "internal labelling: labels drawn on their anchors");
+  cmd->add_option("--label-scale", o->label_scale, "label text and boxes times this (0.25 to 4)")
+      ->check(CLI::Range(0.25f, 4.0f))
+      ->capture_default_str();
   cmd->add_option("--order", o->order,
                   "insertion order: scene, apollonius (Stein & Decoret, innermost first) or "
                   "optimized (random orders, the best kept)")

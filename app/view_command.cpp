@@ -37,6 +37,7 @@ struct ViewOptions {
   uint32_t frames_in_flight = 2;
   bool no_optimize = false;
   bool no_panel = false;
+  float label_scale = 1.0f;  // times the display's content scale
 };
 
 struct Window {
@@ -324,6 +325,8 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   LabellingSettings settings;
   settings.layer_count = o.layers;
   settings.placement.weights = scene.settings.weights;
+  // HiDPI: label text and boxes follow the display's content scale, as the panel does.
+  settings.label_scale = std::clamp(o.label_scale * std::max(scale_x, scale_y), 0.25f, 4.0f);
   ViewerOptions options;
   options.scene_path = o.scene;
   options.screenshot_dir = o.screenshot_dir;
@@ -440,6 +443,10 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--no-optimize", o->no_optimize,
                 "do not try random insertion orders when the camera rests");
   cmd->add_flag("--no-panel", o->no_panel, "start with the panel hidden (h shows it)");
+  cmd->add_option("--label-scale", o->label_scale,
+                  "label text and boxes times this and the display's content scale (0.25 to 4)")
+      ->check(CLI::Range(0.25f, 4.0f))
+      ->capture_default_str();
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
       ->capture_default_str();
   cmd->callback([&device, o] {

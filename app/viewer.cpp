@@ -108,6 +108,7 @@ const std::vector<Parameter>& parameters() {
       {"internal", "on: each label on its anchor", nullptr, [](S s) { return &s.labels.internal; },
        true},
       {"font", "label font size in pixels"},
+      {"label_scale", "label text and boxes times this (0.25 to 4)"},
       {"forces.speed", "pixels per second at full force",
        [](S s) { return &s.labels.forces.speed; }},
       {"forces.epsilon", "pixels: nearer than this the force shrinks",
@@ -418,8 +419,10 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
 void Viewer::set_number(const std::string& name, float value) {
   const Parameter& p = parameter(name);
   if (p.flag) throw Error("parameter " + name + " is on or off, not a number");
-  if (name == "font") {
-    labelled_->set_font_pixels(value);  // (checks the size)
+  if (name == "font" || name == "label_scale") {
+    // (checks the value)
+    if (name == "font") labelled_->set_font_pixels(value);
+    if (name == "label_scale") labelled_->set_label_scale(value);
     settings_changed(false);
     return;
   }

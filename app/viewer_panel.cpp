@@ -141,6 +141,9 @@ void Viewer::panel_labelling() {
   float font = s.font_pixels;
   ImGui::SliderFloat("font size (px)", &font, 8.0f, 40.0f, "%.0f");
   if (ImGui::IsItemDeactivatedAfterEdit()) set_number("font", font);
+  float scale = s.label_scale;
+  ImGui::SliderFloat("label scale", &scale, 0.25f, 4.0f, "%.2f");
+  if (ImGui::IsItemDeactivatedAfterEdit()) set_number("label_scale", scale);
 }
 
 void Viewer::panel_forces() {

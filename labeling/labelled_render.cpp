@@ -63,6 +63,7 @@ struct LabelledRenderer::Parts {
 LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camera& camera,
                                    graph::Extent size, const LabellingSettings& settings)
     : ctx_(ctx), scene_(scene), size_(size), camera_(camera), settings_(settings) {
+  check_label_text(settings.font_pixels, settings.label_scale);
   labels_.resize(scene.labels.size());
   hidden_.assign(scene.labels.size(), false);
   for (size_t i = 0; i < scene.labels.size(); ++i) labels_[i].size = scene.labels[i].size;
@@ -74,24 +75,47 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
   build_graph();
 }
 
+void check_label_text(float font_pixels, float label_scale) {
+  if (!(font_pixels >= 4.0f && font_pixels <= 128.0f)) {
+    throw Error("label font size must be 4 to 128 px, not " + std::to_string(font_pixels));
+  }
+  if (!(label_scale >= 0.25f && label_scale <= 4.0f)) {
+    throw Error("label scale must be 0.25 to 4, not " + std::to_string(label_scale));
+  }
+}
+
 // Boxes from the texts: sizes and glyph ranges stay; anchors and layers follow the camera.
 void LabelledRenderer::build_labels() {
-  const FontAtlas font = load_font_atlas(settings_.font_pixels);
+  const float scale = settings_.label_scale;
+  const Font font(settings_.font_pixels * scale);
+  TextStyle style;
+  style.max_width = settings_.wrap_width;
+  style = style.scaled(scale);
   std::vector<std::string> texts;
   for (const Label& label : scene_.labels) texts.push_back(label.text);
-  const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, texts, labels_);
+  const FontAtlas atlas = bake_label_texts(font, texts, style);
+  const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, atlas, texts, labels_, style);
   Parts& p = *parts_;
   p.glyphs = Buffer(ctx_, std::max<size_t>(1, glyphs.size()) * sizeof(gpu::GlyphGpu),
                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
   if (!glyphs.empty()) upload(ctx_, p.glyphs, as_bytes(glyphs));
-  p.drawing.emplace(ctx_, font);
+  p.drawing.emplace(ctx_, atlas);
   p.drawing->set_label_count(uint32_t(labels_.size()));
 }
 
 void LabelledRenderer::set_font_pixels(float pixels) {
-  if (!(pixels >= 4.0f && pixels <= 128.0f)) throw Error("label font size must be 4 to 128 px");
+  set_label_text(pixels, settings_.label_scale);
+}
+
+void LabelledRenderer::set_label_scale(float scale) {
+  set_label_text(settings_.font_pixels, scale);
+}
+
+void LabelledRenderer::set_label_text(float pixels, float scale) {
+  check_label_text(pixels, scale);
   vkDeviceWaitIdle(ctx_.device());  // the glyphs and the drawing's atlas are replaced
   settings_.font_pixels = pixels;
+  settings_.label_scale = scale;
   for (size_t i = 0; i < labels_.size(); ++i) labels_[i].size = scene_.labels[i].size;
   runner_.reset();
   build_labels();

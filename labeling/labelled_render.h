@@ -34,6 +34,9 @@ struct LabellingSettings {
   LayerHysteresis hysteresis;  // how labels keep their layers while the camera moves
   bool internal = false;       // internal labelling: every label drawn on its anchor
   float font_pixels = 14.0f;
+  float label_scale = 1.0f;  // text and box sizes times this (--label-scale; HiDPI displays)
+  float wrap_width =
+      240.0f;             // pixels (before the scale) past which a line wraps at a space; 0: never
   uint64_t seed = 1;      // k-means++
   RenderSettings render;  // its layer_count and splits come from the layering
 };
@@ -127,8 +130,10 @@ class LabelledRenderer {
   // anchors are layered again, as by set_camera).
   void set_label_hidden(size_t index, bool hidden);
   bool label_hidden(size_t index) const { return hidden_.at(index); }
-  // The label font's size in pixels: rebuilds the glyphs, box sizes and the graph.
+  // The label font's size in pixels, and the scale of text and boxes (HiDPI, --label-scale):
+  // rebuild the glyphs, box sizes and the graph.
   void set_font_pixels(float pixels);
+  void set_label_scale(float scale);
   const Layering& layering() const { return layering_; }
   const std::vector<gpu::LabelGpu>& labels() const { return labels_; }
   const RenderStats& stats() const { return stats_; }
@@ -170,6 +175,7 @@ class LabelledRenderer {
   std::vector<uint32_t> trial_within_;
   bool afresh_ = false;
   void build_labels();  // glyphs and box sizes from the texts at settings_.font_pixels
+  void set_label_text(float pixels, float scale);
   Extension extension_;
   uint32_t frames_in_flight_ = 1;
   std::vector<bool> hidden_;
@@ -182,6 +188,9 @@ class LabelledRenderer {
   uint32_t graph_layers_ = 0;  // the layer count the graph was built for
   LabellingSettings settings_;
 };
+
+// Throws Error unless the font size (4..128 px) and label scale (0.25..4) are in range.
+void check_label_text(float font_pixels, float label_scale);
 
 // Renders and labels one frame offline.
 LabelledFrame render_labelled(Context& ctx, const Scene& scene, const Camera& camera,

@@ -1,6 +1,7 @@
-// Label text as boxes and glyphs: the label box a text needs (its advance and one line, plus
-// padding) and each character's quad in that box with its rectangle in the font atlas, as the
-// label drawing pass (passes/label_drawing.h) reads them.
+// Label text as boxes and glyphs: the lines of a text (split at "\n", wrapped at a maximum width,
+// shaped by the font), the label box they need plus padding, and each glyph's quad in that box
+// with its rectangle in the font atlas, as the label drawing pass (passes/label_drawing.h) reads
+// them.
 #pragma once
 
 #include <span>
@@ -19,23 +20,39 @@ struct TextStyle {
   float padding_x = 5.0f;   // pixels between the text and the box's left and right edges
   float padding_y = 3.0f;   // ... and its top and bottom edges
   float min_width = 24.0f;  // so that a one-letter label still has a box to see
+  float max_width = 0.0f;   // a line wider than this (pixels, padding excluded) wraps at a space;
+                            // 0: lines break at "\n" only
+
+  // The style with every length times `s` (the label scale).
+  TextStyle scaled(float s) const;
 };
 
 struct LabelTextLayout {
   glm::vec2 size{0.0f};               // the label box, whole pixels
-  std::vector<gpu::GlyphGpu> glyphs;  // quads relative to the box's top-left corner; characters
+  std::vector<gpu::GlyphGpu> glyphs;  // quads relative to the box's top-left corner; glyphs
                                       // without ink (spaces) have none
+  size_t lines = 0;
 };
 
-// The box for `text` (UTF-8; see printable_ascii) and its glyphs, the text centred in the box.
-// The box is at least `min_size` (zero: from the text alone), so a label's given size is kept.
-LabelTextLayout layout_label_text(const FontAtlas& font, std::string_view text,
+// The lines of `text` (UTF-8), shaped: split at "\n", each wrapped at style.max_width at spaces
+// (a word wider than that keeps a line of its own).
+std::vector<ShapedLine> shape_label_text(const Font& font, std::string_view text,
+                                         const TextStyle& style = {});
+
+// The atlas with every glyph of `texts`.
+FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,
+                           const TextStyle& style = {});
+
+// The box for `text` and its glyphs (from `atlas`, which holds them: bake_label_texts), each line
+// centred in the box. The box is at least `min_size` (zero: from the text alone), so a label's
+// given size is kept.
+LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std::string_view text,
                                   const TextStyle& style = {}, glm::vec2 min_size = glm::vec2(0));
 
 // The glyph buffer for labels[i] showing texts[i]: every label's glyphs one after the other.
 // Sets each label's glyph_first, glyph_count and size (its size on entry is kept as a minimum, so
 // 0 means "from the text"). texts and labels have the same length.
-std::vector<gpu::GlyphGpu> build_glyph_buffer(const FontAtlas& font,
+std::vector<gpu::GlyphGpu> build_glyph_buffer(const Font& font, const FontAtlas& atlas,
                                               std::span<const std::string> texts,
                                               std::span<gpu::LabelGpu> labels,
                                               const TextStyle& style = {});

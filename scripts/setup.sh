@@ -12,7 +12,9 @@ packages=(
   libspirv-cross-c-shared-dev
   # libraries
   libglm-dev libglfw3-dev libimgui-dev doctest-dev libcli11-dev libstb-dev
-  fonts-dejavu-core  # label text (engine/core/font.cpp)
+  # label text (engine/core/font.cpp): faces read and rasterised by FreeType, shaped by HarfBuzz;
+  # DejaVu Sans, FreeSans and FreeSerif for characters it lacks
+  libfreetype-dev libharfbuzz-dev fonts-dejavu-core fonts-freefont-ttf
   # file formats: gzip, DICOM, meshes, JSON, XML
   zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev
   # videos: H.264 in MP4 through FFmpeg's libraries; ffprobe checks them in the tests

@@ -269,6 +269,27 @@ TEST_SUITE("cli") {
     CHECK(shown > 0);
   }
 
+  // --label-scale scales every label box; a scale out of range is refused before any work.
+  TEST_CASE("label_scale_scales_the_boxes_the_layout_reports") {
+    const std::filesystem::path folder = test::fresh_folder("cli", "label_scale");
+    std::vector<nlohmann::json> layouts;
+    for (const char* scale : {"1", "2"}) {
+      const std::string layout = (folder / (std::string(scale) + ".json")).string();
+      const auto r = run_strata("render " STRATA_SOURCE_DIR
+                                "/assets/scenes/head.json --size 128 -o /dev/null --label-scale " +
+                                std::string(scale) + " --layout " + layout);
+      REQUIRE(r.exit_code == 0);
+      layouts.push_back(nlohmann::json::parse(test::read_file(layout)));
+    }
+    const auto& small = layouts[0]["labels"][0]["box"];
+    const auto& large = layouts[1]["labels"][0]["box"];
+    CHECK(large[2].get<double>() == doctest::Approx(2.0 * small[2].get<double>()).epsilon(0.1));
+    CHECK(large[3].get<double>() == doctest::Approx(2.0 * small[3].get<double>()).epsilon(0.1));
+    const auto bad = run_strata("render --size 8 -o /dev/null --label-scale 9");
+    CHECK(bad.exit_code != 0);
+    CHECK(bad.output.find("--label-scale") != std::string::npos);
+  }
+
   TEST_CASE("bad_sizes_and_unwritable_outputs_are_errors_naming_the_culprit") {
     const auto size = run_strata("render --size 0x10 -o /dev/null");
     CHECK(size.exit_code == 1);

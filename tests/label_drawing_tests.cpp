@@ -13,6 +13,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include <ft2build.h>
+#include FT_FREETYPE_H
 #include <glm/gtc/packing.hpp>
 
 #include "engine/core/error.h"
@@ -29,9 +31,25 @@ namespace {
 
 constexpr float kTolerance = 2.0f / 255.0f;
 
-const FontAtlas& test_font() {
-  static const FontAtlas font = load_font_atlas(14.0f);
+const Font& test_font() {
+  static const Font font(14.0f);
   return font;
+}
+
+// Every printable ASCII character's glyph, and those of the texts the tests draw.
+const FontAtlas& test_atlas() {
+  static const FontAtlas atlas = [] {
+    std::string ascii;
+    for (char c = 32; c < 127; ++c) ascii.push_back(c);
+    const std::vector<std::string> texts = {ascii};
+    return bake_label_texts(test_font(), texts);
+  }();
+  return atlas;
+}
+
+std::vector<gpu::GlyphGpu> test_glyphs(std::span<const std::string> texts,
+                                       std::span<gpu::LabelGpu> labels) {
+  return build_glyph_buffer(test_font(), test_atlas(), texts, labels);
 }
 
 // Layers, labels with their placements, and what the composite puts behind them.
@@ -86,7 +104,7 @@ LabelScene make_scene() {
                   {{0.0f, 0.0f}, 0.0f, PLACEMENT_SHOWN},
                   {{88.0f, 30.0f}, 0.0f, PLACEMENT_HIDDEN}};
   const std::vector<std::string> texts = {"Cortex", "Ventricle", "Pons", "Hidden"};
-  s.glyphs = build_glyph_buffer(test_font(), texts, s.labels);
+  s.glyphs = test_glyphs(texts, s.labels);
   return s;
 }
 
@@ -120,7 +138,7 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
   const Buffer labels = storage_buffer(ctx, as_bytes(s.labels));
   const Buffer placements = storage_buffer(ctx, as_bytes(s.placements));
   const Buffer glyphs = storage_buffer(ctx, as_bytes(s.glyphs));
-  LabelDrawing drawing(ctx, test_font());
+  LabelDrawing drawing(ctx, test_atlas());
   drawing.set_label_count(static_cast<uint32_t>(s.labels.size()));
 
   graph::Graph g;
@@ -159,7 +177,7 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
 
 std::vector<glm::vec4> reference_layers(const LabelScene& s) {
   return draw_labels_reference(s.layers, s.size, s.layer_count, {s.labels, s.placements, s.glyphs},
-                               test_font());
+                               test_atlas());
 }
 
 // The largest difference per channel, and where it is.
@@ -207,64 +225,208 @@ glm::uvec2 brightest_text_pixel(const LabelScene& s, const std::vector<glm::vec4
 }  // namespace
 
 TEST_SUITE("cpu") {
-  TEST_CASE("font_atlas_has_coverage_for_every_letter_and_none_for_space") {
-    const FontAtlas& font = test_font();
-    REQUIRE(font.coverage.size() == size_t{font.width} * font.height);
-    const GlyphMetrics& a = font.glyph('A');
+  TEST_CASE("font_bakes_coverage_for_letters_and_none_for_space") {
+    const Font& font = test_font();
+    const ShapedLine line = font.shape("A A");
+    REQUIRE(line.glyphs.size() == 3);
+    const FontAtlas atlas =
+        font.bake(std::vector<GlyphKey>{line.glyphs[0].key, line.glyphs[1].key});
+    REQUIRE(atlas.coverage.size() == size_t{atlas.width} * atlas.height);
+    const GlyphMetrics a = atlas.glyph(line.glyphs[0].key);
     REQUIRE_FALSE(a.empty());
     const glm::uvec4 texels(
-        glm::round(a.uv * glm::vec4(font.width, font.height, font.width, font.height)));
+        glm::round(a.uv * glm::vec4(atlas.width, atlas.height, atlas.width, atlas.height)));
     int ink = 0;
     for (uint32_t y = texels.y; y < texels.w; ++y) {
       for (uint32_t x = texels.x; x < texels.z; ++x)
-        ink = std::max(ink, int(font.coverage[size_t{y} * font.width + x]));
+        ink = std::max(ink, int(atlas.coverage[size_t{y} * atlas.width + x]));
     }
-    CHECK(ink > 200);  // small glyphs rarely cover a texel fully
-    CHECK(font.glyph(' ').empty());
-    CHECK(font.glyph(' ').advance > 0.0f);
-    CHECK(font.ascent > 0.0f);
-    CHECK(font.descent < 0.0f);
+    CHECK(ink > 200);                                // small glyphs rarely cover a texel fully
+    CHECK(atlas.glyph(line.glyphs[1].key).empty());  // the space has no ink ...
+    CHECK(line.glyphs[2].pen.x > line.glyphs[1].pen.x + 2.0f);  // ... but an advance
+    CHECK(font.ascent() > 0.0f);
+    CHECK(font.descent() < 0.0f);
+    CHECK(font.line_height() == doctest::Approx(14.0f));
+    CHECK(font.line_spacing() >= font.line_height());
   }
 
   TEST_CASE("font_missing_file_names_the_path_and_the_debian_package") {
     const std::string path = "/nonexistent/fonts/NoSuchFont.ttf";
     try {
-      (void)load_font_atlas(14.0f, path);
+      (void)Font(14.0f, path);
       FAIL("no error for a missing font");
     } catch (const Error& e) {
       const std::string message = e.what();
       CHECK(message.find(path) != std::string::npos);
       CHECK(message.find("fonts-dejavu-core") != std::string::npos);
     }
+    CHECK_THROWS_AS(Font(14.0f, STRATA_SOURCE_DIR "/README.md"), Error);  // not a font
+    CHECK_THROWS_AS(Font(2.0f), Error);
   }
 
-  TEST_CASE("text_outside_printable_ascii_becomes_one_question_mark_per_character") {
-    CHECK(printable_ascii("Gyrus") == "Gyrus");
-    CHECK(printable_ascii("N\xC3\xBC"
-                          "cleus\t\xE2\x86\x92!") ==
-          "N?cleus?"
-          "?!");                              // split: "??!" is a trigraph
-    CHECK(printable_ascii("\x80x") == "?x");  // a stray continuation byte
-    const FontAtlas& font = test_font();
-    CHECK(layout_label_text(font, "\xC3\xA9").glyphs.size() == 1);
+  TEST_CASE("utf8_is_decoded_and_malformed_bytes_become_one_replacement_each") {
+    CHECK(decode_utf8("Gyrus") == U"Gyrus");
+    CHECK(decode_utf8("pr\xC3\xA9"
+                      "central \xE2\x80\x93 \xCE\x98") == U"précentral – Θ");
+    CHECK(decode_utf8("\x80x") == U"\uFFFDx");        // a stray continuation byte
+    CHECK(decode_utf8("\xC3") == U"\uFFFD");          // truncated
+    CHECK(decode_utf8("\xC0\xAF") == U"\uFFFD");      // overlong
+    CHECK(decode_utf8("\xED\xA0\x80") == U"\uFFFD");  // a surrogate
+    CHECK(decode_utf8("\xF0\x9F\x98\x80") == U"\U0001F600");
   }
 
-  TEST_CASE("text_layout_gives_a_longer_text_a_wider_box_of_one_line") {
-    const FontAtlas& font = test_font();
-    const LabelTextLayout short_text = layout_label_text(font, "Pons");
-    const LabelTextLayout long_text = layout_label_text(font, "Pons and medulla");
+  TEST_CASE("shaping_kerns_composes_accents_and_falls_back_for_missing_characters") {
+    const Font& font = test_font();
+    // DejaVu Sans kerns "AV": closer than the two letters' own advances.
+    const float a = font.shape("A").advance, v = font.shape("V").advance;
+    CHECK(font.shape("AV").advance < a + v - 0.5f);
+    // A precomposed accent is one glyph of the main face; a base letter with a combining accent
+    // is positioned by the font (the mark sits over the base, not after it).
+    const ShapedLine e = font.shape("\xC3\xA9");
+    REQUIRE(e.glyphs.size() == 1);
+    CHECK(e.glyphs[0].key.face == 0);
+    CHECK(e.glyphs[0].key.glyph != 0);
+    const ShapedLine combining = font.shape("e\xCC\x81");
+    REQUIRE(combining.glyphs.size() >= 1);
+    CHECK(combining.advance == doctest::Approx(font.shape("e").advance));
+    // Greek is in the main face.
+    for (const ShapedGlyph& g :
+         font.shape("\xCE\x98\xCE\xAC\xCE\xBB\xCE\xB1\xCE\xBC\xCE\xBF\xCF\x82").glyphs) {
+      CHECK(g.key.face == 0);
+      CHECK(g.key.glyph != 0);
+    }
+    // Devanagari is not in DejaVu Sans: it comes from a fallback face.
+    REQUIRE(font.face_count() > 1);
+    const ShapedLine fallback = font.shape("\xE0\xA4\x95");  // U+0915
+    REQUIRE_FALSE(fallback.glyphs.empty());
+    CHECK(fallback.glyphs[0].key.face > 0);
+    CHECK(fallback.glyphs[0].key.glyph != 0);
+  }
+
+  TEST_CASE("text_layout_gives_a_longer_text_a_wider_box_and_each_line_its_own_row") {
+    const Font& font = test_font();
+    const FontAtlas& atlas = test_atlas();
+    const LabelTextLayout short_text = layout_label_text(font, atlas, "Pons");
+    const LabelTextLayout long_text = layout_label_text(font, atlas, "Pons and medulla");
     CHECK(long_text.size.x > short_text.size.x + 40.0f);
     CHECK(long_text.size.y == short_text.size.y);
     CHECK(short_text.size.y >= font.line_height());
-    CHECK(layout_label_text(font, "i").size.x == TextStyle{}.min_width);
-    CHECK(layout_label_text(font, "").glyphs.empty());
+    CHECK(layout_label_text(font, atlas, "i").size.x == TextStyle{}.min_width);
+    CHECK(layout_label_text(font, atlas, "").glyphs.empty());
     // A given size is kept as a minimum.
-    CHECK(layout_label_text(font, "Pons", {}, {200.0f, 40.0f}).size == glm::vec2(200.0f, 40.0f));
+    CHECK(layout_label_text(font, atlas, "Pons", {}, {200.0f, 40.0f}).size ==
+          glm::vec2(200.0f, 40.0f));
+    // "\n" starts a line: the box grows by one line spacing and narrows to the wider line.
+    const LabelTextLayout two = layout_label_text(font, atlas, "Pons and\nmedulla");
+    CHECK(two.lines == 2);
+    CHECK(two.size.y == short_text.size.y + std::round(font.line_spacing()));
+    CHECK(two.size.x < long_text.size.x);
+    // Wrapping at a width: at spaces, never inside a word.
+    TextStyle narrow;
+    narrow.max_width = 60.0f;
+    const std::vector<ShapedLine> wrapped = shape_label_text(font, "Pons and medulla", narrow);
+    CHECK(wrapped.size() == 2);
+    for (const ShapedLine& line : wrapped) CHECK(line.advance <= 60.0f);
+    CHECK(shape_label_text(font, "Parahippocampal", narrow).size() == 1);  // one long word
+    // The label scale scales the box.
+    const LabelTextLayout big = layout_label_text(
+        Font(28.0f), bake_label_texts(Font(28.0f), std::vector<std::string>{"Pons"}), "Pons",
+        TextStyle{}.scaled(2.0f));
+    CHECK(big.size.x == doctest::Approx(2.0f * short_text.size.x).epsilon(0.1));
+    CHECK(big.size.y == doctest::Approx(2.0f * short_text.size.y).epsilon(0.1));
+  }
+
+  // Accents, a dash, Greek and a line break, against FreeType's own rendering of the same string
+  // (character by character with its kerning): the same glyphs, the same ink, at the same places
+  // (within a pixel: HarfBuzz and FreeType round advances differently).
+  TEST_CASE("utf8_label_text_matches_a_freetype_rendering_of_the_same_string") {
+    const std::string text =
+        "Pr\xC3\xA9"
+        "central \xE2\x80\x93\n\xCE\x98\xCE\xAC\xCE\xBB\xCE\xB1\xCE\xBC\xCE\xBF\xCF\x82";
+    const Font& font = test_font();
+    const FontAtlas atlas = bake_label_texts(font, std::vector<std::string>{text});
+    const LabelTextLayout layout = layout_label_text(font, atlas, text);
+    REQUIRE(layout.lines == 2);
+
+    FT_Library library = nullptr;
+    REQUIRE(FT_Init_FreeType(&library) == 0);
+    FT_Face face = nullptr;
+    REQUIRE(FT_New_Face(library, font_file().c_str(), 0, &face) == 0);
+    const float em = 14.0f * float(face->units_per_EM) / float(face->ascender - face->descender);
+    FT_Set_Char_Size(face, 0, FT_F26Dot6(std::lround(em * 64.0f)), 72, 72);
+    struct Ink {
+      float left = 0.0f;
+      int line = 0;
+      std::vector<uint8_t> pixels;
+      int width = 0, rows = 0;
+    };
+    std::vector<Ink> reference;
+    int line = 0;
+    for (const std::u32string& characters :
+         {decode_utf8("Pr\xC3\xA9"
+                      "central \xE2\x80\x93"),
+          decode_utf8("\xCE\x98\xCE\xAC\xCE\xBB\xCE\xB1\xCE\xBC\xCE\xBF\xCF\x82")}) {
+      float pen = 0.0f;
+      FT_UInt previous = 0;
+      for (const char32_t c : characters) {
+        const FT_UInt index = FT_Get_Char_Index(face, c);
+        REQUIRE(index != 0);
+        FT_Vector kern{0, 0};
+        if (previous != 0) FT_Get_Kerning(face, previous, index, FT_KERNING_UNFITTED, &kern);
+        pen += float(kern.x) / 64.0f;
+        REQUIRE(FT_Load_Glyph(face, index, FT_LOAD_TARGET_LIGHT | FT_LOAD_RENDER) == 0);
+        const FT_Bitmap& b = face->glyph->bitmap;
+        if (b.width > 0 && b.rows > 0) {
+          Ink ink{pen + float(face->glyph->bitmap_left), line, {}, int(b.width), int(b.rows)};
+          for (unsigned r = 0; r < b.rows; ++r) {
+            const unsigned char* row = b.buffer + std::ptrdiff_t(r) * b.pitch;
+            ink.pixels.insert(ink.pixels.end(), row, row + b.width);
+          }
+          reference.push_back(std::move(ink));
+        }
+        pen += float(face->glyph->linearHoriAdvance) / 65536.0f;
+        previous = index;
+      }
+      ++line;
+    }
+    FT_Done_Face(face);
+    FT_Done_FreeType(library);
+
+    // Ours: each glyph's quad (one texel of border around the ink) and its atlas texels.
+    REQUIRE(layout.glyphs.size() == reference.size());
+    float line_start[2] = {0.0f, 0.0f};
+    for (size_t i = 0; i < reference.size(); ++i) {
+      CAPTURE(i);
+      const gpu::GlyphGpu& g = layout.glyphs[i];
+      const int width = int(std::lround(g.box.z - g.box.x)) - 2;
+      const int rows = int(std::lround(g.box.w - g.box.y)) - 2;
+      CHECK(width == reference[i].width);
+      CHECK(rows == reference[i].rows);
+      const int ax = int(std::lround(g.atlas.x * float(atlas.width))) + 1;
+      const int ay = int(std::lround(g.atlas.y * float(atlas.height))) + 1;
+      int differing = 0;
+      for (int r = 0; r < std::min(rows, reference[i].rows); ++r) {
+        for (int c = 0; c < std::min(width, reference[i].width); ++c) {
+          const int ours = atlas.coverage[size_t(ay + r) * atlas.width + size_t(ax + c)];
+          const int theirs =
+              reference[i].pixels[size_t(r) * size_t(reference[i].width) + size_t(c)];
+          if (ours != theirs) ++differing;
+        }
+      }
+      CHECK(differing == 0);
+      // Place: relative to its line's first glyph, within a pixel of FreeType's pen.
+      const int l = reference[i].line;
+      if (i == 0 || reference[i - 1].line != l) line_start[l] = g.box.x + 1.0f - reference[i].left;
+      CHECK(std::abs(g.box.x + 1.0f - line_start[l] - reference[i].left) <= 1.0f);
+    }
+    // The second line lies one line spacing below the first.
+    CHECK(layout.glyphs.back().box.w > layout.glyphs[0].box.w + font.line_spacing() - 8.0f);
   }
 
   TEST_CASE("text_layout_glyph_boxes_lie_in_the_label_box_in_reading_order") {
-    const FontAtlas& font = test_font();
-    const LabelTextLayout layout = layout_label_text(font, "Thalamus");
+    const Font& font = test_font();
+    const FontAtlas& atlas = test_atlas();
+    const LabelTextLayout layout = layout_label_text(font, atlas, "Thalamus");
     REQUIRE(layout.glyphs.size() == 8);
     for (size_t i = 0; i < layout.glyphs.size(); ++i) {
       const glm::vec4 box = layout.glyphs[i].box;
@@ -274,28 +436,27 @@ TEST_SUITE("cpu") {
       CHECK(box.z <= layout.size.x);
       CHECK(box.w <= layout.size.y);
       // One pixel per texel: the quad is the glyph's atlas rectangle, unscaled.
-      CHECK((box.z - box.x) == doctest::Approx((uv.z - uv.x) * float(font.width)));
-      CHECK((box.w - box.y) == doctest::Approx((uv.w - uv.y) * float(font.height)));
+      CHECK((box.z - box.x) == doctest::Approx((uv.z - uv.x) * float(atlas.width)));
+      CHECK((box.w - box.y) == doctest::Approx((uv.w - uv.y) * float(atlas.height)));
       if (i > 0) CHECK(box.x > layout.glyphs[i - 1].box.x);
     }
   }
 
   TEST_CASE("glyph_buffer_gives_each_label_its_range_and_size") {
-    const FontAtlas& font = test_font();
     std::vector<gpu::LabelGpu> labels(3);
     labels[2].size = {150.0f, 0.0f};
     const std::vector<std::string> texts = {"Insula", "a b", "Amygdala"};
-    const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, texts, labels);
+    const std::vector<gpu::GlyphGpu> glyphs = test_glyphs(texts, labels);
     CHECK(labels[0].glyph_first == 0);
     CHECK(labels[0].glyph_count == 6);
     CHECK(labels[1].glyph_first == 6);
     CHECK(labels[1].glyph_count == 2);  // the space has no quad
     CHECK(labels[2].glyph_first == 8);
     CHECK(glyphs.size() == 16);
-    CHECK(labels[0].size == layout_label_text(font, "Insula").size);
+    CHECK(labels[0].size == layout_label_text(test_font(), test_atlas(), "Insula").size);
     CHECK(labels[2].size.x == 150.0f);
     std::vector<gpu::LabelGpu> too_few(2);
-    CHECK_THROWS_AS(build_glyph_buffer(font, texts, too_few), Error);
+    CHECK_THROWS_AS(test_glyphs(texts, too_few), Error);
   }
 
   TEST_CASE("label_reference_draws_only_enabled_shown_labels_on_their_own_layer") {
@@ -355,7 +516,7 @@ TEST_SUITE("gpu") {
       s.placements.push_back(p);
       texts.push_back(i % 2 ? "Cortex" : "Pons");
     }
-    s.glyphs = build_glyph_buffer(test_font(), texts, s.labels);
+    s.glyphs = test_glyphs(texts, s.labels);
     const DrawnLabels gpu = draw_on_gpu(ctx, s);
     size_t where = 0;
     const float worst = worst_difference(gpu.layers, reference_layers(s), where);

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
-#include <iterator>
+#include <filesystem>
 
-#include <stb_truetype.h>
+#include <ft2build.h>
+#include FT_FREETYPE_H
+#include <hb-ft.h>
+#include <hb.h>
 
 #include "engine/core/error.h"
 
@@ -17,113 +19,244 @@ constexpr uint32_t kAtlasWidth = 512;
 // Zero texels around each glyph's ink: a glyph's quad covers its ink plus this border, so bilinear
 // filtering at the quad's edge fades to zero and never reaches a neighbour's ink.
 constexpr int kPad = 1;
+constexpr char32_t kReplacement = 0xFFFD;
 
-std::vector<unsigned char> read_font_file(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) {
-    throw Error(path + ": no such font file (Debian package fonts-dejavu-core provides " +
-                kDefaultFontPath + ")");
-  }
-  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
-}
-
-struct Cell {
-  int x = 0, y = 0, w = 0, h = 0;  // the glyph's rectangle in the atlas, padding included
-  int ix0 = 0, iy0 = 0;            // ink offset from the pen, pixels
-};
-
-// Shelf packing, in character order: ample for 95 glyphs, and deterministic.
-std::vector<Cell> pack(const stbtt_fontinfo& font, float scale, uint32_t& height) {
-  std::vector<Cell> cells;
-  int x = 0, y = 0, shelf = 0;
-  for (int c = kFirstFontChar; c <= kLastFontChar; ++c) {
-    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-    stbtt_GetCodepointBitmapBox(&font, c, scale, scale, &x0, &y0, &x1, &y1);
-    Cell cell{0, 0, x1 - x0 + 2 * kPad, y1 - y0 + 2 * kPad, x0, y0};
-    if (cell.w > int(kAtlasWidth)) throw Error("font: glyphs too large for the atlas");
-    if (x + cell.w > int(kAtlasWidth)) {
-      x = 0;
-      y += shelf;
-      shelf = 0;
-    }
-    cell.x = x;
-    cell.y = y;
-    x += cell.w;
-    shelf = std::max(shelf, cell.h);
-    cells.push_back(cell);
-  }
-  height = static_cast<uint32_t>(y + shelf);
-  return cells;
-}
+// Light hinting (vertical only) keeps small text crisp without moving glyphs sideways, so the
+// shaped advances (unhinted) and the ink agree.
+constexpr FT_Int32 kLoadFlags = FT_LOAD_TARGET_LIGHT;
 
 }  // namespace
 
-const GlyphMetrics& FontAtlas::glyph(char c) const {
-  if (c < kFirstFontChar || c > kLastFontChar) c = kReplacementChar;
-  return glyphs[static_cast<size_t>(c - kFirstFontChar)];
-}
+struct Font::Faces {
+  FT_Library library = nullptr;
+  std::vector<FT_Face> faces;     // main, then fallbacks
+  std::vector<hb_font_t*> fonts;  // HarfBuzz fonts over them
+
+  ~Faces() {
+    for (hb_font_t* f : fonts) hb_font_destroy(f);
+    for (FT_Face f : faces) FT_Done_Face(f);
+    if (library) FT_Done_FreeType(library);
+  }
+};
 
 std::string font_file(const std::string& path) {
   const char* env = std::getenv("STRATA_FONT");
   return path == kDefaultFontPath && env && *env ? std::string(env) : path;
 }
 
-FontAtlas load_font_atlas(float pixel_height, const std::string& path) {
-  if (!(pixel_height >= 4.0f && pixel_height <= 128.0f)) {
-    throw Error("font: pixel height " + std::to_string(pixel_height) + " is not in 4..128");
+std::u32string decode_utf8(std::string_view text) {
+  std::u32string out;
+  size_t i = 0;
+  while (i < text.size()) {
+    const auto b = static_cast<unsigned char>(text[i]);
+    const int length = b < 0x80u              ? 1
+                       : (b & 0xE0u) == 0xC0u ? 2
+                       : (b & 0xF0u) == 0xE0u ? 3
+                       : (b & 0xF8u) == 0xF0u ? 4
+                                              : 0;
+    char32_t cp = length == 1   ? b
+                  : length == 2 ? (b & 0x1Fu)
+                  : length == 3 ? (b & 0x0Fu)
+                                : (b & 0x07u);
+    bool ok = length > 0 && i + size_t(length) <= text.size();
+    for (int k = 1; ok && k < length; ++k) {
+      const auto c = static_cast<unsigned char>(text[i + size_t(k)]);
+      ok = (c & 0xC0u) == 0x80u;
+      cp = (cp << 6) | (c & 0x3Fu);
+    }
+    // (overlong forms, surrogates and values past U+10FFFF are malformed too)
+    const char32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
+    ok = ok && cp >= least[length] && cp <= 0x10FFFF && !(cp >= 0xD800 && cp <= 0xDFFF);
+    if (!ok) {
+      out.push_back(kReplacement);
+      ++i;
+      while (i < text.size() && (static_cast<unsigned char>(text[i]) & 0xC0u) == 0x80u) ++i;
+      continue;
+    }
+    out.push_back(cp);
+    i += size_t(length);
   }
-  const std::vector<unsigned char> data = read_font_file(font_file(path));
-  // stb_truetype trusts its input: refuse what cannot even hold a font's table directory.
-  if (data.size() < 12) throw Error(path + ": not a TrueType font");
-  stbtt_fontinfo font{};
-  const int offset = stbtt_GetFontOffsetForIndex(data.data(), 0);
-  if (offset < 0 || !stbtt_InitFont(&font, data.data(), offset)) {
-    throw Error(path + ": not a TrueType font");
-  }
-  const float scale = stbtt_ScaleForPixelHeight(&font, pixel_height);
-  FontAtlas atlas;
-  atlas.pixel_height = pixel_height;
-  int ascent = 0, descent = 0, line_gap = 0;
-  stbtt_GetFontVMetrics(&font, &ascent, &descent, &line_gap);
-  atlas.ascent = float(ascent) * scale;
-  atlas.descent = float(descent) * scale;
-  atlas.line_gap = float(line_gap) * scale;
+  return out;
+}
 
-  const std::vector<Cell> cells = pack(font, scale, atlas.height);
+Font::Font(float pixel_height, const std::string& path) : faces_(std::make_unique<Faces>()) {
+  if (!(pixel_height >= 4.0f && pixel_height <= 512.0f)) {
+    throw Error("font: pixel height " + std::to_string(pixel_height) + " is not in 4..512");
+  }
+  const std::string file = font_file(path);
+  if (!std::filesystem::is_regular_file(file)) {
+    throw Error(file + ": no such font file (Debian package fonts-dejavu-core provides " +
+                kDefaultFontPath + ")");
+  }
+  if (FT_Init_FreeType(&faces_->library) != 0) throw Error("font: FreeType did not start");
+  std::vector<std::string> files{file};
+  for (const char* fallback : kFallbackFontPaths) {
+    if (std::filesystem::is_regular_file(fallback)) files.emplace_back(fallback);
+  }
+  float em_pixels = 0.0f;
+  for (size_t i = 0; i < files.size(); ++i) {
+    FT_Face face = nullptr;
+    if (FT_New_Face(faces_->library, files[i].c_str(), 0, &face) != 0 || !FT_IS_SCALABLE(face)) {
+      if (face) FT_Done_Face(face);
+      if (i == 0) throw Error(files[i] + ": not a scalable font FreeType can read");
+      continue;  // (a broken fallback is skipped, never fatal)
+    }
+    if (i == 0) {
+      const float span = float(face->ascender - face->descender);
+      if (!(span > 0.0f)) {
+        FT_Done_Face(face);
+        throw Error(files[i] + ": the font has no ascent or descent");
+      }
+      // The main face's ascent to descent spans pixel_height; every face gets the same em.
+      em_pixels = pixel_height * float(face->units_per_EM) / span;
+      const float scale = em_pixels / float(face->units_per_EM);
+      ascent_ = float(face->ascender) * scale;
+      descent_ = float(face->descender) * scale;
+      line_spacing_ = std::max(float(face->height) * scale, ascent_ - descent_);
+    }
+    FT_Set_Char_Size(face, 0, FT_F26Dot6(std::lround(em_pixels * 64.0f)), 72, 72);
+    faces_->faces.push_back(face);
+    hb_font_t* font = hb_ft_font_create_referenced(face);
+    hb_ft_font_set_load_flags(font, kLoadFlags);
+    faces_->fonts.push_back(font);
+  }
+  pixel_height_ = pixel_height;
+}
+
+Font::~Font() = default;
+Font::Font(Font&&) noexcept = default;
+Font& Font::operator=(Font&&) noexcept = default;
+
+size_t Font::face_count() const {
+  return faces_->faces.size();
+}
+
+bool Font::covers(char32_t codepoint) const {
+  for (FT_Face face : faces_->faces) {
+    if (FT_Get_Char_Index(face, codepoint) != 0) return true;
+  }
+  return false;
+}
+
+ShapedLine Font::shape(std::string_view line) const {
+  const std::u32string text = decode_utf8(line);
+  // The face of each character: the first that has it; a combining mark stays with its base's
+  // face when that face has the mark too; none has it: the main face (its missing-glyph box).
+  hb_unicode_funcs_t* unicode = hb_unicode_funcs_get_default();
+  std::vector<uint32_t> face_of(text.size(), 0);
+  for (size_t i = 0; i < text.size(); ++i) {
+    const bool mark = hb_unicode_general_category(unicode, text[i]) ==
+                      HB_UNICODE_GENERAL_CATEGORY_NON_SPACING_MARK;
+    if (mark && i > 0 && FT_Get_Char_Index(faces_->faces[face_of[i - 1]], text[i]) != 0) {
+      face_of[i] = face_of[i - 1];
+      continue;
+    }
+    for (uint32_t f = 0; f < faces_->faces.size(); ++f) {
+      if (FT_Get_Char_Index(faces_->faces[f], text[i]) != 0) {
+        face_of[i] = f;
+        break;
+      }
+    }
+  }
+  ShapedLine out;
+  glm::vec2 pen(0.0f);
+  hb_buffer_t* buffer = hb_buffer_create();
+  for (size_t start = 0; start < text.size();) {
+    size_t end = start + 1;
+    while (end < text.size() && face_of[end] == face_of[start]) ++end;
+    hb_buffer_clear_contents(buffer);
+    // (the whole line is the context: shaping at a run's edge sees its neighbours)
+    hb_buffer_add_utf32(buffer, reinterpret_cast<const uint32_t*>(text.data()), int(text.size()),
+                        unsigned(start), int(end - start));
+    hb_buffer_guess_segment_properties(buffer);
+    hb_shape(faces_->fonts[face_of[start]], buffer, nullptr, 0);
+    unsigned count = 0;
+    const hb_glyph_info_t* info = hb_buffer_get_glyph_infos(buffer, &count);
+    const hb_glyph_position_t* position = hb_buffer_get_glyph_positions(buffer, &count);
+    for (unsigned g = 0; g < count; ++g) {
+      const glm::vec2 offset(float(position[g].x_offset) / 64.0f,
+                             -float(position[g].y_offset) / 64.0f);
+      out.glyphs.push_back({{face_of[start], info[g].codepoint}, pen + offset});
+      pen += glm::vec2(float(position[g].x_advance), -float(position[g].y_advance)) / 64.0f;
+    }
+    start = end;
+  }
+  hb_buffer_destroy(buffer);
+  out.advance = pen.x;
+  return out;
+}
+
+FontAtlas Font::bake(std::span<const GlyphKey> keys) const {
+  struct Ink {
+    std::vector<uint8_t> pixels;  // rows x width
+    int width = 0, rows = 0, left = 0, top = 0;
+    int x = 0, y = 0;  // the cell's place in the atlas (padding included)
+  };
+  std::map<GlyphKey, Ink> inks;
+  for (const GlyphKey& key : keys) {
+    if (key.face >= faces_->faces.size() || inks.contains(key)) continue;
+    FT_Face face = faces_->faces[key.face];
+    Ink ink;
+    if (FT_Load_Glyph(face, key.glyph, kLoadFlags | FT_LOAD_RENDER) == 0 &&
+        face->glyph->bitmap.pixel_mode == FT_PIXEL_MODE_GRAY) {
+      const FT_Bitmap& b = face->glyph->bitmap;
+      ink.width = int(b.width);
+      ink.rows = int(b.rows);
+      ink.left = face->glyph->bitmap_left;
+      ink.top = face->glyph->bitmap_top;
+      ink.pixels.resize(size_t(ink.width) * size_t(ink.rows));
+      for (int r = 0; r < ink.rows; ++r) {
+        const unsigned char* row = b.buffer + std::ptrdiff_t(r) * b.pitch;
+        std::copy(row, row + ink.width, ink.pixels.begin() + std::ptrdiff_t(r) * ink.width);
+      }
+    }
+    if (ink.width + 2 * kPad > int(kAtlasWidth))
+      throw Error("font: a glyph too large for the atlas");
+    inks.emplace(key, std::move(ink));
+  }
+  // Shelf packing in key order: deterministic.
+  int x = 0, y = 0, shelf = 0;
+  for (auto& [key, ink] : inks) {
+    if (ink.width == 0 || ink.rows == 0) continue;
+    const int w = ink.width + 2 * kPad, h = ink.rows + 2 * kPad;
+    if (x + w > int(kAtlasWidth)) {
+      x = 0;
+      y += shelf;
+      shelf = 0;
+    }
+    ink.x = x;
+    ink.y = y;
+    x += w;
+    shelf = std::max(shelf, h);
+  }
+  FontAtlas atlas;
   atlas.width = kAtlasWidth;
-  atlas.height = std::max(atlas.height, 1u);
+  atlas.height = uint32_t(std::max(y + shelf, 1));
   atlas.coverage.assign(size_t{atlas.width} * atlas.height, 0);
   const glm::vec2 texel = 1.0f / glm::vec2(atlas.width, atlas.height);
-  for (int c = kFirstFontChar; c <= kLastFontChar; ++c) {
-    const Cell& cell = cells[size_t(c - kFirstFontChar)];
-    GlyphMetrics& g = atlas.glyphs[size_t(c - kFirstFontChar)];
-    int advance = 0, left_bearing = 0;
-    stbtt_GetCodepointHMetrics(&font, c, &advance, &left_bearing);
-    g.advance = float(advance) * scale;
-    if (cell.w == 2 * kPad || cell.h == 2 * kPad) continue;  // no ink: ' '
-    uint8_t* ink = &atlas.coverage[size_t(cell.y + kPad) * atlas.width + size_t(cell.x + kPad)];
-    stbtt_MakeCodepointBitmap(&font, ink, cell.w - 2 * kPad, cell.h - 2 * kPad, int(atlas.width),
-                              scale, scale, c);
-    const glm::vec2 origin(float(cell.ix0 - kPad), float(cell.iy0 - kPad));
-    g.quad = glm::vec4(origin, origin + glm::vec2(float(cell.w), float(cell.h)));
-    g.uv = glm::vec4(float(cell.x) * texel.x, float(cell.y) * texel.y,
-                     float(cell.x + cell.w) * texel.x, float(cell.y + cell.h) * texel.y);
+  for (const auto& [key, ink] : inks) {
+    GlyphMetrics g;
+    if (ink.width > 0 && ink.rows > 0) {
+      for (int r = 0; r < ink.rows; ++r) {
+        std::copy_n(ink.pixels.begin() + std::ptrdiff_t(r) * ink.width, ink.width,
+                    atlas.coverage.begin() + std::ptrdiff_t(size_t(ink.y + kPad + r) * atlas.width +
+                                                            size_t(ink.x + kPad)));
+      }
+      const glm::vec2 origin(float(ink.left - kPad), float(-ink.top - kPad));
+      const glm::vec2 size(float(ink.width + 2 * kPad), float(ink.rows + 2 * kPad));
+      g.quad = glm::vec4(origin, origin + size);
+      g.uv = glm::vec4(float(ink.x) * texel.x, float(ink.y) * texel.y,
+                       float(ink.x) * texel.x + size.x * texel.x,
+                       float(ink.y) * texel.y + size.y * texel.y);
+    }
+    atlas.glyphs.emplace(key, g);
   }
   return atlas;
 }
 
-std::string printable_ascii(std::string_view text) {
-  std::string out;
-  bool in_sequence = false;  // after a UTF-8 lead byte: its continuation bytes are skipped
-  for (const char ch : text) {
-    const auto b = static_cast<unsigned char>(ch);
-    const bool continuation = (b & 0xC0u) == 0x80u;
-    if (continuation && in_sequence) continue;
-    in_sequence = b >= 0xC0u;
-    const bool printable = b >= uint8_t(kFirstFontChar) && b <= uint8_t(kLastFontChar);
-    out.push_back(printable ? ch : kReplacementChar);
-  }
-  return out;
+GlyphMetrics FontAtlas::glyph(GlyphKey key) const {
+  const auto found = glyphs.find(key);
+  return found == glyphs.end() ? GlyphMetrics{} : found->second;
 }
 
 }  // namespace strata

@@ -1,10 +1,14 @@
-// A bitmap font for label text: printable ASCII of one TrueType font baked by stb_truetype into an
-// R8 coverage atlas, with per-character metrics. Labels sample the atlas with bilinear filtering,
-// so every glyph keeps one texel of zero coverage around it (see font.cpp).
+// Label text: OpenType/TrueType faces read by FreeType and shaped by HarfBuzz (kerning, ligatures,
+// combining marks), a character the main face lacks taken from the first fallback face that has
+// it, and the glyphs a set of texts uses rasterised into an R8 coverage atlas. Labels sample the
+// atlas with bilinear filtering, so every glyph keeps one texel of zero coverage around it.
 #pragma once
 
-#include <array>
+#include <compare>
 #include <cstdint>
+#include <map>
+#include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -13,14 +17,33 @@
 
 namespace strata {
 
-inline constexpr char kFirstFontChar = 32;  // ' '
-inline constexpr char kLastFontChar = 126;  // '~'
-inline constexpr char kReplacementChar = '?';
 // From Debian's fonts-dejavu-core.
 inline constexpr const char* kDefaultFontPath = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+// Tried in order for characters the main face lacks (Debian's fonts-freefont-ttf); those not
+// installed are skipped.
+inline constexpr const char* kFallbackFontPaths[] = {
+    "/usr/share/fonts/truetype/freefont/FreeSans.ttf",
+    "/usr/share/fonts/truetype/freefont/FreeSerif.ttf"};
+
+// A glyph of one of the font's faces (0: the main face, then the fallbacks in order).
+struct GlyphKey {
+  uint32_t face = 0;
+  uint32_t glyph = 0;
+  auto operator<=>(const GlyphKey&) const = default;
+};
+
+// A shaped glyph: its pen position from the line's start on the baseline, pixels, y down.
+struct ShapedGlyph {
+  GlyphKey key;
+  glm::vec2 pen{0.0f};
+};
+
+struct ShapedLine {
+  std::vector<ShapedGlyph> glyphs;  // in visual order
+  float advance = 0.0f;             // the line's width, pixels
+};
 
 struct GlyphMetrics {
-  float advance = 0.0f;  // pen movement to the next character, pixels
   glm::vec4 quad{0.0f};  // x0, y0, x1, y1: pixels from the pen on the baseline, y down
   glm::vec4 uv{0.0f};    // u0, v0, u1, v1: the same rectangle in the atlas, normalised
   bool empty() const { return quad.z <= quad.x || quad.w <= quad.y; }
@@ -30,28 +53,53 @@ struct FontAtlas {
   uint32_t width = 0;
   uint32_t height = 0;
   std::vector<uint8_t> coverage;  // R8, row-major, width x height
-  float pixel_height = 0.0f;      // as asked for: ascent - descent
-  float ascent = 0.0f;            // pixels above the baseline (positive)
-  float descent = 0.0f;           // pixels below the baseline (negative)
-  float line_gap = 0.0f;
-  std::array<GlyphMetrics, kLastFontChar - kFirstFontChar + 1> glyphs{};
+  std::map<GlyphKey, GlyphMetrics> glyphs;
+  // The glyph's metrics (an empty glyph when it was not baked).
+  GlyphMetrics glyph(GlyphKey key) const;
+};
 
-  float line_height() const { return ascent - descent; }
-  // The metrics of `c`; characters outside printable ASCII get those of '?'.
-  const GlyphMetrics& glyph(char c) const;
+class Font {
+ public:
+  // The main face at `path` (STRATA_FONT replaces the default: see font_file) sized so that its
+  // ascent to descent spans `pixel_height` pixels, with the fallback faces that exist. Throws
+  // Error naming the file (and, for the default font, the Debian package) when the main face is
+  // missing or not a font, or the size is outside 4..512.
+  explicit Font(float pixel_height, const std::string& path = kDefaultFontPath);
+  ~Font();
+  Font(Font&&) noexcept;
+  Font& operator=(Font&&) noexcept;
+
+  float pixel_height() const { return pixel_height_; }
+  float ascent() const { return ascent_; }    // pixels above the baseline (positive)
+  float descent() const { return descent_; }  // pixels below the baseline (negative)
+  float line_height() const { return ascent_ - descent_; }
+  // Baseline to baseline.
+  float line_spacing() const { return line_spacing_; }
+  size_t face_count() const;
+
+  // One line of UTF-8 text (malformed bytes become U+FFFD), shaped. A character no face has is
+  // drawn with the main face's missing-glyph box.
+  ShapedLine shape(std::string_view line) const;
+  // Whether some face has a glyph for `codepoint`.
+  bool covers(char32_t codepoint) const;
+
+  // Rasterises `keys` (duplicates allowed) into an atlas 512 texels wide.
+  FontAtlas bake(std::span<const GlyphKey> keys) const;
+
+ private:
+  struct Faces;
+  std::unique_ptr<Faces> faces_;
+  float pixel_height_ = 0.0f;
+  float ascent_ = 0.0f;
+  float descent_ = 0.0f;
+  float line_spacing_ = 0.0f;
 };
 
 // The font file to read for `path`: STRATA_FONT, when set, replaces the default font (hosts
 // without fonts-dejavu-core).
 std::string font_file(const std::string& path = kDefaultFontPath);
 
-// Bakes printable ASCII of the font at `path` at `pixel_height` (ascent to descent). Throws
-// Error naming the path (and, for the default font, the Debian package) when it is missing or
-// not a font.
-FontAtlas load_font_atlas(float pixel_height, const std::string& path = kDefaultFontPath);
-
-// `text` (UTF-8) as printable ASCII: each character outside 32..126, multi-byte sequences
-// included, becomes one '?'.
-std::string printable_ascii(std::string_view text);
+// UTF-8 to code points; a malformed or truncated sequence becomes one U+FFFD.
+std::u32string decode_utf8(std::string_view text);
 
 }  // namespace strata
