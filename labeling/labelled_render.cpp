@@ -19,23 +19,23 @@
 #include "passes/label_forces.h"
 
 namespace strata {
-namespace {
+namespace {}  // namespace
 
-// Labels in placement order: layer by layer front to back, inside a layer by `within` (a
-// permutation of all label indices).
 std::vector<uint32_t> insertion_order(const std::vector<gpu::LabelGpu>& labels,
-                                      const Layering& layering,
-                                      const std::vector<uint32_t>& within) {
+                                      const Layering& layering, const std::vector<uint32_t>& within,
+                                      std::span<const float> priorities) {
   std::vector<uint32_t> result;
   for (uint32_t layer = 0; layer < layering.layer_count; ++layer) {
     for (uint32_t i : within) {
       if ((labels[i].flags & LABEL_ENABLED) && labels[i].layer == layer) result.push_back(i);
     }
   }
+  if (!priorities.empty()) {
+    std::stable_sort(result.begin(), result.end(),
+                     [&](uint32_t a, uint32_t b) { return priorities[a] > priorities[b]; });
+  }
   return result;
 }
-
-}  // namespace
 
 std::vector<ProjectedPoint> project_anchors(const Scene& scene, const Camera& camera,
                                             graph::Extent size) {
@@ -65,6 +65,7 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
     : ctx_(ctx), scene_(scene), size_(size), camera_(camera), settings_(settings) {
   check_label_text(settings.font_pixels, settings.label_scale);
   labels_.resize(scene.labels.size());
+  for (const Label& label : scene.labels) priorities_.push_back(label.priority);
   hidden_.assign(scene.labels.size(), false);
   for (size_t i = 0; i < scene.labels.size(); ++i) labels_[i].size = scene.labels[i].size;
   project_and_layer(camera);
@@ -252,7 +253,8 @@ void LabelledRenderer::build_graph() {
 void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32_t>& within) {
   PlacementSettings settings = settings_.placement;
   if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
-  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within), settings);
+  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within, priorities_),
+                              settings);
 }
 
 void LabelledRenderer::set_camera(const Camera& camera) {

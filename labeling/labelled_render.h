@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,13 @@ struct LabelledFrame {
   RenderStats render_stats;
   std::vector<graph::PassTiming> timings;
 };
+
+// Labels in placement order: by priority, highest first (labels[i]'s is priorities[i]; none
+// given: all equal), then layer by layer front to back, inside a layer by `within` (a
+// permutation of all label indices). Disabled labels are left out.
+std::vector<uint32_t> insertion_order(const std::vector<gpu::LabelGpu>& labels,
+                                      const Layering& layering, const std::vector<uint32_t>& within,
+                                      std::span<const float> priorities = {});
 
 // Each label's anchor in the image (a label is enabled when its anchor is visible).
 std::vector<ProjectedPoint> project_anchors(const Scene& scene, const Camera& camera,
@@ -179,6 +187,7 @@ class LabelledRenderer {
   Extension extension_;
   uint32_t frames_in_flight_ = 1;
   std::vector<bool> hidden_;
+  std::vector<float> priorities_;  // the scene's, per label
   Camera camera_;
   graph::ResourceId labelled_id_ = 0;
 

@@ -92,6 +92,8 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
       {"labels.composite",
        graph::PassKind::compute,
        {{in.layers, Use::storage_read, LABEL_DRAW_BINDING_LAYERS},
+        {in.labels, Use::storage_read, LABEL_DRAW_BINDING_LABELS},
+        {in.placements, Use::storage_read, LABEL_DRAW_BINDING_PLACEMENTS},
         {in.output, Use::storage_write, LABEL_DRAW_BINDING_FINAL}},
        [this](graph::PassContext& pc) {
          pc.dispatch(composite_, params(pc.viewport), {pc.viewport.width, pc.viewport.height, 1});
@@ -134,17 +136,29 @@ std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, 
 }
 
 std::vector<uint8_t> composite_reference(std::span<const glm::vec4> layers, graph::Extent size,
-                                         uint32_t layer_count, glm::vec3 background) {
+                                         uint32_t layer_count, glm::vec3 background,
+                                         const LabelDrawData& data) {
   check_layers(layers, size, layer_count);
   const size_t pixels = size_t{size.width} * size.height;
+  const size_t count = std::min(data.labels.size(), data.placements.size());
   std::vector<uint8_t> out;
   out.reserve(4 * pixels);
+  std::vector<float> front(layer_count);
   for (size_t p = 0; p < pixels; ++p) {
     glm::vec4 accumulated(0.0f);
     for (uint32_t l = 0; l < layer_count; ++l) {
+      front[l] = accumulated.a;
       accumulated = gpu::label_over(accumulated, layers[l * pixels + p]);
     }
-    const glm::vec4 c = gpu::label_over_background(accumulated, background);
+    glm::vec4 c = gpu::label_over_background(accumulated, background);
+    const glm::vec2 centre(float(p % size.width) + 0.5f, float(p / size.width) + 0.5f);
+    for (size_t i = 0; i < count; ++i) {
+      const gpu::LabelGpu& label = data.labels[i];
+      if (label.layer >= layer_count) continue;
+      const glm::vec4 behind =
+          gpu::label_behind(label, data.placements[i], centre, front[label.layer]);
+      c = glm::vec4(glm::vec3(gpu::label_over(behind, c)), 1.0f);
+    }
     for (int ch = 0; ch < 4; ++ch) {
       out.push_back(static_cast<uint8_t>(std::lround(glm::clamp(c[ch], 0.0f, 1.0f) * 255.0f)));
     }

@@ -69,8 +69,10 @@ std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, 
                                              uint32_t layer_count, const LabelDrawData& data,
                                              const FontAtlas& font);
 
-// labels.composite on the CPU: rgba8, rows top to bottom.
+// labels.composite on the CPU: rgba8, rows top to bottom, with the rear labels' connectors and
+// anchors drawn again where the layers in front hide them (label_behind).
 std::vector<uint8_t> composite_reference(std::span<const glm::vec4> layers, graph::Extent size,
-                                         uint32_t layer_count, glm::vec3 background);
+                                         uint32_t layer_count, glm::vec3 background,
+                                         const LabelDrawData& data);
 
 }  // namespace strata

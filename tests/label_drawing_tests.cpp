@@ -487,8 +487,8 @@ TEST_SUITE("gpu") {
     const float worst = worst_difference(gpu.layers, expected, where);
     CHECK_MESSAGE(worst <= kTolerance,
                   "layer pixel " << where << " differs by " << worst * 255.0f << "/255");
-    const std::vector<uint8_t> final_expected =
-        composite_reference(expected, s.size, s.layer_count, s.background);
+    const std::vector<uint8_t> final_expected = composite_reference(
+        expected, s.size, s.layer_count, s.background, {s.labels, s.placements, s.glyphs});
     CHECK(worst_difference(gpu.final, final_expected) <= 2);
     // Guards against comparing two unlabelled pictures.
     CHECK(gpu.layers != s.layers);
@@ -550,13 +550,51 @@ TEST_SUITE("gpu") {
     CHECK(final_pixel(s, gpu.final, nearest).r >= unobstructed - kTolerance);
   }
 
+  // A label on the rear layer whose connector and anchor lie under an opaque slab of the front
+  // layer: the composite draws them again on top, dashed (bright pixels with gaps between) with
+  // the anchor marker, as the reference does; a hidden label draws nothing there.
+  TEST_CASE_FIXTURE(test::GpuTest, "a_leader_behind_an_opaque_slab_stays_visible_dashed") {
+    LabelScene s;
+    s.layer_count = 2;
+    s.layers.assign(2 * s.pixels(), glm::vec4(0.0f));
+    for (uint32_t y = 0; y < s.size.height; ++y) {
+      for (uint32_t x = 30; x < 80; ++x)
+        s.at(0, x, y) = to_half_precision({0.3f, 0.3f, 0.3f, 1.0f});
+    }
+    s.labels = {label_on(1, {45.5f, 48.5f})};
+    const std::vector<std::string> texts = {"Pons"};
+    s.glyphs = test_glyphs(texts, s.labels);
+    s.placements = {{{95.0f, 48.5f}, 0.0f, PLACEMENT_SHOWN}};
+    const DrawnLabels gpu = draw_on_gpu(ctx, s);
+    const std::vector<uint8_t> expected =
+        composite_reference(reference_layers(s), s.size, s.layer_count, s.background,
+                            {s.labels, s.placements, s.glyphs});
+    CHECK(worst_difference(gpu.final, expected) <= 2);
+    // Along the connector inside the slab (past the marker): dashes and gaps.
+    int bright = 0, slab = 0;
+    for (uint32_t x = 52; x < 78; ++x) {
+      const float r = final_pixel(s, gpu.final, {x, 48}).r;
+      if (r > 0.6f) ++bright;
+      if (std::abs(r - 0.3f) < 0.02f) ++slab;
+    }
+    CHECK(bright >= 6);
+    CHECK(slab >= 6);
+    CHECK(final_pixel(s, gpu.final, {45, 48}).r > 0.8f);  // the anchor marker
+    // Hidden: the slab is untouched.
+    s.placements[0].shown = PLACEMENT_HIDDEN;
+    const DrawnLabels hidden = draw_on_gpu(ctx, s);
+    for (uint32_t x = 40; x < 78; ++x) {
+      CHECK(final_pixel(s, hidden.final, {x, 48}).r == doctest::Approx(0.3f).epsilon(0.03));
+    }
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "label_with_a_hidden_placement_draws_nothing") {
     LabelScene s = make_scene();
     for (gpu::PlacementGpu& p : s.placements) p.shown = PLACEMENT_HIDDEN;
     const DrawnLabels gpu = draw_on_gpu(ctx, s);
     CHECK(gpu.layers == s.layers);
-    const std::vector<uint8_t> expected =
-        composite_reference(s.layers, s.size, s.layer_count, s.background);
+    const std::vector<uint8_t> expected = composite_reference(
+        s.layers, s.size, s.layer_count, s.background, {s.labels, s.placements, s.glyphs});
     CHECK(worst_difference(gpu.final, expected) <= 2);
   }
 }

@@ -14,6 +14,28 @@
 
 namespace strata {
 
+TEST_SUITE("cpu") {
+  // Priority first (highest placed first, so hidden last), then layer by layer, then `within`.
+  TEST_CASE("insertion_order_places_higher_priorities_first_then_layers_then_the_order") {
+    std::vector<gpu::LabelGpu> labels(5);
+    const uint32_t layers[] = {1, 0, 1, 0, 0};
+    for (size_t i = 0; i < labels.size(); ++i) {
+      labels[i].layer = layers[i];
+      labels[i].flags = LABEL_ENABLED;
+    }
+    labels[4].flags = 0;  // disabled: left out
+    Layering layering;
+    layering.layer_count = 2;
+    const std::vector<uint32_t> within = {4, 3, 2, 1, 0};
+    CHECK(insertion_order(labels, layering, within) == std::vector<uint32_t>{3, 1, 2, 0});
+    const std::vector<float> equal(5, 1.0f);
+    CHECK(insertion_order(labels, layering, within, equal) == std::vector<uint32_t>{3, 1, 2, 0});
+    const std::vector<float> priorities = {2.0f, 0.0f, 2.0f, -1.0f, 9.0f};
+    CHECK(insertion_order(labels, layering, within, priorities) ==
+          std::vector<uint32_t>{2, 0, 1, 3});
+  }
+}
+
 TEST_SUITE("gpu") {
   TEST_CASE_FIXTURE(test::GpuTest, "head_demo_labels_are_all_on_screen_and_never_overlap") {
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");

@@ -213,7 +213,7 @@ TEST_SUITE("loaders") {
       "meshes": [{"file": "../models/tetrahedron.obj", "color": [1, 0, 0, 0.5],
                   "transform": [1, 0, 0, 5,  0, 1, 0, 6,  0, 0, 1, 7,  0, 0, 0, 1]}],
       "labels": [{"id": 7, "text": "Tip", "anchor": [0, 0, 1], "size": [64, 16]},
-                 {"id": 8, "text": "Base", "anchor": [0.25, 0.25, 0]}],
+                 {"id": 8, "text": "Base", "anchor": [0.25, 0.25, 0], "priority": 2.5}],
       "camera": {"fov_y": 30, "near": 0.5, "far": 50, "eye": [0, 0, 10], "target": [0, 0, 0],
                  "positions": [{"name": "side", "eye": [10, 0, 0], "target": [0, 0, 0], "up": [0, 0, 1]},
                                {"name": "moved", "view": [1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 1, -3,  0, 0, 0, 1]}]},
@@ -230,6 +230,8 @@ TEST_SUITE("loaders") {
     CHECK(scene.labels[0].text == "Tip");
     CHECK(scene.labels[0].size == glm::vec2(64.0f, 16.0f));
     CHECK(scene.labels[1].size == glm::vec2(0.0f));  // from the text
+    CHECK(scene.labels[0].priority == 0.0f);
+    CHECK(scene.labels[1].priority == 2.5f);
     CHECK(scene.camera.fov_y_degrees == 30.0f);
     CHECK(scene.camera.near_plane == 0.5f);
     CHECK(scene.camera.far_plane == 50.0f);

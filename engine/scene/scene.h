@@ -74,6 +74,9 @@ struct Label {
   std::string text;
   glm::vec3 anchor{0.0f};  // world space
   glm::vec2 size{0.0f};    // pixels; zero means "from the text" (decided when drawing)
+  // Higher is placed first, so when labels must be hidden (hard constraints, crowding) a lower
+  // priority goes first; equal priorities keep the insertion order's own rule.
+  float priority = 0.0f;
 };
 
 // The thesis program's final paper settings (see docs/ARCHITECTURE.md, "Cost weights").

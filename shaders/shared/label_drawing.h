@@ -39,6 +39,15 @@ const vec4 LABEL_MARKER_COLOR = vec4(1.0f, 1.0f, 1.0f, 1.0f);
 const vec4 LABEL_MARKER_OUTLINE_COLOR = vec4(0.05f, 0.05f, 0.05f, 1.0f);
 const float LABEL_MARKER_RADIUS = 4.0f;
 const float LABEL_MARKER_OUTLINE = 1.5f;
+// Where a rear label's connector or anchor lies behind content of the layers in front of its own,
+// the composite draws it again on top, dashed, with a dark halo, fading in as that content gets
+// opaque (front alpha from LABEL_BEHIND_FROM to LABEL_BEHIND_TO) up to LABEL_BEHIND_OPACITY.
+const vec4 LABEL_HALO_COLOR = vec4(0.0f, 0.0f, 0.0f, 0.8f);
+const float LABEL_HALO_WIDTH = 1.0f;
+const float LABEL_DASH = 8.0f;  // pixels: a dash about 3 long, then a gap
+const float LABEL_BEHIND_FROM = 0.15f;
+const float LABEL_BEHIND_TO = 0.6f;
+const float LABEL_BEHIND_OPACITY = 0.85f;
 
 // Eq. 3.9's "over" for premultiplied colours, front to back.
 STRATA_INLINE vec4 label_over(vec4 front, vec4 back) {
@@ -93,6 +102,41 @@ STRATA_INLINE vec4 label_anchor_marker(vec2 p, vec2 anchor) {
   float inner_radius = LABEL_MARKER_RADIUS - LABEL_MARKER_OUTLINE;
   return label_over(label_premultiplied(LABEL_MARKER_COLOR, label_edge_coverage(d - inner_radius)),
                     rim);
+}
+
+// How much of a dash covers p, `along` pixels from the anchor along the connector: a ramp at each
+// end (no step for CPU and GPU rounding to land on).
+STRATA_INLINE float label_dash(float along) {
+  float phase = along - LABEL_DASH * floor(along / LABEL_DASH) - 2.0f;
+  if (phase > 0.5f * LABEL_DASH) phase -= LABEL_DASH;
+  return clamp(2.0f - abs(phase), 0.0f, 1.0f);
+}
+
+// What the composite draws over the final image for a label on a rear layer (layer > 0) at p,
+// premultiplied: its connector dashed with a halo, and its anchor marker, as far as the layers in
+// front of its own hide them there (`front_alpha`: their composite alpha at p). Nothing for front,
+// internal, disabled or hidden labels.
+STRATA_INLINE vec4 label_behind(LabelGpu label, PlacementGpu placement, vec2 p, float front_alpha) {
+  if ((label.flags & LABEL_ENABLED) == 0u || (label.flags & LABEL_INTERNAL) != 0u ||
+      label.layer == 0u || placement.shown != PLACEMENT_SHOWN) {
+    return vec4(0.0f);
+  }
+  float hidden = smoothstep(LABEL_BEHIND_FROM, LABEL_BEHIND_TO, front_alpha);
+  if (hidden <= 0.0f) return vec4(0.0f);
+  vec2 half_size = 0.5f * label.size;
+  vec2 end = clamp(label.anchor, placement.position - half_size, placement.position + half_size);
+  vec2 ab = end - label.anchor;
+  float length2 = dot(ab, ab);
+  float along = length2 > 0.0f ? dot(p - label.anchor, ab) / sqrt(length2) : 0.0f;
+  float dash = label_dash(along);
+  float d = label_segment_distance(p, label.anchor, end);
+  vec4 color = label_premultiplied(
+      LABEL_HALO_COLOR, dash * label_edge_coverage(d - LABEL_LINE_HALF_WIDTH - LABEL_HALO_WIDTH));
+  color = label_over(
+      label_premultiplied(LABEL_LINE_COLOR, dash * label_edge_coverage(d - LABEL_LINE_HALF_WIDTH)),
+      color);
+  color = label_over(label_anchor_marker(p, label.anchor), color);
+  return color * (hidden * LABEL_BEHIND_OPACITY * placement.opacity);
 }
 
 // True when p lies outside everything a label draws (box, connector, marker and their ramps), so

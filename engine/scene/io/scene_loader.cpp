@@ -280,7 +280,7 @@ void SceneReader::atlas(const json& object, const Field& field) {
 }
 
 void SceneReader::label(const json& object, const Field& field) {
-  check_keys(object, field, {"id", "text", "anchor", "size"});
+  check_keys(object, field, {"id", "text", "anchor", "size", "priority"});
   Label label;
   label.id = integer(required(object, field, "id"), field / "id");
   label.text = string(required(object, field, "text"), field / "text");
@@ -290,6 +290,9 @@ void SceneReader::label(const json& object, const Field& field) {
     if (v[0] < 0.0f || v[1] < 0.0f)
       (field / "size").fail("expected 2 numbers >= 0 (0 = from the text)");
     label.size = {v[0], v[1]};
+  }
+  if (const json* priority = optional(object, "priority")) {
+    label.priority = number(*priority, field / "priority");
   }
   scene_.labels.push_back(std::move(label));
 }

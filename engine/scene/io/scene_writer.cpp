@@ -96,10 +96,12 @@ void save_scene_json(const std::filesystem::path& path, const Scene& scene) {
   }
   ordered_json labels = ordered_json::array();
   for (const Label& label : scene.labels) {
-    labels.push_back({{"id", label.id},
-                      {"text", label.text},
-                      {"anchor", vector_json(&label.anchor[0], 3)},
-                      {"size", vector_json(&label.size[0], 2)}});
+    ordered_json entry = {{"id", label.id},
+                          {"text", label.text},
+                          {"anchor", vector_json(&label.anchor[0], 3)},
+                          {"size", vector_json(&label.size[0], 2)}};
+    if (label.priority != 0.0f) entry["priority"] = label.priority;
+    labels.push_back(std::move(entry));
   }
   const ordered_json root = {{"strata_scene", 1},
                              {"volumes", volumes},
