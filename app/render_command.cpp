@@ -136,10 +136,16 @@ void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions
   renderer.run();
   const LabelledFrame frame = renderer.result();
   write_png(still.image, size.width, size.height, frame.image);
-  uint32_t shown = 0;
-  for (const LabelLayout& l : frame.labels) shown += l.shown;
-  std::printf("wrote %s (%ux%u, %u layers): %u of %zu labels shown\n", still.image.c_str(),
+  uint32_t shown = 0, placed = 0;
+  for (const LabelLayout& l : frame.labels) {
+    shown += l.shown;
+    placed += l.placed;
+  }
+  // Shown: placed and legible (at least kLegibleShare of the box visible).
+  std::printf("wrote %s (%ux%u, %u layers): %u of %zu labels shown", still.image.c_str(),
               size.width, size.height, frame.layering.layer_count, shown, frame.labels.size());
+  if (placed > shown) std::printf(" (%u more placed but not legible)", placed - shown);
+  std::printf("\n");
   if (!still.layout.empty()) write_layout(still.layout, frame);
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <optional>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -367,11 +368,59 @@ LabelledFrame LabelledRenderer::result() const {
     l.anchor = labels_[i].anchor;
     l.box_size = labels_[i].size;
     l.box_origin = drawn[i].position - labels_[i].size * 0.5f;
-    l.shown = drawn[i].shown == PLACEMENT_SHOWN;
+    l.placed = drawn[i].shown == PLACEMENT_SHOWN;
+    l.visible = l.placed ? 1.0f : 0.0f;
     l.cost = results[i].cost;
     frame.labels.push_back(l);
   }
+  // Offline (no extension, nothing in flight): what the picture really shows of each box.
+  if (!extension_) {
+    const std::vector<std::byte> bytes = runner_->download_image(layers_id_);
+    std::vector<glm::vec4> layers(bytes.size() / sizeof(uint64_t));
+    for (size_t i = 0; i < layers.size(); ++i) {
+      uint64_t half4 = 0;
+      std::memcpy(&half4, bytes.data() + i * sizeof(uint64_t), sizeof half4);
+      layers[i] = glm::unpackHalf4x16(half4);
+    }
+    const std::vector<float> visible =
+        label_visibility(layers, size_, layering_.layer_count, frame.labels);
+    for (size_t i = 0; i < frame.labels.size(); ++i) frame.labels[i].visible = visible[i];
+  }
+  for (LabelLayout& l : frame.labels) l.shown = l.placed && l.visible >= kLegibleShare;
   return frame;
+}
+
+std::vector<float> label_visibility(std::span<const glm::vec4> layers, graph::Extent size,
+                                    uint32_t layer_count, std::span<const LabelLayout> labels) {
+  const size_t pixels = size_t{size.width} * size.height;
+  if (layers.size() != pixels * layer_count) {
+    throw Error("label visibility: " + std::to_string(layers.size()) + " layer pixels for " +
+                std::to_string(layer_count) + " layers of " + std::to_string(size.width) + "x" +
+                std::to_string(size.height));
+  }
+  std::vector<float> out;
+  for (const LabelLayout& l : labels) {
+    const int x0 = int(std::floor(l.box_origin.x)), y0 = int(std::floor(l.box_origin.y));
+    const int w = int(std::lround(l.box_size.x)), h = int(std::lround(l.box_size.y));
+    if (!l.placed || w <= 0 || h <= 0) {
+      out.push_back(0.0f);
+      continue;
+    }
+    size_t seen = 0;
+    for (int y = y0; y < y0 + h; ++y) {
+      for (int x = x0; x < x0 + w; ++x) {
+        if (x < 0 || y < 0 || x >= int(size.width) || y >= int(size.height)) continue;
+        const size_t p = size_t(y) * size.width + size_t(x);
+        float front = 0.0f;
+        for (uint32_t k = 0; k < std::min(l.layer, layer_count); ++k) {
+          front += (1.0f - front) * layers[k * pixels + p].a;
+        }
+        if (front < kHidingAlpha) ++seen;
+      }
+    }
+    out.push_back(float(seen) / float(size_t(w) * size_t(h)));
+  }
+  return out;
 }
 
 LabelledFrame render_labelled(Context& ctx, const Scene& scene, const Camera& camera,
@@ -393,6 +442,8 @@ std::string layout_json(const LabelledFrame& frame) {
                        {shortest_double(l.box_origin.x), shortest_double(l.box_origin.y),
                         shortest_double(l.box_size.x), shortest_double(l.box_size.y)}},
                       {"shown", l.shown},
+                      {"placed", l.placed},
+                      {"visible", shortest_double(l.visible)},
                       {"cost", shortest_double(l.cost)}});
   }
   const ordered_json layout = {

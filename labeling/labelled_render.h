@@ -50,9 +50,23 @@ struct LabelLayout {
   glm::vec2 anchor{0.0f};  // pixels
   glm::vec2 box_origin{0.0f};
   glm::vec2 box_size{0.0f};
-  bool shown = false;
+  bool placed = false;   // the placement shows it (a position was found)
+  float visible = 0.0f;  // share of its box a viewer sees: inside the image, not behind content
+  bool shown = false;    // placed and legible: visible >= kLegibleShare
   float cost = 0.0f;
 };
+
+// A label counts as shown when at least this share of its box is visible (label_visibility).
+inline constexpr float kLegibleShare = 0.75f;
+// A box pixel is hidden when the layers in front of the label's composite to at least this alpha.
+inline constexpr float kHidingAlpha = 0.5f;
+
+// The visible share of each label's box: its pixels inside the image where the layers in front
+// of the label's own (drawn labels included) composite to less than kHidingAlpha. `layers`:
+// layer_count premultiplied images of `size`, layer after layer, as the labelled frame leaves
+// them. Labels not placed get 0.
+std::vector<float> label_visibility(std::span<const glm::vec4> layers, graph::Extent size,
+                                    uint32_t layer_count, std::span<const LabelLayout> labels);
 
 struct LabelledFrame {
   graph::Extent size;

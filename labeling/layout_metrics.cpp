@@ -67,6 +67,11 @@ LayoutLabel read_label(const json& object, const Field& field) {
   const json& shown = required(object, field, "shown");
   if (!shown.is_boolean()) (field / "shown").fail("expected true or false");
   label.shown = shown.get<bool>();
+  label.placed = label.shown;
+  if (const json* placed = optional(object, "placed")) {
+    if (!placed->is_boolean()) (field / "placed").fail("expected true or false");
+    label.placed = placed->get<bool>();
+  }
   if (const json* text = optional(object, "text")) {
     if (!text->is_string()) (field / "text").fail("expected a string");
     label.text = text->get<std::string>();
@@ -188,10 +193,11 @@ bool strictly_inside(const Rect& rect, glm::dvec2 p) {
 
 namespace {
 
-std::vector<const LayoutLabel*> shown_labels(const Layout& layout) {
+// The labels the picture draws (placed), legible or not.
+std::vector<const LayoutLabel*> drawn_labels(const Layout& layout) {
   std::vector<const LayoutLabel*> shown;
   for (const LayoutLabel& l : layout.labels) {
-    if (l.shown) shown.push_back(&l);
+    if (l.placed || l.shown) shown.push_back(&l);  // (shown implies placed)
   }
   return shown;
 }
@@ -259,10 +265,13 @@ void measure_leaders(const Layout& layout, const std::vector<const LayoutLabel*>
 }  // namespace
 
 FrameMetrics frame_metrics(const Layout& layout) {
-  const std::vector<const LayoutLabel*> shown = shown_labels(layout);
+  const std::vector<const LayoutLabel*> shown = drawn_labels(layout);
   FrameMetrics m;
   m.labels = layout.labels.size();
-  m.shown = shown.size();
+  for (const LayoutLabel& l : layout.labels) {
+    m.shown += l.shown ? 1 : 0;
+    m.illegible += l.placed && !l.shown ? 1 : 0;
+  }
   m.hidden = m.labels - m.shown;
   count_overlaps(shown, m);
   count_leader_crossings(shown, m);
@@ -284,6 +293,7 @@ FrameMetrics sum_frame_metrics(const std::vector<FrameMetrics>& frames) {
     total.labels += f.labels;
     total.shown += f.shown;
     total.hidden += f.hidden;
+    total.illegible += f.illegible;
     total.overlaps += f.overlaps;
     total.overlap_area += f.overlap_area;
     total.leader_crossings += f.leader_crossings;
@@ -323,7 +333,7 @@ void compare_frames(const Layout& from, const Layout& to, SequenceMetrics& m,
     const LayoutLabel& after = *it->second;
     ++m.label_frame_pairs;
     if (before.shown != after.shown) ++m.show_hide_flips;
-    if (!before.shown || !after.shown) continue;
+    if (!(before.placed || before.shown) || !(after.placed || after.shown)) continue;
     ++m.shown_pairs;
     const double movement = glm::distance(offset_from_anchor(after), offset_from_anchor(before));
     movements.push_back(movement);
@@ -366,6 +376,7 @@ ordered_json to_json(const FrameMetrics& m) {
   return {{"labels", m.labels},
           {"shown", m.shown},
           {"hidden", m.hidden},
+          {"illegible", m.illegible},
           {"overlaps", m.overlaps},
           {"overlap_area_px2", m.overlap_area},
           {"leader_crossings", m.leader_crossings},

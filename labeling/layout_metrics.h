@@ -37,8 +37,9 @@ struct LayoutLabel {
   glm::dvec2 anchor{0.0};
   glm::dvec2 box_origin{0.0};  // top-left corner
   glm::dvec2 box_size{0.0};
-  bool shown = false;
-  double cost = 0.0;  // NaN when the file has null (a non-finite cost)
+  bool shown = false;   // placed and legible
+  bool placed = false;  // drawn (the file's "placed"; without it, "shown")
+  double cost = 0.0;    // NaN when the file has null (a non-finite cost)
 };
 
 struct Layout {
@@ -87,8 +88,10 @@ bool strictly_inside(const Rect& rect, glm::dvec2 p);
 // Over the shown labels unless said otherwise. Pair counts count each unordered pair once.
 struct FrameMetrics {
   size_t labels = 0;
-  size_t shown = 0;
-  size_t hidden = 0;
+  size_t shown = 0;      // placed and legible
+  size_t hidden = 0;     // not shown: not placed, or placed but illegible
+  size_t illegible = 0;  // placed (drawn) but too little of the box is visible
+  // The geometry below is over the drawn (placed) labels: an illegible label still draws.
   size_t overlaps = 0;                     // pairs of boxes sharing a positive area
   double overlap_area = 0.0;               // px^2, summed over those pairs
   size_t leader_crossings = 0;             // pairs of leaders that cross (segments_cross)
