@@ -30,6 +30,7 @@ struct RenderOptions {
   bool hard = false;
   bool internal = false;
   float label_scale = 1.0f;
+  bool layer_colors = false;
   bool decoret = false;
   std::string order = "scene";
   std::string layout;
@@ -114,6 +115,7 @@ LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene)
   settings.placement.hard = o.hard;
   settings.internal = o.internal;
   settings.label_scale = o.label_scale;
+  settings.layer_colors = o.layer_colors;
   if (o.order == "apollonius") settings.order = InsertionOrder::apollonius;
   if (o.order == "optimized") settings.order = InsertionOrder::optimized;
   if (o.decoret) {  // Stein & Decoret's setting, as the thesis compares against it
@@ -238,6 +240,9 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--label-scale", o->label_scale, "label text and boxes times this (0.25 to 4)")
       ->check(CLI::Range(0.25f, 4.0f))
       ->capture_default_str();
+  cmd->add_flag("--layer-colors", o->layer_colors,
+                "label borders in their depth layer's colour (front to back: orange, blue, green, "
+                "pink, ...)");
   cmd->add_option("--order", o->order,
                   "insertion order: scene, apollonius (Stein & Decoret, innermost first) or "
                   "optimized (random orders, the best kept)")

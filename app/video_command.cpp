@@ -35,6 +35,7 @@ struct VideoOptions {
   bool no_forces = false;
   bool hard = false;
   float label_scale = 1.0f;
+  bool layer_colors = false;
   ForceSettings forces;
   float layer_margin = LayerHysteresis{}.margin;
   uint32_t layers = 4;
@@ -96,6 +97,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
   settings.label_scale = o.label_scale;
+  settings.layer_colors = o.layer_colors;
   settings.forces = o.forces;
   settings.forces.anchor_relative = !o.screen_space;
   settings.hysteresis.margin = o.layer_margin;
@@ -153,6 +155,9 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--label-scale", o->label_scale, "label text and boxes times this (0.25 to 4)")
       ->check(CLI::Range(0.25f, 4.0f))
       ->capture_default_str();
+  cmd->add_flag("--layer-colors", o->layer_colors,
+                "label borders in their depth layer's colour (front to back: orange, blue, green, "
+                "pink, ...)");
   cmd->add_option("--speed", o->forces.speed, "forces: pixels per second at full force")
       ->capture_default_str()
       ->check(CLI::Range(1.0f, 1e6f));

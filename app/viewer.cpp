@@ -109,6 +109,8 @@ const std::vector<Parameter>& parameters() {
        true},
       {"font", "label font size in pixels"},
       {"label_scale", "label text and boxes times this (0.25 to 4)"},
+      {"layer_colors", "on: label borders in their layer's colour", nullptr,
+       [](S s) { return &s.labels.layer_colors; }},
       {"forces.speed", "pixels per second at full force",
        [](S s) { return &s.labels.forces.speed; }},
       {"forces.epsilon", "pixels: nearer than this the force shrinks",

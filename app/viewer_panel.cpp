@@ -137,6 +137,7 @@ void Viewer::panel_labelling() {
               static_cast<unsigned long long>(summary_.adopted));
   checkbox(*this, "hard constraints", "hard", s.placement.hard);
   checkbox(*this, "internal labelling", "internal", s.internal);
+  checkbox(*this, "borders in layer colours", "layer_colors", s.layer_colors);
   // (applied when the slider is let go: the glyphs and the graph are rebuilt)
   float font = s.font_pixels;
   ImGui::SliderFloat("font size (px)", &font, 8.0f, 40.0f, "%.0f");

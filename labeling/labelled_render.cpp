@@ -256,6 +256,7 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
   if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
   parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within, priorities_),
                               settings);
+  parts_->drawing->set_layer_frames(settings_.layer_colors);
 }
 
 void LabelledRenderer::set_camera(const Camera& camera) {

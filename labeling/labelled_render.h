@@ -36,10 +36,11 @@ struct LabellingSettings {
   bool internal = false;       // internal labelling: every label drawn on its anchor
   float font_pixels = 14.0f;
   float label_scale = 1.0f;  // text and box sizes times this (--label-scale; HiDPI displays)
-  float wrap_width =
-      240.0f;             // pixels (before the scale) past which a line wraps at a space; 0: never
-  uint64_t seed = 1;      // k-means++
-  RenderSettings render;  // its layer_count and splits come from the layering
+  // Pixels (before the scale) past which a line of label text wraps at a space; 0: never.
+  float wrap_width = 240.0f;
+  bool layer_colors = false;  // label borders in their layer's colour (the thesis's depth cue)
+  uint64_t seed = 1;          // k-means++
+  RenderSettings render;      // its layer_count and splits come from the layering
 };
 
 // One label of the result, for --layout and for tests.

@@ -27,6 +27,7 @@ struct LabelDrawReference {
     return static_cast<uint>(std::min(data.labels.size(), data.placements.size()));
   }
   LabelGpu label_at(uint i) const { return data.labels[i]; }
+  bool layer_frames() const { return data.layer_frames; }
   PlacementGpu placement_at(uint i) const { return data.placements[i]; }
   GlyphGpu glyph_at(uint i) const { return data.glyphs[i]; }
 
@@ -63,8 +64,15 @@ LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font)
 }
 
 gpu::LabelDrawParams LabelDrawing::params(graph::Extent viewport) const {
-  return {viewport.width, viewport.height, layer_count_, label_count_,
-          glm::vec4(background_, 1.0f)};
+  return {viewport.width,
+          viewport.height,
+          layer_count_,
+          label_count_,
+          glm::vec4(background_, 1.0f),
+          layer_frames_ ? 1u : 0u,
+          0u,
+          0u,
+          0u};
 }
 
 void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {

@@ -43,6 +43,8 @@ class LabelDrawing {
   // never reads past the end of the labels or placements buffer either way.
   void set_label_count(uint32_t count) { label_count_ = count; }
   void set_background(glm::vec3 background) { background_ = background; }
+  // Borders in their layer's colour (LABEL_LAYER_COLORS), read when the graph is recorded.
+  void set_layer_frames(bool on) { layer_frames_ = on; }
 
  private:
   gpu::LabelDrawParams params(graph::Extent viewport) const;
@@ -53,6 +55,7 @@ class LabelDrawing {
   uint32_t layer_count_ = 0;
   uint32_t label_count_ = LABEL_MAX;
   glm::vec3 background_{0.0f};
+  bool layer_frames_ = false;
 };
 
 // What the CPU reference draws: the contents of the three buffers.
@@ -60,6 +63,7 @@ struct LabelDrawData {
   std::span<const gpu::LabelGpu> labels;
   std::span<const gpu::PlacementGpu> placements;
   std::span<const gpu::GlyphGpu> glyphs;
+  bool layer_frames = false;  // as LabelDrawing::set_layer_frames
 };
 
 // labels.draw on the CPU. `layers` holds layer_count images of `size`, layer after layer, rows

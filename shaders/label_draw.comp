@@ -23,6 +23,7 @@ LabelGpu label_at(uint i) { return labels[i]; }
 PlacementGpu placement_at(uint i) { return placements[i]; }
 GlyphGpu glyph_at(uint i) { return glyphs[i]; }
 float atlas_coverage(vec2 uv) { return textureLod(atlas, uv, 0.0).r; }
+bool layer_frames() { return params.layer_frames != 0u; }
 
 #include "shared/label_draw_pixel.h"
 

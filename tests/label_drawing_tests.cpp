@@ -61,6 +61,7 @@ struct LabelScene {
   std::vector<gpu::PlacementGpu> placements;
   std::vector<gpu::GlyphGpu> glyphs;
   glm::vec3 background{0.2f, 0.25f, 0.3f};
+  bool layer_frames = false;
 
   size_t pixels() const { return size_t{size.width} * size.height; }
   glm::vec4& at(uint32_t layer, uint32_t x, uint32_t y) {
@@ -140,6 +141,7 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
   const Buffer glyphs = storage_buffer(ctx, as_bytes(s.glyphs));
   LabelDrawing drawing(ctx, test_atlas());
   drawing.set_label_count(static_cast<uint32_t>(s.labels.size()));
+  drawing.set_layer_frames(s.layer_frames);
 
   graph::Graph g;
   const auto filled = [&g](const char* name, const Buffer& buffer) {
@@ -176,8 +178,8 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
 }
 
 std::vector<glm::vec4> reference_layers(const LabelScene& s) {
-  return draw_labels_reference(s.layers, s.size, s.layer_count, {s.labels, s.placements, s.glyphs},
-                               test_atlas());
+  return draw_labels_reference(s.layers, s.size, s.layer_count,
+                               {s.labels, s.placements, s.glyphs, s.layer_frames}, test_atlas());
 }
 
 // The largest difference per channel, and where it is.
@@ -586,6 +588,18 @@ TEST_SUITE("gpu") {
     for (uint32_t x = 40; x < 78; ++x) {
       CHECK(final_pixel(s, hidden.final, {x, 48}).r == doctest::Approx(0.3f).epsilon(0.03));
     }
+  }
+
+  // Borders in their layer's colour (a depth cue): as the reference draws them, and different
+  // from the plain ones on a rear layer.
+  TEST_CASE_FIXTURE(test::GpuTest, "layer_colored_borders_match_the_cpu_reference") {
+    LabelScene s = make_scene();
+    s.layer_frames = true;
+    const DrawnLabels gpu = draw_on_gpu(ctx, s);
+    size_t where = 0;
+    CHECK(worst_difference(gpu.layers, reference_layers(s), where) <= kTolerance);
+    s.layer_frames = false;
+    CHECK(worst_difference(gpu.layers, reference_layers(s), where) > 0.1f);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "label_with_a_hidden_placement_draws_nothing") {

@@ -6,6 +6,7 @@
 //   PlacementGpu placement_at(uint i)
 //   GlyphGpu glyph_at(uint i)
 //   float atlas_coverage(vec2 uv)      the font atlas, bilinear, clamped to its edge
+//   bool layer_frames()                borders in their layer's colour
 
 // Text coverage of a label at p. Glyph quads overlap only in their zero-coverage borders, so the
 // largest coverage is the text's.
@@ -35,7 +36,8 @@ vec4 draw_label_at(uint i, vec2 p, uint layer, vec4 content) {
   bool is_internal = (label.flags & LABEL_INTERNAL) != 0u;
   vec2 centre = is_internal ? label.anchor : placement.position;
   if (label_far_from(p, label.anchor, centre, label.size)) return content;
-  vec4 color = label_frame(p, label.anchor, centre, label.size, !is_internal);
+  vec4 color = label_frame(p, label.anchor, centre, label.size, !is_internal,
+                           label_border_color(label.layer, layer_frames()));
   float text = text_coverage(p, centre - 0.5f * label.size, label);
   color = label_over(label_premultiplied(LABEL_TEXT_COLOR, text), color);
   if (!is_internal) color = label_over(label_anchor_marker(p, label.anchor), color);

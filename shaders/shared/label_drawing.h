@@ -25,6 +25,10 @@ struct LabelDrawParams {
   uint layer_count;
   uint label_count;  // labels to consider (the shader also stops at the buffer's end)
   vec4 background;   // rgb: what the composite shows where every layer is transparent
+  uint layer_frames;  // 1: a box's border (and leader) in its layer's colour (a depth cue)
+  uint pad0;
+  uint pad1;
+  uint pad2;
 };
 
 // The look of a label. Colours are straight alpha.
@@ -32,6 +36,19 @@ const vec4 LABEL_LINE_COLOR = vec4(0.95f, 0.95f, 0.95f, 0.9f);
 const float LABEL_LINE_HALF_WIDTH = 0.75f;
 const vec4 LABEL_BOX_COLOR = vec4(0.05f, 0.06f, 0.08f, 0.7f);
 const vec4 LABEL_BORDER_COLOR = vec4(0.85f, 0.88f, 0.92f, 0.95f);
+// Border colours per layer, front to back, with --layer-colors (the thesis coloured labels by
+// layer): distinguishable with the common colour-vision deficiencies, and bright enough on the
+// box's dark fill.
+const vec4 LABEL_LAYER_COLORS[8] = {
+    vec4(0.95f, 0.62f, 0.15f, 0.95f), vec4(0.35f, 0.72f, 0.95f, 0.95f),
+    vec4(0.35f, 0.85f, 0.55f, 0.95f), vec4(0.92f, 0.45f, 0.75f, 0.95f),
+    vec4(0.95f, 0.92f, 0.35f, 0.95f), vec4(0.85f, 0.4f, 0.25f, 0.95f),
+    vec4(0.55f, 0.55f, 0.95f, 0.95f), vec4(0.75f, 0.75f, 0.75f, 0.95f)};
+
+// The border colour of a label on `layer`.
+STRATA_INLINE vec4 label_border_color(uint layer, bool layer_frames) {
+  return layer_frames ? LABEL_LAYER_COLORS[min(layer, 7u)] : LABEL_BORDER_COLOR;
+}
 const float LABEL_BORDER_WIDTH = 1.0f;
 const float LABEL_BOX_RADIUS = 3.0f;
 const vec4 LABEL_TEXT_COLOR = vec4(1.0f, 1.0f, 1.0f, 1.0f);
@@ -79,7 +96,8 @@ STRATA_INLINE float label_box_distance(vec2 p, vec2 centre, vec2 half_size, floa
 
 // The connector (from the anchor to the nearest point of the box), the box and its border at p,
 // premultiplied: everything of a label but its text and anchor marker.
-STRATA_INLINE vec4 label_frame(vec2 p, vec2 anchor, vec2 centre, vec2 size, bool connector) {
+STRATA_INLINE vec4 label_frame(vec2 p, vec2 anchor, vec2 centre, vec2 size, bool connector,
+                               vec4 border) {
   vec2 half_size = 0.5f * size;
   vec4 color = vec4(0.0f);
   if (connector) {
@@ -91,7 +109,7 @@ STRATA_INLINE vec4 label_frame(vec2 p, vec2 anchor, vec2 centre, vec2 size, bool
   float outer = label_edge_coverage(d);
   float inner = label_edge_coverage(d + LABEL_BORDER_WIDTH);
   color = label_over(label_premultiplied(LABEL_BOX_COLOR, outer), color);
-  return label_over(label_premultiplied(LABEL_BORDER_COLOR, outer - inner), color);
+  return label_over(label_premultiplied(border, outer - inner), color);
 }
 
 // A filled disc with a dark rim on the anchor, premultiplied.
