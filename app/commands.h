@@ -22,6 +22,13 @@ struct DeviceOptions {
 // Loads a scene and prints its warnings (missing data files, ...) to stderr.
 Scene load_scene_reporting(const std::string& path);
 
+// How labels look (render and video): --label-scale and --layer-colors.
+struct LabelLookOptions {
+  float label_scale = 1.0f;
+  bool layer_colors = false;
+};
+void add_label_look_options(CLI::App* cmd, LabelLookOptions& o);
+
 // "1024" or "1024x768"; throws Error naming the option when it is neither.
 graph::Extent parse_size(const std::string& text, const char* option);
 

@@ -39,6 +39,15 @@ graph::Extent parse_size(const std::string& text, const char* option) {
   return {w, h};
 }
 
+void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {
+  cmd->add_option("--label-scale", o.label_scale, "label text and boxes times this (0.25 to 4)")
+      ->check(CLI::Range(0.25f, 4.0f))
+      ->capture_default_str();
+  cmd->add_flag("--layer-colors", o.layer_colors,
+                "label borders in their depth layer's colour (front to back: orange, blue, green, "
+                "pink, ...)");
+}
+
 }  // namespace strata::app
 
 int main(int argc, char** argv) {

@@ -29,8 +29,7 @@ struct RenderOptions {
   bool no_labels = false;
   bool hard = false;
   bool internal = false;
-  float label_scale = 1.0f;
-  bool layer_colors = false;
+  LabelLookOptions look;
   bool decoret = false;
   std::string order = "scene";
   std::string layout;
@@ -114,8 +113,8 @@ LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene)
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
   settings.internal = o.internal;
-  settings.label_scale = o.label_scale;
-  settings.layer_colors = o.layer_colors;
+  settings.label_scale = o.look.label_scale;
+  settings.layer_colors = o.look.layer_colors;
   if (o.order == "apollonius") settings.order = InsertionOrder::apollonius;
   if (o.order == "optimized") settings.order = InsertionOrder::optimized;
   if (o.decoret) {  // Stein & Decoret's setting, as the thesis compares against it
@@ -237,12 +236,7 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--no-labels", o->no_labels, "render the scene without its labels");
   cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
   cmd->add_flag("--internal", o->internal, "internal labelling: labels drawn on their anchors");
-  cmd->add_option("--label-scale", o->label_scale, "label text and boxes times this (0.25 to 4)")
-      ->check(CLI::Range(0.25f, 4.0f))
-      ->capture_default_str();
-  cmd->add_flag("--layer-colors", o->layer_colors,
-                "label borders in their depth layer's colour (front to back: orange, blue, green, "
-                "pink, ...)");
+  add_label_look_options(cmd, o->look);
   cmd->add_option("--order", o->order,
                   "insertion order: scene, apollonius (Stein & Decoret, innermost first) or "
                   "optimized (random orders, the best kept)")

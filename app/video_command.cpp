@@ -34,8 +34,7 @@ struct VideoOptions {
   bool screen_space = false;
   bool no_forces = false;
   bool hard = false;
-  float label_scale = 1.0f;
-  bool layer_colors = false;
+  LabelLookOptions look;
   ForceSettings forces;
   float layer_margin = LayerHysteresis{}.margin;
   uint32_t layers = 4;
@@ -96,8 +95,8 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   settings.layer_count = o.layers;
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
-  settings.label_scale = o.label_scale;
-  settings.layer_colors = o.layer_colors;
+  settings.label_scale = o.look.label_scale;
+  settings.layer_colors = o.look.layer_colors;
   settings.forces = o.forces;
   settings.forces.anchor_relative = !o.screen_space;
   settings.hysteresis.margin = o.layer_margin;
@@ -152,12 +151,7 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
                 "labels live on screen (the thesis), not as offsets from their anchors");
   cmd->add_flag("--no-forces", o->no_forces, "place every frame from scratch (labels jump)");
   cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
-  cmd->add_option("--label-scale", o->label_scale, "label text and boxes times this (0.25 to 4)")
-      ->check(CLI::Range(0.25f, 4.0f))
-      ->capture_default_str();
-  cmd->add_flag("--layer-colors", o->layer_colors,
-                "label borders in their depth layer's colour (front to back: orange, blue, green, "
-                "pink, ...)");
+  add_label_look_options(cmd, o->look);
   cmd->add_option("--speed", o->forces.speed, "forces: pixels per second at full force")
       ->capture_default_str()
       ->check(CLI::Range(1.0f, 1e6f));
