@@ -559,8 +559,10 @@ void Viewer::read_slot(uint32_t slot) {
           labelled_->set_order(o.orders[best]);
           ++summary_.adopted;
           settled_ = false;  // the labels move to the cheaper layout
-          message_ = "optimised on idle: cost " + std::to_string(o.baseline) + " -> " +
-                     std::to_string(o.costs[best]);
+          char text[96];
+          std::snprintf(text, sizeof text, "optimised on idle: cost %.6g -> %.6g", o.baseline,
+                        o.costs[best]);
+          message_ = text;
         }
       }
     }
