@@ -312,15 +312,16 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint
   const Stat baseline = stat_of(readback_ms.empty() ? std::vector<double>{0.0} : readback_ms);
   // The stages before the loop (per-pass stamps) plus the loop with a readback per label.
   const double baseline_total = placement_ms - loop_ms + baseline.median;
+  const LabelledFrame last = frame.result(false);
   uint32_t enabled = 0;
-  for (const LabelLayout& l : frame.result().labels) enabled += l.shown;
+  for (const LabelLayout& l : last.labels) enabled += l.placed;
   const ordered_json setup = {{"benchmark", "placement"},
                               {"scene", o.scene},
                               {"width", size.width},
                               {"height", size.height},
                               {"labels", scene.labels.size()},
                               {"labels_shown", enabled},
-                              {"layers", frame.result().layering.layer_count}};
+                              {"layers", last.layering.layer_count}};
   const glm::uvec2 tiles = gpu::placement_tiles(size.width, size.height);
   ordered_json results = {
       {"placement_ms", ms_json(whole_ms)},

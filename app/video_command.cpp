@@ -112,7 +112,8 @@ void video(DeviceOptions& device, const VideoOptions& o) {
         renderer.advance(1.0 / o.fps);
       }
     }
-    const LabelledFrame frame = renderer.result();
+    // (legibility only where a layout is written: it reads the layers back)
+    const LabelledFrame frame = renderer.result(!o.layout_dir.empty());
     if (file) {
       file->write(frame.image);
     } else {

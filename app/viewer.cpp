@@ -421,10 +421,12 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
 void Viewer::set_number(const std::string& name, float value) {
   const Parameter& p = parameter(name);
   if (p.flag) throw Error("parameter " + name + " is on or off, not a number");
-  if (name == "font" || name == "label_scale") {
-    // (checks the value)
-    if (name == "font") labelled_->set_font_pixels(value);
-    if (name == "label_scale") labelled_->set_label_scale(value);
+  if (name == "font" || name == "label_scale") {  // (the renderer checks the value)
+    if (name == "font") {
+      labelled_->set_font_pixels(value);
+    } else {
+      labelled_->set_label_scale(value);
+    }
     settings_changed(false);
     return;
   }

@@ -20,7 +20,6 @@
 #include "passes/label_forces.h"
 
 namespace strata {
-namespace {}  // namespace
 
 std::vector<uint32_t> insertion_order(const std::vector<gpu::LabelGpu>& labels,
                                       const Layering& layering, const std::vector<uint32_t>& within,
@@ -290,14 +289,12 @@ void LabelledRenderer::run_frame() {
 // Stein & Decoret's order inside each layer, from the first frame's image: occupancy is the
 // alpha of all layers composited (drawn labels are only added later in the frame).
 std::vector<uint32_t> LabelledRenderer::apollonius_layers_order() {
-  const std::vector<std::byte> bytes = runner_->download_image(layers_id_);
-  const auto* half = reinterpret_cast<const uint16_t*>(bytes.data());
+  const std::vector<glm::vec4> layers = download_layers();
   const size_t pixels = size_t{size_.width} * size_.height;
   std::vector<float> occupancy(pixels, 0.0f);
   for (uint32_t l = 0; l < layering_.layer_count; ++l) {
     for (size_t p = 0; p < pixels; ++p) {
-      const float a = glm::unpackHalf1x16(half[(l * pixels + p) * 4 + 3]);
-      occupancy[p] += (1.0f - occupancy[p]) * a;
+      occupancy[p] += (1.0f - occupancy[p]) * layers[l * pixels + p].a;
     }
   }
   std::vector<glm::vec2> anchors;
@@ -349,7 +346,19 @@ void LabelledRenderer::run() {
   }
 }
 
-LabelledFrame LabelledRenderer::result() const {
+// The layer images of the last frame (rgba16f, layer after layer), waited for.
+std::vector<glm::vec4> LabelledRenderer::download_layers() const {
+  const std::vector<std::byte> bytes = runner_->download_image(layers_id_);
+  std::vector<glm::vec4> layers(bytes.size() / sizeof(uint64_t));
+  for (size_t i = 0; i < layers.size(); ++i) {
+    uint64_t half4 = 0;
+    std::memcpy(&half4, bytes.data() + i * sizeof(uint64_t), sizeof half4);
+    layers[i] = glm::unpackHalf4x16(half4);
+  }
+  return layers;
+}
+
+LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
   LabelledFrame frame;
   frame.size = size_;
   frame.layering = layering_;
@@ -370,24 +379,18 @@ LabelledFrame LabelledRenderer::result() const {
     l.box_size = labels_[i].size;
     l.box_origin = drawn[i].position - labels_[i].size * 0.5f;
     l.placed = drawn[i].shown == PLACEMENT_SHOWN;
-    l.visible = l.placed ? 1.0f : 0.0f;
     l.cost = results[i].cost;
     frame.labels.push_back(l);
   }
   // Offline (no extension, nothing in flight): what the picture really shows of each box.
-  if (!extension_) {
-    const std::vector<std::byte> bytes = runner_->download_image(layers_id_);
-    std::vector<glm::vec4> layers(bytes.size() / sizeof(uint64_t));
-    for (size_t i = 0; i < layers.size(); ++i) {
-      uint64_t half4 = 0;
-      std::memcpy(&half4, bytes.data() + i * sizeof(uint64_t), sizeof half4);
-      layers[i] = glm::unpackHalf4x16(half4);
-    }
+  if (measure_visibility && !extension_) {
     const std::vector<float> visible =
-        label_visibility(layers, size_, layering_.layer_count, frame.labels);
+        label_visibility(download_layers(), size_, layering_.layer_count, frame.labels);
     for (size_t i = 0; i < frame.labels.size(); ++i) frame.labels[i].visible = visible[i];
   }
-  for (LabelLayout& l : frame.labels) l.shown = l.placed && l.visible >= kLegibleShare;
+  for (LabelLayout& l : frame.labels) {
+    l.shown = l.placed && (std::isnan(l.visible) || l.visible >= kLegibleShare);
+  }
   return frame;
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -51,9 +52,11 @@ struct LabelLayout {
   glm::vec2 anchor{0.0f};  // pixels
   glm::vec2 box_origin{0.0f};
   glm::vec2 box_size{0.0f};
-  bool placed = false;   // the placement shows it (a position was found)
-  float visible = 0.0f;  // share of its box a viewer sees: inside the image, not behind content
-  bool shown = false;    // placed and legible: visible >= kLegibleShare
+  bool placed = false;  // the placement shows it (a position was found)
+  // Share of its box a viewer sees: inside the image, not behind content (label_visibility);
+  // NaN where it was not measured (the viewer's frames, result(false)).
+  float visible = std::numeric_limits<float>::quiet_NaN();
+  bool shown = false;  // placed and legible: visible >= kLegibleShare (placed, when not measured)
   float cost = 0.0f;
 };
 
@@ -175,8 +178,9 @@ class LabelledRenderer {
   const Placement::Outputs& placement() const { return placed_; }
   // The placement's pipelines and what the driver reports of each (benchmark output).
   std::vector<PipelineReport> placement_pipelines() const;
-  // The picture (none with an extension) and layout of the last run.
-  LabelledFrame result() const;
+  // The picture (none with an extension) and layout of the last run; without an extension also
+  // each label's visible share (measure_visibility: the layers are downloaded and read).
+  LabelledFrame result(bool measure_visibility = true) const;
   // Eq. 3.2 of the last frame's placement: the sum of the shown labels' costs (without the hold),
   // a hidden label counting as much as an anchor-constraint violation.
   double total_cost() const;
@@ -199,6 +203,7 @@ class LabelledRenderer {
   bool afresh_ = false;
   void build_labels();  // glyphs and box sizes from the texts at settings_.font_pixels
   void set_label_text(float pixels, float scale);
+  std::vector<glm::vec4> download_layers() const;
   Extension extension_;
   uint32_t frames_in_flight_ = 1;
   std::vector<bool> hidden_;
