@@ -86,6 +86,8 @@ const std::vector<Parameter>& parameters() {
        [](S s) { return &s.labels.placement.weights.anchor_constraint; }},
       {"weights.connector_shadow", "eq. 3.1: a leader over an earlier box or leader",
        [](S s) { return &s.labels.placement.weights.connector_shadow; }},
+      {"weights.leader_crossing", "tidy-up: a leader crossing a leader or through a box",
+       [](S s) { return &s.labels.placement.weights.leader_crossing; }},
       {"weights.integral_costs", "eq. 3.1: the occlusion and saliency under the box",
        [](S s) { return &s.labels.placement.weights.integral_costs; }},
       {"weights.distance_to_anchor", "eq. 3.1: leader length",

@@ -107,6 +107,8 @@ void Viewer::panel_labelling() {
          "%.3g", log);
   slider(*this, "connector shadow", "weights.connector_shadow", w.connector_shadow, 0.0f, 1e4f,
          "%.3g", log);
+  slider(*this, "leader crossing", "weights.leader_crossing", w.leader_crossing, 0.0f, 1e5f,
+         "%.3g", log);
   slider(*this, "integral costs", "weights.integral_costs", w.integral_costs, 0.0f, 1000.0f, "%.3g",
          log);
   slider(*this, "distance to anchor", "weights.distance_to_anchor", w.distance_to_anchor, 0.0f,

@@ -5,6 +5,7 @@
 
 #include "engine/core/error.h"
 #include "engine/gpu/context.h"
+#include "shared/tidy_gpu.h"
 
 static_assert(PLACEMENT_BOUNDS_TILES * (PLACEMENT_TILE / PLACEMENT_CELL) *
                       (PLACEMENT_TILE / PLACEMENT_CELL) ==
@@ -21,7 +22,7 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   gpu::PlacementParams p{};
   const CostWeights& w = s.weights;
   p.weights = {w.distance_to_anchor, w.connector_direction, w.label_shadow,      w.connector_shadow,
-               w.anchor_constraint,  w.integral_costs,      w.previous_position, 0.0f};
+               w.anchor_constraint,  w.integral_costs,      w.previous_position, w.leader_crossing};
   p.width = viewport.width;
   p.height = viewport.height;
   p.layer_count = layer_count;
@@ -34,6 +35,7 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   p.occlusion_weight = s.occlusion_weight;
   p.single_saliency_weight = s.single_saliency_weight;
   p.bucket_width = s.bucket_width;
+  p.tidy_rounds = s.hard ? 0u : std::min(s.tidy_rounds, TIDY_ROUNDS_MAX);
   return p;
 }
 
@@ -143,6 +145,9 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
   b.args = graph.add_buffer("placement.args", fixed((n + 1) * 3 * sizeof(uint32_t)));
   b.speculative = graph.add_buffer("placement.speculative", per_tile(sizeof(uint64_t), 2));
   b.samples = graph.add_buffer("placement.samples", per_tile(sizeof(uint64_t)));
+  b.tidy = graph.add_buffer("placement.tidy", fixed(n * sizeof(gpu::TidyGpu)));
+  b.tidy_rounds =
+      graph.add_buffer("placement.tidy_rounds", fixed((TIDY_ROUNDS_MAX + 1) * sizeof(uint32_t)));
   b.regions = graph.add_buffer("placement.regions",
                                fixed(VkDeviceSize{n} * n * sizeof(gpu::PairRegionsGpu)));
   b.readback = readback_.import(graph, "placement.readback");
@@ -301,15 +306,39 @@ glm::uvec3 Placement::direct_groups(graph::Extent viewport) const {
       gpu::placement_classify_groups(tile_count, classify_tiles(viewport)) + tiles + 1);
 }
 
-// Each label's position and whether it is shown, copied to the host after the frame.
+// The layout tidy-up (its rounds: five dispatches each, those after a round that changed nothing
+// leaving at once) and each label's position and whether it is shown, copied to the host after
+// the frame.
 void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
   graph.add_pass({"placement.finalize",
                   graph::PassKind::compute,
-                  {{b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+                  {{b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
+                   {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+                   {b.order, Use::storage_read, PLACEMENT_BINDING_ORDER},
                    {b.results, Use::storage_read, PLACEMENT_BINDING_RESULTS},
+                   {b.tidy, Use::storage_write, PLACEMENT_BINDING_TIDY},
+                   {b.tidy_rounds, Use::storage_write, PLACEMENT_BINDING_TIDY_ROUNDS},
                    {b.placements, Use::storage_write, PLACEMENT_BINDING_PLACEMENTS}},
                   [this](graph::PassContext& pc) {
-                    pc.dispatch(finalize_, params(pc.viewport, 0), {label_count_, 1, 1});
+                    gpu::PlacementParams p = params(pc.viewport, 0);
+                    const uint32_t n = label_count_;
+                    p.phase = TIDY_PHASE_START;
+                    pc.dispatch(finalize_, p, {std::max(n, p.tidy_rounds + 1), 1, 1});
+                    for (uint32_t round = 0; round < p.tidy_rounds; ++round) {
+                      p.step = round;
+                      for (const uint32_t phase :
+                           {TIDY_PHASE_CONFLICTS, TIDY_PHASE_SEARCH, TIDY_PHASE_OWNERS,
+                            TIDY_PHASE_SELECT, TIDY_PHASE_APPLY}) {
+                        pc.barrier();
+                        p.phase = phase;
+                        const uint32_t threads =
+                            phase == TIDY_PHASE_SEARCH ? n * TIDY_SWAP + n * n : n;
+                        pc.dispatch(finalize_, p, {threads, 1, 1});
+                      }
+                    }
+                    pc.barrier();
+                    p.phase = TIDY_PHASE_OUTPUT;
+                    pc.dispatch(finalize_, p, {n, 1, 1});
                   },
                   "placement"});
   graph.add_pass({"placement.readback",

@@ -35,6 +35,10 @@ struct PlacementSettings {
   // Cost above a label's lowest tile bound that its speculative pass covers (speed only:
   // the positions do not depend on it).
   float bucket_width = 0.0625f;
+  // Rounds of the layout tidy-up after the greedy placement at most (shaders/shared/
+  // layout_tidy.h: swaps, moves and hiding that lower the finished layout's cost with crossings
+  // and overlaps counted); 0: none. Hard mode has none: its layouts have no conflicts.
+  uint32_t tidy_rounds = 64;
 };
 
 gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent viewport,
@@ -107,7 +111,8 @@ class Placement {
  private:
   struct Buffers {
     graph::ResourceId labels, order, results, placements, saliency, costs, tables, constraints;
-    graph::ResourceId bounds, tiles, buckets, lower, args, speculative, samples, regions;
+    graph::ResourceId bounds, tiles, buckets, lower, args, speculative, samples, regions, tidy,
+        tidy_rounds;
     graph::ResourceId readback;
   };
   Buffers add_buffers(graph::Graph& graph);

@@ -43,8 +43,128 @@ struct Placer {
 #include "shared/placement_cost.h"
 };
 
+// The layout tidy-up's rounds (shared/layout_tidy_search.h) one step at a time: each step over
+// every label before the next, as the GPU's barriers separate them.
+struct Tidier {
+  PlacementParams params;
+  std::span<const LabelGpu> labels;
+  const std::vector<float>& tables;
+  std::vector<uint> ranks;
+  std::vector<TidyLabel> states, nexts;
+  std::vector<float> frees;
+  std::vector<uint64_t> bests;
+  std::vector<uint> partners;
+
+  float table_at(uint layer, int x, int y) const {
+    if (x < 0 || y < 0) return 0.0f;
+    return tables[size_t(layer) * params.width * params.height + size_t(y) * params.width +
+                  size_t(x)];
+  }
+  uint tidy_count() const { return uint(labels.size()); }
+  LabelGpu tidy_input(uint k) const { return labels[k]; }
+  TidyLabel tidy_state(uint k) const { return states[k]; }
+  float tidy_free(uint k) const { return frees[k]; }
+  uint tidy_rank(uint k) const { return ranks[k]; }
+  uint64_t tidy_best(uint k) const { return bests[k]; }
+  TidyLabel tidy_next(uint k) const { return nexts[k]; }
+  uint tidy_partner(uint k) const { return partners[k]; }
+
+#include "shared/layout_tidy.h"
+#include "shared/layout_tidy_search.h"
+
+  bool movable(uint k) const {
+    return (states[k].flags & (TIDY_PLACED | TIDY_MOVABLE)) == (TIDY_PLACED | TIDY_MOVABLE);
+  }
+
+  void offer(uint k, float delta, uint change) {
+    if (delta < 0.0f) bests[k] = std::min(bests[k], tidy_key(delta, change));
+  }
+
+  // One round; false when it applied nothing.
+  bool round() {
+    const uint n = tidy_count();
+    std::vector<bool> conflicted(n);
+    for (uint i = 0; i < n; ++i) conflicted[i] = movable(i) && tidy_conflicted(i);
+    bests.assign(n, TIDY_NONE);
+    for (uint i = 0; i < n; ++i) {
+      if (!conflicted[i]) continue;
+      for (uint change = 0; change < TIDY_SWAP; ++change) offer(i, tidy_delta(i, change), change);
+    }
+    for (uint i = 0; i < n; ++i) {
+      for (uint j = i + 1; j < n; ++j) {
+        if (!movable(i) || !movable(j)) continue;
+        const ivec4 c = tidy_conflicts(states[i], states[j]);
+        if (c.x + c.y == 0) continue;
+        const float delta = tidy_delta(i, TIDY_SWAP + j);
+        offer(i, delta, TIDY_SWAP + j);
+        offer(j, delta, TIDY_SWAP + i);
+      }
+    }
+    nexts = states;
+    for (uint i = 0; i < n; ++i) partners[i] = tidy_owned_partner(i);
+    for (uint i = 0; i < n; ++i) {
+      if (partners[i] == TIDY_NO_PARTNER) continue;
+      nexts[i] = tidy_changed(i, uint(bests[i] & 0xFFFFFFFFu));
+      if (partners[i] != i) nexts[partners[i]] = tidy_changed(partners[i], TIDY_SWAP + i);
+    }
+    std::vector<uint> applied;
+    for (uint i = 0; i < n; ++i) {
+      if (partners[i] != TIDY_NO_PARTNER && !tidy_blocked(i)) applied.push_back(i);
+    }
+    for (uint i : applied) {
+      for (uint k : {i, partners[i]}) {
+        states[k] = nexts[k];
+        frees[k] = tidy_free_cost(nexts[k], labels[k]);
+      }
+    }
+    return !applied.empty();
+  }
+};
+
 }  // namespace
 }  // namespace gpu
+
+std::vector<gpu::PlacementGpu> tidy_reference(std::span<const gpu::LabelGpu> labels,
+                                              std::span<const uint32_t> order,
+                                              std::span<const uint64_t> results,
+                                              const std::vector<float>& tables,
+                                              const PlacementSettings& settings,
+                                              graph::Extent size, uint32_t layer_count) {
+  const auto n = uint32_t(labels.size());
+  gpu::Tidier tidier{placement_params(settings, size, layer_count, n, 0),
+                     labels,
+                     tables,
+                     std::vector<uint32_t>(n, LABEL_MAX),
+                     {},
+                     {},
+                     {},
+                     {},
+                     std::vector<uint32_t>(n, TIDY_NO_PARTNER)};
+  for (uint32_t k = 0; k < order.size(); ++k) tidier.ranks[order[k]] = k;
+  for (uint32_t i = 0; i < n; ++i) {
+    tidier.states.push_back(tidier.tidy_label(labels[i], results[i]));
+    tidier.frees.push_back(tidier.tidy_free_cost(tidier.states[i], labels[i]));
+  }
+  for (uint32_t r = 0; r < tidier.params.tidy_rounds && tidier.round(); ++r) {
+  }
+  std::vector<gpu::PlacementGpu> placements(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    const gpu::TidyLabel& l = tidier.states[i];
+    const uint64_t r = results[i];
+    if ((l.flags & TIDY_PLACED) == 0u) {
+      placements[i] = gpu::hidden_placement(labels[i]);
+    } else if (r != PLACEMENT_NONE && l.pixel == uint32_t(r & 0xFFFFFFFFu)) {
+      const uint32_t cost_bits = uint32_t(r >> 32);
+      float cost;
+      std::memcpy(&cost, &cost_bits, 4);
+      placements[i] = gpu::shown_placement(labels[i], l.pixel, cost, size.width);
+    } else {
+      const float cost = tidier.frees[i] + tidier.tidy_weight(tidier.tidy_all_conflicts(i));
+      placements[i] = gpu::shown_placement(labels[i], l.pixel, cost, size.width);
+    }
+  }
+  return placements;
+}
 
 ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
                                    std::span<const glm::vec4> layers, uint32_t layer_count,
@@ -129,19 +249,8 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
       }
     }
   }
-  out.placements.resize(labels.size());
-  for (size_t i = 0; i < labels.size(); ++i) {
-    const uint64_t r = placer.results[i];
-    gpu::PlacementGpu& result = out.placements[i];
-    if (r == PLACEMENT_NONE || (labels[i].flags & LABEL_ENABLED) == 0u) {
-      result = gpu::hidden_placement(labels[i]);
-      continue;
-    }
-    const uint32_t cost_bits = uint32_t(r >> 32);
-    float cost;
-    std::memcpy(&cost, &cost_bits, 4);
-    result = gpu::shown_placement(labels[i], uint32_t(r & 0xFFFFFFFFu), cost, w);
-  }
+  out.placements = tidy_reference(labels, order, placer.results, out.tables, settings, size,
+                                  layer_count);
   return out;
 }
 

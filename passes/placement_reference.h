@@ -19,6 +19,15 @@ struct ReferencePlacement {
   std::vector<gpu::PlacementGpu> placements;  // per label
 };
 
+// The placement finalize pass: the greedy loop's results (cost bits << 32 | pixel per label)
+// after the layout tidy-up (shaders/shared/layout_tidy.h) over the integral costs' `tables`.
+std::vector<gpu::PlacementGpu> tidy_reference(std::span<const gpu::LabelGpu> labels,
+                                              std::span<const uint32_t> order,
+                                              std::span<const uint64_t> results,
+                                              const std::vector<float>& tables,
+                                              const PlacementSettings& settings,
+                                              graph::Extent size, uint32_t layer_count);
+
 // final_rgba8: the label-free final image; layers: premultiplied RGBA, layer after layer.
 ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
                                    std::span<const glm::vec4> layers, uint32_t layer_count,

@@ -10,7 +10,8 @@ namespace {
 DeviceCapabilities everything() {
   DeviceCapabilities c;
   c.api_version = VK_API_VERSION_1_3;
-  c.shader_int64 = c.buffer_int64_atomics = c.fragment_stores_and_atomics = true;
+  c.shader_int64 = c.buffer_int64_atomics = c.shared_int64_atomics = true;
+  c.fragment_stores_and_atomics = true;
   c.synchronization2 = c.dynamic_rendering = c.maintenance4 = c.timeline_semaphore =
       c.push_descriptor = true;
   c.subgroup_arithmetic_in_compute = c.graphics_compute_queue_with_timestamps = true;

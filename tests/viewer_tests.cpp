@@ -123,7 +123,8 @@ TEST_SUITE("window") {
                  d("left.json") + "\nscreenshot " + d("left.png") + "\nhide 3\nlayout " +
                  d("hidden.json") + "\nscreenshot " + d("hidden.png") +
                  "\nhide 60\nhide 52\nhide 81\nhide 29\nhide 31\nhide 37\nlayout " + d("few.json") +
-                 "\nset weights.anchor_constraint 0\nset weights.distance_to_anchor 1\nlayout " +
+                 "\nset weights.anchor_constraint 0\nset weights.distance_to_anchor 1\n"
+                 "set weights.leader_crossing 0\nlayout " +
                  d("weighted.json") + "\nquit\n");
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
@@ -179,8 +180,8 @@ TEST_SUITE("window") {
     const size_t in_box = changed_pixels(was, now, before.box);
     CHECK(double(in_box) > 0.35 * double(before.box.z * before.box.w));
 
-    // Without the anchor constraint's weight and with a heavier leader length, the four labels
-    // left move toward their anchors.
+    // Without the anchor constraint's and the tidy-up's crossing weights and with a heavier leader
+    // length, the four labels left move toward their anchors.
     const auto few = read_layout(d("few.json")), weighted = read_layout(d("weighted.json"));
     CHECK(std::count_if(few.begin(), few.end(), [](const LabelBox& l) { return l.shown; }) == 4);
     CHECK(mean_leader(weighted) < 0.8f * mean_leader(few));

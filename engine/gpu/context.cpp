@@ -80,6 +80,7 @@ DeviceReport describe(VkPhysicalDevice device, uint32_t index) {
   caps.api_version = props.properties.apiVersion;
   caps.shader_int64 = features.features.shaderInt64;
   caps.buffer_int64_atomics = f12.shaderBufferInt64Atomics;
+  caps.shared_int64_atomics = f12.shaderSharedInt64Atomics;
   caps.fragment_stores_and_atomics = features.features.fragmentStoresAndAtomics;
   caps.timeline_semaphore = f12.timelineSemaphore;
   caps.synchronization2 = f13.synchronization2;
@@ -144,6 +145,7 @@ std::vector<std::string> missing_requirements(const DeviceCapabilities& caps) {
   need(caps.api_version >= VK_API_VERSION_1_3, "Vulkan 1.3");
   need(caps.shader_int64, "shaderInt64");
   need(caps.buffer_int64_atomics, "shaderBufferInt64Atomics (64-bit buffer atomics)");
+  need(caps.shared_int64_atomics, "shaderSharedInt64Atomics (64-bit shared memory atomics)");
   need(caps.fragment_stores_and_atomics, "fragmentStoresAndAtomics");
   need(caps.synchronization2, "synchronization2");
   need(caps.dynamic_rendering, "dynamicRendering");
@@ -314,6 +316,7 @@ Context::Context(const ContextOptions& options)
   f13.maintenance4 = VK_TRUE;  // core in 1.3; SPIR-V 1.6 declares workgroup sizes with LocalSizeId
   VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
   f12.shaderBufferInt64Atomics = VK_TRUE;
+  f12.shaderSharedInt64Atomics = VK_TRUE;
   f12.timelineSemaphore = VK_TRUE;
   VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
   features.features.shaderInt64 = VK_TRUE;

@@ -22,6 +22,7 @@ struct DeviceCapabilities {
   uint32_t api_version = 0;
   bool shader_int64 = false;
   bool buffer_int64_atomics = false;
+  bool shared_int64_atomics = false;
   bool fragment_stores_and_atomics = false;
   bool synchronization2 = false;
   bool dynamic_rendering = false;

@@ -88,6 +88,9 @@ struct CostWeights {
   float distance_to_anchor = 0.015f;
   float connector_direction = 1.0f;
   float previous_position = 0.0f;
+  // Not the thesis's: the layout tidy-up after the placement (shaders/shared/layout_tidy.h)
+  // counts this per pair of crossing leaders and per leader through another label's box.
+  float leader_crossing = 1000.0f;
 };
 
 struct SceneSettings {

@@ -12,6 +12,8 @@
 // other names could silently win overload resolution over strata's own.
 namespace strata::gpu {
 using uint = uint32_t;
+using glm::ivec2;
+using glm::ivec4;
 using glm::mat3;
 using glm::mat4;
 using glm::uvec2;
@@ -26,6 +28,7 @@ using glm::all;
 using glm::ceil;
 using glm::clamp;
 using glm::dot;
+using glm::floatBitsToUint;
 using glm::floor;
 using glm::greaterThanEqual;
 using glm::inversesqrt;
@@ -41,6 +44,7 @@ using glm::sin;
 using glm::smoothstep;
 using glm::sqrt;
 using glm::transpose;
+using glm::uintBitsToFloat;
 using glm::unpackUnorm4x8;
 }  // namespace strata::gpu
 

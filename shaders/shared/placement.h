@@ -48,6 +48,18 @@
 #define PLACEMENT_BINDING_SPECULATIVE 15  // uint64_t per bucket-0 tile, two labels' worth
 #define PLACEMENT_BINDING_REGIONS 16      // PairRegionsGpu per (order position, placed one's)
 #define PLACEMENT_BINDING_SAMPLES 17      // uint64_t per tile-list position: a sampled candidate
+#define PLACEMENT_BINDING_TIDY 18         // TidyGpu per label: the layout tidy-up's state
+#define PLACEMENT_BINDING_TIDY_ROUNDS 19  // uint per tidy-up round + 1: changes applied before it
+
+// PlacementParams.phase of placement_finalize.comp: the tidy-up's start, the five steps of each
+// round (params.step), and the placements' output.
+#define TIDY_PHASE_START 0u
+#define TIDY_PHASE_CONFLICTS 1u  // per label: in some conflict? best change reset
+#define TIDY_PHASE_SEARCH 2u     // per (label, move or hiding) and pair: the best changes
+#define TIDY_PHASE_OWNERS 3u     // per label: owned change, state after it
+#define TIDY_PHASE_SELECT 4u     // per owner: applied unless a better owner's change interacts
+#define TIDY_PHASE_APPLY 5u      // per label: take the state after the applied changes
+#define TIDY_PHASE_OUTPUT 6u     // per label: the placement
 
 // The tile lists are in bucket order; an entry's x has this bit when its tile is in bucket 0 (the
 // speculative pass's). The speculative minima are kept for two labels at a time (by order
@@ -79,6 +91,22 @@
 #define PLACEMENT_PHASE_COUNT 1u   // ... tiles per bucket
 #define PLACEMENT_PHASE_SORT 2u    // ... tiles sorted by bucket, the first dispatch's size
 
+// The layout tidy-up after the greedy placement (shared/layout_tidy.h).
+#define TIDY_SUBPIXEL 64.0f
+#define TIDY_DIRECTIONS 24u  // move candidates: 24 directions from the anchor ...
+#define TIDY_RADII 5u        // ... at 5 distances (tidy_radius)
+#define TIDY_MOVES (TIDY_DIRECTIONS * TIDY_RADII)
+#define TIDY_HIDE TIDY_MOVES         // change id: hide the label
+#define TIDY_SWAP (TIDY_MOVES + 1u)  // change id TIDY_SWAP + j: swap boxes with label j
+#define TIDY_NONE 0xFFFFFFFFFFFFFFFFul
+#define TIDY_NO_PARTNER 0xFFFFFFFFu
+#define TIDY_ROUNDS_MAX 256u  // PlacementParams::tidy_rounds at most
+
+// TidyLabel.flags
+#define TIDY_PLACED 1u   // the label has a box (placed, and not hidden by the tidy-up)
+#define TIDY_MOVABLE 2u  // the tidy-up may move it (enabled, external, placed by the greedy loop)
+#define TIDY_ANCHOR 4u   // its anchor counts (the label is enabled)
+
 STRATA_BEGIN
 
 // Cost weights of eq. 3.1 (defaults: the thesis program's final paper settings).
@@ -90,7 +118,7 @@ struct CostWeightsGpu {
   float anchor_constraint;    // epsilon
   float integral_costs;       // zeta, times the integral over the label box
   float previous_position;    // eta, per pixel
-  float pad;
+  float leader_crossing;      // the layout tidy-up: per leader crossing or through a box
 };
 
 struct PlacementParams {
@@ -115,6 +143,7 @@ struct PlacementParams {
   uint finish_lanes;  // place_label: invocations of the last workgroup taking list entries
                       // (0: all; fewer make more chunks, for tests)
   uint classify_tiles;  // place_label: list entries per classifying workgroup (4, 8 or 16)
+  uint tidy_rounds;     // placement_finalize: rounds of the layout tidy-up at most (0: none)
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,
@@ -125,6 +154,15 @@ struct PairRegionsGpu {
   vec4 box[4];
   vec4 connector[6];
   uvec4 info;  // x: REGION_* bits
+};
+
+// A label as the tidy-up sees it: fixed point, the box's corners and the anchor.
+struct TidyLabel {
+  ivec2 anchor;
+  ivec2 lo;  // box, top-left ...
+  ivec2 hi;  // ... and bottom-right corner
+  uint flags;
+  uint pixel;  // the candidate pixel (placement's convention) of the box
 };
 
 // Per label (order position s): its tiles per bucket, and its main pass.

@@ -342,10 +342,11 @@ void SceneReader::settings(const json& object, const Field& field) {
                                                 {"integral_costs", &w.integral_costs},
                                                 {"distance_to_anchor", &w.distance_to_anchor},
                                                 {"connector_direction", &w.connector_direction},
-                                                {"previous_position", &w.previous_position}};
+                                                {"previous_position", &w.previous_position},
+                                                {"leader_crossing", &w.leader_crossing}};
   check_keys(*weights, weights_field,
              {"label_shadow", "anchor_constraint", "connector_shadow", "integral_costs",
-              "distance_to_anchor", "connector_direction", "previous_position"});
+              "distance_to_anchor", "connector_direction", "previous_position", "leader_crossing"});
   for (const auto& [key, target] : all) {
     if (const json* value = optional(*weights, key))
       *target = non_negative(*value, weights_field / key);

@@ -50,7 +50,8 @@ ordered_json settings_json(const SceneSettings& settings) {
             {"integral_costs", shortest_double(w.integral_costs)},
             {"distance_to_anchor", shortest_double(w.distance_to_anchor)},
             {"connector_direction", shortest_double(w.connector_direction)},
-            {"previous_position", shortest_double(w.previous_position)}}}};
+            {"previous_position", shortest_double(w.previous_position)},
+            {"leader_crossing", shortest_double(w.leader_crossing)}}}};
 }
 
 ordered_json meshes_json(const std::vector<Mesh>& meshes, const auto& relative) {

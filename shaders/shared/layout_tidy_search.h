@@ -1,0 +1,176 @@
+// One round of the layout tidy-up (layout_tidy.h), written once for the GPU and the CPU:
+//   1. every label's best change (tidy_key of its J change and the change id; none when no change
+//      lowers J): moves and hiding for labels in some conflict, swaps for pairs whose leaders
+//      cross or run through the other's box;
+//   2. owners: a label whose best change is a move or hiding, or the lower of two labels whose
+//      best changes are the same swap;
+//   3. an owner's change is applied unless a better owner's (lower key; ties: lower label)
+//      interacts with it: applying both would change J by more than the sum of their changes
+//      (some pair of their labels conflicts differently). So every applied pair of changes adds
+//      at most its own changes and J falls every round; the best owner is always applied.
+// The includer provides, besides layout_tidy.h's needs:
+//   uint tidy_count()               labels
+//   LabelGpu tidy_input(uint k)     the label as placed
+//   TidyLabel tidy_state(uint k)    its state this round
+//   float tidy_free(uint k)         tidy_free_cost of that state
+//   uint tidy_rank(uint k)          its insertion order position
+//   uint64_t tidy_best(uint k)      step 1's result (steps 2 and 3)
+//   TidyLabel tidy_next(uint k)     its state after its owner's change (itself if none; step 3)
+//   uint tidy_partner(uint k)       an owner's swap partner (TIDY_NO_PARTNER: none; step 3)
+
+// Does label i conflict with any other?
+bool tidy_conflicted(uint i) {
+  TidyLabel l = tidy_state(i);
+  ivec4 reach = tidy_extent(l);
+  for (uint k = 0u; k < tidy_count(); ++k) {
+    if (k == i) continue;
+    TidyLabel other = tidy_state(k);
+    if (!tidy_rects_touch(reach, tidy_extent(other))) continue;
+    if (tidy_conflicts(l, other) != ivec4(0)) return true;
+  }
+  return false;
+}
+
+// All of label i's conflicts with the others.
+ivec4 tidy_all_conflicts(uint i) {
+  ivec4 sum = ivec4(0);
+  for (uint k = 0u; k < tidy_count(); ++k) {
+    if (k != i) sum += tidy_conflicts(tidy_state(i), tidy_state(k));
+  }
+  return sum;
+}
+
+// How label i's conflicts with the others (but `skip`) change when it goes from `from` to `to`.
+ivec4 tidy_conflict_change(uint i, TidyLabel from, TidyLabel to, uint skip) {
+  ivec4 change = ivec4(0);
+  ivec4 reach = tidy_union(tidy_extent(from), tidy_extent(to));
+  for (uint k = 0u; k < tidy_count(); ++k) {
+    if (k == i || k == skip) continue;
+    TidyLabel other = tidy_state(k);
+    if (!tidy_rects_touch(reach, tidy_extent(other))) continue;
+    change += tidy_conflicts(to, other) - tidy_conflicts(from, other);
+  }
+  return change;
+}
+
+// Label i's state after change `change` (itself when the change is not possible).
+TidyLabel tidy_changed(uint i, uint change) {
+  TidyLabel l = tidy_state(i);
+  if (change == TIDY_HIDE) {
+    l.flags &= ~TIDY_PLACED;
+    return l;
+  }
+  if (change < TIDY_MOVES) return tidy_move(l, tidy_input(i), change);
+  return tidy_centred(l, tidy_input(i), tidy_centre(tidy_state(change - TIDY_SWAP)));
+}
+
+// May label i be hidden? Only when its box shares area with the box of a label earlier in the
+// insertion order (so of higher priority) or covers an anchor, and nothing better is found.
+bool tidy_may_hide(uint i) {
+  TidyLabel l = tidy_state(i);
+  for (uint k = 0u; k < tidy_count(); ++k) {
+    if (k == i) continue;
+    TidyLabel other = tidy_state(k);
+    if (tidy_covers(l, other)) return true;
+    if ((other.flags & TIDY_PLACED) != 0u && tidy_rank(k) < tidy_rank(i) &&
+        tidy_conflicts(l, other).z != 0) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// Does a change of conflict counts put boxes on more boxes or anchors (where those weigh)?
+bool tidy_adds_hard(ivec4 c) {
+  return (c.z > 0 && params.weights.label_shadow > 0.0f) ||
+         (c.w > 0 && params.weights.anchor_constraint > 0.0f);
+}
+
+// J's change for label i's change `change`; 0 (never a gain) when it is not possible or would
+// make more boxes share area or cover more anchors: those stay as hard as in the placement, whose
+// label shadow and anchor weights outweigh any position (a label in very salient content could
+// otherwise buy its way onto another's box).
+float tidy_delta(uint i, uint change) {
+  TidyLabel from = tidy_state(i), to = tidy_changed(i, change);
+  LabelGpu me = tidy_input(i);
+  if (change < TIDY_SWAP) {
+    bool same = change == TIDY_HIDE ? to.flags == from.flags : to.pixel == from.pixel;
+    if (same || (change == TIDY_HIDE && !tidy_may_hide(i))) return 0.0f;
+    ivec4 conflicts = tidy_conflict_change(i, from, to, TIDY_NO_PARTNER);
+    if (tidy_adds_hard(conflicts)) return 0.0f;
+    float hiding = change == TIDY_HIDE ? params.weights.label_shadow : 0.0f;
+    return (tidy_free_cost(to, me) + hiding - tidy_free(i)) + tidy_weight(conflicts);
+  }
+  uint j = change - TIDY_SWAP;
+  TidyLabel from_j = tidy_state(j), to_j = tidy_changed(j, TIDY_SWAP + i);
+  if (to.pixel == from.pixel || to_j.pixel == from_j.pixel) return 0.0f;
+  ivec4 conflicts = tidy_conflict_change(i, from, to, j) + tidy_conflict_change(j, from_j, to_j, i) +
+                    tidy_conflicts(to, to_j) - tidy_conflicts(from, from_j);
+  if (tidy_adds_hard(conflicts)) return 0.0f;
+  float before = tidy_free(i) + tidy_free(j);
+  float after = tidy_free_cost(to, me) + tidy_free_cost(to_j, tidy_input(j));
+  return (after - before) + tidy_weight(conflicts);
+}
+
+// Is i's best change a swap with j (whatever its key)?
+bool tidy_best_swaps_with(uint i, uint j) {
+  uint64_t best = tidy_best(i);
+  return best != TIDY_NONE && uint(best & 0xFFFFFFFFul) == TIDY_SWAP + j;
+}
+
+// Step 2: the change label i owns, as its partner: i itself for a move or hiding, the other
+// label of a swap; TIDY_NO_PARTNER when i owns none. (tidy_best only.)
+uint tidy_owned_partner(uint i) {
+  uint64_t best = tidy_best(i);
+  if (best == TIDY_NONE) return TIDY_NO_PARTNER;
+  uint change = uint(best & 0xFFFFFFFFul);
+  if (change < TIDY_SWAP) return i;
+  uint j = change - TIDY_SWAP;
+  return i < j && tidy_best_swaps_with(j, i) ? j : TIDY_NO_PARTNER;
+}
+
+// Step 2: label i's owner: i, the owner of the swap i is the higher label of, or TIDY_NO_PARTNER.
+uint tidy_owner(uint i) {
+  if (tidy_owned_partner(i) != TIDY_NO_PARTNER) return i;
+  uint64_t best = tidy_best(i);
+  if (best == TIDY_NONE || uint(best & 0xFFFFFFFFul) < TIDY_SWAP) return TIDY_NO_PARTNER;
+  uint j = uint(best & 0xFFFFFFFFul) - TIDY_SWAP;
+  return tidy_owned_partner(j) == i ? j : TIDY_NO_PARTNER;
+}
+
+// Step 2: label i's state after its owner's change (itself when it has no owner).
+TidyLabel tidy_after(uint i) {
+  uint owner = tidy_owner(i);
+  if (owner == TIDY_NO_PARTNER) return tidy_state(i);
+  if (owner != i) return tidy_changed(i, TIDY_SWAP + owner);
+  return tidy_changed(i, uint(tidy_best(i) & 0xFFFFFFFFul));
+}
+
+// How much more J changes with both labels a and b changed than the two changes alone counted.
+ivec4 tidy_pair_correction(uint a, uint b) {
+  TidyLabel a0 = tidy_state(a), a1 = tidy_next(a), b0 = tidy_state(b), b1 = tidy_next(b);
+  ivec4 reach = tidy_union(tidy_extent(a0), tidy_extent(a1));
+  if (!tidy_rects_touch(reach, tidy_union(tidy_extent(b0), tidy_extent(b1)))) return ivec4(0);
+  return tidy_conflicts(a1, b1) - tidy_conflicts(a1, b0) - tidy_conflicts(a0, b1) +
+         tidy_conflicts(a0, b0);
+}
+
+// Step 3: is owner i's change held back by a better owner's that interacts with it?
+bool tidy_blocked(uint i) {
+  uint64_t key = tidy_best(i);
+  uint pi = tidy_partner(i);
+  for (uint l = 0u; l < tidy_count(); ++l) {
+    uint pl = tidy_partner(l);
+    if (l == i || pl == TIDY_NO_PARTNER) continue;
+    uint64_t other = tidy_best(l);
+    if (other > key || (other == key && l > i)) continue;
+    ivec4 c = tidy_pair_correction(i, l);
+    if (pl != l) c += tidy_pair_correction(i, pl);
+    if (pi != i) {
+      c += tidy_pair_correction(pi, l);
+      if (pl != l) c += tidy_pair_correction(pi, pl);
+    }
+    if (tidy_adds_hard(c) || tidy_weight(c) > 0.0f) return true;
+  }
+  return false;
+}
