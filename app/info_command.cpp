@@ -86,8 +86,14 @@ void describe_labels(const Scene& scene, std::string& out) {
   for (const Label& l : scene.labels) {
     const std::string size = l.size == glm::vec2(0.0f) ? std::string("from the text")
                                                        : format("%gx%g", l.size.x, l.size.y);
+    std::string image;
+    if (l.image) {
+      image = format("  image %s (%ux%u, %g px high, %s)", l.image->file.filename().c_str(),
+                     l.image->pixels.width, l.image->pixels.height, l.image->height,
+                     l.image->side == LabelImage::Side::left ? "left" : "above");
+    }
     out += format("  %4d  %-24s anchor ", l.id, ("\"" + l.text + "\"").c_str()) + vec(l.anchor) +
-           "  size " + size + "\n";
+           "  size " + size + image + "\n";
   }
 }
 

@@ -95,12 +95,14 @@ void LabelledRenderer::build_labels() {
   std::vector<std::string> texts;
   for (const Label& label : scene_.labels) texts.push_back(label.text);
   const FontAtlas atlas = bake_label_texts(font, texts, style);
-  const std::vector<gpu::GlyphGpu> glyphs = build_glyph_buffer(font, atlas, texts, labels_, style);
+  const LabelImages images = bake_label_images(scene_.labels, scale);
+  const std::vector<gpu::GlyphGpu> glyphs =
+      build_glyph_buffer(font, atlas, texts, labels_, style, images.blocks);
   Parts& p = *parts_;
   p.glyphs = Buffer(ctx_, std::max<size_t>(1, glyphs.size()) * sizeof(gpu::GlyphGpu),
                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
   if (!glyphs.empty()) upload(ctx_, p.glyphs, as_bytes(glyphs));
-  p.drawing.emplace(ctx_, atlas);
+  p.drawing.emplace(ctx_, atlas, images.atlas);
   p.drawing->set_label_count(uint32_t(labels_.size()));
 }
 
@@ -374,6 +376,7 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
     LabelLayout l;
     l.id = scene_.labels[i].id;
     l.text = scene_.labels[i].text;
+    if (const auto& image = scene_.labels[i].image) l.image = image->file.string();
     l.layer = labels_[i].layer;
     l.anchor = labels_[i].anchor;
     l.box_size = labels_[i].size;
@@ -438,17 +441,19 @@ std::string layout_json(const LabelledFrame& frame) {
   using ordered_json = nlohmann::ordered_json;
   ordered_json labels = ordered_json::array();
   for (const LabelLayout& l : frame.labels) {
-    labels.push_back({{"id", l.id},
-                      {"text", l.text},
-                      {"layer", l.layer},
-                      {"anchor", {shortest_double(l.anchor.x), shortest_double(l.anchor.y)}},
-                      {"box",
-                       {shortest_double(l.box_origin.x), shortest_double(l.box_origin.y),
-                        shortest_double(l.box_size.x), shortest_double(l.box_size.y)}},
-                      {"shown", l.shown},
-                      {"placed", l.placed},
-                      {"visible", shortest_double(l.visible)},
-                      {"cost", shortest_double(l.cost)}});
+    ordered_json entry = {{"id", l.id},
+                          {"text", l.text},
+                          {"layer", l.layer},
+                          {"anchor", {shortest_double(l.anchor.x), shortest_double(l.anchor.y)}},
+                          {"box",
+                           {shortest_double(l.box_origin.x), shortest_double(l.box_origin.y),
+                            shortest_double(l.box_size.x), shortest_double(l.box_size.y)}},
+                          {"shown", l.shown},
+                          {"placed", l.placed},
+                          {"visible", shortest_double(l.visible)},
+                          {"cost", shortest_double(l.cost)}};
+    if (!l.image.empty()) entry["image"] = l.image;
+    labels.push_back(std::move(entry));
   }
   const ordered_json layout = {
       {"width", frame.size.width}, {"height", frame.size.height}, {"labels", labels}};

@@ -48,6 +48,7 @@ struct LabellingSettings {
 struct LabelLayout {
   int id = 0;
   std::string text;
+  std::string image;  // the picture's file, as the scene resolved it; empty: none
   uint32_t layer = 0;
   glm::vec2 anchor{0.0f};  // pixels
   glm::vec2 box_origin{0.0f};

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "engine/core/error.h"
+#include "engine/core/image.h"
 
 namespace strata {
 
@@ -56,25 +57,70 @@ FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,
   return font.bake(keys);
 }
 
+LabelImages bake_label_images(std::span<const Label> labels, float scale) {
+  LabelImages out;
+  std::vector<Rgba8Image> drawn;
+  for (const Label& label : labels) {
+    if (!label.image) {
+      out.blocks.emplace_back();
+      continue;
+    }
+    const Rgba8Image& pixels = label.image->pixels;
+    const float height = std::max(1.0f, std::round(label.image->height * scale));
+    const float width =
+        std::max(1.0f, std::round(height * float(pixels.width) / float(pixels.height)));
+    drawn.push_back(resized_premultiplied(pixels, uint32_t(width), uint32_t(height)));
+    out.blocks.push_back(
+        LabelImageBlock{{width, height}, label.image->side == LabelImage::Side::left, {}});
+  }
+  out.atlas = pack_image_atlas(drawn);
+  size_t next = 0;
+  for (auto& block : out.blocks) {
+    if (block) block->atlas = out.atlas.rects[next++];
+  }
+  return out;
+}
+
 LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std::string_view text,
-                                  const TextStyle& style, glm::vec2 min_size) {
+                                  const TextStyle& style, glm::vec2 min_size,
+                                  const std::optional<LabelImageBlock>& image) {
   const std::vector<ShapedLine> lines = shape_label_text(font, text, style);
   float widest = 0.0f;
   for (const ShapedLine& line : lines) widest = std::max(widest, line.advance);
   const float spacing = std::round(font.line_spacing());
   const float text_height = font.line_height() + spacing * float(lines.size() - 1);
 
+  // The text's own box; a picture adds a strip above or left of it (its padding on the far side
+  // comes from the text box, or from the text box's padding alone when there is no text).
+  glm::vec2 text_box(std::max(std::ceil(widest + 2.0f * style.padding_x), style.min_width),
+                     std::ceil(text_height + 2.0f * style.padding_y));
+  if (image && text.empty()) text_box = {style.padding_x, style.padding_y};
+  const glm::vec2 padding = glm::round(glm::vec2(style.padding_x, style.padding_y));
+  glm::vec2 strip(0.0f), box = text_box;
+  if (image && image->left) {
+    strip.x = padding.x + image->size.x;
+    box = {strip.x + text_box.x, std::max(text_box.y, image->size.y + 2.0f * padding.y)};
+  } else if (image) {
+    strip.y = padding.y + image->size.y;
+    box = {std::max(text_box.x, image->size.x + 2.0f * padding.x), strip.y + text_box.y};
+  }
+
   LabelTextLayout out;
   out.lines = lines.size();
-  out.size.x = std::max({std::ceil(widest + 2.0f * style.padding_x), style.min_width, min_size.x});
-  out.size.y = std::max(std::ceil(text_height + 2.0f * style.padding_y), min_size.y);
-  out.size = glm::ceil(out.size);
+  out.size = glm::ceil(glm::max(glm::max(box, min_size), glm::vec2(style.min_width, 0.0f)));
+  if (image) {
+    const glm::vec2 at =
+        image->left ? glm::vec2(padding.x, std::round(0.5f * (out.size.y - image->size.y)))
+                    : glm::vec2(std::round(0.5f * (out.size.x - image->size.x)), padding.y);
+    out.image = gpu::GlyphGpu{image->atlas, glm::vec4(at, at + image->size)};
+  }
 
   // Glyphs sit on whole pixels: with quads aligned to the texel grid, a box at a whole-pixel
   // position samples texel centres and the text stays sharp.
-  float baseline = std::round(0.5f * (out.size.y - text_height) + font.ascent());
+  const glm::vec2 region = out.size - strip;  // what the text is centred in
+  float baseline = strip.y + std::round(0.5f * (region.y - text_height) + font.ascent());
   for (const ShapedLine& line : lines) {
-    const float start = std::round(0.5f * (out.size.x - line.advance));
+    const float start = strip.x + std::round(0.5f * (region.x - line.advance));
     for (const ShapedGlyph& shaped : line.glyphs) {
       const GlyphMetrics g = atlas.glyph(shaped.key);
       if (g.empty()) continue;
@@ -86,22 +132,26 @@ LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std:
   return out;
 }
 
-std::vector<gpu::GlyphGpu> build_glyph_buffer(const Font& font, const FontAtlas& atlas,
-                                              std::span<const std::string> texts,
-                                              std::span<gpu::LabelGpu> labels,
-                                              const TextStyle& style) {
-  if (texts.size() != labels.size()) {
-    throw Error("labels: " + std::to_string(texts.size()) + " texts for " +
-                std::to_string(labels.size()) + " labels");
+std::vector<gpu::GlyphGpu> build_glyph_buffer(
+    const Font& font, const FontAtlas& atlas, std::span<const std::string> texts,
+    std::span<gpu::LabelGpu> labels, const TextStyle& style,
+    std::span<const std::optional<LabelImageBlock>> images) {
+  if (texts.size() != labels.size() || (!images.empty() && images.size() != labels.size())) {
+    throw Error("labels: " + std::to_string(texts.size()) + " texts and " +
+                std::to_string(images.size()) + " images for " + std::to_string(labels.size()) +
+                " labels");
   }
   std::vector<gpu::GlyphGpu> glyphs;
   for (size_t i = 0; i < texts.size(); ++i) {
     gpu::LabelGpu& label = labels[i];
-    const LabelTextLayout layout = layout_label_text(font, atlas, texts[i], style, label.size);
+    const LabelTextLayout layout = layout_label_text(font, atlas, texts[i], style, label.size,
+                                                     images.empty() ? std::nullopt : images[i]);
     label.size = layout.size;
     label.glyph_first = static_cast<uint32_t>(glyphs.size());
     label.glyph_count = static_cast<uint32_t>(layout.glyphs.size());
+    label.image_quads = layout.image ? 1u : 0u;
     glyphs.insert(glyphs.end(), layout.glyphs.begin(), layout.glyphs.end());
+    if (layout.image) glyphs.push_back(*layout.image);
   }
   return glyphs;
 }

@@ -1,9 +1,10 @@
 // Label text as boxes and glyphs: the lines of a text (split at "\n", wrapped at a maximum width,
 // shaped by the font), the label box they need plus padding, and each glyph's quad in that box
 // with its rectangle in the font atlas, as the label drawing pass (passes/label_drawing.h) reads
-// them.
+// them. A label's picture, when it has one, takes a strip of the box above or left of the text.
 #pragma once
 
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -12,6 +13,8 @@
 #include <glm/glm.hpp>
 
 #include "engine/core/font.h"
+#include "engine/core/image_atlas.h"
+#include "engine/scene/scene.h"
 #include "shared/labels.h"
 
 namespace strata {
@@ -27,12 +30,28 @@ struct TextStyle {
   TextStyle scaled(float s) const;
 };
 
+// A label's picture as the layout places it.
+struct LabelImageBlock {
+  glm::vec2 size{0.0f};   // drawn size, whole pixels
+  bool left = false;      // left of the text; else above it
+  glm::vec4 atlas{0.0f};  // u0, v0, u1, v1 in the image atlas
+};
+
 struct LabelTextLayout {
   glm::vec2 size{0.0f};               // the label box, whole pixels
   std::vector<gpu::GlyphGpu> glyphs;  // quads relative to the box's top-left corner; glyphs
                                       // without ink (spaces) have none
   size_t lines = 0;
+  std::optional<gpu::GlyphGpu> image;  // the picture's quad, in the image atlas
 };
+
+// The pictures of `labels` (none for a label without one) at `scale` times their height, in one
+// atlas, and where each lies in it.
+struct LabelImages {
+  ImageAtlas atlas;
+  std::vector<std::optional<LabelImageBlock>> blocks;  // one per label
+};
+LabelImages bake_label_images(std::span<const Label> labels, float scale);
 
 // The lines of `text` (UTF-8), shaped: split at "\n", each wrapped at style.max_width at spaces
 // (a word wider than that keeps a line of its own).
@@ -45,16 +64,19 @@ FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,
 
 // The box for `text` and its glyphs (from `atlas`, which holds them: bake_label_texts), each line
 // centred in the box. The box is at least `min_size` (zero: from the text alone), so a label's
-// given size is kept.
+// given size is kept. With an image, the box holds it (padding around it, centred across the
+// box) above or left of the text, and the text is centred in the rest.
 LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std::string_view text,
-                                  const TextStyle& style = {}, glm::vec2 min_size = glm::vec2(0));
+                                  const TextStyle& style = {}, glm::vec2 min_size = glm::vec2(0),
+                                  const std::optional<LabelImageBlock>& image = std::nullopt);
 
-// The glyph buffer for labels[i] showing texts[i]: every label's glyphs one after the other.
-// Sets each label's glyph_first, glyph_count and size (its size on entry is kept as a minimum, so
-// 0 means "from the text"). texts and labels have the same length.
-std::vector<gpu::GlyphGpu> build_glyph_buffer(const Font& font, const FontAtlas& atlas,
-                                              std::span<const std::string> texts,
-                                              std::span<gpu::LabelGpu> labels,
-                                              const TextStyle& style = {});
+// The glyph buffer for labels[i] showing texts[i] (and images[i], when images is not empty):
+// every label's glyphs one after the other, then its picture's quad. Sets each label's
+// glyph_first, glyph_count, image_quads and size (its size on entry is kept as a minimum, so 0
+// means "from the text"). texts, labels and a non-empty images have the same length.
+std::vector<gpu::GlyphGpu> build_glyph_buffer(
+    const Font& font, const FontAtlas& atlas, std::span<const std::string> texts,
+    std::span<gpu::LabelGpu> labels, const TextStyle& style = {},
+    std::span<const std::optional<LabelImageBlock>> images = {});
 
 }  // namespace strata

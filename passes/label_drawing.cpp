@@ -22,6 +22,7 @@ using glm::ivec2;  // the software sampler's texel coordinates, by their GLSL na
 struct LabelDrawReference {
   const LabelDrawData& data;
   const FontAtlas& font;
+  const ImageAtlas& images;
 
   uint label_count() const {
     return static_cast<uint>(std::min(data.labels.size(), data.placements.size()));
@@ -47,20 +48,42 @@ struct LabelDrawReference {
     return mix(top, bottom, f.y);
   }
 
+  vec4 image_texel(ivec2 p) const {
+    const ivec2 c = clamp(p, ivec2(0), ivec2(images.width, images.height) - 1);
+    const size_t at = (size_t(c.y) * images.width + size_t(c.x)) * 4;
+    return vec4(images.texels[at], images.texels[at + 1], images.texels[at + 2],
+                images.texels[at + 3]) /
+           255.0f;
+  }
+  vec4 image_texel(vec2 uv) const {
+    const vec2 x = uv * vec2(images.width, images.height) - 0.5f;
+    const vec2 base = floor(x);
+    const vec2 f = x - base;
+    const ivec2 i = ivec2(base);
+    const vec4 top = mix(image_texel(i), image_texel(i + ivec2(1, 0)), f.x);
+    const vec4 bottom = mix(image_texel(i + ivec2(0, 1)), image_texel(i + ivec2(1, 1)), f.x);
+    return mix(top, bottom, f.y);
+  }
+
 #include "shared/label_draw_pixel.h"
 };
 
 }  // namespace
 }  // namespace gpu
 
-LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font)
+LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas& images)
     : atlas_(ctx, {VK_FORMAT_R8_UNORM,
                    {font.width, font.height, 1},
                    VK_IMAGE_TYPE_2D,
                    VK_IMAGE_USAGE_SAMPLED_BIT}),
+      images_(ctx, {VK_FORMAT_R8G8B8A8_UNORM,
+                    {images.width, images.height, 1},
+                    VK_IMAGE_TYPE_2D,
+                    VK_IMAGE_USAGE_SAMPLED_BIT}),
       draw_(ctx, "label_draw.comp"),
       composite_(ctx, "label_composite.comp") {
   upload(ctx, atlas_, as_bytes(font.coverage), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  upload(ctx, images_, as_bytes(images.texels), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
 gpu::LabelDrawParams LabelDrawing::params(graph::Extent viewport) const {
@@ -84,6 +107,12 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
                             .format = VK_FORMAT_R8_UNORM,
                             .has_content = true,
                             .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  const ResourceId images = graph.import_image(
+      "labels.image_atlas", {.image = images_.handle(),
+                             .view = images_.view(),
+                             .format = VK_FORMAT_R8G8B8A8_UNORM,
+                             .has_content = true,
+                             .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
   graph.add_pass(
       {"labels.draw",
        graph::PassKind::compute,
@@ -91,7 +120,8 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
         {in.labels, Use::storage_read, LABEL_DRAW_BINDING_LABELS},
         {in.placements, Use::storage_read, LABEL_DRAW_BINDING_PLACEMENTS},
         {in.glyphs, Use::storage_read, LABEL_DRAW_BINDING_GLYPHS},
-        {atlas, Use::sampled, LABEL_DRAW_BINDING_ATLAS}},
+        {atlas, Use::sampled, LABEL_DRAW_BINDING_ATLAS},
+        {images, Use::sampled, LABEL_DRAW_BINDING_IMAGES}},
        [this](graph::PassContext& pc) {
          pc.dispatch(draw_, params(pc.viewport), {pc.viewport.width, pc.viewport.height, 1});
        },
@@ -127,9 +157,9 @@ void check_layers(std::span<const glm::vec4> layers, graph::Extent size, uint32_
 
 std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, graph::Extent size,
                                              uint32_t layer_count, const LabelDrawData& data,
-                                             const FontAtlas& font) {
+                                             const FontAtlas& font, const ImageAtlas& images) {
   check_layers(layers, size, layer_count);
-  gpu::LabelDrawReference reference{data, font};
+  gpu::LabelDrawReference reference{data, font, images};
   std::vector<glm::vec4> out(layers.size());
   size_t i = 0;
   for (uint32_t l = 0; l < layer_count; ++l) {

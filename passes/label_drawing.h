@@ -14,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include "engine/core/font.h"
+#include "engine/core/image_atlas.h"
 #include "engine/gpu/resources.h"
 #include "engine/gpu/shader_library.h"
 #include "engine/graph/graph_runner.h"
@@ -24,8 +25,8 @@ namespace strata {
 
 class LabelDrawing {
  public:
-  // Uploads the font's atlas once.
-  LabelDrawing(Context& ctx, const FontAtlas& font);
+  // Uploads the font's atlas and the labels' pictures once.
+  LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas& images = {});
 
   struct Inputs {
     graph::ResourceId layers;  // the renderer's rgba16f array image, read and written in place
@@ -36,7 +37,7 @@ class LabelDrawing {
     graph::ResourceId output;      // a viewport-sized rgba8 image the composite overwrites
     glm::vec3 background{0.0f};
   };
-  // Adds both passes; the font atlas is imported with its handle.
+  // Adds both passes; the font and image atlases are imported with their handles.
   void add_to(graph::Graph& graph, const Inputs& in);
 
   // How many labels of the labels buffer to draw (read when the graph is recorded); the shader
@@ -50,6 +51,7 @@ class LabelDrawing {
   gpu::LabelDrawParams params(graph::Extent viewport) const;
 
   Image atlas_;
+  Image images_;
   ComputePipeline draw_;
   ComputePipeline composite_;
   uint32_t layer_count_ = 0;
@@ -71,7 +73,7 @@ struct LabelDrawData {
 // precision as the GPU's rgba16f layers store it.
 std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, graph::Extent size,
                                              uint32_t layer_count, const LabelDrawData& data,
-                                             const FontAtlas& font);
+                                             const FontAtlas& font, const ImageAtlas& images = {});
 
 // labels.composite on the CPU: rgba8, rows top to bottom, with the rear labels' connectors and
 // anchors drawn again where the layers in front hide them (label_behind).

@@ -15,8 +15,8 @@ packages=(
   # label text (engine/core/font.cpp): faces read and rasterised by FreeType, shaped by HarfBuzz;
   # DejaVu Sans, FreeSans and FreeSerif for characters it lacks
   libfreetype-dev libharfbuzz-dev fonts-dejavu-core fonts-freefont-ttf
-  # file formats: gzip, DICOM, meshes, JSON, XML
-  zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev
+  # file formats: gzip, DICOM, meshes, JSON, XML, JPEG (label pictures)
+  zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev libjpeg62-turbo-dev
   # videos: H.264 in MP4 through FFmpeg's libraries; ffprobe checks them in the tests
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
   # window tests without a display

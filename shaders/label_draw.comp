@@ -13,6 +13,7 @@ layout(binding = LABEL_DRAW_BINDING_PLACEMENTS, std430) readonly buffer Placemen
 };
 layout(binding = LABEL_DRAW_BINDING_GLYPHS, std430) readonly buffer Glyphs { GlyphGpu glyphs[]; };
 layout(binding = LABEL_DRAW_BINDING_ATLAS) uniform sampler2D atlas;
+layout(binding = LABEL_DRAW_BINDING_IMAGES) uniform sampler2D images;
 layout(push_constant) uniform Push { LabelDrawParams params; };
 
 // Never past the end of either buffer, whatever the host says.
@@ -23,6 +24,7 @@ LabelGpu label_at(uint i) { return labels[i]; }
 PlacementGpu placement_at(uint i) { return placements[i]; }
 GlyphGpu glyph_at(uint i) { return glyphs[i]; }
 float atlas_coverage(vec2 uv) { return textureLod(atlas, uv, 0.0).r; }
+vec4 image_texel(vec2 uv) { return textureLod(images, uv, 0.0); }
 bool layer_frames() { return params.layer_frames != 0u; }
 
 #include "shared/label_draw_pixel.h"

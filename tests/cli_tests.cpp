@@ -290,6 +290,43 @@ TEST_SUITE("cli") {
     CHECK(bad.output.find("--label-scale") != std::string::npos);
   }
 
+  // The demo scene with pictures (a JPEG above a label's text, a PNG left of another's): its
+  // layout notes each picture and gives those labels the taller or wider boxes.
+  TEST_CASE("render_of_a_scene_with_label_pictures_lays_them_out") {
+    const std::filesystem::path folder = test::fresh_folder("cli", "label_pictures");
+    const std::string layout = (folder / "layout.json").string();
+    const auto r =
+        run_strata("render " STRATA_SOURCE_DIR "/assets/scenes/head-images.json --size 128 -o " +
+                   (folder / "head.png").string() + " --layout " + layout);
+    REQUIRE(r.exit_code == 0);
+    const nlohmann::json labels = nlohmann::json::parse(test::read_file(layout))["labels"];
+    int pictures = 0;
+    for (const auto& label : labels) {
+      if (!label.contains("image")) {
+        CHECK(label["box"][3] == 20);  // one line of text
+        continue;
+      }
+      ++pictures;
+      const std::string image = label["image"];
+      CHECK(std::filesystem::exists(image));
+      CHECK(label["box"][3].get<double>() >= 48.0 + 6.0);  // the picture and its padding
+    }
+    CHECK(pictures == 2);
+  }
+
+  TEST_CASE("a_label_picture_that_cannot_be_read_is_one_error_naming_the_label") {
+    const std::filesystem::path folder = test::fresh_folder("cli", "bad_label_picture");
+    const std::filesystem::path scene =
+        test::write_file(folder / "scene.json", R"({"strata_scene": 1, "labels": [
+          {"id": 1, "text": "a", "anchor": [0, 0, 0], "image": "notes.png"}]})");
+    test::write_file(folder / "notes.png", "not a picture");
+    const auto r = run_strata("render " + scene.string() + " --size 64 -o /dev/null");
+    CHECK(r.exit_code == 1);
+    CHECK(r.output.find("strata: error: " + scene.string() +
+                        ": labels[0].image: " + (folder / "notes.png").string() +
+                        ": not a PNG or JPEG file") != std::string::npos);
+  }
+
   TEST_CASE("bad_sizes_and_unwritable_outputs_are_errors_naming_the_culprit") {
     const auto size = run_strata("render --size 0x10 -o /dev/null");
     CHECK(size.exit_code == 1);

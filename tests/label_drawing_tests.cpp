@@ -9,6 +9,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -19,6 +20,7 @@
 
 #include "engine/core/error.h"
 #include "engine/core/font.h"
+#include "engine/core/image_atlas.h"
 #include "engine/core/png.h"
 #include "engine/gpu/resources.h"
 #include "engine/graph/graph_runner.h"
@@ -62,6 +64,7 @@ struct LabelScene {
   std::vector<gpu::GlyphGpu> glyphs;
   glm::vec3 background{0.2f, 0.25f, 0.3f};
   bool layer_frames = false;
+  ImageAtlas images;  // the labels' pictures (none: one transparent texel)
 
   size_t pixels() const { return size_t{size.width} * size.height; }
   glm::vec4& at(uint32_t layer, uint32_t x, uint32_t y) {
@@ -139,7 +142,7 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
   const Buffer labels = storage_buffer(ctx, as_bytes(s.labels));
   const Buffer placements = storage_buffer(ctx, as_bytes(s.placements));
   const Buffer glyphs = storage_buffer(ctx, as_bytes(s.glyphs));
-  LabelDrawing drawing(ctx, test_atlas());
+  LabelDrawing drawing(ctx, test_atlas(), s.images);
   drawing.set_label_count(static_cast<uint32_t>(s.labels.size()));
   drawing.set_layer_frames(s.layer_frames);
 
@@ -179,7 +182,8 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
 
 std::vector<glm::vec4> reference_layers(const LabelScene& s) {
   return draw_labels_reference(s.layers, s.size, s.layer_count,
-                               {s.labels, s.placements, s.glyphs, s.layer_frames}, test_atlas());
+                               {s.labels, s.placements, s.glyphs, s.layer_frames}, test_atlas(),
+                               s.images);
 }
 
 // The largest difference per channel, and where it is.
@@ -222,6 +226,38 @@ glm::uvec2 brightest_text_pixel(const LabelScene& s, const std::vector<glm::vec4
     }
   }
   return best;
+}
+
+// Four flat quadrants, 32x32 texels, opaque: red, green / blue, yellow.
+const std::array<glm::vec4, 4> kQuadrants = {
+    glm::vec4(0.86f, 0.12f, 0.12f, 1.0f), glm::vec4(0.12f, 0.78f, 0.16f, 1.0f),
+    glm::vec4(0.16f, 0.24f, 0.82f, 1.0f), glm::vec4(0.9f, 0.86f, 0.16f, 1.0f)};
+
+Rgba8Image quadrant_picture(uint32_t width = 32, uint32_t height = 32) {
+  Rgba8Image image{width, height, std::vector<uint8_t>(size_t{width} * height * 4)};
+  for (uint32_t y = 0; y < height; ++y) {
+    for (uint32_t x = 0; x < width; ++x) {
+      const glm::vec4 c = kQuadrants[(2 * y / height) * 2 + 2 * x / width];
+      for (uint32_t k = 0; k < 4; ++k)
+        image.pixels[(size_t{y} * width + x) * 4 + k] = uint8_t(std::lround(c[int(k)] * 255.0f));
+    }
+  }
+  return image;
+}
+
+Label picture_label(float height, LabelImage::Side side, uint32_t width = 32) {
+  Label label;
+  label.image = LabelImage{"quadrants.png", quadrant_picture(width), height, side};
+  return label;
+}
+
+// The pixel centre at the middle of quadrant q of label i's picture, as drawn.
+glm::uvec2 quadrant_pixel(const LabelScene& s, size_t i, int q) {
+  const gpu::LabelGpu& label = s.labels[i];
+  const glm::vec4 box = s.glyphs[label.glyph_first + label.glyph_count].box;
+  const glm::vec2 top_left = s.placements[i].position - 0.5f * label.size;
+  const glm::vec2 f(q % 2 ? 0.75f : 0.25f, q / 2 ? 0.75f : 0.25f);
+  return glm::uvec2(top_left + glm::mix(glm::vec2(box), glm::vec2(box.z, box.w), f));
 }
 
 }  // namespace
@@ -444,6 +480,83 @@ TEST_SUITE("cpu") {
     }
   }
 
+  // The box holds the picture above the text (centred across the box) or left of it (centred
+  // down the box), with the text's padding around it; the text moves out of its way.
+  TEST_CASE("text_layout_holds_a_picture_above_or_left_of_the_text") {
+    const Font& font = test_font();
+    const FontAtlas& atlas = test_atlas();
+    const TextStyle style;
+    const LabelTextLayout text = layout_label_text(font, atlas, "Pons");
+    const LabelImageBlock picture{{40.0f, 24.0f}, false, {0.1f, 0.2f, 0.3f, 0.4f}};
+    const LabelTextLayout above = layout_label_text(font, atlas, "Pons", style, {}, picture);
+    CHECK(above.size ==
+          glm::vec2(40.0f + 2.0f * style.padding_x, text.size.y + 24.0f + style.padding_y));
+    REQUIRE(above.image);
+    CHECK(above.image->atlas == picture.atlas);
+    CHECK(above.image->box == glm::vec4(std::round(0.5f * (above.size.x - 40.0f)), style.padding_y,
+                                        std::round(0.5f * (above.size.x - 40.0f)) + 40.0f,
+                                        style.padding_y + 24.0f));
+    REQUIRE(above.glyphs.size() == text.glyphs.size());
+    for (size_t g = 0; g < text.glyphs.size(); ++g) {
+      CHECK(above.glyphs[g].box.y == text.glyphs[g].box.y + 24.0f + style.padding_y);
+      CHECK(above.glyphs[g].box.y >= above.image->box.w);
+    }
+
+    LabelImageBlock beside = picture;
+    beside.left = true;
+    beside.size = {20.0f, 40.0f};  // taller than the text
+    const LabelTextLayout left = layout_label_text(font, atlas, "Pons", style, {}, beside);
+    CHECK(left.size ==
+          glm::vec2(style.padding_x + 20.0f + text.size.x, 40.0f + 2.0f * style.padding_y));
+    REQUIRE(left.image);
+    CHECK(left.image->box == glm::vec4(style.padding_x, style.padding_y, style.padding_x + 20.0f,
+                                       style.padding_y + 40.0f));
+    for (size_t g = 0; g < text.glyphs.size(); ++g) {
+      CHECK(left.glyphs[g].box.x == text.glyphs[g].box.x + 20.0f + style.padding_x);
+      CHECK(left.glyphs[g].box.x >= left.image->box.z);
+    }
+
+    // No text: the picture and its padding. A given size is still a minimum.
+    const LabelTextLayout alone = layout_label_text(font, atlas, "", style, {}, picture);
+    CHECK(alone.size == glm::vec2(40.0f + 2.0f * style.padding_x, 24.0f + 2.0f * style.padding_y));
+    CHECK(layout_label_text(font, atlas, "Pons", style, {300.0f, 100.0f}, picture).size ==
+          glm::vec2(300.0f, 100.0f));
+    CHECK_FALSE(text.image);
+  }
+
+  TEST_CASE("label_pictures_are_baked_at_their_height_times_the_scale_with_their_aspect") {
+    std::vector<Label> labels(3);
+    labels[0] = picture_label(20.0f, LabelImage::Side::above, 64);  // 64 x 32 texels
+    labels[2] = picture_label(16.0f, LabelImage::Side::left);
+    const LabelImages images = bake_label_images(labels, 1.5f);
+    REQUIRE(images.blocks.size() == 3);
+    REQUIRE(images.blocks[0]);
+    CHECK(images.blocks[0]->size == glm::vec2(60.0f, 30.0f));
+    CHECK_FALSE(images.blocks[0]->left);
+    CHECK_FALSE(images.blocks[1]);
+    REQUIRE(images.blocks[2]);
+    CHECK(images.blocks[2]->size == glm::vec2(24.0f, 24.0f));
+    CHECK(images.blocks[2]->left);
+    REQUIRE(images.atlas.rects.size() == 2);
+    CHECK(images.blocks[2]->atlas == images.atlas.rects[1]);
+    const glm::vec4 r = images.blocks[0]->atlas;
+    CHECK((r.z - r.x) * float(images.atlas.width) == doctest::Approx(60.0f));
+    CHECK((r.w - r.y) * float(images.atlas.height) == doctest::Approx(30.0f));
+
+    // In the glyph buffer: the picture's quad after the label's glyphs.
+    std::vector<gpu::LabelGpu> gpu_labels(3);
+    const std::vector<std::string> texts = {"Insula", "Pons", "Cortex"};
+    const std::vector<gpu::GlyphGpu> glyphs =
+        build_glyph_buffer(test_font(), test_atlas(), texts, gpu_labels, {}, images.blocks);
+    CHECK(gpu_labels[0].image_quads == 1);
+    CHECK(gpu_labels[1].image_quads == 0);
+    CHECK(gpu_labels[1].glyph_first == 7);
+    CHECK(gpu_labels[2].glyph_first == 11);
+    CHECK(glyphs[6].atlas == images.blocks[0]->atlas);
+    CHECK(glyphs.size() == 6 + 1 + 4 + 6 + 1);
+    CHECK(gpu_labels[0].size.y > 30.0f + test_font().line_height());
+  }
+
   TEST_CASE("glyph_buffer_gives_each_label_its_range_and_size") {
     std::vector<gpu::LabelGpu> labels(3);
     labels[2].size = {150.0f, 0.0f};
@@ -600,6 +713,55 @@ TEST_SUITE("gpu") {
     CHECK(worst_difference(gpu.layers, reference_layers(s), where) <= kTolerance);
     s.layer_frames = false;
     CHECK(worst_difference(gpu.layers, reference_layers(s), where) > 0.1f);
+  }
+
+  // The acceptance test of labels with pictures: two labels, a picture above the text (at a
+  // whole-pixel position: a texel per pixel) and one left of it (at a half-pixel position: each
+  // pixel filtered between texels, the picture's edges half covered), drawn as the reference
+  // draws them, and each quadrant's colour found where the picture lies in the box.
+  TEST_CASE_FIXTURE(test::GpuTest, "an_image_label_draws_its_image") {
+    LabelScene s = make_scene();
+    const std::vector<Label> pictures = {picture_label(24.0f, LabelImage::Side::above),
+                                         picture_label(16.0f, LabelImage::Side::left)};
+    const LabelImages images = bake_label_images(pictures, 1.0f);
+    s.images = images.atlas;
+    s.labels = {label_on(2, {20.0f, 80.0f}), label_on(1, {100.0f, 88.0f})};
+    s.placements = {{{30.0f, 30.0f}, 0.0f, PLACEMENT_SHOWN},
+                    {{76.5f, 61.5f}, 0.0f, PLACEMENT_SHOWN}};
+    const std::vector<std::string> texts = {"Cortex", "Pons"};
+    s.glyphs = build_glyph_buffer(test_font(), test_atlas(), texts, s.labels, {}, images.blocks);
+    REQUIRE(s.labels[0].image_quads == 1);
+    REQUIRE(s.labels[1].image_quads == 1);
+
+    const DrawnLabels gpu = draw_on_gpu(ctx, s);
+    const std::vector<glm::vec4> expected = reference_layers(s);
+    size_t where = 0;
+    const float worst = worst_difference(gpu.layers, expected, where);
+    CHECK_MESSAGE(worst <= kTolerance,
+                  "layer pixel " << where << " differs by " << worst * 255.0f << "/255");
+    const std::vector<uint8_t> final_expected = composite_reference(
+        expected, s.size, s.layer_count, s.background, {s.labels, s.placements, s.glyphs});
+    CHECK(worst_difference(gpu.final, final_expected) <= 2);
+
+    // The picture in each label's own layer (label 0 lies under the front layer's blue), and
+    // in the final image where nothing lies in front of it (label 1).
+    for (size_t i = 0; i < 2; ++i) {
+      for (int q = 0; q < 4; ++q) {
+        CAPTURE(i);
+        CAPTURE(q);
+        const glm::uvec2 p = quadrant_pixel(s, i, q);
+        const glm::vec4 drawn =
+            gpu.layers[s.labels[i].layer * s.pixels() + size_t{p.y} * s.size.width + p.x];
+        CHECK(glm::all(glm::lessThan(glm::abs(drawn - kQuadrants[size_t(q)]), glm::vec4(0.01f))));
+        if (i == 1) {
+          const glm::vec4 shown = final_pixel(s, gpu.final, p);
+          CHECK(glm::all(glm::lessThan(glm::abs(shown - kQuadrants[size_t(q)]), glm::vec4(0.01f))));
+        }
+      }
+    }
+    if (std::getenv("STRATA_KEEP_IMAGES")) {
+      write_png(test::output_dir() + "/image_labels.png", s.size.width, s.size.height, gpu.final);
+    }
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "label_with_a_hidden_placement_draws_nothing") {

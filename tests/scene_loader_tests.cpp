@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "engine/core/error.h"
+#include "engine/core/png.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
 #include "engine/scene/io/volume_loader.h"
@@ -376,6 +377,71 @@ TEST_SUITE("loaders") {
     CHECK(error_of([&] { strata::load_scene(unknown); }) ==
           unknown.string() +
               ": unknown scene format '.yaml' (expected .json, or .xml from the thesis program)");
+  }
+
+  TEST_CASE("json_scene_label_image_is_read_with_its_height_and_side") {
+    const fs::path folder = test_folder("label_image");
+    const std::vector<uint8_t> pixels = {255, 0, 0,   255, 0, 255, 0, 128,  //
+                                         0,   0, 255, 255, 9, 9,   9, 0,    //
+                                         1,   2, 3,   4,   5, 6,   7, 8};
+    fs::create_directories(folder / "pictures");
+    strata::write_png((folder / "pictures/p.png").string(), 2, 3, pixels);
+    const fs::path path = write_file(folder / "scenes/scene.json", R"({"strata_scene": 1,
+      "labels": [{"id": 1, "text": "Photo", "anchor": [0, 0, 0], "image": "../pictures/p.png"},
+                 {"id": 2, "text": "Side", "anchor": [0, 0, 0], "image": "../pictures/p.png",
+                  "image_height": 40, "image_side": "left"},
+                 {"id": 3, "text": "None", "anchor": [0, 0, 0]}]})");
+    const strata::Scene scene = strata::load_scene(path);
+    REQUIRE(scene.labels.size() == 3);
+    REQUIRE(scene.labels[0].image);
+    const strata::LabelImage& above = *scene.labels[0].image;
+    CHECK(above.file == (folder / "pictures/p.png").lexically_normal());
+    CHECK(above.pixels.width == 2);
+    CHECK(above.pixels.height == 3);
+    CHECK(above.pixels.pixels == pixels);  // straight alpha, as in the file
+    CHECK(above.height == 64.0f);
+    CHECK(above.side == strata::LabelImage::Side::above);
+    REQUIRE(scene.labels[1].image);
+    CHECK(scene.labels[1].image->height == 40.0f);
+    CHECK(scene.labels[1].image->side == strata::LabelImage::Side::left);
+    CHECK_FALSE(scene.labels[2].image);
+
+    // Written and read back: the picture's path relative to the new file, height and side kept.
+    const fs::path saved = folder / "out/saved.json";
+    fs::create_directories(saved.parent_path());
+    strata::save_scene_json(saved, scene);
+    CHECK(read_text(saved).find("\"image\": \"../pictures/p.png\"") != std::string::npos);
+    const strata::Scene back = strata::load_scene(saved);
+    REQUIRE(back.labels[1].image);
+    CHECK(back.labels[1].image->pixels.pixels == pixels);
+    CHECK(back.labels[1].image->height == 40.0f);
+    CHECK(back.labels[1].image->side == strata::LabelImage::Side::left);
+    CHECK_FALSE(back.labels[2].image);
+  }
+
+  TEST_CASE("json_scene_label_image_errors_name_the_label_field") {
+    const fs::path folder = test_folder("bad_label_image");
+    write_file(folder / "notes.png", "not a picture");
+    const std::string prefix = (folder / "s.json").string() + ": labels[0].";
+    const auto load = [&](const std::string& image_fields) {
+      const fs::path path = write_file(folder / "s.json",
+                                       R"({"strata_scene": 1, "labels": [{"id": 1, "text": "a",
+                                           "anchor": [0, 0, 0], )" +
+                                           image_fields + "}]}");
+      return error_of([&] { strata::load_scene(path); });
+    };
+    CHECK(load(R"("image": "missing.png")") ==
+          prefix + "image: " + (folder / "missing.png").string() + ": no such file");
+    CHECK(load(R"("image": "notes.png")") ==
+          prefix + "image: " + (folder / "notes.png").string() + ": not a PNG or JPEG file");
+    CHECK(load(R"("image": 5)") == prefix + "image: expected a string");
+    CHECK(load(R"("image": "missing.png", "image_height": 0)") ==
+          prefix + "image_height: expected pixels from 1 to 1024");
+    CHECK(load(R"("image": "missing.png", "image_side": "below")") ==
+          prefix + "image_side: 'below' is not one of above, left");
+    CHECK(load(R"("image_side": "left")") ==
+          (folder / "s.json").string() +
+              ": labels[0]: 'image_height' and 'image_side' need an 'image'");
   }
 
   TEST_CASE("saved_json_scene_reads_back_the_imported_thesis_scene") {

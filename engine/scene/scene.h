@@ -6,11 +6,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "engine/core/png.h"
 #include "engine/scene/camera.h"
 
 namespace strata {
@@ -69,11 +71,22 @@ struct Mesh {
   size_t triangle_count() const { return indices.size() / 3; }
 };
 
+// A picture shown in a label's box above or left of its text (the thesis's future work: labels
+// with attached photographs). The box grows to hold it.
+struct LabelImage {
+  enum class Side { above, left };
+  std::filesystem::path file;
+  Rgba8Image pixels;     // straight alpha, as read
+  float height = 64.0f;  // pixels at label scale 1; the width keeps the picture's aspect
+  Side side = Side::above;
+};
+
 struct Label {
   int id = 0;
   std::string text;
   glm::vec3 anchor{0.0f};  // world space
   glm::vec2 size{0.0f};    // pixels; zero means "from the text" (decided when drawing)
+  std::optional<LabelImage> image;
   // Higher is placed first, so when labels must be hidden (hard constraints, crowding) a lower
   // priority goes first; equal priorities keep the insertion order's own rule.
   float priority = 0.0f;

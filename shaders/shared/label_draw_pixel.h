@@ -6,6 +6,7 @@
 //   PlacementGpu placement_at(uint i)
 //   GlyphGpu glyph_at(uint i)
 //   float atlas_coverage(vec2 uv)      the font atlas, bilinear, clamped to its edge
+//   vec4 image_texel(vec2 uv)          the image atlas (premultiplied), bilinear, clamped likewise
 //   bool layer_frames()                borders in their layer's colour
 
 // Text coverage of a label at p. Glyph quads overlap only in their zero-coverage borders, so the
@@ -25,9 +26,25 @@ float text_coverage(vec2 p, vec2 top_left, LabelGpu label) {
   return coverage;
 }
 
+// The label's picture at p, premultiplied, times the pixel's share of the picture's rectangle (a
+// one-pixel ramp at its edges, as at every edge here). The atlas keeps a border of edge texels
+// around each picture, so the ramp outside the rectangle reads the picture's own edge.
+vec4 image_color(vec2 p, vec2 top_left, LabelGpu label) {
+  if (label.image_quads == 0u) return vec4(0.0f);
+  GlyphGpu quad = glyph_at(label.glyph_first + label.glyph_count);
+  vec2 q = p - top_left;
+  vec2 lo = vec2(quad.box);
+  vec2 hi = vec2(quad.box.z, quad.box.w);
+  vec2 inside = min(q - lo, hi - q);  // distance to the nearer edge, per axis
+  float coverage = label_edge_coverage(-inside.x) * label_edge_coverage(-inside.y);
+  if (coverage <= 0.0f) return vec4(0.0f);
+  vec2 uv = mix(vec2(quad.atlas), vec2(quad.atlas.z, quad.atlas.w), (q - lo) / (hi - lo));
+  return image_texel(uv) * coverage;
+}
+
 // Label i drawn over `content` (premultiplied) at pixel centre p if it is shown on `layer`, as
-// opaque as its placement says. External labels: connector, box, text, then the anchor marker on
-// top. Internal labels: the box centred on the anchor, no connector or marker.
+// opaque as its placement says. External labels: connector, box, picture, text, then the anchor
+// marker on top. Internal labels: the box centred on the anchor, no connector or marker.
 vec4 draw_label_at(uint i, vec2 p, uint layer, vec4 content) {
   LabelGpu label = label_at(i);
   if ((label.flags & LABEL_ENABLED) == 0u || label.layer != layer) return content;
@@ -38,7 +55,9 @@ vec4 draw_label_at(uint i, vec2 p, uint layer, vec4 content) {
   if (label_far_from(p, label.anchor, centre, label.size)) return content;
   vec4 color = label_frame(p, label.anchor, centre, label.size, !is_internal,
                            label_border_color(label.layer, layer_frames()));
-  float text = text_coverage(p, centre - 0.5f * label.size, label);
+  vec2 top_left = centre - 0.5f * label.size;
+  color = label_over(image_color(p, top_left, label), color);
+  float text = text_coverage(p, top_left, label);
   color = label_over(label_premultiplied(LABEL_TEXT_COLOR, text), color);
   if (!is_internal) color = label_over(label_anchor_marker(p, label.anchor), color);
   return label_over(color * placement.opacity, content);  // (premultiplied: a fade)

@@ -16,6 +16,7 @@
 #define LABEL_DRAW_BINDING_GLYPHS 3      // GlyphGpu[]
 #define LABEL_DRAW_BINDING_ATLAS 4       // R8 font coverage, sampled bilinearly
 #define LABEL_DRAW_BINDING_FINAL 5       // rgba8: the layers composited over the background
+#define LABEL_DRAW_BINDING_IMAGES 6      // rgba8 label pictures, premultiplied, sampled bilinearly
 
 STRATA_BEGIN
 

@@ -32,7 +32,7 @@ struct LabelGpu {
                   // centre, pixels)
   float padding;  // pixels added to the constraint margin around this label's box (hard
                   // mode: a label needs a larger clear zone to appear than to stay)
-  uint pad;
+  uint image_quads;  // 1: the quad after the label's glyphs is its picture, in the image atlas
 };
 
 // The result for one label: written by the placement, read by drawing and by the host.
@@ -44,8 +44,9 @@ struct PlacementGpu {
   uint pad STRATA_DEFAULT(0u);
 };
 
+// A glyph's quad, or a label picture's (LabelGpu::image_quads).
 struct GlyphGpu {
-  vec4 atlas;  // u0, v0, u1, v1 in the font atlas (normalised)
+  vec4 atlas;  // u0, v0, u1, v1 in the font atlas, or the image atlas (normalised)
   vec4 box;    // x0, y0, x1, y1 in pixels relative to the label box's top-left corner
 };
 STRATA_END

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
+#include "engine/core/image.h"
 #include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
 #include "engine/scene/atlas.h"
@@ -133,6 +134,7 @@ class SceneReader {
   void atlas(const json& object, const Field& field);
   std::vector<AtlasRegion> atlas_regions(const json& object, const Field& field);
   void label(const json& object, const Field& field);
+  std::optional<LabelImage> label_image(const json& object, const Field& field);
   void camera(const json& object, const Field& field);
   void settings(const json& object, const Field& field);
 
@@ -279,8 +281,36 @@ void SceneReader::atlas(const json& object, const Field& field) {
   }
 }
 
+// "image" with its optional "image_height" and "image_side"; the picture is read here, so a bad
+// file is reported as the label's field.
+std::optional<LabelImage> SceneReader::label_image(const json& object, const Field& field) {
+  const json* file = optional(object, "image");
+  const json* height = optional(object, "image_height");
+  const json* side = optional(object, "image_side");
+  if (!file) {
+    if (height || side) field.fail("'image_height' and 'image_side' need an 'image'");
+    return std::nullopt;
+  }
+  LabelImage image;
+  image.file = resolve(*file, field / "image");
+  if (height) {
+    image.height = number(*height, field / "image_height");
+    if (!(image.height >= 1.0f && image.height <= 1024.0f))
+      (field / "image_height").fail("expected pixels from 1 to 1024");
+  }
+  if (side) {
+    const std::string name = string(*side, field / "image_side");
+    if (name != "above" && name != "left")
+      (field / "image_side").fail("'" + name + "' is not one of above, left");
+    image.side = name == "left" ? LabelImage::Side::left : LabelImage::Side::above;
+  }
+  image.pixels = (field / "image").wrap([&] { return read_image(image.file); });
+  return image;
+}
+
 void SceneReader::label(const json& object, const Field& field) {
-  check_keys(object, field, {"id", "text", "anchor", "size", "priority"});
+  check_keys(object, field,
+             {"id", "text", "anchor", "size", "priority", "image", "image_height", "image_side"});
   Label label;
   label.id = integer(required(object, field, "id"), field / "id");
   label.text = string(required(object, field, "text"), field / "text");
@@ -294,6 +324,7 @@ void SceneReader::label(const json& object, const Field& field) {
   if (const json* priority = optional(object, "priority")) {
     label.priority = number(*priority, field / "priority");
   }
+  label.image = label_image(object, field);
   scene_.labels.push_back(std::move(label));
 }
 

@@ -102,6 +102,11 @@ void save_scene_json(const std::filesystem::path& path, const Scene& scene) {
                           {"anchor", vector_json(&label.anchor[0], 3)},
                           {"size", vector_json(&label.size[0], 2)}};
     if (label.priority != 0.0f) entry["priority"] = label.priority;
+    if (const auto& image = label.image) {
+      entry["image"] = relative(image->file);
+      entry["image_height"] = shortest_double(image->height);
+      entry["image_side"] = image->side == LabelImage::Side::left ? "left" : "above";
+    }
     labels.push_back(std::move(entry));
   }
   const ordered_json root = {{"strata_scene", 1},
