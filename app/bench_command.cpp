@@ -344,6 +344,7 @@ struct ViewBenchOptions {
   std::string size = "1024";
   uint32_t frames = 120;
   double degrees = 90.0;
+  uint32_t tidy_rounds = kViewerTidyRounds;
 };
 
 // The viewer's whole frame (labelled scene, forces, label drawing, the panel), headless, with two
@@ -354,6 +355,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   Context ctx(device.context());
   LabellingSettings settings;
   settings.placement.weights = scene.settings.weights;
+  settings.placement.tidy_rounds = o.tidy_rounds;
   const double fps = 30.0;
   const std::vector<Camera> cameras =
       sample(orbit_path(scene, scene.camera, o.degrees, double(o.frames) / fps), fps);
@@ -485,6 +487,9 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       ->capture_default_str()
       ->check(CLI::Range(1u, 100000u));
   view_cmd->add_option("--degrees", view->degrees, "how far the turntable turns")
+      ->capture_default_str();
+  view_cmd->add_option("--tidy-rounds", view->tidy_rounds, "rounds of the layout tidy-up per frame")
+      ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
       ->capture_default_str();
   view_cmd->callback([&device, view] { bench_view(device, *view); });
 }

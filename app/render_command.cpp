@@ -23,6 +23,7 @@ struct RenderOptions {
   std::string size = "512x512";
   std::string camera;
   uint32_t layers = 4;
+  uint32_t tidy_rounds = PlacementSettings{}.tidy_rounds;
   std::string dump_layers;
   bool no_skipping = false;
   uint32_t blur = 12;
@@ -112,6 +113,7 @@ LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene)
   settings.render = render_settings(o);
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
+  settings.placement.tidy_rounds = o.tidy_rounds;
   settings.internal = o.internal;
   settings.label_scale = o.look.label_scale;
   settings.layer_colors = o.look.layer_colors;
@@ -230,6 +232,10 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
                   "named camera position of the scene, or several (front,left): one image each, "
                   "named after it (out-front.png, out-left.png)");
   cmd->add_option("--layers", o->layers, "depth layers, 1 to 8")->capture_default_str();
+  cmd->add_option("--tidy-rounds", o->tidy_rounds,
+                  "rounds of the layout tidy-up after the placement (0: none)")
+      ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
+      ->capture_default_str();
   cmd->add_option("--dump-layers", o->dump_layers,
                   "folder to write each (label-free) layer image to");
   cmd->add_flag("--no-skipping", o->no_skipping, "turn empty-space skipping off");

@@ -38,6 +38,7 @@ struct VideoOptions {
   ForceSettings forces;
   float layer_margin = LayerHysteresis{}.margin;
   uint32_t layers = 4;
+  uint32_t tidy_rounds = PlacementSettings{}.tidy_rounds;
 };
 
 CameraPath camera_path(const Scene& scene, const VideoOptions& o) {
@@ -95,6 +96,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   settings.layer_count = o.layers;
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
+  settings.placement.tidy_rounds = o.tidy_rounds;
   settings.label_scale = o.look.label_scale;
   settings.layer_colors = o.look.layer_colors;
   settings.forces = o.forces;
@@ -148,6 +150,10 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
       ->required();
   cmd->add_option("--layout-dir", o->layout_dir, "folder for each frame's layout JSON");
   cmd->add_option("--layers", o->layers, "depth layers, 1 to 8")->capture_default_str();
+  cmd->add_option("--tidy-rounds", o->tidy_rounds,
+                  "rounds of the layout tidy-up after the placement (0: none)")
+      ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
+      ->capture_default_str();
   cmd->add_flag("--screen-space", o->screen_space,
                 "labels live on screen (the thesis), not as offsets from their anchors");
   cmd->add_flag("--no-forces", o->no_forces, "place every frame from scratch (labels jump)");

@@ -33,6 +33,7 @@ struct ViewOptions {
   std::string screenshot_dir = ".";
   uint32_t frames = 0;
   uint32_t layers = 4;
+  uint32_t tidy_rounds = kViewerTidyRounds;
   uint32_t blur = 12;
   uint32_t frames_in_flight = 2;
   bool no_optimize = false;
@@ -325,6 +326,7 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   LabellingSettings settings;
   settings.layer_count = o.layers;
   settings.placement.weights = scene.settings.weights;
+  settings.placement.tidy_rounds = o.tidy_rounds;
   // HiDPI: label text and boxes follow the display's content scale, as the panel does.
   settings.label_scale = std::clamp(o.label_scale * std::max(scale_x, scale_y), 0.25f, 4.0f);
   ViewerOptions options;
@@ -430,6 +432,9 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--frames", o->frames,
                   "close after this many frames (0: when the window closes)");
   cmd->add_option("--layers", o->layers, "depth layers, 1 to 8")->capture_default_str();
+  cmd->add_option("--tidy-rounds", o->tidy_rounds, "rounds of the layout tidy-up per frame")
+      ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
+      ->capture_default_str();
   cmd->add_option("--script", o->script,
                   "input script: events and actions run one by one, each once the view has "
                   "settled (docs/viewer.md)");

@@ -105,6 +105,7 @@ const std::vector<Parameter>& parameters() {
       {"margin", "pixels around boxes in the constraints",
        [](S s) { return &s.labels.placement.margin; }},
       {"layers", "depth layers asked for, 1 to 8"},
+      {"tidy_rounds", "rounds of the layout tidy-up per frame, 0 to 256"},
       {"hard", "on: no constraint violations (labels may be hidden)", nullptr,
        [](S s) { return &s.labels.placement.hard; }},
       {"internal", "on: each label on its anchor", nullptr, [](S s) { return &s.labels.internal; },
@@ -439,6 +440,11 @@ void Viewer::set_number(const std::string& name, float value) {
   if (name == "layers") {
     if (!(value >= 1.0f && value <= 8.0f)) throw Error("parameter layers: 1 to 8");
     labels.layer_count = uint32_t(value);
+  } else if (name == "tidy_rounds") {
+    if (!(value >= 0.0f && value <= float(TIDY_ROUNDS_MAX))) {
+      throw Error("parameter tidy_rounds: 0 to " + std::to_string(TIDY_ROUNDS_MAX));
+    }
+    labels.placement.tidy_rounds = uint32_t(value);
   } else {
     *p.number({labels, render, viewer}) = value;
   }

@@ -107,8 +107,8 @@ void Viewer::panel_labelling() {
          "%.3g", log);
   slider(*this, "connector shadow", "weights.connector_shadow", w.connector_shadow, 0.0f, 1e4f,
          "%.3g", log);
-  slider(*this, "leader crossing", "weights.leader_crossing", w.leader_crossing, 0.0f, 1e5f,
-         "%.3g", log);
+  slider(*this, "leader crossing", "weights.leader_crossing", w.leader_crossing, 0.0f, 1e5f, "%.3g",
+         log);
   slider(*this, "integral costs", "weights.integral_costs", w.integral_costs, 0.0f, 1000.0f, "%.3g",
          log);
   slider(*this, "distance to anchor", "weights.distance_to_anchor", w.distance_to_anchor, 0.0f,
@@ -129,6 +129,10 @@ void Viewer::panel_labelling() {
   int layers = int(s.layer_count);
   if (ImGui::SliderInt("layers", &layers, 1, 8)) set_number("layers", float(layers));
   ImGui::Text("layers used: %u", labelled_->layering().layer_count);
+  int tidy_rounds = int(s.placement.tidy_rounds);
+  if (ImGui::SliderInt("tidy-up rounds", &tidy_rounds, 0, 64)) {
+    set_number("tidy_rounds", float(tidy_rounds));
+  }
   const char* orders[] = {"scene", "Apollonius (when the camera rests)"};
   if (ImGui::Combo("insertion order", &insertion_order_, orders, 2)) {
     labelled_->set_order(scene_order(uint32_t(scene_.labels.size())));

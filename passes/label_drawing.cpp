@@ -37,15 +37,20 @@ struct LabelDrawReference {
     const ivec2 c = clamp(p, ivec2(0), top);
     return float(font.coverage[size_t(c.y) * font.width + size_t(c.x)]) / 255.0f;
   }
-  // Linear filtering with clamp-to-edge addressing, as the graph's sampler does.
-  float atlas_coverage(vec2 uv) const {
-    const vec2 x = uv * vec2(font.width, font.height) - 0.5f;
+  // Linear filtering with clamp-to-edge addressing (the texel reads clamp), as the graph's
+  // sampler does.
+  template <typename Texel>
+  static auto bilinear(Texel texel_at, vec2 size, vec2 uv) {
+    const vec2 x = uv * size - 0.5f;
     const vec2 base = floor(x);
     const vec2 f = x - base;
     const ivec2 i = ivec2(base);
-    const float top = mix(texel(i), texel(i + ivec2(1, 0)), f.x);
-    const float bottom = mix(texel(i + ivec2(0, 1)), texel(i + ivec2(1, 1)), f.x);
+    const auto top = mix(texel_at(i), texel_at(i + ivec2(1, 0)), f.x);
+    const auto bottom = mix(texel_at(i + ivec2(0, 1)), texel_at(i + ivec2(1, 1)), f.x);
     return mix(top, bottom, f.y);
+  }
+  float atlas_coverage(vec2 uv) const {
+    return bilinear([this](ivec2 p) { return texel(p); }, vec2(font.width, font.height), uv);
   }
 
   vec4 image_texel(ivec2 p) const {
@@ -56,13 +61,8 @@ struct LabelDrawReference {
            255.0f;
   }
   vec4 image_texel(vec2 uv) const {
-    const vec2 x = uv * vec2(images.width, images.height) - 0.5f;
-    const vec2 base = floor(x);
-    const vec2 f = x - base;
-    const ivec2 i = ivec2(base);
-    const vec4 top = mix(image_texel(i), image_texel(i + ivec2(1, 0)), f.x);
-    const vec4 bottom = mix(image_texel(i + ivec2(0, 1)), image_texel(i + ivec2(1, 1)), f.x);
-    return mix(top, bottom, f.y);
+    return bilinear([this](ivec2 p) { return image_texel(p); }, vec2(images.width, images.height),
+                    uv);
   }
 
 #include "shared/label_draw_pixel.h"

@@ -310,37 +310,42 @@ glm::uvec3 Placement::direct_groups(graph::Extent viewport) const {
 // leaving at once) and each label's position and whether it is shown, copied to the host after
 // the frame.
 void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
-  graph.add_pass({"placement.finalize",
-                  graph::PassKind::compute,
-                  {{b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
-                   {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
-                   {b.order, Use::storage_read, PLACEMENT_BINDING_ORDER},
-                   {b.results, Use::storage_read, PLACEMENT_BINDING_RESULTS},
-                   {b.tidy, Use::storage_write, PLACEMENT_BINDING_TIDY},
-                   {b.tidy_rounds, Use::storage_write, PLACEMENT_BINDING_TIDY_ROUNDS},
-                   {b.placements, Use::storage_write, PLACEMENT_BINDING_PLACEMENTS}},
-                  [this](graph::PassContext& pc) {
-                    gpu::PlacementParams p = params(pc.viewport, 0);
-                    const uint32_t n = label_count_;
-                    p.phase = TIDY_PHASE_START;
-                    pc.dispatch(finalize_, p, {std::max(n, p.tidy_rounds + 1), 1, 1});
-                    for (uint32_t round = 0; round < p.tidy_rounds; ++round) {
-                      p.step = round;
-                      for (const uint32_t phase :
-                           {TIDY_PHASE_CONFLICTS, TIDY_PHASE_SEARCH, TIDY_PHASE_OWNERS,
-                            TIDY_PHASE_SELECT, TIDY_PHASE_APPLY}) {
-                        pc.barrier();
-                        p.phase = phase;
-                        const uint32_t threads =
-                            phase == TIDY_PHASE_SEARCH ? n * TIDY_SWAP + n * n : n;
-                        pc.dispatch(finalize_, p, {threads, 1, 1});
-                      }
-                    }
-                    pc.barrier();
-                    p.phase = TIDY_PHASE_OUTPUT;
-                    pc.dispatch(finalize_, p, {n, 1, 1});
-                  },
-                  "placement"});
+  graph.add_pass(
+      {"placement.finalize",
+       graph::PassKind::compute,
+       {{b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
+        {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+        {b.order, Use::storage_read, PLACEMENT_BINDING_ORDER},
+        {b.results, Use::storage_read, PLACEMENT_BINDING_RESULTS},
+        {b.tidy, Use::storage_write, PLACEMENT_BINDING_TIDY},
+        {b.tidy_rounds, Use::storage_write, PLACEMENT_BINDING_TIDY_ROUNDS},
+        {b.placements, Use::storage_write, PLACEMENT_BINDING_PLACEMENTS}},
+       [this](graph::PassContext& pc) {
+         gpu::PlacementParams p = params(pc.viewport, 0);
+         const uint32_t n = label_count_;
+         p.phase = TIDY_PHASE_START;
+         pc.dispatch(finalize_, p, {std::max(n, p.tidy_rounds + 1), 1, 1});
+         for (uint32_t round = 0; round < p.tidy_rounds; ++round) {
+           p.step = round;
+           for (const uint32_t phase : {TIDY_PHASE_CONFLICTS, TIDY_PHASE_SEARCH, TIDY_PHASE_OWNERS,
+                                        TIDY_PHASE_SELECT, TIDY_PHASE_APPLY}) {
+             pc.barrier();
+             p.phase = phase;
+             // (conflicts and selection: a workgroup of 64 per label)
+             const bool per_label_group =
+                 phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_SELECT;
+             const uint32_t changes = n * TIDY_SWAP + n * (n - 1) / 2;
+             const uint32_t threads = phase == TIDY_PHASE_SEARCH ? changes * TIDY_SEARCH_LANES
+                                      : per_label_group          ? n * 64
+                                                                 : n;
+             pc.dispatch(finalize_, p, {threads, 1, 1});
+           }
+         }
+         pc.barrier();
+         p.phase = TIDY_PHASE_OUTPUT;
+         pc.dispatch(finalize_, p, {n, 1, 1});
+       },
+       "placement"});
   graph.add_pass({"placement.readback",
                   graph::PassKind::transfer,
                   {{b.placements, Use::transfer_src}, {b.readback, Use::transfer_dst}},

@@ -84,7 +84,7 @@ struct Tidier {
   bool round() {
     const uint n = tidy_count();
     std::vector<bool> conflicted(n);
-    for (uint i = 0; i < n; ++i) conflicted[i] = movable(i) && tidy_conflicted(i);
+    for (uint i = 0; i < n; ++i) conflicted[i] = movable(i) && tidy_conflicted(i, 0, 1);
     bests.assign(n, TIDY_NONE);
     for (uint i = 0; i < n; ++i) {
       if (!conflicted[i]) continue;
@@ -109,7 +109,7 @@ struct Tidier {
     }
     std::vector<uint> applied;
     for (uint i = 0; i < n; ++i) {
-      if (partners[i] != TIDY_NO_PARTNER && !tidy_blocked(i)) applied.push_back(i);
+      if (partners[i] != TIDY_NO_PARTNER && !tidy_blocked(i, 0, 1)) applied.push_back(i);
     }
     for (uint i : applied) {
       for (uint k : {i, partners[i]}) {
@@ -128,8 +128,8 @@ std::vector<gpu::PlacementGpu> tidy_reference(std::span<const gpu::LabelGpu> lab
                                               std::span<const uint32_t> order,
                                               std::span<const uint64_t> results,
                                               const std::vector<float>& tables,
-                                              const PlacementSettings& settings,
-                                              graph::Extent size, uint32_t layer_count) {
+                                              const PlacementSettings& settings, graph::Extent size,
+                                              uint32_t layer_count) {
   const auto n = uint32_t(labels.size());
   gpu::Tidier tidier{placement_params(settings, size, layer_count, n, 0),
                      labels,
@@ -249,8 +249,8 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
       }
     }
   }
-  out.placements = tidy_reference(labels, order, placer.results, out.tables, settings, size,
-                                  layer_count);
+  out.placements =
+      tidy_reference(labels, order, placer.results, out.tables, settings, size, layer_count);
   return out;
 }
 

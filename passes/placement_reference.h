@@ -25,8 +25,8 @@ std::vector<gpu::PlacementGpu> tidy_reference(std::span<const gpu::LabelGpu> lab
                                               std::span<const uint32_t> order,
                                               std::span<const uint64_t> results,
                                               const std::vector<float>& tables,
-                                              const PlacementSettings& settings,
-                                              graph::Extent size, uint32_t layer_count);
+                                              const PlacementSettings& settings, graph::Extent size,
+                                              uint32_t layer_count);
 
 // final_rgba8: the label-free final image; layers: premultiplied RGBA, layer after layer.
 ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,

@@ -25,39 +25,98 @@ float table_at(uint layer, int x, int y) {
 
 #include "shared/layout_tidy.h"
 
+// A round's dispatches read every label's state many times over (each change is weighed against
+// all labels): each workgroup copies what its phase reads into shared memory first. (Read from
+// the buffer, a round took 40 us or more on an H100, latency-bound.)
+shared TidyLabel s_label[LABEL_MAX];
+shared TidyLabel s_next[LABEL_MAX];
+shared uint64_t s_best[LABEL_MAX];
+shared float s_free[LABEL_MAX];
+shared uint s_rank[LABEL_MAX];
+shared uint s_partner[LABEL_MAX];
+shared uint s_any;
+
 uint tidy_count() { return params.label_count; }
 LabelGpu tidy_input(uint k) { return labels[k]; }
-TidyLabel tidy_state(uint k) { return tidy[k].label; }
-float tidy_free(uint k) { return tidy[k].free; }
-uint tidy_rank(uint k) { return tidy[k].rank; }
-uint64_t tidy_best(uint k) { return tidy[k].best; }
-TidyLabel tidy_next(uint k) { return tidy[k].next; }
-uint tidy_partner(uint k) { return tidy[k].partner; }
+TidyLabel tidy_state(uint k) { return s_label[k]; }
+float tidy_free(uint k) { return s_free[k]; }
+uint tidy_rank(uint k) { return s_rank[k]; }
+uint64_t tidy_best(uint k) { return s_best[k]; }
+TidyLabel tidy_next(uint k) { return s_next[k]; }
+uint tidy_partner(uint k) { return s_partner[k]; }
+
+// The workgroup's copy of the labels' states (the bests only after the search has them).
+void load_states(uint n, uint phase) {
+  for (uint k = gl_LocalInvocationID.x; k < n; k += gl_WorkGroupSize.x) {
+    s_label[k] = tidy[k].label;
+    s_free[k] = tidy[k].free;
+    s_rank[k] = tidy[k].rank;
+    if (phase != TIDY_PHASE_CONFLICTS && phase != TIDY_PHASE_SEARCH) s_best[k] = tidy[k].best;
+    if (phase == TIDY_PHASE_SELECT) {
+      s_next[k] = tidy[k].next;
+      s_partner[k] = tidy[k].partner;
+    }
+  }
+  barrier();
+}
 
 #include "shared/layout_tidy_search.h"
 
 bool movable(uint k) {
-  return (tidy[k].label.flags & (TIDY_PLACED | TIDY_MOVABLE)) == (TIDY_PLACED | TIDY_MOVABLE);
+  return (s_label[k].flags & (TIDY_PLACED | TIDY_MOVABLE)) == (TIDY_PLACED | TIDY_MOVABLE);
 }
 
-// TIDY_PHASE_SEARCH: item q is (label, move or hiding) below n x TIDY_SWAP, a pair of labels above.
-void search(uint q, uint n) {
+// TIDY_PHASE_SEARCH: item q is (label, move or hiding) below n x TIDY_SWAP, a pair of labels
+// (i < j) above; TIDY_SEARCH_LANES invocations take an item, splitting the other labels.
+shared ivec4 s_counts[64 / TIDY_SEARCH_LANES];
+shared uint s_hide[64 / TIDY_SEARCH_LANES];
+
+void search(uint t, uint n) {
+  const uint q = t / TIDY_SEARCH_LANES, lane = t % TIDY_SEARCH_LANES;
+  const uint slot = gl_LocalInvocationID.x / TIDY_SEARCH_LANES;
   const uint singles = n * TIDY_SWAP;
+  uint i = 0u, change = 0u;
+  bool live = false;
   if (q < singles) {
-    const uint i = q / TIDY_SWAP, change = q % TIDY_SWAP;
-    if (tidy[i].conflicted == 0u) return;
-    const float delta = tidy_delta(i, change);
-    if (delta < 0.0f) atomicMin(tidy[i].best, tidy_key(delta, change));
-    return;
+    i = q / TIDY_SWAP;
+    change = q % TIDY_SWAP;
+    live = tidy[i].conflicted != 0u;
+  } else if (q < singles + n * (n - 1u) / 2u) {
+    // the pair at position p of (0, 1), (0, 2) ... (0, n - 1), (1, 2) ...
+    uint p = q - singles;
+    while (p >= n - 1u - i) {
+      p -= n - 1u - i;
+      ++i;
+    }
+    const uint j = i + 1u + p;
+    change = TIDY_SWAP + j;
+    if (movable(i) && movable(j)) {
+      const ivec4 c = tidy_conflicts(s_label[i], s_label[j]);
+      live = c.x + c.y != 0;
+    }
   }
-  const uint i = (q - singles) / n, j = (q - singles) % n;
-  if (j <= i || !movable(i) || !movable(j)) return;
-  const ivec4 c = tidy_conflicts(tidy[i].label, tidy[j].label);
-  if (c.x + c.y == 0) return;
-  const float delta = tidy_delta(i, TIDY_SWAP + j);
+  live = live && tidy_change_possible(i, change);
+  if (lane == 0u) {
+    s_counts[slot] = ivec4(0);
+    s_hide[slot] = 0u;
+  }
+  barrier();
+  if (live) {
+    const ivec4 c = tidy_change_conflicts(i, change, lane, TIDY_SEARCH_LANES);
+    if (c != ivec4(0)) {
+      atomicAdd(s_counts[slot].x, c.x);
+      atomicAdd(s_counts[slot].y, c.y);
+      atomicAdd(s_counts[slot].z, c.z);
+      atomicAdd(s_counts[slot].w, c.w);
+    }
+    if (change == TIDY_HIDE && tidy_may_hide(i, lane, TIDY_SEARCH_LANES)) atomicOr(s_hide[slot], 1u);
+  }
+  barrier();
+  if (!live || lane != 0u || (change == TIDY_HIDE && s_hide[slot] == 0u)) return;
+  const float delta = tidy_change_delta(i, change, s_counts[slot]);
   if (delta >= 0.0f) return;
-  atomicMin(tidy[i].best, tidy_key(delta, TIDY_SWAP + j));
-  atomicMin(tidy[j].best, tidy_key(delta, TIDY_SWAP + i));
+  atomicMin(tidy[i].best, tidy_key(delta, change));
+  if (change >= TIDY_SWAP) atomicMin(tidy[change - TIDY_SWAP].best, tidy_key(delta, TIDY_SWAP + i));
 }
 
 void main() {
@@ -76,8 +135,9 @@ void main() {
     return;
   }
   if (phase == TIDY_PHASE_OUTPUT) {
+    load_states(n, phase);
     if (t >= n) return;
-    const TidyLabel l = tidy[t].label;
+    const TidyLabel l = s_label[t];
     const uint64_t r = results[t];
     PlacementGpu p = hidden_placement(labels[t]);
     if ((l.flags & TIDY_PLACED) != 0u) {
@@ -91,20 +151,38 @@ void main() {
   }
   // A round: nothing to do once the round before applied nothing.
   const uint r = params.step;
-  if (rounds[r] == 0u) return;
+  if (rounds[r] == 0u) return;  // (the same for the whole dispatch)
+  load_states(n, phase);
   if (phase == TIDY_PHASE_SEARCH) {
     search(t, n);
     return;
   }
+  if (phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_SELECT) {
+    // One workgroup per label, its invocations splitting the other labels between them.
+    const uint i = gl_WorkGroupID.x, lane = gl_LocalInvocationID.x;
+    if (lane == 0u) s_any = 0u;
+    barrier();
+    bool any = false;
+    if (phase == TIDY_PHASE_CONFLICTS) {
+      any = movable(i) && tidy_conflicted(i, lane, gl_WorkGroupSize.x);
+    } else {
+      any = s_partner[i] != TIDY_NO_PARTNER && tidy_blocked(i, lane, gl_WorkGroupSize.x);
+    }
+    if (any) atomicOr(s_any, 1u);
+    barrier();
+    if (lane != 0u) return;
+    if (phase == TIDY_PHASE_CONFLICTS) {
+      tidy[i].best = TIDY_NONE;
+      tidy[i].conflicted = s_any;
+    } else {
+      tidy[i].applied = s_partner[i] != TIDY_NO_PARTNER && s_any == 0u ? 1u : 0u;
+    }
+    return;
+  }
   if (t >= n) return;
-  if (phase == TIDY_PHASE_CONFLICTS) {
-    tidy[t].best = TIDY_NONE;
-    tidy[t].conflicted = movable(t) && tidy_conflicted(t) ? 1u : 0u;
-  } else if (phase == TIDY_PHASE_OWNERS) {
+  if (phase == TIDY_PHASE_OWNERS) {
     tidy[t].partner = tidy_owned_partner(t);
     tidy[t].next = tidy_after(t);
-  } else if (phase == TIDY_PHASE_SELECT) {
-    tidy[t].applied = tidy[t].partner != TIDY_NO_PARTNER && !tidy_blocked(t) ? 1u : 0u;
   } else if (phase == TIDY_PHASE_APPLY) {
     const uint owner = tidy_owner(t);
     if (owner == TIDY_NO_PARTNER || tidy[owner].applied == 0u) return;

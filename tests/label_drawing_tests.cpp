@@ -260,6 +260,21 @@ glm::uvec2 quadrant_pixel(const LabelScene& s, size_t i, int q) {
   return glm::uvec2(top_left + glm::mix(glm::vec2(box), glm::vec2(box.z, box.w), f));
 }
 
+// The scene drawn on the GPU, its layers and final image checked against the reference.
+DrawnLabels draw_matching_the_reference(Context& ctx, const LabelScene& s) {
+  DrawnLabels gpu = draw_on_gpu(ctx, s);
+  const std::vector<glm::vec4> expected = reference_layers(s);
+  REQUIRE(gpu.layers.size() == expected.size());
+  size_t where = 0;
+  const float worst = worst_difference(gpu.layers, expected, where);
+  CHECK_MESSAGE(worst <= kTolerance,
+                "layer pixel " << where << " differs by " << worst * 255.0f << "/255");
+  const std::vector<uint8_t> final_expected = composite_reference(
+      expected, s.size, s.layer_count, s.background, {s.labels, s.placements, s.glyphs});
+  CHECK(worst_difference(gpu.final, final_expected) <= 2);
+  return gpu;
+}
+
 }  // namespace
 
 TEST_SUITE("cpu") {
@@ -595,16 +610,7 @@ TEST_SUITE("cpu") {
 TEST_SUITE("gpu") {
   TEST_CASE_FIXTURE(test::GpuTest, "label_drawing_and_composite_match_the_cpu_reference") {
     const LabelScene s = make_scene();
-    const DrawnLabels gpu = draw_on_gpu(ctx, s);
-    const std::vector<glm::vec4> expected = reference_layers(s);
-    REQUIRE(gpu.layers.size() == expected.size());
-    size_t where = 0;
-    const float worst = worst_difference(gpu.layers, expected, where);
-    CHECK_MESSAGE(worst <= kTolerance,
-                  "layer pixel " << where << " differs by " << worst * 255.0f << "/255");
-    const std::vector<uint8_t> final_expected = composite_reference(
-        expected, s.size, s.layer_count, s.background, {s.labels, s.placements, s.glyphs});
-    CHECK(worst_difference(gpu.final, final_expected) <= 2);
+    const DrawnLabels gpu = draw_matching_the_reference(ctx, s);
     // Guards against comparing two unlabelled pictures.
     CHECK(gpu.layers != s.layers);
     if (std::getenv("STRATA_KEEP_IMAGES")) {
@@ -733,15 +739,7 @@ TEST_SUITE("gpu") {
     REQUIRE(s.labels[0].image_quads == 1);
     REQUIRE(s.labels[1].image_quads == 1);
 
-    const DrawnLabels gpu = draw_on_gpu(ctx, s);
-    const std::vector<glm::vec4> expected = reference_layers(s);
-    size_t where = 0;
-    const float worst = worst_difference(gpu.layers, expected, where);
-    CHECK_MESSAGE(worst <= kTolerance,
-                  "layer pixel " << where << " differs by " << worst * 255.0f << "/255");
-    const std::vector<uint8_t> final_expected = composite_reference(
-        expected, s.size, s.layer_count, s.background, {s.labels, s.placements, s.glyphs});
-    CHECK(worst_difference(gpu.final, final_expected) <= 2);
+    const DrawnLabels gpu = draw_matching_the_reference(ctx, s);
 
     // The picture in each label's own layer (label 0 lies under the front layer's blue), and
     // in the final image where nothing lies in front of it (label 1).

@@ -217,8 +217,8 @@ TEST_SUITE("gpu") {
     settings.tidy_rounds = 0;
     const GpuPlacement greedy = place_on_gpu(ctx, in, settings);
     const FrameMetrics before = metrics_of(in, greedy.placements);
-    MESSAGE("greedy: " << before.leader_crossings << " crossings, "
-                       << before.leaders_through_boxes << " leaders through boxes");
+    MESSAGE("greedy: " << before.leader_crossings << " crossings, " << before.leaders_through_boxes
+                       << " leaders through boxes");
     REQUIRE(before.leader_crossings == 2);
     settings.tidy_rounds = 64;
     const GpuPlacement gpu = place_on_gpu(ctx, in, settings);

@@ -24,8 +24,8 @@ struct LabelDrawParams {
   uint width;
   uint height;
   uint layer_count;
-  uint label_count;  // labels to consider (the shader also stops at the buffer's end)
-  vec4 background;   // rgb: what the composite shows where every layer is transparent
+  uint label_count;   // labels to consider (the shader also stops at the buffer's end)
+  vec4 background;    // rgb: what the composite shows where every layer is transparent
   uint layer_frames;  // 1: a box's border (and leader) in its layer's colour (a depth cue)
   uint pad0;
   uint pad1;

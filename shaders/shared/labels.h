@@ -26,12 +26,12 @@ struct LabelGpu {
   uint flags;          // LABEL_*
   uint glyph_first;    // the label's glyphs in the glyph buffer
   uint glyph_count;
-  float hold;     // eq. 3.1 adds this to every position but `held`: a label moves only for
-                  // a position better by more (0: no held position)
-  vec2 held;      // the position the label was heading for in the previous frame (box
-                  // centre, pixels)
-  float padding;  // pixels added to the constraint margin around this label's box (hard
-                  // mode: a label needs a larger clear zone to appear than to stay)
+  float hold;        // eq. 3.1 adds this to every position but `held`: a label moves only for
+                     // a position better by more (0: no held position)
+  vec2 held;         // the position the label was heading for in the previous frame (box
+                     // centre, pixels)
+  float padding;     // pixels added to the constraint margin around this label's box (hard
+                     // mode: a label needs a larger clear zone to appear than to stay)
   uint image_quads;  // 1: the quad after the label's glyphs is its picture, in the image atlas
 };
 

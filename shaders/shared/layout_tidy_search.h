@@ -18,11 +18,12 @@
 //   TidyLabel tidy_next(uint k)     its state after its owner's change (itself if none; step 3)
 //   uint tidy_partner(uint k)       an owner's swap partner (TIDY_NO_PARTNER: none; step 3)
 
-// Does label i conflict with any other?
-bool tidy_conflicted(uint i) {
+// Does label i conflict with any other of first, first + stride, ... (the GPU splits the labels
+// over a workgroup's invocations)?
+bool tidy_conflicted(uint i, uint first, uint stride) {
   TidyLabel l = tidy_state(i);
   ivec4 reach = tidy_extent(l);
-  for (uint k = 0u; k < tidy_count(); ++k) {
+  for (uint k = first; k < tidy_count(); k += stride) {
     if (k == i) continue;
     TidyLabel other = tidy_state(k);
     if (!tidy_rects_touch(reach, tidy_extent(other))) continue;
@@ -40,11 +41,13 @@ ivec4 tidy_all_conflicts(uint i) {
   return sum;
 }
 
-// How label i's conflicts with the others (but `skip`) change when it goes from `from` to `to`.
-ivec4 tidy_conflict_change(uint i, TidyLabel from, TidyLabel to, uint skip) {
+// How label i's conflicts with the others (but `skip`; of first, first + stride, ...) change
+// when it goes from `from` to `to`.
+ivec4 tidy_conflict_change(uint i, TidyLabel from, TidyLabel to, uint skip, uint first,
+                           uint stride) {
   ivec4 change = ivec4(0);
   ivec4 reach = tidy_union(tidy_extent(from), tidy_extent(to));
-  for (uint k = 0u; k < tidy_count(); ++k) {
+  for (uint k = first; k < tidy_count(); k += stride) {
     if (k == i || k == skip) continue;
     TidyLabel other = tidy_state(k);
     if (!tidy_rects_touch(reach, tidy_extent(other))) continue;
@@ -65,10 +68,11 @@ TidyLabel tidy_changed(uint i, uint change) {
 }
 
 // May label i be hidden? Only when its box shares area with the box of a label earlier in the
-// insertion order (so of higher priority) or covers an anchor, and nothing better is found.
-bool tidy_may_hide(uint i) {
+// insertion order (so of higher priority) or covers an anchor (of the labels first, first +
+// stride, ...), and nothing better is found.
+bool tidy_may_hide(uint i, uint first, uint stride) {
   TidyLabel l = tidy_state(i);
-  for (uint k = 0u; k < tidy_count(); ++k) {
+  for (uint k = first; k < tidy_count(); k += stride) {
     if (k == i) continue;
     TidyLabel other = tidy_state(k);
     if (tidy_covers(l, other)) return true;
@@ -86,30 +90,55 @@ bool tidy_adds_hard(ivec4 c) {
          (c.w > 0 && params.weights.anchor_constraint > 0.0f);
 }
 
-// J's change for label i's change `change`; 0 (never a gain) when it is not possible or would
-// make more boxes share area or cover more anchors: those stay as hard as in the placement, whose
-// label shadow and anchor weights outweigh any position (a label in very salient content could
-// otherwise buy its way onto another's box).
-float tidy_delta(uint i, uint change) {
+// Label i's change `change` in parts, so that the GPU can split the sums over the other labels
+// between invocations: whether it is possible at all (moves somewhere new; hiding a shown label),
+// the conflict counts it changes (over the labels first, first + stride, ...; the swapped pair's
+// own term with the part whose first is 0), and J's change from those counts.
+bool tidy_change_possible(uint i, uint change) {
   TidyLabel from = tidy_state(i), to = tidy_changed(i, change);
-  LabelGpu me = tidy_input(i);
-  if (change < TIDY_SWAP) {
-    bool same = change == TIDY_HIDE ? to.flags == from.flags : to.pixel == from.pixel;
-    if (same || (change == TIDY_HIDE && !tidy_may_hide(i))) return 0.0f;
-    ivec4 conflicts = tidy_conflict_change(i, from, to, TIDY_NO_PARTNER);
-    if (tidy_adds_hard(conflicts)) return 0.0f;
-    float hiding = change == TIDY_HIDE ? params.weights.label_shadow : 0.0f;
-    return (tidy_free_cost(to, me) + hiding - tidy_free(i)) + tidy_weight(conflicts);
-  }
+  if (change == TIDY_HIDE) return to.flags != from.flags;
+  if (to.pixel == from.pixel) return false;
+  if (change < TIDY_SWAP) return true;
+  uint j = change - TIDY_SWAP;
+  return tidy_changed(j, TIDY_SWAP + i).pixel != tidy_state(j).pixel;
+}
+
+ivec4 tidy_change_conflicts(uint i, uint change, uint first, uint stride) {
+  TidyLabel from = tidy_state(i), to = tidy_changed(i, change);
+  if (change < TIDY_SWAP) return tidy_conflict_change(i, from, to, TIDY_NO_PARTNER, first, stride);
   uint j = change - TIDY_SWAP;
   TidyLabel from_j = tidy_state(j), to_j = tidy_changed(j, TIDY_SWAP + i);
-  if (to.pixel == from.pixel || to_j.pixel == from_j.pixel) return 0.0f;
-  ivec4 conflicts = tidy_conflict_change(i, from, to, j) + tidy_conflict_change(j, from_j, to_j, i) +
-                    tidy_conflicts(to, to_j) - tidy_conflicts(from, from_j);
+  ivec4 c = tidy_conflict_change(i, from, to, j, first, stride) +
+            tidy_conflict_change(j, from_j, to_j, i, first, stride);
+  if (first == 0u) c += tidy_conflicts(to, to_j) - tidy_conflicts(from, from_j);
+  return c;
+}
+
+// J's change for a possible change whose conflict counts change by `conflicts`; 0 (never a gain)
+// when it would make more boxes share area or cover more anchors: those stay as hard as in the
+// placement, whose label shadow and anchor weights outweigh any position (a label in very salient
+// content could otherwise buy its way onto another's box).
+float tidy_change_delta(uint i, uint change, ivec4 conflicts) {
   if (tidy_adds_hard(conflicts)) return 0.0f;
+  TidyLabel to = tidy_changed(i, change);
+  float weight = tidy_weight(conflicts);
+  if (change < TIDY_SWAP) {
+    float hiding = change == TIDY_HIDE ? params.weights.label_shadow : 0.0f;
+    return (tidy_free_cost(to, tidy_input(i)) + hiding - tidy_free(i)) + weight;
+  }
+  uint j = change - TIDY_SWAP;
   float before = tidy_free(i) + tidy_free(j);
-  float after = tidy_free_cost(to, me) + tidy_free_cost(to_j, tidy_input(j));
-  return (after - before) + tidy_weight(conflicts);
+  float after = tidy_free_cost(to, tidy_input(i)) +
+                tidy_free_cost(tidy_changed(j, TIDY_SWAP + i), tidy_input(j));
+  return (after - before) + weight;
+}
+
+// J's change for label i's change `change` in one piece (the CPU reference); 0 when it is not
+// possible.
+float tidy_delta(uint i, uint change) {
+  if (!tidy_change_possible(i, change)) return 0.0f;
+  if (change == TIDY_HIDE && !tidy_may_hide(i, 0u, 1u)) return 0.0f;
+  return tidy_change_delta(i, change, tidy_change_conflicts(i, change, 0u, 1u));
 }
 
 // Is i's best change a swap with j (whatever its key)?
@@ -155,11 +184,12 @@ ivec4 tidy_pair_correction(uint a, uint b) {
          tidy_conflicts(a0, b0);
 }
 
-// Step 3: is owner i's change held back by a better owner's that interacts with it?
-bool tidy_blocked(uint i) {
+// Step 3: is owner i's change held back by a better owner's (of first, first + stride, ...) that
+// interacts with it?
+bool tidy_blocked(uint i, uint first, uint stride) {
   uint64_t key = tidy_best(i);
   uint pi = tidy_partner(i);
-  for (uint l = 0u; l < tidy_count(); ++l) {
+  for (uint l = first; l < tidy_count(); l += stride) {
     uint pl = tidy_partner(l);
     if (l == i || pl == TIDY_NO_PARTNER) continue;
     uint64_t other = tidy_best(l);

@@ -101,6 +101,7 @@
 #define TIDY_NONE 0xFFFFFFFFFFFFFFFFul
 #define TIDY_NO_PARTNER 0xFFFFFFFFu
 #define TIDY_ROUNDS_MAX 256u  // PlacementParams::tidy_rounds at most
+#define TIDY_SEARCH_LANES 8u  // invocations weighing one change (placement_finalize.comp)
 
 // TidyLabel.flags
 #define TIDY_PLACED 1u   // the label has a box (placed, and not hidden by the tidy-up)
@@ -138,10 +139,10 @@ struct PlacementParams {
   uint phase;                    // placement_bounds.comp: PLACEMENT_PHASE_*
   float bucket_width;            // cost above the label's lowest tile bound that bucket 0 holds
   uint order_count;              // labels in the insertion order
-  uint label;         // place_label: the label at order position step - 1 (main pass) ...
-  uint spec_label;    // ... and at step (speculative pass)
-  uint finish_lanes;  // place_label: invocations of the last workgroup taking list entries
-                      // (0: all; fewer make more chunks, for tests)
+  uint label;           // place_label: the label at order position step - 1 (main pass) ...
+  uint spec_label;      // ... and at step (speculative pass)
+  uint finish_lanes;    // place_label: invocations of the last workgroup taking list entries
+                        // (0: all; fewer make more chunks, for tests)
   uint classify_tiles;  // place_label: list entries per classifying workgroup (4, 8 or 16)
   uint tidy_rounds;     // placement_finalize: rounds of the layout tidy-up at most (0: none)
 };
