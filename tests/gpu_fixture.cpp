@@ -1,5 +1,8 @@
 #include "gpu_fixture.h"
 
+#include "engine/core/png.h"
+
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -76,6 +79,31 @@ std::string output_dir() {
   const std::string dir = STRATA_TEST_OUTPUT;
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+void check_close(const std::vector<uint8_t>& actual, const std::vector<uint8_t>& expected,
+                 graph::Extent size, const std::string& name, int tolerance) {
+  REQUIRE(actual.size() == expected.size());
+  size_t bad = 0;
+  std::vector<uint8_t> diff(actual.size(), 255);
+  for (size_t p = 0; p < actual.size() / 4; ++p) {
+    int worst = 0;
+    for (int ch = 0; ch < 3; ++ch) {
+      const int d = std::abs(int(actual[4 * p + ch]) - int(expected[4 * p + ch]));
+      worst = std::max(worst, d);
+      diff[4 * p + ch] = uint8_t(std::min(255, d * 8));
+    }
+    bad += worst > tolerance;
+  }
+  const size_t pixels = actual.size() / 4;
+  if (bad * 100 > pixels) {
+    const std::string base = test::output_dir() + "/" + name;
+    write_png(base + ".actual.png", size.width, size.height, actual);
+    write_png(base + ".expected.png", size.width, size.height, expected);
+    write_png(base + ".difference.png", size.width, size.height, diff);
+  }
+  CHECK_MESSAGE(bad * 100 <= pixels, name << ": " << bad << " of " << pixels
+                                          << " pixels differ by more than " << tolerance << "/255");
 }
 
 }  // namespace strata::test

@@ -109,31 +109,6 @@ std::vector<uint8_t> to_rgba8(const std::vector<glm::vec4>& colors) {
 }
 
 // Checks the tolerance above; on failure writes actual, expected and difference images.
-void check_close(const std::vector<uint8_t>& actual, const std::vector<uint8_t>& expected,
-                 graph::Extent size, const std::string& name, int tolerance = 3) {
-  REQUIRE(actual.size() == expected.size());
-  size_t bad = 0;
-  std::vector<uint8_t> diff(actual.size(), 255);
-  for (size_t p = 0; p < actual.size() / 4; ++p) {
-    int worst = 0;
-    for (int ch = 0; ch < 3; ++ch) {
-      const int d = std::abs(int(actual[4 * p + ch]) - int(expected[4 * p + ch]));
-      worst = std::max(worst, d);
-      diff[4 * p + ch] = uint8_t(std::min(255, d * 8));
-    }
-    bad += worst > tolerance;
-  }
-  const size_t pixels = actual.size() / 4;
-  if (bad * 100 > pixels) {
-    const std::string base = test::output_dir() + "/" + name;
-    write_png(base + ".actual.png", size.width, size.height, actual);
-    write_png(base + ".expected.png", size.width, size.height, expected);
-    write_png(base + ".difference.png", size.width, size.height, diff);
-  }
-  CHECK_MESSAGE(bad * 100 <= pixels, name << ": " << bad << " of " << pixels
-                                          << " pixels differ by more than " << tolerance << "/255");
-}
-
 void check_against_reference(Context& ctx, const Scene& scene, const Camera& camera,
                              const std::string& name, RenderSettings settings = {},
                              graph::Extent size = {96, 96}) {
@@ -147,7 +122,7 @@ void check_against_reference(Context& ctx, const Scene& scene, const Camera& cam
     covered += glm::length(glm::vec3(c) - settings.background) > 0.02f;
   CHECK_MESSAGE(covered * 5 >= ref.final.size(),
                 name << ": only " << covered << " pixels show anything");
-  check_close(gpu.final, to_rgba8(ref.final), size, name);
+  test::check_close(gpu.final, to_rgba8(ref.final), size, name);
   // The walk itself agrees: as many samples taken and shaded (2% for edge pixels).
   CHECK(double(gpu.stats.samples) == doctest::Approx(double(ref.samples)).epsilon(0.02));
   CHECK(double(gpu.stats.shaded) == doctest::Approx(double(ref.shaded)).epsilon(0.02));
@@ -169,7 +144,7 @@ TEST_SUITE("gpu") {
     CHECK(gpu.stats.overflow == 0);
     const Rgba8Image golden = read_png(STRATA_SOURCE_DIR "/tests/golden/head-front-256.png");
     REQUIRE(golden.width == size.width);
-    check_close(gpu.final, golden.pixels, size, "head-front-256");
+    test::check_close(gpu.final, golden.pixels, size, "head-front-256");
   }
 
   TEST_CASE_FIXTURE(test::GpuTest,
@@ -257,7 +232,7 @@ TEST_SUITE("gpu") {
       non_empty_layers += alpha > 1.0f;
     }
     CHECK(non_empty_layers >= 3);
-    check_close(gpu.final, to_rgba8(composite), size, "layers-composite", 2);
+    test::check_close(gpu.final, to_rgba8(composite), size, "layers-composite", 2);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "empty_space_skipping_changes_nothing_but_the_sample_count") {
@@ -268,7 +243,7 @@ TEST_SUITE("gpu") {
     const Camera camera = camera_at({15.0f, 10.0f, 70.0f});
     const GpuResult a = render_gpu(ctx, scene, camera, on, {64, 64});
     const GpuResult b = render_gpu(ctx, scene, camera, off, {64, 64});
-    check_close(a.final, b.final, {64, 64}, "skipping", 1);
+    test::check_close(a.final, b.final, {64, 64}, "skipping", 1);
     CHECK(a.stats.samples < b.stats.samples);
   }
 
@@ -301,8 +276,8 @@ TEST_SUITE("gpu") {
     CHECK(frames[0].table_size == 32);
     CHECK(frames[1].overflow == 0);
     CHECK(frames[1].table_size > 32);
-    check_close(std::vector<uint8_t>(target.pixels().begin(), target.pixels().end()), expected,
-                size, "overflow-second-frame");
+    test::check_close(std::vector<uint8_t>(target.pixels().begin(), target.pixels().end()),
+                      expected, size, "overflow-second-frame");
   }
 }
 
