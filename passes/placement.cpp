@@ -323,6 +323,7 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
        [this](graph::PassContext& pc) {
          gpu::PlacementParams p = params(pc.viewport, 0);
          const uint32_t n = label_count_;
+         const uint32_t changes = n * TIDY_SWAP + n * (n - 1) / 2;  // moves, hidings, swaps
          p.phase = TIDY_PHASE_START;
          pc.dispatch(finalize_, p, {std::max(n, p.tidy_rounds + 1), 1, 1});
          for (uint32_t round = 0; round < p.tidy_rounds; ++round) {
@@ -334,7 +335,6 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
              // (conflicts and selection: a workgroup of 64 per label)
              const bool per_label_group =
                  phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_SELECT;
-             const uint32_t changes = n * TIDY_SWAP + n * (n - 1) / 2;
              const uint32_t threads = phase == TIDY_PHASE_SEARCH ? changes * TIDY_SEARCH_LANES
                                       : per_label_group          ? n * 64
                                                                  : n;

@@ -12,6 +12,14 @@ namespace strata {
 namespace gpu {
 namespace {
 
+// The summed-area tables as the shaders read them (0 left of and above the image).
+float table_value(const std::vector<float>& tables, const PlacementParams& params, uint layer,
+                  int x, int y) {
+  if (x < 0 || y < 0) return 0.0f;
+  return tables[size_t(layer) * params.width * params.height + size_t(y) * params.width +
+                size_t(x)];
+}
+
 // The shared cost code sees these members as the shader sees its buffers.
 struct Placer {
   PlacementParams params;
@@ -35,9 +43,7 @@ struct Placer {
     return vec3(box_origin(p, labels[j].size) + labels[j].size * 0.5f, 1.0f);
   }
   float table_at(uint layer, int x, int y) const {
-    if (x < 0 || y < 0) return 0.0f;
-    return tables[size_t(layer) * params.width * params.height + size_t(y) * params.width +
-                  size_t(x)];
+    return table_value(tables, params, layer, x, y);
   }
 
 #include "shared/placement_cost.h"
@@ -56,9 +62,7 @@ struct Tidier {
   std::vector<uint> partners;
 
   float table_at(uint layer, int x, int y) const {
-    if (x < 0 || y < 0) return 0.0f;
-    return tables[size_t(layer) * params.width * params.height + size_t(y) * params.width +
-                  size_t(x)];
+    return table_value(tables, params, layer, x, y);
   }
   uint tidy_count() const { return uint(labels.size()); }
   LabelGpu tidy_input(uint k) const { return labels[k]; }
@@ -148,21 +152,7 @@ std::vector<gpu::PlacementGpu> tidy_reference(std::span<const gpu::LabelGpu> lab
   for (uint32_t r = 0; r < tidier.params.tidy_rounds && tidier.round(); ++r) {
   }
   std::vector<gpu::PlacementGpu> placements(n);
-  for (uint32_t i = 0; i < n; ++i) {
-    const gpu::TidyLabel& l = tidier.states[i];
-    const uint64_t r = results[i];
-    if ((l.flags & TIDY_PLACED) == 0u) {
-      placements[i] = gpu::hidden_placement(labels[i]);
-    } else if (r != PLACEMENT_NONE && l.pixel == uint32_t(r & 0xFFFFFFFFu)) {
-      const uint32_t cost_bits = uint32_t(r >> 32);
-      float cost;
-      std::memcpy(&cost, &cost_bits, 4);
-      placements[i] = gpu::shown_placement(labels[i], l.pixel, cost, size.width);
-    } else {
-      const float cost = tidier.frees[i] + tidier.tidy_weight(tidier.tidy_all_conflicts(i));
-      placements[i] = gpu::shown_placement(labels[i], l.pixel, cost, size.width);
-    }
-  }
+  for (uint32_t i = 0; i < n; ++i) placements[i] = tidier.tidy_placement(i, results[i]);
   return placements;
 }
 

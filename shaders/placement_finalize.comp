@@ -136,17 +136,7 @@ void main() {
   }
   if (phase == TIDY_PHASE_OUTPUT) {
     load_states(n, phase);
-    if (t >= n) return;
-    const TidyLabel l = s_label[t];
-    const uint64_t r = results[t];
-    PlacementGpu p = hidden_placement(labels[t]);
-    if ((l.flags & TIDY_PLACED) != 0u) {
-      const bool kept = r != PLACEMENT_NONE && l.pixel == uint(r & 0xFFFFFFFFul);
-      const float cost = kept ? uintBitsToFloat(uint(r >> 32))
-                              : tidy[t].free + tidy_weight(tidy_all_conflicts(t));
-      p = shown_placement(labels[t], l.pixel, cost, params.width);
-    }
-    placements[t] = p;
+    if (t < n) placements[t] = tidy_placement(t, results[t]);
     return;
   }
   // A round: nothing to do once the round before applied nothing.

@@ -198,8 +198,3 @@ uint64_t tidy_key(float delta, uint change) {
   uint ordered = (bits & 0x80000000u) != 0u ? ~bits : bits | 0x80000000u;
   return (uint64_t(ordered) << 32) | uint64_t(change);
 }
-
-float tidy_key_delta(uint64_t key) {
-  uint ordered = uint(key >> 32);
-  return uintBitsToFloat((ordered & 0x80000000u) != 0u ? ordered & 0x7FFFFFFFu : ~ordered);
-}

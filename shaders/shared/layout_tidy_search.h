@@ -204,3 +204,14 @@ bool tidy_blocked(uint i, uint first, uint stride) {
   }
   return false;
 }
+
+// Label i's placement after the tidy-up, from the label loop's (cost bits << 32 | pixel) result:
+// hidden, kept with the loop's cost, or moved, costing its free cost plus its conflicts' weights.
+PlacementGpu tidy_placement(uint i, uint64_t result) {
+  TidyLabel l = tidy_state(i);
+  if ((l.flags & TIDY_PLACED) == 0u) return hidden_placement(tidy_input(i));
+  bool kept = result != PLACEMENT_NONE && l.pixel == uint(result & 0xFFFFFFFFul);
+  float cost = kept ? uintBitsToFloat(uint(result >> 32))
+                    : tidy_free(i) + tidy_weight(tidy_all_conflicts(i));
+  return shown_placement(tidy_input(i), l.pixel, cost, params.width);
+}
