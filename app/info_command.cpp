@@ -112,9 +112,10 @@ void describe_camera_and_settings(const Scene& scene, std::string& out) {
   out += format(
       "  weights: label_shadow %g, anchor_constraint %g, connector_shadow %g, integral_costs %g,\n"
       "           distance_to_anchor %g, connector_direction %g, previous_position %g,\n"
-      "           leader_crossing %g\n",
+      "           leader_crossing %g, illegible %g\n",
       w.label_shadow, w.anchor_constraint, w.connector_shadow, w.integral_costs,
-      w.distance_to_anchor, w.connector_direction, w.previous_position, w.leader_crossing);
+      w.distance_to_anchor, w.connector_direction, w.previous_position, w.leader_crossing,
+      w.illegible);
 }
 
 // A single volume, mesh or transfer-function file shows only its own section; a scene shows all.

@@ -88,6 +88,8 @@ const std::vector<Parameter>& parameters() {
        [](S s) { return &s.labels.placement.weights.connector_shadow; }},
       {"weights.leader_crossing", "tidy-up: a leader crossing a leader or through a box",
        [](S s) { return &s.labels.placement.weights.leader_crossing; }},
+      {"weights.illegible", "a box the layers in front hide (hard mode: never)",
+       [](S s) { return &s.labels.placement.weights.illegible; }},
       {"weights.integral_costs", "eq. 3.1: the occlusion and saliency under the box",
        [](S s) { return &s.labels.placement.weights.integral_costs; }},
       {"weights.distance_to_anchor", "eq. 3.1: leader length",

@@ -109,6 +109,7 @@ void Viewer::panel_labelling() {
          "%.3g", log);
   slider(*this, "leader crossing", "weights.leader_crossing", w.leader_crossing, 0.0f, 1e5f, "%.3g",
          log);
+  slider(*this, "illegible box", "weights.illegible", w.illegible, 0.0f, 1e6f, "%.3g", log);
   slider(*this, "integral costs", "weights.integral_costs", w.integral_costs, 0.0f, 1000.0f, "%.3g",
          log);
   slider(*this, "distance to anchor", "weights.distance_to_anchor", w.distance_to_anchor, 0.0f,

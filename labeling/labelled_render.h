@@ -62,9 +62,9 @@ struct LabelLayout {
 };
 
 // A label counts as shown when at least this share of its box is visible (label_visibility).
-inline constexpr float kLegibleShare = 0.75f;
+inline constexpr float kLegibleShare = LEGIBLE_SHARE;
 // A box pixel is hidden when the layers in front of the label's composite to at least this alpha.
-inline constexpr float kHidingAlpha = 0.5f;
+inline constexpr float kHidingAlpha = HIDING_ALPHA;
 
 // The visible share of each label's box: its pixels inside the image where the layers in front
 // of the label's own (drawn labels included) composite to less than kHidingAlpha. `layers`:

@@ -21,8 +21,9 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
                                       uint32_t layer_count, uint32_t label_count, uint32_t step) {
   gpu::PlacementParams p{};
   const CostWeights& w = s.weights;
-  p.weights = {w.distance_to_anchor, w.connector_direction, w.label_shadow,      w.connector_shadow,
-               w.anchor_constraint,  w.integral_costs,      w.previous_position, w.leader_crossing};
+  p.weights = {w.distance_to_anchor, w.connector_direction, w.label_shadow,
+               w.connector_shadow,   w.anchor_constraint,   w.integral_costs,
+               w.previous_position,  w.leader_crossing,     w.illegible};
   p.width = viewport.width;
   p.height = viewport.height;
   p.layer_count = layer_count;
@@ -133,8 +134,9 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
   b.results = graph.add_buffer("placement.results", fixed(n * sizeof(uint64_t)));
   b.placements = graph.add_buffer("placement.placements", fixed(n * sizeof(gpu::PlacementGpu)));
   b.saliency = graph.add_buffer("placement.saliency", per_pixel(sizeof(float)));
-  b.costs = graph.add_buffer("placement.integral_costs", per_pixel(sizeof(float) * layers));
-  b.tables = graph.add_buffer("placement.tables", per_pixel(sizeof(float) * layers));
+  // (integral costs, then hidden pixels: two stacks of `layers`)
+  b.costs = graph.add_buffer("placement.integral_costs", per_pixel(sizeof(float) * 2 * layers));
+  b.tables = graph.add_buffer("placement.tables", per_pixel(sizeof(float) * 2 * layers));
   b.constraints = graph.add_buffer("placement.constraints", per_pixel(sizeof(uint32_t)));
   b.bounds = graph.add_buffer("placement.bounds", per_tile(sizeof(float), n));
   b.tiles = graph.add_buffer("placement.tiles", per_tile(2 * sizeof(uint32_t), n));
@@ -204,8 +206,8 @@ void Placement::add_previous(graph::Graph& graph, const Buffers& b, const Previo
                   "placement"});
 }
 
-// Saliency (eq. 3.5) and integral costs per layer (eq. 3.3/3.4) in one pass, then their
-// summed-area tables.
+// Saliency (eq. 3.5), integral costs per layer (eq. 3.3/3.4) and hidden pixels per layer in one
+// pass, then their summed-area tables.
 void Placement::add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in) {
   graph.add_pass({"placement.integral_costs",
                   graph::PassKind::compute,
@@ -218,7 +220,7 @@ void Placement::add_costs(graph::Graph& graph, const Buffers& b, const Inputs& i
                                 {pc.viewport.width, pc.viewport.height, 1});
                   },
                   "placement"});
-  tables_.add_to(graph, b.costs, b.tables, "placement.sat", in.layer_count);
+  tables_.add_to(graph, b.costs, b.tables, "placement.sat", 2 * in.layer_count);
 }
 
 // Tile bounds, bucket counts, tiles sorted by bucket: for every label at once, since none of it

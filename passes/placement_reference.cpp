@@ -181,21 +181,24 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
                               at(x + 1, y), at(x - 1, y + 1), at(x, y + 1), at(x + 1, y + 1));
     }
   }
-  // Integral costs per layer and their tables.
-  out.costs.resize(pixels * layer_count);
+  // Integral costs per layer, hidden pixels per layer (after them), and their tables.
+  out.costs.resize(pixels * layer_count * 2);
   out.tables.resize(out.costs.size());
   for (size_t p = 0; p < pixels; ++p) {
     float all = 0.0f;
     for (uint32_t l = 0; l < layer_count; ++l) all += layers[l * pixels + p].a;
     float in_front = 0.0f;
+    float composite = 0.0f;  // of the layers in front of layer l
     for (uint32_t l = 0; l < layer_count; ++l) {
+      out.costs[(layer_count + l) * pixels + p] = composite >= HIDING_ALPHA ? 1.0f : 0.0f;
+      composite += (1.0f - composite) * layers[l * pixels + p].a;
       in_front += layers[l * pixels + p].a;
       out.costs[l * pixels + p] = gpu::integral_cost(
           in_front, all - in_front, all, out.saliency[p], layer_count, settings.saliency_weight,
           settings.occlusion_weight, settings.single_saliency_weight);
     }
   }
-  for (uint32_t l = 0; l < layer_count; ++l) {
+  for (uint32_t l = 0; l < 2 * layer_count; ++l) {
     const std::vector<double> table =
         summed_area_table_reference(std::span(out.costs).subspan(l * pixels, pixels), w, h);
     for (size_t p = 0; p < pixels; ++p) out.tables[l * pixels + p] = float(table[p]);

@@ -12,15 +12,15 @@
 namespace strata {
 
 struct ReferencePlacement {
-  std::vector<float> saliency;                // per pixel
-  std::vector<float> costs;                   // per layer, per pixel (eq. 3.3/3.4)
-  std::vector<float> tables;                  // their summed-area tables
+  std::vector<float> saliency;  // per pixel
+  std::vector<float> costs;     // per layer, per pixel: eq. 3.3/3.4, then 1 where hidden, else 0
+  std::vector<float> tables;    // their summed-area tables
   std::vector<uint32_t> constraints;          // bits of the last label placed, per pixel
   std::vector<gpu::PlacementGpu> placements;  // per label
 };
 
 // The placement finalize pass: the greedy loop's results (cost bits << 32 | pixel per label)
-// after the layout tidy-up (shaders/shared/layout_tidy.h) over the integral costs' `tables`.
+// after the layout tidy-up (shaders/shared/layout_tidy.h) over the placement's `tables`.
 std::vector<gpu::PlacementGpu> tidy_reference(std::span<const gpu::LabelGpu> labels,
                                               std::span<const uint32_t> order,
                                               std::span<const uint64_t> results,

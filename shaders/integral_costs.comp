@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 #include "shared/saliency.h"
 
-// Saliency (eq. 3.5) and every layer's integral costs (eq. 3.3/3.4) of a pixel, in one pass: the
+// Saliency (eq. 3.5), every layer's integral costs (eq. 3.3/3.4) of a pixel and whether the layers
+// in front of each layer hide it (composited alpha at least HIDING_ALPHA), in one pass: the
 // workgroup converts its tile and a one-pixel border of the label-free final image to CIELAB
 // once (each conversion is six powers), the Sobel filter reads them from shared memory.
 layout(local_size_x = PLACEMENT_GROUP, local_size_y = PLACEMENT_GROUP) in;
@@ -46,9 +47,13 @@ void main() {
     all += occlusion[l];
   }
   float in_front = 0.0;
+  float composite = 0.0;  // of the layers in front of layer l
+  const uint layer_size = params.width * params.height;
   for (uint l = 0u; l < params.layer_count; ++l) {
+    costs[(params.layer_count + l) * layer_size + pixel] = composite >= HIDING_ALPHA ? 1.0 : 0.0;
+    composite += (1.0 - composite) * occlusion[l];
     in_front += occlusion[l];
-    costs[l * params.width * params.height + pixel] =
+    costs[l * layer_size + pixel] =
         integral_cost(in_front, all - in_front, all, s, params.layer_count, params.saliency_weight,
                       params.occlusion_weight, params.single_saliency_weight);
   }

@@ -15,6 +15,7 @@
 #include "engine/gpu/resources.h"
 #include "engine/graph/graph_runner.h"
 #include "gpu_fixture.h"
+#include "labeling/labelled_render.h"
 #include "labeling/layout_metrics.h"
 #include "passes/label_forces.h"
 #include "passes/placement.h"
@@ -231,6 +232,82 @@ TEST_SUITE("gpu") {
     CHECK(after.anchors_covered == 0);
     CHECK(after.shown == in.labels.size());
     CHECK(after.leaders_through_boxes <= before.leaders_through_boxes);
+  }
+
+  // A near-opaque slab on the front layer over the left two thirds of the image (or all of it),
+  // nothing else, no integral costs: a rear label anchored under the slab would sit on it,
+  // unreadable. The illegible weight moves it off the slab (soft mode); hard mode forbids the
+  // slab (and hides the label when the slab covers everything); a front-layer label is not
+  // concerned. GPU == reference throughout; the visibility strata reports agrees.
+  TEST_CASE_FIXTURE(test::GpuTest, "placement_avoids_boxes_the_front_layers_hide") {
+    const auto slab_scene = [](float slab_end) {
+      Inputs in;
+      in.size = {96, 72};
+      const size_t pixels = size_t{in.size.width} * in.size.height;
+      in.final_rgba8.assign(pixels * 4, 90);
+      in.layers.assign(pixels * 2, glm::vec4(0.0f));
+      for (uint32_t y = 0; y < in.size.height; ++y) {
+        for (uint32_t x = 0; x < in.size.width; ++x) {
+          const float a = glm::unpackHalf1x16(glm::packHalf1x16(0.875f));
+          if (float(x) < slab_end)
+            in.layers[size_t{y} * in.size.width + x] = glm::vec4(0.3f * a, 0.3f * a, 0.3f * a, a);
+        }
+      }
+      in.labels = {label({30.0f, 36.0f}, {20.0f, 8.0f}, 1),
+                   label({20.0f, 20.0f}, {16.0f, 8.0f}, 0)};
+      in.order = {0, 1};
+      return in;
+    };
+    const auto visible = [](const Inputs& in, const std::vector<gpu::PlacementGpu>& placements) {
+      std::vector<LabelLayout> layout;
+      for (size_t i = 0; i < placements.size(); ++i) {
+        LabelLayout l;
+        l.layer = in.labels[i].layer;
+        l.box_size = in.labels[i].size;
+        l.box_origin = placements[i].position - l.box_size * 0.5f;
+        l.placed = placements[i].shown == PLACEMENT_SHOWN;
+        layout.push_back(l);
+      }
+      return label_visibility(in.layers, in.size, in.layer_count, layout);
+    };
+    const auto place = [&](const Inputs& in, float illegible, bool hard) {
+      PlacementSettings settings;
+      settings.weights.integral_costs = 0.0f;
+      settings.weights.illegible = illegible;
+      settings.hard = hard;
+      settings.write_constraints = true;
+      const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
+      const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                     in.labels, in.order, settings, in.size);
+      check_values(gpu.costs, cpu.costs, 1e-3f, false, "integral costs and hidden pixels");
+      check_values(gpu.tables, cpu.tables, 1e-5f, true, "tables");
+      check_placements(gpu, cpu);
+      return gpu.placements;
+    };
+    const Inputs in = slab_scene(64.0f);
+    // (unaware: the rear label on the slab, next to its anchor)
+    const std::vector<gpu::PlacementGpu> unaware = place(in, 0.0f, false);
+    REQUIRE(unaware[0].shown == PLACEMENT_SHOWN);
+    CHECK(visible(in, unaware)[0] < kLegibleShare);
+    for (const bool hard : {false, true}) {
+      CAPTURE(hard);
+      const std::vector<gpu::PlacementGpu> aware = place(in, hard ? 0.0f : 1000.0f, hard);
+      const std::vector<float> seen = visible(in, aware);
+      REQUIRE(aware[0].shown == PLACEMENT_SHOWN);
+      CHECK(seen[0] >= kLegibleShare);
+      CHECK(aware[0].position.x - 10.0f >= 64.0f - 0.25f * 20.0f);  // at most a quarter on the slab
+      // The front-layer label stays by its anchor, on the slab.
+      CHECK(aware[1].shown == PLACEMENT_SHOWN);
+      CHECK(glm::distance(aware[1].position, unaware[1].position) <= 1.0f);
+      CHECK(seen[1] == 1.0f);
+    }
+    // Nowhere legible: hard mode hides the rear label, soft mode shows it (and says it costs).
+    const Inputs covered = slab_scene(96.0f);
+    CHECK(place(covered, 0.0f, true)[0].shown == PLACEMENT_HIDDEN);
+    const std::vector<gpu::PlacementGpu> soft = place(covered, 1000.0f, false);
+    CHECK(soft[0].shown == PLACEMENT_SHOWN);
+    CHECK(soft[0].cost >= 1000.0f);
+    CHECK(place(covered, 0.0f, true)[1].shown == PLACEMENT_SHOWN);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "placement_stages_and_positions_match_the_cpu_reference") {

@@ -366,7 +366,7 @@ TEST_SUITE("loaders") {
           prefix +
               "settings.weights: unknown key 'label_shadw' (expected label_shadow, "
               "anchor_constraint, connector_shadow, integral_costs, distance_to_anchor, "
-              "connector_direction, previous_position, leader_crossing)");
+              "connector_direction, previous_position, leader_crossing, illegible)");
     CHECK(load(R"({"strata_scene": 1, "settings": {"layers": 0}})") ==
           prefix + "settings.layers: expected an integer >= 1");
     CHECK(load(R"({"strata_scene": 1, "atlas": [{"make": ["meshes"]}]})") ==

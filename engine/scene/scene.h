@@ -104,6 +104,9 @@ struct CostWeights {
   // Not the thesis's: the layout tidy-up after the placement (shaders/shared/layout_tidy.h)
   // counts this per pair of crossing leaders and per leader through another label's box.
   float leader_crossing = 1000.0f;
+  // Not the thesis's: a box the layers in front of the label's would hide (less than
+  // LEGIBLE_SHARE of it visible, shaders/shared/placement.h) costs this; hard mode forbids it.
+  float illegible = 1000.0f;
 };
 
 struct SceneSettings {

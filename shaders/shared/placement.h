@@ -17,6 +17,12 @@
 #define PLACEMENT_BOUNDS_TILES 4       // ... one cell each: 4 tiles
 #define VR_MAX_LAYERS_FOR_PLACEMENT 8  // as VR_MAX_LAYERS
 #define SALIENCY_SCALE 100.0f          // |CIELAB gradient| of this size counts as saliency 1
+// Legibility: a box pixel is hidden where the layers in front of the label's composite to at
+// least HIDING_ALPHA; a box is legible when at least LEGIBLE_SHARE of its pixels are not hidden.
+// The placement's tables hold each layer's hidden pixels after its integral costs (layer_count +
+// layer); strata's counts (labeling/labelled_render.h) use the same two figures.
+#define HIDING_ALPHA 0.5f
+#define LEGIBLE_SHARE 0.75f
 
 // Constraint bits (one constraint image, thesis 4.1.1).
 #define CONSTRAINT_LABEL 1u      // the new box or connector would touch a placed label's shadow
@@ -33,7 +39,8 @@
 #define PLACEMENT_BINDING_FINAL 0        // rgba8 label-free final image
 #define PLACEMENT_BINDING_SALIENCY 1     // float per pixel
 #define PLACEMENT_BINDING_LAYERS 2       // rgba16f array image, premultiplied
-#define PLACEMENT_BINDING_COSTS 3        // float per pixel per layer (integral costs, eq. 3.3/3.4)
+#define PLACEMENT_BINDING_COSTS 3        // float per pixel per layer (integral costs, eq. 3.3/3.4),
+                                         // then per layer 1 where its pixel is hidden, else 0
 #define PLACEMENT_BINDING_TABLES 4       // their summed-area tables, same layout
 #define PLACEMENT_BINDING_LABELS 5       // LabelGpu[]
 #define PLACEMENT_BINDING_ORDER 6        // uint[]: label indices in insertion order
@@ -120,6 +127,7 @@ struct CostWeightsGpu {
   float integral_costs;       // zeta, times the integral over the label box
   float previous_position;    // eta, per pixel
   float leader_crossing;      // the layout tidy-up: per leader crossing or through a box
+  float illegible;            // a box the front layers hide (less than LEGIBLE_SHARE visible)
 };
 
 struct PlacementParams {
@@ -130,7 +138,8 @@ struct PlacementParams {
   uint label_count;
   uint step;               // place_label: the dispatch (main pass of order position step - 1,
                            // speculative pass of step)
-  uint hard;               // 1: constraint violations are forbidden (the label may end up hidden)
+  uint hard;               // 1: constraint violations and illegible boxes are forbidden (the
+                           // label may end up hidden)
   uint write_constraints;  // 1: store the constraint bits of every pixel (tests, debugging)
   float margin;            // pixels added around label boxes in the constraints
   float saliency_weight;   // eq. 3.3: beta, how much saliency modulates occlusion behind

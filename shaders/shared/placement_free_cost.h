@@ -3,26 +3,47 @@
 // (placement_finalize.comp, through layout_tidy.h) and their CPU references. The includer
 // provides params (PlacementParams) and
 //   float table_at(uint layer, int x, int y)   summed-area table of the layer's integral costs
+//                                  (layer < layer_count) or hidden pixels (layer_count + layer)
 
-// The sum of the layer's integral costs over the box of `size` pixels at `origin`.
+// The sum of a table's layer over the box of `size` pixels at `origin`, the part on screen (an
+// internal label's box may reach past the image's right or bottom edge; left of it and above,
+// table_at gives 0).
 float box_integral(uint layer, vec2 origin, vec2 size) {
   int x0 = int(origin.x), y0 = int(origin.y);
-  int x1 = x0 + int(size.x) - 1, y1 = y0 + int(size.y) - 1;
+  int x1 = min(x0 + int(size.x), int(params.width)) - 1;
+  int y1 = min(y0 + int(size.y), int(params.height)) - 1;
   return table_at(layer, x1, y1) - table_at(layer, x0 - 1, y1) - table_at(layer, x1, y0 - 1) +
          table_at(layer, x0 - 1, y0 - 1);
 }
 
+// Whether a viewer can read the label's box at `origin`: at least LEGIBLE_SHARE of its pixels on
+// screen and not hidden by the layers in front of the label's (the counts are whole numbers,
+// exact in the float tables).
+bool box_legible(LabelGpu me, vec2 origin) {
+  ivec2 lo = max(ivec2(origin), ivec2(0));
+  ivec2 hi = min(ivec2(origin) + ivec2(me.size), ivec2(params.width, params.height));
+  float on_screen = float(max(hi.x - lo.x, 0) * max(hi.y - lo.y, 0));
+  float hidden = box_integral(params.layer_count + me.layer, origin, me.size);
+  return on_screen - hidden >= LEGIBLE_SHARE * float(int(me.size.x) * int(me.size.y));
+}
+
 // Whether pixel p may hold the label at all: its box lies on screen (internal labels: only the
-// anchor's own pixel).
+// anchor's own pixel) and, in hard mode, is legible.
 bool candidate_allowed(LabelGpu me, uvec2 p) {
-  if ((me.flags & LABEL_INTERNAL) != 0u) return uvec2(me.anchor) == p;
-  vec2 o = box_origin(p, me.size);
-  return o.x >= 0.0f && o.y >= 0.0f && o.x + me.size.x <= float(params.width) &&
-         o.y + me.size.y <= float(params.height);
+  if ((me.flags & LABEL_INTERNAL) != 0u) {
+    if (uvec2(me.anchor) != p) return false;
+  } else {
+    vec2 o = box_origin(p, me.size);
+    if (o.x < 0.0f || o.y < 0.0f || o.x + me.size.x > float(params.width) ||
+        o.y + me.size.y > float(params.height)) {
+      return false;
+    }
+  }
+  return params.hard == 0u || box_legible(me, box_origin(p, me.size));
 }
 
 // Eq. 3.1 at centre c without its constraint terms: distance, direction, integral costs,
-// previous position.
+// previous position; and strata's own term for a box the front layers hide.
 float free_cost(LabelGpu me, vec2 origin, vec2 c) {
   CostWeightsGpu w = params.weights;
   vec2 d = c - me.anchor;
@@ -32,5 +53,6 @@ float free_cost(LabelGpu me, vec2 origin, vec2 c) {
   cost += w.integral_costs * max(box_integral(me.layer, origin, me.size), 0.0f);
   cost += w.previous_position * length(c - me.previous);
   if (!holds(me, c)) cost += me.hold;
+  if (w.illegible > 0.0f && !box_legible(me, origin)) cost += w.illegible;
   return cost;
 }

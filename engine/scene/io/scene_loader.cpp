@@ -374,10 +374,12 @@ void SceneReader::settings(const json& object, const Field& field) {
                                                 {"distance_to_anchor", &w.distance_to_anchor},
                                                 {"connector_direction", &w.connector_direction},
                                                 {"previous_position", &w.previous_position},
-                                                {"leader_crossing", &w.leader_crossing}};
+                                                {"leader_crossing", &w.leader_crossing},
+                                                {"illegible", &w.illegible}};
   check_keys(*weights, weights_field,
              {"label_shadow", "anchor_constraint", "connector_shadow", "integral_costs",
-              "distance_to_anchor", "connector_direction", "previous_position", "leader_crossing"});
+              "distance_to_anchor", "connector_direction", "previous_position", "leader_crossing",
+              "illegible"});
   for (const auto& [key, target] : all) {
     if (const json* value = optional(*weights, key))
       *target = non_negative(*value, weights_field / key);

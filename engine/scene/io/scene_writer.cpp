@@ -51,7 +51,8 @@ ordered_json settings_json(const SceneSettings& settings) {
             {"distance_to_anchor", shortest_double(w.distance_to_anchor)},
             {"connector_direction", shortest_double(w.connector_direction)},
             {"previous_position", shortest_double(w.previous_position)},
-            {"leader_crossing", shortest_double(w.leader_crossing)}}}};
+            {"leader_crossing", shortest_double(w.leader_crossing)},
+            {"illegible", shortest_double(w.illegible)}}}};
 }
 
 ordered_json meshes_json(const std::vector<Mesh>& meshes, const auto& relative) {
