@@ -161,8 +161,9 @@ ordered_json pipelines_json(const std::vector<PipelineReport>& reports) {
 }
 
 void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t runs) {
+  const std::string scene_file = find_data_file(o.scene);
   const graph::Extent size = parse_size(o.size, "--size");
-  const Scene scene = load_scene_reporting(o.scene);
+  const Scene scene = load_scene_reporting(scene_file);
   Context ctx(device.context());
   RenderSettings settings;
   settings.layer_count = o.layers;
@@ -187,7 +188,7 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
   // The sampling distance the frame used (--step 0 asks for half a voxel).
   const float step = frame_data(renderer.inputs(), renderer.camera(), settings, size, 1).step;
   const ordered_json setup = {{"benchmark", "render"},
-                              {"scene", o.scene},
+                              {"scene", scene_file},
                               {"camera", o.camera},
                               {"width", size.width},
                               {"height", size.height},
@@ -232,8 +233,9 @@ void resize_labels(Scene& scene, uint32_t count) {
 }
 
 void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint32_t runs) {
+  const std::string scene_file = find_data_file(o.scene);
   const graph::Extent size = parse_size(o.size, "--size");
-  Scene scene = load_scene_reporting(o.scene);
+  Scene scene = load_scene_reporting(scene_file);
   resize_labels(scene, o.labels);
   Context ctx(device.context());
   LabellingSettings settings;
@@ -316,7 +318,7 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o, uint
   uint32_t enabled = 0;
   for (const LabelLayout& l : last.labels) enabled += l.placed;
   const ordered_json setup = {{"benchmark", "placement"},
-                              {"scene", o.scene},
+                              {"scene", scene_file},
                               {"width", size.width},
                               {"height", size.height},
                               {"labels", scene.labels.size()},
@@ -350,8 +352,9 @@ struct ViewBenchOptions {
 // The viewer's whole frame (labelled scene, forces, label drawing, the panel), headless, with two
 // frames in flight, along a turntable at 30 frames a second of animation time.
 void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
+  const std::string scene_file = find_data_file(o.scene);
   const graph::Extent size = parse_size(o.size, "--size");
-  Scene scene = load_scene_reporting(o.scene);
+  Scene scene = load_scene_reporting(scene_file);
   Context ctx(device.context());
   LabellingSettings settings;
   settings.placement.weights = scene.settings.weights;
@@ -415,7 +418,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   };
   nlohmann::ordered_json out;
   out["device"] = ctx.report().name;
-  out["scene"] = o.scene;
+  out["scene"] = scene_file;
   out["size"] = {size.width, size.height};
   out["labels"] = scene.labels.size();
   out["frames"] = cameras.size();
@@ -455,7 +458,9 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   render_cmd->add_option("--scene", render->scene, "scene file")->capture_default_str();
   render_cmd->add_option("--size", render->size, "N or WxH")->capture_default_str();
   render_cmd->add_option("--camera", render->camera, "named camera position");
-  render_cmd->add_option("--layers", render->layers, "depth layers, 1 to 8")->capture_default_str();
+  render_cmd->add_option("--layers", render->layers, "depth layers, 1 to 8")
+      ->check(CLI::Range(1u, 8u))
+      ->capture_default_str();
   render_cmd->add_flag("--no-skipping", render->no_skipping, "turn empty-space skipping off");
   render_cmd->add_option("--step", render->step,
                          "sampling distance in world units (0: half a voxel)");

@@ -19,8 +19,29 @@ struct DeviceOptions {
   ContextOptions context() const;
 };
 
-// Loads a scene and prints its warnings (missing data files, ...) to stderr.
+// The scene a command works on: a scene file, or a volume file or DICOM folder opened as one
+// (docs/scene-format.md), and what the command line adds or overrides.
+struct SceneInput {
+  std::string file;
+  std::string preset;   // --preset: every volume's transfer function
+  std::string labels;   // --labels: a label file (.mrk.json, .fcsv, .csv) added
+  int frame = -1;       // --frame: a 4-D volume's frame (-1: the first, with a warning)
+  uint32_t layers = 0;  // --layers: 0 keeps the scene's settings.layers
+  // The depth layers asked for: --layers, else the scene's (an Error naming the limit when the
+  // scene's is above kMaxLayers).
+  uint32_t layer_count(const Scene& scene) const;
+};
+// --preset, --labels, --frame and --layers (the positional FILE is the command's own).
+void add_scene_input_options(CLI::App* cmd, SceneInput& in);
+
+// Loads the scene (load_scene with the input's options) and prints its warnings (missing data
+// files, a transfer-function preset chosen, ...) to stderr.
+Scene load_scene_reporting(const SceneInput& in);
 Scene load_scene_reporting(const std::string& path);
+
+// A file of strata's data (a demo scene): under the working folder if it is there, else beside
+// the program (build/app/strata: the source tree's; bin/strata: share/strata/), else an Error.
+std::string find_data_file(const std::string& relative);
 
 // How labels look (render and video): --label-scale and --layer-colors.
 struct LabelLookOptions {
@@ -29,8 +50,11 @@ struct LabelLookOptions {
 };
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o);
 
-// "1024" or "1024x768"; throws Error naming the option when it is neither.
+// "1024" or "1024x768"; throws Error naming the option when it is neither or a side is outside 1
+// to 16384 (the device's own limit is checked when it is open: check_image_size).
 graph::Extent parse_size(const std::string& text, const char* option);
+// An Error naming the option and the device's limit when `size` is over maxImageDimension2D.
+void check_image_size(const Context& ctx, graph::Extent size, const char* option);
 
 void add_devices_command(CLI::App& app, DeviceOptions& device);
 void add_render_command(CLI::App& app, DeviceOptions& device);

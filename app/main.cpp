@@ -1,10 +1,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
+#include <vector>
 
 #include "app/commands.h"
 #include "engine/core/error.h"
 #include "engine/scene/io/scene_loader.h"
+#include "engine/scene/transfer_function_presets.h"
+#include "shaders/shared/volume_render.h"
 
 namespace strata::app {
 
@@ -20,11 +24,75 @@ ContextOptions DeviceOptions::context() const {
   return options;
 }
 
-Scene load_scene_reporting(const std::string& path) {
-  Scene scene = load_scene(path);
+Scene load_scene_reporting(const SceneInput& in) {
+  SceneOpenOptions options;
+  options.preset = in.preset;
+  options.labels = in.labels;
+  if (in.frame >= 0) options.frame = in.frame;
+  Scene scene = load_scene(in.file, options);
   for (const std::string& warning : scene.warnings)
     std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
   return scene;
+}
+
+Scene load_scene_reporting(const std::string& path) {
+  return load_scene_reporting(SceneInput{.file = path});
+}
+
+uint32_t SceneInput::layer_count(const Scene& scene) const {
+  if (layers > 0) return layers;
+  if (scene.settings.layer_count < 1 || scene.settings.layer_count > VR_MAX_LAYERS) {
+    throw Error(scene.source.string() +
+                ": settings: layers: " + std::to_string(scene.settings.layer_count) +
+                " is not 1 to " + std::to_string(VR_MAX_LAYERS));
+  }
+  return uint32_t(scene.settings.layer_count);
+}
+
+void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
+  std::string presets;
+  for (const TransferFunctionPreset& p : transfer_function_presets())
+    presets += std::string(presets.empty() ? "" : ", ") + p.name;
+  cmd->add_option("--preset", in.preset,
+                  "transfer-function preset for every volume: " + presets +
+                      " (default: the volume's own, else chosen from its values)");
+  cmd->add_option("--labels", in.labels,
+                  "labels from a file: 3D Slicer markups (.mrk.json, .fcsv) or CSV "
+                  "(docs/scene-format.md)");
+  cmd->add_option("--frame", in.frame, "a 4-D volume's frame, from 0 (default: the first)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--layers", in.layers,
+                  "depth layers, 1 to " + std::to_string(VR_MAX_LAYERS) +
+                      " (default: the scene's settings.layers, else 4)")
+      ->check(CLI::Range(1u, uint32_t(VR_MAX_LAYERS)));
+}
+
+std::string find_data_file(const std::string& relative) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (fs::exists(relative, error)) return relative;
+  const fs::path program = fs::read_symlink("/proc/self/exe", error);
+  std::vector<fs::path> tried;
+  if (!error) {
+    const fs::path folder = program.parent_path();
+    tried = {folder.parent_path().parent_path() / relative,      // build/app/strata
+             folder.parent_path() / "share/strata" / relative};  // bin/strata, installed
+  }
+  tried.push_back(fs::path(STRATA_SOURCE_DIR) / relative);  // the tree it was built from
+  for (const fs::path& p : tried) {
+    if (fs::exists(p, error)) return p.lexically_normal().string();
+  }
+  throw Error(relative + ": not found here, beside the program or in " STRATA_SOURCE_DIR
+                         " (give the file)");
+}
+
+void check_image_size(const Context& ctx, graph::Extent size, const char* option) {
+  const uint32_t limit = ctx.properties().limits.maxImageDimension2D;
+  if (size.width > limit || size.height > limit) {
+    throw Error(std::string(option) + ": " + std::to_string(size.width) + "x" +
+                std::to_string(size.height) + " is larger than the device's " +
+                std::to_string(limit) + " pixels a side (maxImageDimension2D)");
+  }
 }
 
 graph::Extent parse_size(const std::string& text, const char* option) {

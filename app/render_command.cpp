@@ -4,7 +4,8 @@
 #include <glm/gtc/packing.hpp>
 
 #include "app/commands.h"
-#include "engine/core/png.h"
+#include "app/progress.h"
+#include "engine/core/image.h"
 #include "engine/core/text_file.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
@@ -18,11 +19,10 @@ namespace strata::app {
 namespace {
 
 struct RenderOptions {
-  std::string scene;
+  SceneInput scene;
   std::string output = "strata.png";
   std::string size = "512x512";
   std::string camera;
-  uint32_t layers = 4;
   uint32_t tidy_rounds = PlacementSettings{}.tidy_rounds;
   std::string dump_layers;
   bool no_skipping = false;
@@ -42,18 +42,26 @@ void print_graph(const RenderOptions& o, graph::GraphRunner& runner) {
   if (o.dump_graph) std::fputs(graph::describe(runner.graph(), runner.compiled()).c_str(), stdout);
 }
 
-// Layer images are premultiplied rgba16f; written as straight-alpha PNGs.
-void dump_layers(graph::GraphRunner& runner, graph::ResourceId layers, graph::Extent size,
-                 uint32_t count, const std::string& folder) {
-  std::filesystem::create_directories(folder);
+// The layers' premultiplied rgba16f, as floats.
+std::vector<glm::vec4> layer_pixels(graph::GraphRunner& runner, graph::ResourceId layers) {
   const std::vector<std::byte> bytes = runner.download_image(layers);
   const auto* half = reinterpret_cast<const uint16_t*>(bytes.data());
+  std::vector<glm::vec4> out(bytes.size() / 8);
+  for (size_t i = 0; i < out.size(); ++i) {
+    for (int ch = 0; ch < 4; ++ch) out[i][ch] = glm::unpackHalf1x16(half[i * 4 + ch]);
+  }
+  return out;
+}
+
+// Layer images (premultiplied) written as straight-alpha PNGs.
+void dump_layers(const std::vector<glm::vec4>& layers, graph::Extent size, uint32_t count,
+                 const std::string& folder) {
+  std::filesystem::create_directories(folder);
   const size_t pixels = size_t{size.width} * size.height;
   for (uint32_t l = 0; l < count; ++l) {
     std::vector<uint8_t> rgba(pixels * 4);
     for (size_t p = 0; p < pixels; ++p) {
-      glm::vec4 c;
-      for (int ch = 0; ch < 4; ++ch) c[ch] = glm::unpackHalf1x16(half[(l * pixels + p) * 4 + ch]);
+      const glm::vec4 c = layers[l * pixels + p];
       const glm::vec3 straight = c.a > 0.0f ? glm::vec3(c) / c.a : glm::vec3(0.0f);
       for (int ch = 0; ch < 3; ++ch)
         rgba[p * 4 + ch] = uint8_t(std::clamp(straight[ch], 0.0f, 1.0f) * 255.0f + 0.5f);
@@ -65,9 +73,9 @@ void dump_layers(graph::GraphRunner& runner, graph::ResourceId layers, graph::Ex
   }
 }
 
-RenderSettings render_settings(const RenderOptions& o) {
+RenderSettings render_settings(const RenderOptions& o, const Scene& scene) {
   RenderSettings settings;
-  settings.layer_count = o.layers;
+  settings.layer_count = o.scene.layer_count(scene);
   settings.skip_empty = !o.no_skipping;
   return settings;
 }
@@ -109,8 +117,8 @@ std::vector<Still> stills(const Scene& scene, const RenderOptions& o) {
 
 LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene) {
   LabellingSettings settings;
-  settings.layer_count = o.layers;
-  settings.render = render_settings(o);
+  settings.layer_count = o.scene.layer_count(scene);
+  settings.render = render_settings(o, scene);
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
   settings.placement.tidy_rounds = o.tidy_rounds;
@@ -134,11 +142,17 @@ void write_layout(const std::string& path, const LabelledFrame& frame) {
 
 void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions& o,
                            graph::Extent size, const Still& still) {
-  LabelledRenderer renderer(ctx, scene, still.camera, size, labelling_settings(o, scene));
+  const LabellingSettings settings = labelling_settings(o, scene);
+  LabelledRenderer renderer(ctx, scene, still.camera, size, settings);
   print_graph(o, renderer.runner());
-  renderer.run();
+  if (settings.order == InsertionOrder::optimized) {
+    Progress progress("insertion order", settings.optimize_tries);
+    renderer.run([&](uint32_t done, uint32_t) { progress.step_done(done); });
+  } else {
+    renderer.run();
+  }
   const LabelledFrame frame = renderer.result();
-  write_png(still.image, size.width, size.height, frame.image);
+  write_image(still.image, size.width, size.height, frame.image);
   uint32_t shown = 0, placed = 0;
   for (const LabelLayout& l : frame.labels) {
     shown += l.shown;
@@ -150,6 +164,14 @@ void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions
   if (placed > shown) std::printf(" (%u more placed but not legible)", placed - shown);
   std::printf("\n");
   if (!still.layout.empty()) write_layout(still.layout, frame);
+  if (!still.layers.empty()) {
+    dump_layers(renderer.download_layers(), size, frame.layering.layer_count, still.layers);
+  }
+}
+
+// Every output file's format is known before anything renders.
+void check_outputs(const std::vector<Still>& all) {
+  for (const Still& still : all) check_image_extension(still.image);
 }
 
 // strata's main job: the labelled image (labeling/labelled_render.h), once per position.
@@ -157,7 +179,9 @@ void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const Scene scene = load_scene_reporting(o.scene);
   const std::vector<Still> all = stills(scene, o);
+  check_outputs(all);
   Context ctx(device.context());
+  check_image_size(ctx, size, "--size");
   for (const Still& still : all) render_labelled_still(ctx, scene, o, size, still);
 }
 
@@ -180,8 +204,10 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const Scene scene = load_scene_reporting(o.scene);
   const std::vector<Still> all = stills(scene, o);
+  check_outputs(all);
   Context ctx(device.context());
-  const RenderSettings settings = render_settings(o);
+  check_image_size(ctx, size, "--size");
+  const RenderSettings settings = render_settings(o, scene);
   VolumeRenderer renderer(ctx, scene, settings);
   HeadlessTarget target(ctx);
   graph::Graph graph;
@@ -194,18 +220,22 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   for (const Still& still : all) {
     renderer.set_camera(still.camera);
     const RenderStats stats = render_until_clean(renderer, runner, size);
-    write_png(still.image, size.width, size.height, target.pixels());
+    write_image(still.image, size.width, size.height, target.pixels());
     std::printf(
         "wrote %s (%ux%u, %u layers): %u fragments, load factor %.2f, %.1f samples per ray\n",
-        still.image.c_str(), size.width, size.height, o.layers, stats.fragments,
+        still.image.c_str(), size.width, size.height, settings.layer_count, stats.fragments,
         stats.load_factor(), double(stats.samples) / (double(size.width) * size.height));
-    if (!still.layers.empty()) dump_layers(runner, out.layers, size, o.layers, still.layers);
+    if (!still.layers.empty()) {
+      dump_layers(layer_pixels(runner, out.layers), size, settings.layer_count, still.layers);
+    }
   }
 }
 
 void render_test_pattern(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
+  check_image_extension(o.output);
   Context ctx(device.context());
+  check_image_size(ctx, size, "--size");
   TestPattern pattern(ctx);
   HeadlessTarget target(ctx);
   graph::Graph graph;
@@ -215,29 +245,32 @@ void render_test_pattern(DeviceOptions& device, const RenderOptions& o) {
   target.bind(runner);
   print_graph(o, runner);
   runner.run_now();
-  write_png(o.output, size.width, size.height, target.pixels());
+  write_image(o.output, size.width, size.height, target.pixels());
   std::printf("wrote %s (%ux%u)\n", o.output.c_str(), size.width, size.height);
 }
 
 }  // namespace
 
 void add_render_command(CLI::App& app, DeviceOptions& device) {
-  CLI::App* cmd = app.add_subcommand("render", "Render a scene offline and write it as PNG");
+  CLI::App* cmd =
+      app.add_subcommand("render", "Render a scene offline and write it as PNG or JPEG");
   auto o = std::make_shared<RenderOptions>();
-  cmd->add_option("scene", o->scene,
-                  "scene file (.json, or .xml of the thesis program); none: a test pattern");
-  cmd->add_option("-o,--output", o->output, "PNG file to write")->capture_default_str();
+  cmd->add_option("scene", o->scene.file,
+                  "scene file (.json, or .xml of the thesis program), or a volume (.nii, .nii.gz, "
+                  ".mhd, .mha, .nrrd, .nhdr, a DICOM file or folder); none: a test pattern");
+  cmd->add_option("-o,--output", o->output, "image to write: .png, .jpg or .jpeg")
+      ->capture_default_str();
+  add_scene_input_options(cmd, o->scene);
   cmd->add_option("--size", o->size, "image size, N or WxH")->capture_default_str();
   cmd->add_option("--camera", o->camera,
                   "named camera position of the scene, or several (front,left): one image each, "
                   "named after it (out-front.png, out-left.png)");
-  cmd->add_option("--layers", o->layers, "depth layers, 1 to 8")->capture_default_str();
   cmd->add_option("--tidy-rounds", o->tidy_rounds,
                   "rounds of the layout tidy-up after the placement (0: none)")
       ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
       ->capture_default_str();
   cmd->add_option("--dump-layers", o->dump_layers,
-                  "folder to write each (label-free) layer image to");
+                  "folder to write each (label-free) layer image to, beside the -o image");
   cmd->add_flag("--no-skipping", o->no_skipping, "turn empty-space skipping off");
   cmd->add_flag("--no-labels", o->no_labels, "render the scene without its labels");
   cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
@@ -257,9 +290,9 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
       ->capture_default_str();
   cmd->callback([&device, o] {
-    if (o->scene.empty()) {
+    if (o->scene.file.empty()) {
       render_test_pattern(device, *o);
-    } else if (o->no_labels || !o->dump_layers.empty()) {
+    } else if (o->no_labels) {
       render_scene(device, *o);
     } else {
       render_labelled_scene(device, *o);

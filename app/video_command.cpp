@@ -2,16 +2,14 @@
 // seconds, with the labels moved by the forces between frames (a fixed time step, so the same
 // command gives the same frames). Frames go into an H.264 MP4 (-o NAME.mp4) or a folder as a
 // numbered PNG sequence, and with --layout-dir each frame's layout as JSON (for `strata eval`).
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 
-#include <unistd.h>
-
 #include "app/commands.h"
+#include "app/progress.h"
 #include "engine/core/png.h"
 #include "engine/core/text_file.h"
 #include "engine/core/video_file.h"
@@ -22,7 +20,7 @@ namespace strata::app {
 namespace {
 
 struct VideoOptions {
-  std::string scene;
+  SceneInput scene;
   std::string path;
   double orbit = 0.0;    // degrees; 0: --path
   double seconds = 0.0;  // of the orbit; 0: 30 degrees a second
@@ -37,7 +35,6 @@ struct VideoOptions {
   LabelLookOptions look;
   ForceSettings forces;
   float layer_margin = LayerHysteresis{}.margin;
-  uint32_t layers = 4;
   uint32_t tidy_rounds = PlacementSettings{}.tidy_rounds;
 };
 
@@ -48,27 +45,6 @@ CameraPath camera_path(const Scene& scene, const VideoOptions& o) {
   const double seconds = o.seconds > 0.0 ? o.seconds : std::abs(o.orbit) / 30.0;
   return orbit_path(scene, camera_for(scene, o.camera), o.orbit, seconds);
 }
-
-// "frame 12/60, 8.3 frames/s, 6 s left" on one line of a terminal; nothing when stderr is not one.
-class Progress {
- public:
-  explicit Progress(size_t total) : total_(total), quiet_(!isatty(STDERR_FILENO)) {}
-  void frame_done(size_t done) const {
-    if (quiet_) return;
-    const double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
-    const double rate = elapsed > 0.0 ? double(done) / elapsed : 0.0;
-    const double left = rate > 0.0 ? double(total_ - done) / rate : 0.0;
-    std::fprintf(stderr, "\rframe %zu/%zu, %.1f frames/s, %.0f s left   ", done, total_, rate,
-                 left);
-    if (done == total_) std::fputc('\n', stderr);
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  size_t total_;
-  bool quiet_;
-  Clock::time_point start_ = Clock::now();
-};
 
 std::string frame_name(size_t frame, const char* extension) {
   char name[32];
@@ -93,7 +69,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
 
   Context ctx(device.context());
   LabellingSettings settings;
-  settings.layer_count = o.layers;
+  settings.layer_count = o.scene.layer_count(scene);
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
   settings.placement.tidy_rounds = o.tidy_rounds;
@@ -104,7 +80,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   settings.hysteresis.margin = o.layer_margin;
   LabelledRenderer renderer(ctx, scene, cameras.front(), size, settings);
   renderer.run();  // the first frame: the labels settled on their placement
-  const Progress progress(cameras.size());
+  Progress progress("frame", cameras.size());
   for (size_t f = 0; f < cameras.size(); ++f) {
     if (f > 0) {
       renderer.set_camera(cameras[f]);
@@ -125,7 +101,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
       write_text_file(std::filesystem::path(o.layout_dir) / frame_name(f, "json"),
                       layout_json(frame));
     }
-    progress.frame_done(f + 1);
+    progress.step_done(f + 1);
   }
   if (file) file->finish();
   std::printf("wrote %zu frames (%ux%u, %g fps) to %s\n", cameras.size(), size.width, size.height,
@@ -138,7 +114,9 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   CLI::App* cmd = app.add_subcommand(
       "video", "Render the labelled scene along a camera path or a turntable, frame by frame");
   auto o = std::make_shared<VideoOptions>();
-  cmd->add_option("scene", o->scene, "scene file")->required();
+  cmd->add_option("scene", o->scene.file, "scene file, or a volume file or DICOM folder")
+      ->required();
+  add_scene_input_options(cmd, o->scene);
   cmd->add_option("--path", o->path, "camera path: front,left_2,top_3 (docs/scene-format.md)");
   cmd->add_option("--orbit", o->orbit, "turntable: degrees about the scene's centre");
   cmd->add_option("--seconds", o->seconds,
@@ -149,7 +127,6 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("-o,--output", o->output, "NAME.mp4 (H.264), or a folder for PNG frames")
       ->required();
   cmd->add_option("--layout-dir", o->layout_dir, "folder for each frame's layout JSON");
-  cmd->add_option("--layers", o->layers, "depth layers, 1 to 8")->capture_default_str();
   cmd->add_option("--tidy-rounds", o->tidy_rounds,
                   "rounds of the layout tidy-up after the placement (0: none)")
       ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))

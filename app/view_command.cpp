@@ -26,13 +26,12 @@ namespace strata::app {
 namespace {
 
 struct ViewOptions {
-  std::string scene;
+  SceneInput scene;
   std::string camera;
   std::string size = "960x720";
   std::string script;
   std::string screenshot_dir = ".";
   uint32_t frames = 0;
-  uint32_t layers = 4;
   uint32_t tidy_rounds = kViewerTidyRounds;
   uint32_t blur = 12;
   uint32_t frames_in_flight = 2;
@@ -106,10 +105,7 @@ float script_number(const std::string& word) {
 }
 
 AnatomicalView view_named(const std::string& name) {
-  const char* names[] = {"anterior", "posterior", "left", "right", "superior", "inferior"};
-  for (int i = 0; i < 6; ++i) {
-    if (name == names[i]) return AnatomicalView(i);
-  }
+  if (const auto view = anatomical_view_named(name)) return *view;
   throw Error("no view '" + name + "' (anterior, posterior, left, right, superior, inferior)");
 }
 
@@ -176,6 +172,10 @@ void Script::run(Viewer& viewer, const std::vector<std::string>& w) {
   } else if (c == "view") {
     need(2, "view anterior|posterior|left|right|superior|inferior");
     viewer.view_from(view_named(w[1]));
+  } else if (c == "preset") {
+    if (w.size() != 2 && w.size() != 3)
+      throw Error("'preset' takes the form: preset NAME [VOLUME]");
+    viewer.set_preset(w.size() == 3 ? uint32_t(script_number(w[2])) : 0u, w[1]);
   } else if (c == "set") {
     need(3, "set PARAMETER VALUE");
     viewer.set_parameter(w[1], w[2]);
@@ -226,7 +226,7 @@ void Script::run(Viewer& viewer, const std::vector<std::string>& w) {
     viewer.request_quit();
   } else {
     throw Error("no command '" + c +
-                "' (drag, scroll, key, view, set, hide, show, screenshot, capture, layout, "
+                "' (drag, scroll, key, view, preset, set, hide, show, screenshot, capture, layout, "
                 "record, frames, sleep, save-position, report, quit)");
   }
 }
@@ -318,19 +318,19 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   context.instance_extensions = glfw.instance_extensions();
   context.presentation = true;
   Context ctx(context);
-  const std::string title = "strata - " + std::filesystem::path(o.scene).filename().string();
+  const std::string title = "strata - " + std::filesystem::path(o.scene.file).filename().string();
   Window window(size, o.size, title);
   float scale_x = 1.0f, scale_y = 1.0f;
   glfwGetWindowContentScale(window.handle, &scale_x, &scale_y);
 
   LabellingSettings settings;
-  settings.layer_count = o.layers;
+  settings.layer_count = o.scene.layer_count(scene);
   settings.placement.weights = scene.settings.weights;
   settings.placement.tidy_rounds = o.tidy_rounds;
   // HiDPI: label text and boxes follow the display's content scale, as the panel does.
   settings.label_scale = std::clamp(o.label_scale * std::max(scale_x, scale_y), 0.25f, 4.0f);
   ViewerOptions options;
-  options.scene_path = o.scene;
+  options.scene_path = o.scene.file;
   options.screenshot_dir = o.screenshot_dir;
   options.optimize_on_idle = !o.no_optimize;
   options.ui_scale = std::max(scale_x, scale_y);
@@ -378,7 +378,7 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
     }
   }
   output.wait_idle();
-  print_summary(viewer, o.scene);
+  print_summary(viewer, o.scene.file);
 }
 
 // --- no scene: the test pattern ----------------------------------------------------------------
@@ -424,14 +424,15 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
       "Open the interactive viewer (mouse: left rotate, right/wheel zoom, middle or "
       "shift+left pan; keys: arrows, r reset, 1-9 positions, F12 screenshot, h panel, q)");
   auto o = std::make_shared<ViewOptions>();
-  cmd->add_option("scene", o->scene,
-                  "scene file (.json, or .xml of the thesis program); none: a test pattern");
+  cmd->add_option("scene", o->scene.file,
+                  "scene file (.json, or .xml of the thesis program), or a volume file or DICOM "
+                  "folder; none: a test pattern");
+  add_scene_input_options(cmd, o->scene);
   cmd->add_option("--camera", o->camera, "named camera position of the scene to start at");
   cmd->add_option("--size", o->size, "window size in screen units, N or WxH")
       ->capture_default_str();
   cmd->add_option("--frames", o->frames,
                   "close after this many frames (0: when the window closes)");
-  cmd->add_option("--layers", o->layers, "depth layers, 1 to 8")->capture_default_str();
   cmd->add_option("--tidy-rounds", o->tidy_rounds, "rounds of the layout tidy-up per frame")
       ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
       ->capture_default_str();
@@ -456,7 +457,7 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
       ->capture_default_str();
   cmd->callback([&device, o] {
     const graph::Extent size = parse_size(o->size, "--size");
-    if (o->scene.empty()) {
+    if (o->scene.file.empty()) {
       view_pattern(device, *o, size);
     } else {
       view_scene(device, *o, size);

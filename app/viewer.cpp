@@ -14,6 +14,7 @@
 #include "engine/core/text_file.h"
 #include "engine/gpu/context.h"
 #include "engine/scene/io/scene_loader.h"
+#include "engine/scene/transfer_function_presets.h"
 #include "labeling/camera_path.h"
 #include "labeling/insertion_order.h"
 
@@ -408,7 +409,10 @@ void Viewer::save_position(const std::string& name) {
   }
   scene_.camera_positions.push_back(control_.pose(chosen));
   std::filesystem::path path = options_.scene_path;
-  if (path.extension() != ".json") path.replace_extension(".json");  // (a thesis .xml scene)
+  if (path.extension() != ".json") {  // a thesis .xml scene, a volume or a DICOM folder
+    const std::string file = path.lexically_normal().filename().string();
+    path = path.lexically_normal().parent_path() / (file.substr(0, file.find('.')) + ".json");
+  }
   save_scene_json(path, scene_);
   message_ = "saved position '" + chosen + "' in " + path.string();
   std::printf("view: %s\n", message_.c_str());
@@ -476,6 +480,16 @@ void Viewer::settings_changed(bool reproject) {
   if (reproject) labelled_->set_camera(control_.camera());
   labelled_->place_afresh();  // the new settings' layout, reached smoothly
   changed();
+}
+
+void Viewer::set_preset(uint32_t volume, const std::string& name) {
+  if (volume >= scene_.volumes.size()) {
+    throw Error("no volume " + std::to_string(volume) + " (the scene has " +
+                std::to_string(scene_.volumes.size()) + ")");
+  }
+  original_tfs_[volume] = make_transfer_function_preset(name, scene_.volumes[volume]);
+  set_transfer(volume);
+  message_ = "volume '" + scene_.volumes[volume].name + "': preset " + name;
 }
 
 void Viewer::set_transfer(uint32_t volume) {

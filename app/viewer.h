@@ -136,6 +136,9 @@ class Viewer {
   void jump_to_position(size_t index);  // the scene's named position (keys 1-9), animated
   void view_from(AnatomicalView view);
   void reset_camera();
+  // Volume `volume`'s transfer function becomes the preset `name` (transfer_function_presets.h),
+  // seen through the volume's level, window and opacity.
+  void set_preset(uint32_t volume, const std::string& name);
   // The labelled picture without the UI (PNG); the path written.
   std::filesystem::path screenshot(const std::filesystem::path& path = {});
   // The window's picture, UI included (PNG).
@@ -233,7 +236,7 @@ class Viewer {
   } optimisation_;
 
   // Panel state.
-  std::vector<TransferFunction> original_tfs_;  // per volume
+  std::vector<TransferFunction> original_tfs_;  // per volume: the scene's, or the preset chosen
   struct VolumeLook {
     float level = 0.5f, window = 1.0f, opacity = 1.0f;
   };

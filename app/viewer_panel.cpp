@@ -8,6 +8,7 @@
 
 #include "app/viewer.h"
 #include "engine/core/error.h"
+#include "engine/scene/transfer_function_presets.h"
 #include "labeling/insertion_order.h"
 
 namespace strata::app {
@@ -27,8 +28,6 @@ bool checkbox(Viewer& viewer, const char* label, const char* parameter, bool val
   viewer.set_flag(parameter, value);
   return true;
 }
-
-const char* const kViews[] = {"anterior", "posterior", "left", "right", "superior", "inferior"};
 
 }  // namespace
 
@@ -86,7 +85,7 @@ void Viewer::panel_camera() {
   }
   for (int v = 0; v < 6; ++v) {
     if (v % 3 != 0) ImGui::SameLine();
-    if (ImGui::Button(kViews[v])) view_from(AnatomicalView(v));
+    if (ImGui::Button(kAnatomicalViewNames[v])) view_from(AnatomicalView(v));
   }
   if (ImGui::Button("Reset (r)")) reset_camera();
   ImGui::SetNextItemWidth(140.0f * ui_.scale());
@@ -196,6 +195,14 @@ void Viewer::panel_rendering() {
     ImGui::PushID(int(v));
     ImGui::TextUnformatted(scene_.volumes[v].name.c_str());
     VolumeLook& look = looks_[v];
+    if (ImGui::BeginCombo("preset", original_tfs_[v].name.c_str())) {
+      for (const TransferFunctionPreset& p : transfer_function_presets()) {
+        if (ImGui::Selectable(p.name, original_tfs_[v].name == p.name))
+          set_preset(uint32_t(v), p.name);
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", p.description);
+      }
+      ImGui::EndCombo();
+    }
     bool edited = ImGui::SliderFloat("level", &look.level, 0.0f, 1.0f, "%.3f");
     edited |= ImGui::SliderFloat("window", &look.window, 0.01f, 2.0f, "%.3f");
     edited |= ImGui::SliderFloat("opacity", &look.opacity, 0.0f, 4.0f, "%.2f");

@@ -22,31 +22,6 @@ double units_per_pixel(const Camera& lens, double distance, double height) {
   return 2.0 * distance * std::tan(glm::radians(double(lens.fov_y_degrees)) / 2.0) / height;
 }
 
-struct Side {
-  glm::dvec3 eye_direction;  // from the centre, in LPS
-  glm::dvec3 up;
-};
-
-// ctkVTKRenderView::lookFromAxis in Slicer's RAS, with x and y negated for strata's LPS.
-Side side_of(AnatomicalView view) {
-  const glm::dvec3 superior(0, 0, 1), anterior(0, -1, 0), left(1, 0, 0);
-  switch (view) {
-    case AnatomicalView::anterior:
-      return {anterior, superior};
-    case AnatomicalView::posterior:
-      return {-anterior, superior};
-    case AnatomicalView::left:
-      return {left, superior};
-    case AnatomicalView::right:
-      return {-left, superior};
-    case AnatomicalView::superior:
-      return {superior, anterior};
-    case AnatomicalView::inferior:
-      return {-superior, anterior};
-  }
-  return {anterior, superior};
-}
-
 }  // namespace
 
 CameraControl::CameraControl(const Scene& scene) : CameraControl(scene, scene.camera) {}
@@ -141,7 +116,7 @@ void CameraControl::place(const Camera& camera) {
 }
 
 Camera CameraControl::view_from(AnatomicalView view) const {
-  const Side side = side_of(view);
+  const ViewSide side = side_of(view);
   Camera camera = start_;
   camera.view = glm::mat4(glm::lookAt(centre_ + side.eye_direction * distance_, centre_, side.up));
   return camera;

@@ -17,6 +17,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "engine/scene/camera.h"
+#include "engine/scene/fitted_camera.h"
 #include "engine/scene/scene.h"
 #include "labeling/camera_path.h"
 
@@ -32,11 +33,6 @@ inline constexpr double rotate_step_degrees = 15.0;
 // MotionFactor)). A right drag over the whole viewport height zooms by 1.1^20 (6.7 times).
 inline constexpr double zoom_per_wheel_tick = 1.21;
 inline constexpr double zoom_drag_exponent_per_viewport = 20.0;  // of 1.1
-
-// The six buttons of Slicer's 3D view controller (ctkVTKRenderView::lookFromAxis): the camera
-// on that side of the patient, looking at the scene's centre. Front, back and the sides have the
-// head up (+z); from above and below, the face (anterior, -y) is up.
-enum class AnatomicalView { anterior, posterior, left, right, superior, inferior };
 
 // The camera as an orbit: a target, the eye's distance from it and the camera's orientation.
 // The lens (field of view, near, far) is always the scene camera's.

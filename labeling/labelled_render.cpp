@@ -316,7 +316,7 @@ double LabelledRenderer::total_cost() const {
   return total;
 }
 
-void LabelledRenderer::run() {
+void LabelledRenderer::run(const std::function<void(uint32_t done, uint32_t total)>& progress) {
   // A still: every frame puts the labels on their placement (the forces start afresh).
   const auto run_still = [this] {
     set_placement_frame(false, within_);
@@ -342,6 +342,7 @@ void LabelledRenderer::run() {
         best_cost = cost;
         best = candidate;
       }
+      if (progress) progress(t + 1, settings_.optimize_tries);
     }
     set_order(best);
     run_still();

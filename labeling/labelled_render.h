@@ -112,8 +112,9 @@ class LabelledRenderer {
 
   // A still, waited for: the labels put on their placement; re-rendered while the HA-Buffer
   // overflows (it grows each time). The Apollonius and optimised orders take more frames: they
-  // need a frame's image or costs, read between frames, never inside one.
-  void run();
+  // need a frame's image or costs, read between frames, never inside one; `progress` hears of
+  // each order tried (done, total) when there are several.
+  void run(const std::function<void(uint32_t done, uint32_t total)>& progress = {});
   // Moves the camera: anchors, layering and the renderer's layers follow; the labels' drawn
   // positions stay on the GPU for the forces of the next frames.
   void set_camera(const Camera& camera);
@@ -186,6 +187,10 @@ class LabelledRenderer {
   // a hidden label counting as much as an anchor-constraint violation.
   double total_cost() const;
 
+  // The label-free layer images of the last frame (premultiplied rgba, layer after layer, each
+  // size.width x size.height), waited for.
+  std::vector<glm::vec4> download_layers() const;
+
  private:
   struct Parts;
   Context& ctx_;
@@ -204,7 +209,6 @@ class LabelledRenderer {
   bool afresh_ = false;
   void build_labels();  // glyphs and box sizes from the texts at settings_.font_pixels
   void set_label_text(float pixels, float scale);
-  std::vector<glm::vec4> download_layers() const;
   Extension extension_;
   uint32_t frames_in_flight_ = 1;
   std::vector<bool> hidden_;

@@ -2,9 +2,13 @@
 # Downloads the real data strata's demo and tests use, from Debian's archive, into the git-ignored
 # assets/cache (nothing is installed system-wide): `apt-get download` fetches the .deb (apt checks
 # it against the archive's signed index), `dpkg -x` unpacks it, and every file we use is checked
-# against the SHA-256 pinned here. Idempotent: files already in place and verified are kept.
+# against the SHA-256 pinned here (a .gz unpacked to a name without .gz is checked unpacked).
+# Idempotent: files already in place and verified are kept.
 #   mricron-data:   ch2.nii.gz (Colin27 T1 head MRI), aal.nii.gz + aal.nii.txt (116 AAL regions)
-#   python3-pydicom: its DICOM test series dicomdirtests/98892001/CT5N (5 CT slices)
+#   python3-pydicom: its DICOM test series dicomdirtests/98892001/CT5N (5 CT slices) and
+#                    CT_small.dcm (one 128x128 CT slice)
+#   python3-nibabel: philips_mprage.dcm (an enhanced multi-frame MR: 176 frames of 256x256 in one
+#                    file; its pixels are zeros) and example4d.nii.gz (4-D NIfTI, 2 frames)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cache=assets/cache
@@ -16,13 +20,20 @@ files=(
   "mricron-data usr/share/mricron/templates/aal.nii.gz mricron/aal.nii.gz b512dcd3f36b77f56be7a9a038134096e66314b7e8c31d25875b96bcf6991454"
   "mricron-data usr/share/mricron/templates/aal.nii.txt mricron/aal.nii.txt 1788d6556a9ec056de9867b2382cf1ce1b51b87ae4cfd9cd25de48ae4dde709e"
 )
-ct5n=usr/lib/python3/dist-packages/pydicom/data/test_files/dicomdirtests/98892001/CT5N
+pydicom=usr/lib/python3/dist-packages/pydicom/data/test_files
+ct5n=$pydicom/dicomdirtests/98892001/CT5N
 files+=(
   "python3-pydicom $ct5n/2062 dicom/CT5N/2062 27f8126485634a817f0941cc727094e8cfacb18341fbc317d175ff373804118b"
   "python3-pydicom $ct5n/2392 dicom/CT5N/2392 02b0af20eeae95f6d42554c53a630babaa5ed2519657208137d3c7418b6acb81"
   "python3-pydicom $ct5n/2693 dicom/CT5N/2693 6020fdffd513017e7b2d5dc52435b2bbf27209aabee183a30207a149dccecb2e"
   "python3-pydicom $ct5n/3023 dicom/CT5N/3023 4f7f4f2b3c79acdd5e0fc23fdd9f6bae6e6da9dccfadd1f9147b7bff53756653"
   "python3-pydicom $ct5n/3353 dicom/CT5N/3353 5eaa662118b8d87601a14231893cb7ecf1737a434c95120cfb4076cfce667b18"
+  "python3-pydicom $pydicom/CT_small.dcm dicom/CT_small.dcm 3dd31e5cc835b3f2cdd46c9da1982f59251e78518fefa8163d914631c66437d6"
+)
+nibabel=usr/lib/python3/dist-packages/nibabel
+files+=(
+  "python3-nibabel $nibabel/nicom/tests/data/philips_mprage.dcm.gz dicom/philips_mprage.dcm 00058b3a5141b839493c21393c317e1cfe12ca912be8edf2f856ad3ea69fb6e3"
+  "python3-nibabel $nibabel/tests/data/example4d.nii.gz nibabel/example4d.nii.gz 42097dfbab9d2a036b41ae5c97a359591cf2cf5c3f8dc6ca6455c0b8a7f22696"
 )
 
 verified() { [[ -f $1 ]] && echo "$2  $1" | sha256sum --check --status; }
@@ -43,7 +54,11 @@ for entry in "${files[@]}"; do
     unpacked+=("$package")
   fi
   mkdir -p "$(dirname "$dest")"
-  cp "$cache/deb-$package/root/$inside" "$dest"
+  if [[ $inside == *.gz && $dest != *.gz ]]; then
+    gunzip -c "$cache/deb-$package/root/$inside" >"$dest"
+  else
+    cp "$cache/deb-$package/root/$inside" "$dest"
+  fi
   if ! verified "$dest" "$sum"; then
     echo "fetch-data: $dest: SHA-256 does not match the pinned value (package $package changed?)" >&2
     rm -f "$dest"

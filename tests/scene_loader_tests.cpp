@@ -337,7 +337,7 @@ TEST_SUITE("loaders") {
               "camera, settings)");
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "trasform": []}]})") ==
           prefix +
-              "volumes[0]: unknown key 'trasform' (expected name, file, transfer_function, "
+              "volumes[0]: unknown key 'trasform' (expected name, file, frame, transfer_function, "
               "transform)");
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "transform": [1, 2, 3]}]})") ==
           prefix + "volumes[0].transform: expected 16 numbers");
@@ -376,7 +376,9 @@ TEST_SUITE("loaders") {
     const fs::path unknown = write_file(folder / "scene.yaml", "");
     CHECK(error_of([&] { strata::load_scene(unknown); }) ==
           unknown.string() +
-              ": unknown scene format '.yaml' (expected .json, or .xml from the thesis program)");
+              ": unknown scene format '.yaml' (expected a scene: .json, or .xml from the "
+              "thesis program; or a volume: .nii, .nii.gz, .mhd, .mha, .nrrd, "
+              ".nhdr, .dcm and DICOM folders)");
   }
 
   TEST_CASE("json_scene_label_image_is_read_with_its_height_and_side") {

@@ -294,6 +294,33 @@ TEST_SUITE("window") {
     REQUIRE(files.size() == 2);
     CHECK(changed_pixels(read_png(files[0].string()), read_png(files[1].string())) > 1000);
   }
+
+  // A volume opened directly: the fitted views and the presets are the viewer's too.
+  TEST_CASE("viewer_opens_a_volume_with_its_anatomical_views_and_switches_presets") {
+    const auto dir = test::fresh_folder("viewer", "volume");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto script = test::write_file(
+        dir / "script.txt", "screenshot " + d("head.png") + "\npreset mr-brain\nscreenshot " +
+                                d("brain.png") + "\nview superior\nscreenshot " + d("top.png") +
+                                "\npreset ct-bone\nscreenshot " + d("bone.png") +
+                                "\npreset lung\nquit\n");
+    const auto r = run_strata("--validate view " STRATA_SOURCE_DIR
+                              "/assets/cache/mricron/ch2.nii.gz --size 96 --no-optimize "
+                              "--no-panel --script " +
+                              script.string());
+    INFO(r.output);
+    CHECK(r.output.find("validation") == std::string::npos);
+    CHECK(r.output.find("preset mr-head") != std::string::npos);  // chosen and said
+    // The script stops at the unknown preset, with the names.
+    CHECK(r.exit_code != 0);
+    CHECK(r.output.find("no transfer-function preset 'lung' (ct-skin,") != std::string::npos);
+    const Rgba8Image head = read_png(d("head.png")), brain = read_png(d("brain.png"));
+    const Rgba8Image bone = read_png(d("bone.png")), top = read_png(d("top.png"));
+    CHECK(changed_pixels(head, brain) > 500);
+    CHECK(changed_pixels(brain, top) > 500);  // from above
+    // ct-bone on an MR: hardly a value reaches bone's Hounsfield units; the head all but goes.
+    CHECK(changed_pixels(top, bone) > 2000);
+  }
 }
 
 }  // namespace strata

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <new>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "engine/core/error.h"
+#include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/volume_loader.h"
 
 // ---- heap accounting
@@ -332,8 +334,8 @@ TEST_SUITE("loaders") {
                      "pixdim[1..3] = 1 0 1: spacing must be positive");
     CHECK_LOAD_ERROR(file("negative.nii", Header{good}.put<float>(88, -2.0f).bytes + data),
                      "spacing must be positive");
-    CHECK_LOAD_ERROR(file("4d.nii", Header{good}.put<int16_t>(40, 4).put<int16_t>(48, 2).bytes),
-                     "dim[4] = 2: only 3D volumes");
+    CHECK_LOAD_ERROR(file("5d.nii", Header{good}.put<int16_t>(40, 5).put<int16_t>(50, 2).bytes),
+                     "dim[5] = 2: images of more than 4 dimensions are not supported");
     CHECK_LOAD_ERROR(file("huge.nii", nifti1(false, 2, {32767, 32767, 32767}).bytes),
                      "dim[1..3] = 32767x32767x32767: 35181150961663 bytes of voxels, more than the "
                      "16 GiB");
@@ -550,8 +552,8 @@ TEST_SUITE("loaders") {
                           "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 1 1 1\n"
                           "encoding: bzip2\n\nx"),
                      "encoding 'bzip2' is not supported");
-    CHECK_LOAD_ERROR(file("4d.nrrd", "NRRD0004\ntype: uchar\ndimension: 4\n\n"),
-                     "dimension = 4: only 3D volumes");
+    CHECK_LOAD_ERROR(file("5d.nrrd", "NRRD0004\ntype: uchar\ndimension: 5\n\n"),
+                     "dimension = 5: expected 2, 3 or 4");
     CHECK_LOAD_ERROR(file("nodata.nhdr", header("uchar", "1 1 1", "data file: gone.raw\n")),
                      "data file 'gone.raw': no such file");
     const std::string gzip_header =
@@ -697,6 +699,463 @@ TEST_SUITE("loaders") {
     CHECK(mixed.type == VoxelType::int16);
     CHECK(mixed.value(0, 0, 4) == 974.0f * 2.0f - 1024.0f);
     CHECK(mixed.value(0, 0, 0) == 991.0f - 1024.0f);
+  }
+
+  // ---- enhanced multi-frame DICOM
+
+  namespace {
+
+  // The volume and the warnings of the full load_volume.
+  struct Loaded {
+    Volume volume;
+    std::vector<std::string> warnings;
+  };
+
+  Loaded load_with_warnings(const fs::path& path, std::optional<int> frame = std::nullopt) {
+    Loaded loaded;
+    loaded.volume = strata::load_volume(path, {.frame = frame}, loaded.warnings);
+    return loaded;
+  }
+
+  std::string frame_error(const fs::path& path, int frame) {
+    return strata::test::error_of([&] { load_with_warnings(path, frame); });
+  }
+
+  // DICOM written here: explicit VR little endian, every length defined.
+  std::string dicom_element(uint16_t group, uint16_t element, const std::string& vr,
+                            std::string value) {
+    if (value.size() % 2 == 1) value += vr == "UI" || vr == "OB" || vr == "OW" ? '\0' : ' ';
+    std::string bytes = element_bytes<uint16_t>({group, element}) + vr;
+    if (vr == "SQ" || vr == "OB" || vr == "OW")
+      return bytes + std::string(2, '\0') + element_bytes<uint32_t>({uint32_t(value.size())}) +
+             value;
+    return bytes + element_bytes<uint16_t>({uint16_t(value.size())}) + value;
+  }
+
+  std::string dicom_us(uint16_t group, uint16_t element, uint16_t value) {
+    return dicom_element(group, element, "US", element_bytes<uint16_t>({value}));
+  }
+
+  // A sequence of items, each given as its elements.
+  std::string dicom_sequence(uint16_t group, uint16_t element,
+                             const std::vector<std::string>& items) {
+    std::string value;
+    for (const std::string& item : items)
+      value += element_bytes<uint16_t>({0xfffe, 0xe000}) +
+               element_bytes<uint32_t>({uint32_t(item.size())}) + item;
+    return dicom_element(group, element, "SQ", value);
+  }
+
+  // A functional group macro: a sequence of one item.
+  std::string macro(uint16_t group, uint16_t element, const std::string& attributes) {
+    return dicom_sequence(group, element, {attributes});
+  }
+
+  std::string part10(const std::string& transfer_syntax, const std::string& data_set) {
+    const std::string meta = dicom_element(0x0002, 0x0001, "OB", std::string("\0\1", 2)) +
+                             dicom_element(0x0002, 0x0002, "UI", "1.2.840.10008.5.1.4.1.1.2.1") +
+                             dicom_element(0x0002, 0x0003, "UI", "1.2.826.0.1.3680043.2.1") +
+                             dicom_element(0x0002, 0x0010, "UI", transfer_syntax);
+    return std::string(128, '\0') + "DICM" +
+           dicom_element(0x0002, 0x0000, "UL", element_bytes<uint32_t>({uint32_t(meta.size())})) +
+           meta + data_set;
+  }
+
+  // One frame of the enhanced CT built from CT5N: the slice file it takes its position and pixels
+  // from, and what a test changes.
+  struct CtFrame {
+    std::string file;
+    std::string slope = "1";
+    std::string stack = "1";
+    std::string orientation = "";  // per-frame ImageOrientationPatient instead of the shared one
+  };
+
+  // ImagePositionPatient of CT5N's slices (gdcmdump).
+  std::string ct5n_position(const std::string& file) {
+    if (file == "2062") return "-72.199997\\-143.000000\\8.762500";
+    if (file == "2392") return "-72.199997\\-143.000000\\6.262500";
+    if (file == "2693") return "-72.199997\\-143.000000\\3.762500";
+    if (file == "3023") return "-72.199997\\-143.000000\\1.262500";
+    return "-72.199997\\-143.000000\\-1.237500";  // 3353
+  }
+
+  struct EnhancedCt {
+    std::vector<CtFrame> frames;
+    std::string transfer_syntax = "1.2.840.10008.1.2.1";
+    bool functional_groups = true;
+  };
+
+  // CT5N's slices as one Enhanced CT Image (what a scanner writes today): geometry and rescale in
+  // the functional groups, the pixels of every frame in one PixelData.
+  std::string enhanced_ct(const EnhancedCt& ct) {
+    std::vector<std::string> per_frame;
+    std::string pixels;
+    for (const CtFrame& f : ct.frames) {
+      std::string item = macro(0x0020, 0x9111, dicom_element(0x0020, 0x9056, "SH", f.stack));
+      item += macro(0x0020, 0x9113, dicom_element(0x0020, 0x0032, "DS", ct5n_position(f.file)));
+      if (!f.orientation.empty())
+        item += macro(0x0020, 0x9116, dicom_element(0x0020, 0x0037, "DS", f.orientation));
+      item += macro(0x0028, 0x9145,
+                    dicom_element(0x0028, 0x1052, "DS", "-1024") +
+                        dicom_element(0x0028, 0x1053, "DS", f.slope));
+      per_frame.push_back(item);
+      const std::string bytes = read_file(ct5n / f.file);
+      pixels += bytes.substr(bytes.size() - 512);  // CT5N's PixelData: the last 16x16x2 bytes
+    }
+    std::string shared;
+    if (ct.frames.front().orientation.empty())
+      shared += macro(0x0020, 0x9116, dicom_element(0x0020, 0x0037, "DS", "1\\0\\0\\0\\1\\0"));
+    shared += macro(0x0028, 0x9110,
+                    dicom_element(0x0018, 0x0050, "DS", "2.5") +
+                        dicom_element(0x0028, 0x0030, "DS", "0.488281\\0.488281"));
+    std::string top = dicom_element(0x0008, 0x0016, "UI", "1.2.840.10008.5.1.4.1.1.2.1") +
+                      dicom_element(0x0008, 0x0060, "CS", "CT");
+    if (!ct.functional_groups)
+      top += dicom_element(0x0020, 0x0032, "DS", ct5n_position(ct.frames.front().file)) +
+             dicom_element(0x0020, 0x0037, "DS", "1\\0\\0\\0\\1\\0");
+    top += dicom_us(0x0028, 0x0002, 1) + dicom_element(0x0028, 0x0004, "CS", "MONOCHROME2") +
+           dicom_element(0x0028, 0x0008, "IS", std::to_string(ct.frames.size())) +
+           dicom_us(0x0028, 0x0010, 16) + dicom_us(0x0028, 0x0011, 16);
+    if (!ct.functional_groups) top += dicom_element(0x0028, 0x0030, "DS", "0.488281\\0.488281");
+    top += dicom_us(0x0028, 0x0100, 16) + dicom_us(0x0028, 0x0101, 16) +
+           dicom_us(0x0028, 0x0102, 15) + dicom_us(0x0028, 0x0103, 1);
+    if (ct.functional_groups)
+      top += dicom_sequence(0x5200, 0x9229, {shared}) + dicom_sequence(0x5200, 0x9230, per_frame);
+    if (ct.transfer_syntax == "1.2.840.10008.1.2.1")
+      return part10(ct.transfer_syntax, top + dicom_element(0x7fe0, 0x0010, "OW", pixels));
+    // Encapsulated: an empty offset table, then the "compressed" frames as one fragment.
+    const std::string fragments =
+        element_bytes<uint16_t>({0xfffe, 0xe000}) + element_bytes<uint32_t>({0}) +
+        element_bytes<uint16_t>({0xfffe, 0xe000}) +
+        element_bytes<uint32_t>({uint32_t(pixels.size())}) + pixels +
+        element_bytes<uint16_t>({0xfffe, 0xe0dd}) + element_bytes<uint32_t>({0});
+    const std::string undefined = element_bytes<uint16_t>({0x7fe0, 0x0010}) + "OB" +
+                                  std::string(2, '\0') + element_bytes<uint32_t>({0xffffffff});
+    return part10(ct.transfer_syntax, top + undefined + fragments);
+  }
+
+  // Frames in an order that is not the slices' order along the normal.
+  std::vector<CtFrame> shuffled_ct5n() {
+    return {{"2693"}, {"2062"}, {"3353"}, {"2392"}, {"3023"}};
+  }
+
+  }  // namespace
+
+  TEST_CASE("dicom_enhanced_ct_matches_the_series_it_was_made_from_voxel_for_voxel") {
+    const fs::path folder = output_folder("dicom_enhanced_ct");
+    const fs::path file = write_file(folder / "ct5n.dcm", enhanced_ct({shuffled_ct5n()}));
+    const Volume series = strata::load_volume(ct5n);
+    const Loaded loaded = load_with_warnings(file);
+    const Volume& v = loaded.volume;
+    CHECK(loaded.warnings.empty());
+    CHECK(v.dims == glm::uvec3(16, 16, 5));
+    CHECK(v.name == "ct5n");
+    CHECK(v.type == VoxelType::int16);  // stored int16, slope 1, intercept -1024 per frame
+    CHECK(v.spacing == series.spacing);
+    CHECK(v.origin == series.origin);  // 3353's position: the first along the normal
+    CHECK(v.direction == glm::mat3(1.0f));
+    CHECK(v.value_range == series.value_range);
+    CHECK(v.voxels == series.voxels);  // frames put in order along the normal
+
+    // A folder holding only the multi-frame file loads the same.
+    const fs::path only = output_folder("dicom_enhanced_ct_folder");
+    fs::copy_file(file, only / "IM0001");
+    const Volume from_folder = strata::load_volume(only);
+    CHECK(from_folder.voxels == series.voxels);
+    CHECK(from_folder.name == "dicom_enhanced_ct_folder");
+  }
+
+  TEST_CASE("dicom_enhanced_ct_applies_each_frames_rescale") {
+    std::vector<CtFrame> frames = shuffled_ct5n();
+    frames[1].slope = "2";  // 2062, the last along the normal
+    const fs::path file =
+        write_file(output_folder("dicom_enhanced_slope") / "ct.dcm", enhanced_ct({frames}));
+    const Volume v = strata::load_volume(file);
+    CHECK(v.type == VoxelType::int16);
+    CHECK(v.value(0, 0, 4) == 974.0f * 2.0f - 1024.0f);  // CT5N/2062 stores 974 first
+    CHECK(v.value(0, 0, 0) == 991.0f - 1024.0f);         // 3353
+    frames[1].slope = ".5";
+    write_file(file, enhanced_ct({frames}));
+    const Volume fractional = strata::load_volume(file);
+    CHECK(fractional.type == VoxelType::float32);
+    CHECK(fractional.value(0, 0, 4) == 974.0f * 0.5f - 1024.0f);
+  }
+
+  // nibabel's philips_mprage.dcm: a Philips Enhanced MR Image, 176 sagittal frames of 256x256,
+  // every attribute per frame. Expected values read with pydicom: frame 1 at (92.7090416119899,
+  // -125.12766968458, 136.495256863534), frame 176 at (-82.190830214181, -125.12766968458,
+  // 142.421648465096), cosines (-0.0022011068649, 0.99788552522659, -0.0649590045213) and
+  // (-0.0337935090065, -0.0649962872266, -0.9973131418228), PixelSpacing 1\1, RescaleSlope
+  // 2.1079365079365; the anonymised pixels are all 0.
+  TEST_CASE("dicom_enhanced_mr_from_philips_loads_176_frames_along_the_normal") {
+    const fs::path path = cache / "dicom/philips_mprage.dcm";
+    REQUIRE_MESSAGE(fs::exists(path), "run scripts/fetch-data.sh");
+    const size_t before = heap_in_use.load();
+    heap_peak.store(before);
+    const Loaded loaded = load_with_warnings(path);
+    const size_t peak = heap_peak.load() - before;
+    const Volume& v = loaded.volume;
+    CHECK(loaded.warnings.empty());
+    CHECK(v.dims == glm::uvec3(256, 256, 176));
+    CHECK(v.name == "philips_mprage");
+    CHECK(v.type == VoxelType::float32);  // a fractional slope
+    CHECK(v.value_range == glm::vec2(0.0f));
+    // GDCM's copy of the file (the stored uint16) and the float32 voxels: at most two copies.
+    CHECK(peak < 2 * v.byte_size());
+    const glm::vec3 row(-0.0022011068649f, 0.99788552522659f, -0.0649590045213f);
+    const glm::vec3 column(-0.0337935090065f, -0.0649962872266f, -0.9973131418228f);
+    for (int axis = 0; axis < 3; ++axis) {
+      CHECK(v.direction[0][axis] == doctest::Approx(row[axis]).epsilon(1e-5));
+      CHECK(v.direction[1][axis] == doctest::Approx(column[axis]).epsilon(1e-5));
+    }
+    CHECK(v.direction[2].x == doctest::Approx(-0.999426).epsilon(1e-5));  // row x column
+    CHECK(v.spacing.x == 1.0f);
+    CHECK(v.spacing.y == 1.0f);
+    CHECK(v.spacing.z == doctest::Approx(1.0).epsilon(1e-5));
+    const glm::vec4 first = v.index_to_patient() * glm::vec4(0, 0, 0, 1);
+    const glm::vec4 last = v.index_to_patient() * glm::vec4(0, 0, 175, 1);
+    CHECK(first.x == doctest::Approx(92.7090416));
+    CHECK(first.z == doctest::Approx(136.4952569));
+    CHECK(last.x == doctest::Approx(-82.1908302).epsilon(1e-4));
+    CHECK(last.y == doctest::Approx(-125.1276697).epsilon(1e-4));
+    CHECK(last.z == doctest::Approx(142.4216485).epsilon(1e-4));
+    CHECK(frame_error(path, 1) ==
+          path.string() + ": frame 1 is out of range: the image has one frame, 0");
+  }
+
+  TEST_CASE("dicom_multi_frame_files_strata_cannot_read_give_one_error_naming_the_file") {
+    const fs::path folder = output_folder("dicom_enhanced_bad");
+    const auto file = [&](const char* name, const EnhancedCt& ct) {
+      return write_file(folder / name, enhanced_ct(ct));
+    };
+    std::vector<CtFrame> turned = shuffled_ct5n();
+    for (CtFrame& f : turned) f.orientation = "1\\0\\0\\0\\1\\0";
+    turned[3].orientation = "0\\1\\0\\1\\0\\0";
+    CHECK_LOAD_ERROR(file("turned.dcm", {turned}),
+                     "mixed ImageOrientationPatient: frame 1 and frame 4 differ");
+    std::vector<CtFrame> stacks = shuffled_ct5n();
+    stacks[2].stack = "2";
+    CHECK_LOAD_ERROR(file("stacks.dcm", {stacks}),
+                     "holds several stacks (frame 1 has StackID '1', frame 3 '2')");
+    std::vector<CtFrame> twice = shuffled_ct5n();
+    twice[4].file = "2693";
+    CHECK_LOAD_ERROR(file("twice.dcm", {twice}), "frame 1 and frame 5 are at the same position");
+    CHECK_LOAD_ERROR(
+        file("htj2k.dcm", {shuffled_ct5n(), "1.2.840.10008.1.2.4.201"}),
+        "TransferSyntaxUID 1.2.840.10008.1.2.4.201 is not supported (GDCM does not know it");
+    CHECK_LOAD_ERROR(file("mpeg2.dcm", {shuffled_ct5n(), "1.2.840.10008.1.2.4.100"}),
+                     "cannot decode the pixel data (transfer syntax 1.2.840.10008.1.2.4.100");
+    CHECK_LOAD_ERROR(file("legacy.dcm", {shuffled_ct5n(), "1.2.840.10008.1.2.1", false}),
+                     "NumberOfFrames = 5 without a Per-frame Functional Groups Sequence");
+    CHECK_LOAD_ERROR(folder / "missing.dcm", "no such file");
+    write_file(folder / "notes.dcm", "not DICOM\n");
+    CHECK_LOAD_ERROR(folder / "notes.dcm", "not a DICOM file");
+
+    const fs::path mixed = copy_ct5n("dicom_enhanced_and_slices", {"2062"});
+    write_file(mixed / "enhanced.dcm", enhanced_ct({shuffled_ct5n()}));
+    CHECK_LOAD_ERROR(mixed, "holds the multi-frame file enhanced.dcm and other images");
+  }
+
+  // ---- 2-D images: one voxel thick, with a warning
+
+  // pydicom's CT_small.dcm: one 128x128 CT slice, PixelSpacing 0.661468, SliceThickness 5,
+  // ImagePositionPatient (-158.135803, -179.035797, -75.699997), RescaleIntercept -1024; stored
+  // 128..2191 (pydicom), the pixel at row 5, column 10 stores 187.
+  TEST_CASE("dicom_single_slice_file_loads_one_voxel_thick_with_a_warning") {
+    const fs::path path = cache / "dicom/CT_small.dcm";
+    REQUIRE_MESSAGE(fs::exists(path), "run scripts/fetch-data.sh");
+    const Loaded loaded = load_with_warnings(path);
+    const Volume& v = loaded.volume;
+    CHECK(v.dims == glm::uvec3(128, 128, 1));
+    CHECK(v.name == "CT_small");
+    CHECK(v.type == VoxelType::int16);
+    CHECK(v.spacing.x == doctest::Approx(0.661468));
+    CHECK(v.spacing.z == 5.0f);  // SliceThickness
+    CHECK(v.origin == glm::vec3(-158.135803f, -179.035797f, -75.699997f));
+    CHECK(v.value(10, 5, 0) == 187.0f - 1024.0f);
+    CHECK(v.value_range == glm::vec2(128.0f - 1024.0f, 2191.0f - 1024.0f));
+    REQUIRE(loaded.warnings.size() == 1);
+    CHECK(loaded.warnings[0] == path.string() +
+                                    ": 2-D image (one slice of 128x128); shown as a volume one "
+                                    "voxel (5 mm) thick");
+    // The same slice alone in a folder.
+    const fs::path folder = output_folder("dicom_one_slice");
+    fs::copy_file(path, folder / "CT_small");
+    CHECK(load_with_warnings(folder).volume.voxels == v.voxels);
+  }
+
+  TEST_CASE("two_dimensional_nifti_nrrd_and_metaimage_load_one_voxel_thick") {
+    const fs::path folder = output_folder("two_d");
+    // NIfTI dim[0] = 2 with pixdim[3] 0: k is 1 mm.
+    Header nifti = nifti1(false, 2, {3, 2, 0});
+    nifti.put<int16_t>(40, 2).put<float>(88, 0.0f);
+    write_file(folder / "flat.nii", nifti.bytes + "abcdef");
+    const Loaded n = load_with_warnings(folder / "flat.nii");
+    CHECK(n.volume.dims == glm::uvec3(3, 2, 1));
+    CHECK(n.volume.spacing == glm::vec3(1.0f));
+    CHECK(n.volume.value(2, 1, 0) == float('f'));
+    REQUIRE(n.warnings.size() == 1);
+    CHECK(n.warnings[0].find("flat.nii: 2-D image (one slice of 3x2)") != std::string::npos);
+
+    write_file(folder / "flat.nrrd",
+               "NRRD0004\ntype: uchar\ndimension: 2\nsizes: 2 3\nspace: left-posterior-superior\n"
+               "space directions: (0,0.5,0) (0.25,0,0)\nspace origin: (1,2,3)\nencoding: raw\n\n"
+               "abcdef");
+    const Loaded r = load_with_warnings(folder / "flat.nrrd");
+    CHECK(r.volume.dims == glm::uvec3(2, 3, 1));
+    CHECK(r.volume.value(1, 2, 0) == float('f'));
+    // k is the normal of the slice: (0,1,0) x (1,0,0).
+    check_matrix(r.volume.index_to_patient(),
+                 columns({0, 0.5f, 0}, {0.25f, 0, 0}, {0, 0, -1}, {1, 2, 3}));
+    CHECK(r.warnings.size() == 1);
+
+    write_file(folder / "flat.mha",
+               "ObjectType = Image\nNDims = 2\nDimSize = 2 3\nElementSpacing = 0.5 0.25\n"
+               "Offset = 1 2\nTransformMatrix = 0 1 1 0\nElementType = MET_UCHAR\n"
+               "ElementDataFile = LOCAL\nabcdef");
+    const Loaded m = load_with_warnings(folder / "flat.mha");
+    CHECK(m.volume.dims == glm::uvec3(2, 3, 1));
+    check_matrix(m.volume.index_to_patient(),
+                 columns({0, 0.5f, 0}, {0.25f, 0, 0}, {0, 0, -1}, {1, 2, 0}));
+    CHECK(m.warnings.size() == 1);
+  }
+
+  // ---- 4-D images: one frame
+
+  // nibabel's example4d.nii.gz: 128x96x24 int16, 2 frames. Read with nibabel: frame 0 ranges 0 to
+  // 1162 (at voxel 64,49,0; frame 1 there: 1056), frame 1 0 to 1140 (at 62,86,10; frame 0 there:
+  // 1135); sform rows (-2 0 0 117.8551025) (0 1.9737115 -0.3555282 -35.7229424)
+  // (0 0.3232076 2.1710818 -7.2487984).
+  TEST_CASE("nifti_4d_loads_frame_0_by_default_and_the_frame_asked_for_with_a_warning") {
+    const fs::path path = cache / "nibabel/example4d.nii.gz";
+    REQUIRE_MESSAGE(fs::exists(path), "run scripts/fetch-data.sh");
+    const Loaded first = load_with_warnings(path);
+    CHECK(first.volume.dims == glm::uvec3(128, 96, 24));
+    CHECK(first.volume.type == VoxelType::int16);
+    CHECK(first.volume.value(64, 49, 0) == 1162.0f);
+    CHECK(first.volume.value(62, 86, 10) == 1135.0f);
+    CHECK(first.volume.value_range == glm::vec2(0.0f, 1162.0f));
+    CHECK(first.warnings ==
+          std::vector<std::string>{path.string() +
+                                   ": 4-D image with 2 frames; showing frame 0 (choose with "
+                                   "--frame)"});
+    CHECK(first.volume.spacing.x == doctest::Approx(2.0));
+    CHECK(first.volume.spacing.z == doctest::Approx(2.2).epsilon(1e-5));
+    CHECK(first.volume.origin.x == doctest::Approx(-117.8551025));  // RAS x negated into LPS
+    CHECK(first.volume.origin.y == doctest::Approx(35.7229424));
+
+    const Loaded second = load_with_warnings(path, 1);
+    CHECK(second.volume.value(64, 49, 0) == 1056.0f);
+    CHECK(second.volume.value(62, 86, 10) == 1140.0f);
+    CHECK(second.volume.value_range == glm::vec2(0.0f, 1140.0f));
+    CHECK(second.volume.voxels != first.volume.voxels);
+    CHECK(second.volume.index_to_patient() == first.volume.index_to_patient());
+    CHECK(second.warnings[0].find("showing frame 1 (choose with --frame)") != std::string::npos);
+
+    const std::string range = ": the image has 2 frames, 0 to 1";
+    CHECK(frame_error(path, 2) == path.string() + ": frame 2 is out of range" + range);
+    CHECK(frame_error(path, -1) == path.string() + ": frame -1 is out of range" + range);
+    CHECK(frame_error(cache / "mricron/ch2.nii.gz", 1)
+              .find("ch2.nii.gz: frame 1 is out of range: "
+                    "the image has one frame, 0") != std::string::npos);
+  }
+
+  TEST_CASE("scene_volume_frame_key_picks_the_frame_and_the_warning_reaches_the_scene") {
+    const fs::path path = cache / "nibabel/example4d.nii.gz";
+    REQUIRE_MESSAGE(fs::exists(path), "run scripts/fetch-data.sh");
+    const fs::path folder = output_folder("scene_frame");
+    const auto scene = [&](const std::string& frame) {
+      return write_file(folder / "s.json", R"({"strata_scene": 1, "volumes": [{"file": ")" +
+                                               path.string() + R"(", "frame": )" + frame + "}]}");
+    };
+    const strata::Scene loaded = strata::load_scene(scene("1"));
+    REQUIRE(loaded.volumes.size() == 1);
+    CHECK(loaded.volumes[0].value(64, 49, 0) == 1056.0f);
+    REQUIRE(loaded.warnings.size() == 2);  // the frame, then the preset for the bare volume
+    CHECK(loaded.warnings[0].find("showing frame 1 (choose with --frame)") != std::string::npos);
+    CHECK(loaded.warnings[1].find("has no transfer function; preset") != std::string::npos);
+    const std::string prefix = (folder / "s.json").string() + ": volumes[0].";
+    CHECK(strata::test::error_of([&] { strata::load_scene(scene("-1")); }) ==
+          prefix + "frame: expected an integer >= 0");
+    CHECK(strata::test::error_of([&] { strata::load_scene(scene("2.5")); }) ==
+          prefix + "frame: expected an integer");
+    CHECK(strata::test::error_of([&] {
+            strata::load_scene(scene("2"));
+          }).find("frame 2 is out of range: the image has 2 frames, 0 to 1") != std::string::npos);
+  }
+
+  TEST_CASE("nrrd_and_metaimage_4d_read_the_frame_asked_for") {
+    const fs::path folder = output_folder("four_d");
+    const std::string frames = "abcdefghijkl";  // 3 frames of 2x2x1
+    write_file(folder / "time.nrrd",
+               "NRRD0004\ntype: uchar\ndimension: 4\nsizes: 2 2 1 3\nkinds: space space space "
+               "time\nspace: left-posterior-superior\nspace directions: (2,0,0) (0,2,0) (0,0,2) "
+               "none\nencoding: raw\n\n" +
+                   frames);
+    const Loaded r = load_with_warnings(folder / "time.nrrd", 2);
+    CHECK(r.volume.dims == glm::uvec3(2, 2, 1));
+    CHECK(r.volume.value(0, 0, 0) == float('i'));
+    CHECK(r.volume.value(1, 1, 0) == float('l'));
+    CHECK(r.volume.spacing == glm::vec3(2.0f));
+    CHECK(r.warnings.front() ==
+          (folder / "time.nrrd").string() +
+              ": 4-D image with 3 frames; showing frame 2 (choose with --frame)");
+
+    write_gzip(folder / "frames.gz", frames);
+    write_file(folder / "time_gzip.nrrd",
+               "NRRD0004\ntype: uchar\ndimension: 4\nsizes: 2 2 1 3\nspacings: 1 1 1 nan\n"
+               "encoding: gzip\n\n" +
+                   read_file(folder / "frames.gz"));
+    CHECK(load_with_warnings(folder / "time_gzip.nrrd", 1).volume.value(0, 0, 0) == float('e'));
+
+    write_file(folder / "time.mha",
+               "ObjectType = Image\nNDims = 4\nDimSize = 2 2 1 3\nElementSpacing = 1 1 3 0.5\n"
+               "Offset = 1 2 3 0\nTransformMatrix = 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\n"
+               "ElementType = MET_UCHAR\nElementDataFile = LOCAL\n" +
+                   frames);
+    const Loaded m = load_with_warnings(folder / "time.mha", 1);
+    CHECK(m.volume.value(0, 0, 0) == float('e'));
+    CHECK(m.volume.spacing == glm::vec3(1, 1, 3));
+    CHECK(m.volume.origin == glm::vec3(1, 2, 3));
+    CHECK(m.warnings.front().find("4-D image with 3 frames; showing frame 1") != std::string::npos);
+    CHECK(frame_error(folder / "time.mha", 3)
+              .find("frame 3 is out of range: the image has 3 "
+                    "frames, 0 to 2") != std::string::npos);
+  }
+
+  TEST_CASE("4d_images_strata_cannot_read_give_one_error_naming_the_file") {
+    const fs::path folder = output_folder("four_d_bad");
+    const auto file = [&](const char* name, const std::string& bytes) {
+      return write_file(folder / name, bytes);
+    };
+    // NIfTI: the data holds frame 0 only, frame 1 is asked for.
+    Header nifti = nifti1(false, 2, {2, 2, 1});
+    nifti.put<int16_t>(40, 4).put<int16_t>(48, 2);
+    file("cut4d.nii", nifti.bytes + "abcd");
+    CHECK(frame_error(folder / "cut4d.nii", 1) ==
+          (folder / "cut4d.nii").string() + ": voxel data ends before frame 1 (4 bytes a frame)");
+    CHECK_LOAD_ERROR(file("zero_frames.nii", Header{nifti}.put<int16_t>(48, 0).bytes),
+                     "dim[4] = 0: the frame count must be positive");
+    // Vectors first (a DWI or an RGB image): frames are not stored one after the other.
+    CHECK_LOAD_ERROR(file("dwi.nrrd",
+                          "NRRD0004\ntype: uchar\ndimension: 4\nsizes: 3 2 2 1\nkinds: list "
+                          "domain domain domain\nencoding: raw\n\n" +
+                              std::string(12, 'x')),
+                     "kinds: axis 0 is 'list': strata reads 4-D images whose fourth axis is the "
+                     "non-spatial one");
+    CHECK_LOAD_ERROR(file("none_first.nrrd",
+                          "NRRD0004\ntype: uchar\ndimension: 4\nsizes: 3 2 2 1\nspace: RAS\n"
+                          "space directions: none (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\n\n" +
+                              std::string(12, 'x')),
+                     "space directions: axis 0 is 'none'");
+    CHECK_LOAD_ERROR(file("sizes.nrrd", "NRRD0004\ntype: uchar\ndimension: 4\nsizes: 2 2 2\n\n"),
+                     "sizes: expected 4 numbers (dimension 4), got '2 2 2'");
+    CHECK_LOAD_ERROR(file("5d.mha", "ObjectType = Image\nNDims = 5\nElementDataFile = LOCAL\n"),
+                     "NDims = 5: expected 2, 3 or 4");
+    CHECK_LOAD_ERROR(file("sizes.mha",
+                          "ObjectType = Image\nNDims = 4\nDimSize = 2 2 2\nElementType = "
+                          "MET_UCHAR\nElementDataFile = LOCAL\n"),
+                     "DimSize: expected 4 numbers (NDims = 4), got '2 2 2'");
   }
 
   // ---- load_volume

@@ -10,6 +10,7 @@
 
 #include <jpeglib.h>
 #include <stb_image.h>
+#include <stb_image_write.h>
 
 #include "engine/core/error.h"
 #include "engine/core/text_file.h"
@@ -118,6 +119,51 @@ Rgba8Image read_image(const std::filesystem::path& path) {
     throw Error(path.string() + ": " + e.what());
   }
   throw Error(path.string() + ": not a PNG or JPEG file");
+}
+
+namespace {
+
+enum class ImageFormat { png, jpeg };
+
+ImageFormat image_format(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  if (extension == ".png") return ImageFormat::png;
+  if (extension == ".jpg" || extension == ".jpeg") return ImageFormat::jpeg;
+  // A device or pipe (-o /dev/null: render, but keep nothing) takes the PNG.
+  std::error_code error;
+  const auto type = std::filesystem::status(path, error).type();
+  if (type == std::filesystem::file_type::character || type == std::filesystem::file_type::fifo)
+    return ImageFormat::png;
+  throw Error(path.string() + ": cannot write images as '" + extension +
+              "' (the extension must be .png, .jpg or .jpeg)");
+}
+
+}  // namespace
+
+void check_image_extension(const std::filesystem::path& path) {
+  image_format(path);
+}
+
+void write_image(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                 std::span<const uint8_t> rgba) {
+  if (image_format(path) == ImageFormat::png) {
+    write_png(path.string(), width, height, rgba);
+    return;
+  }
+  if (rgba.size() != size_t{width} * height * 4) {
+    throw Error(path.string() + ": " + std::to_string(rgba.size()) + " bytes is not a " +
+                std::to_string(width) + "x" + std::to_string(height) + " rgba8 image");
+  }
+  std::vector<uint8_t> rgb(size_t{width} * height * 3);
+  for (size_t p = 0; p < size_t{width} * height; ++p) {
+    for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = rgba[p * 4 + c];
+  }
+  constexpr int kQuality = 92;
+  if (!stbi_write_jpg(path.c_str(), int(width), int(height), 3, rgb.data(), kQuality)) {
+    throw Error(path.string() + ": cannot write JPEG (does the folder exist and is it writable?)");
+  }
 }
 
 namespace {

@@ -1,9 +1,10 @@
 // Pictures for labels: PNG or JPEG files read as rgba8, and resampled to the size a label shows
-// them at.
+// them at; and rendered images written as PNG or JPEG.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 
 #include "engine/core/png.h"
 
@@ -17,6 +18,15 @@ inline constexpr uint32_t kMaxImageSide = 8192;
 // rgba8. Throws Error "<file>: <reason>" for a missing file, another format, a corrupt or
 // truncated file, or a side over kMaxImageSide.
 Rgba8Image read_image(const std::filesystem::path& path);
+
+// rgba8 pixels as PNG (.png) or JPEG (.jpg, .jpeg; quality 92, alpha dropped), by the file's
+// extension, case-insensitive; PNG into a device or pipe (/dev/null). Throws Error "<file>:
+// <reason>" for another extension or a file that cannot be written.
+void write_image(const std::filesystem::path& path, uint32_t width, uint32_t height,
+                 std::span<const uint8_t> rgba);
+// Whether write_image writes `path`; else an Error naming the extensions (checked before a
+// long render, so a typo costs no time).
+void check_image_extension(const std::filesystem::path& path);
 
 // `image` (straight alpha) resampled to width x height, premultiplied: a triangle filter as wide
 // as one source texel or one target pixel, whichever is larger (bilinear when enlarging, an

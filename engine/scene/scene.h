@@ -121,6 +121,7 @@ struct Scene {
   std::vector<Mesh> meshes;
   std::vector<Label> labels;
   Camera camera;
+  bool has_camera = false;  // the file gave the camera's view (else complete_scene fits one)
   std::vector<CameraPose> camera_positions;  // named poses ("--camera NAME")
   SceneSettings settings;
   std::vector<std::string> warnings;  // e.g. a referenced file that does not exist

@@ -1,9 +1,16 @@
-// DICOM series: a folder whose image files are the slices of one volume, read with GDCM.
+// DICOM, read with GDCM: a series (a folder whose image files are the slices of one volume) or one
+// file, either an enhanced multi-frame CT or MR image that holds every slice, or a single slice.
 //
-// Two passes keep memory at one volume plus one slice: the first reads every file's header and
-// checks that the slices fit together (size, orientation, spacing, series), the second decodes
-// each slice's pixels straight into its place in Volume::voxels, in order along the slice normal.
-// DICOM's patient space (LPS+) is strata's, so positions and cosines are taken as they are.
+// Two passes keep memory at one volume plus one file: the first reads every header and checks
+// that the slices fit together (size, orientation, spacing, series), the second decodes the
+// pixels straight into Volume::voxels, in order along the slice normal: each slice file into its
+// place, a multi-frame file whole, its frames then put in order in place.
+//
+// An enhanced file gives each frame's position (and possibly orientation, spacing and rescale) in
+// its Per-frame Functional Groups Sequence; what is the same for all frames may sit in the Shared
+// Functional Groups Sequence instead, or, in converted files, at the top level. Lookups try the
+// three in that order. DICOM's patient space (LPS+) is strata's, so positions and cosines are
+// taken as they are.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -12,8 +19,10 @@
 
 #include <gdcmImageReader.h>
 #include <gdcmReader.h>
+#include <gdcmSequenceOfItems.h>
 #include <gdcmStringFilter.h>
 #include <gdcmTrace.h>
+#include <gdcmTransferSyntax.h>
 
 #include "engine/scene/io/dicom_structure.h"
 #include "engine/scene/io/volume_io.h"
@@ -28,24 +37,31 @@ namespace fs = std::filesystem;
 
 const gdcm::Tag pixel_data_tag(0x7fe0, 0x0010);
 
+// One slice: a single-frame file, or one frame of a multi-frame file.
 struct Slice {
   fs::path file;
+  size_t frame = 0;  // in its file, from 0
+  size_t frames_in_file = 1;
   uint32_t rows = 0, columns = 0;
   glm::dvec3 position{0.0}, row_cosine{0.0}, column_cosine{0.0};
   glm::dvec2 pixel_spacing{0.0};  // (along a row = between columns, between rows)
   int bits_allocated = 0, bits_stored = 0, high_bit = 0;
   bool is_signed = false;
   Rescale rescale;
-  std::string series;
+  std::string series, syntax;  // SeriesInstanceUID, TransferSyntaxUID
+  std::string stack, time;     // StackID and TemporalPositionIndex of enhanced files' frames
   double thickness = 0.0;
   double along_normal = 0.0;  // the position projected onto the slice normal
 };
 
-// Element values as text (GDCM's StringFilter renders binary VRs such as US too), parsed by hand
-// so that malformed values become errors instead of zeros.
+// Element values of one data set (the file's, or a functional group's item) as text: GDCM's
+// StringFilter renders binary VRs such as US too. Parsed by hand so that malformed values become
+// errors instead of zeros; errors name `context` ("frame 3: ") before the element.
 class Elements {
  public:
-  Elements(const gdcm::File& file, fs::path path) : data_set_(file.GetDataSet()), path_(path) {
+  Elements(const gdcm::File& file, const gdcm::DataSet& data_set, fs::path path,
+           std::string context = "")
+      : data_set_(data_set), path_(std::move(path)), context_(std::move(context)) {
     filter_.SetFile(file);
   }
   bool has(uint16_t group, uint16_t element) const {
@@ -53,35 +69,38 @@ class Elements {
     return data_set_.FindDataElement(tag) && !data_set_.GetDataElement(tag).IsEmpty();
   }
   std::string text(uint16_t group, uint16_t element) const {
-    return has(group, element) ? std::string(trim(filter_.ToString(gdcm::Tag(group, element))))
-                               : std::string();
+    if (!has(group, element)) return {};
+    return std::string(trim(filter_.ToString(data_set_.GetDataElement(gdcm::Tag(group, element)))));
   }
   // The backslash-separated numbers of a required element (or of an optional one, if present).
   std::vector<double> numbers(uint16_t group, uint16_t element, const char* name, size_t count,
                               std::optional<double> fallback = std::nullopt) const {
     if (!has(group, element)) {
-      if (!fallback) fail(path_, concat(name, " is missing"));
+      if (!fallback) fail(path_, concat(context_, name, " is missing"));
       return std::vector<double>(count, *fallback);
     }
     std::string value = text(group, element);
     std::replace(value.begin(), value.end(), '\\', ' ');
-    const std::vector<double> result = parse_numbers<double>(path_, name, value);
+    const std::vector<double> result = parse_numbers<double>(path_, context_ + name, value);
     if (result.size() != count)
-      fail(path_, concat(name, " = '", printable(value), "': expected ", count, " numbers"));
+      fail(path_,
+           concat(context_, name, " = '", printable(value), "': expected ", count, " numbers"));
     return result;
   }
   int integer(uint16_t group, uint16_t element, const char* name,
               std::optional<double> fallback = std::nullopt) const {
     const double v = numbers(group, element, name, 1, fallback)[0];
     if (v != std::floor(v) || std::fabs(v) > 65535.0)
-      fail(path_, concat(name, " = ", v, ": expected a whole number"));
+      fail(path_, concat(context_, name, " = ", v, ": expected a whole number"));
     return static_cast<int>(v);
   }
   const gdcm::DataSet& data_set() const { return data_set_; }
+  const fs::path& path() const { return path_; }
 
  private:
   const gdcm::DataSet& data_set_;
   fs::path path_;
+  std::string context_;
   gdcm::StringFilter filter_;
 };
 
@@ -93,20 +112,38 @@ glm::dvec3 unit(const fs::path& file, const std::vector<double>& v, size_t first
   return d / length;
 }
 
-void read_geometry(const Elements& e, Slice& s) {
+// ---- the attributes of one slice, wherever they are
+
+void read_position(const Elements& e, Slice& s) {
   const auto position = e.numbers(0x0020, 0x0032, "ImagePositionPatient", 3);
   s.position = glm::dvec3(position[0], position[1], position[2]);
+}
+
+void read_orientation(const Elements& e, Slice& s) {
   const auto cosines = e.numbers(0x0020, 0x0037, "ImageOrientationPatient", 6);
-  s.row_cosine = unit(s.file, cosines, 0);
-  s.column_cosine = unit(s.file, cosines, 3);
+  s.row_cosine = unit(e.path(), cosines, 0);
+  s.column_cosine = unit(e.path(), cosines, 3);
   if (std::fabs(glm::dot(s.row_cosine, s.column_cosine)) > 1e-3)
-    fail(s.file, "ImageOrientationPatient: the row and column cosines are not perpendicular");
+    fail(e.path(), "ImageOrientationPatient: the row and column cosines are not perpendicular");
+}
+
+void read_pixel_measures(const Elements& e, Slice& s) {
   const auto spacing = e.numbers(0x0028, 0x0030, "PixelSpacing", 2);
   s.pixel_spacing = glm::dvec2(spacing[1], spacing[0]);  // DICOM lists the row spacing first
   if (!(spacing[0] > 0.0 && spacing[1] > 0.0 && std::isfinite(spacing[0] + spacing[1])))
-    fail(s.file,
+    fail(e.path(),
          concat("PixelSpacing = ", spacing[0], " ", spacing[1], ": spacing must be positive"));
   s.thickness = e.numbers(0x0018, 0x0050, "SliceThickness", 1, 0.0)[0];
+}
+
+void read_rescale(const Elements& e, Slice& s) {
+  s.rescale.slope = e.numbers(0x0028, 0x1053, "RescaleSlope", 1, 1.0)[0];
+  s.rescale.intercept = e.numbers(0x0028, 0x1052, "RescaleIntercept", 1, 0.0)[0];
+}
+
+void read_frame_content(const Elements& e, Slice& s) {
+  s.stack = e.text(0x0020, 0x9056);
+  s.time = e.text(0x0020, 0x9128);
 }
 
 void read_pixel_format(const Elements& e, Slice& s) {
@@ -114,37 +151,161 @@ void read_pixel_format(const Elements& e, Slice& s) {
   s.columns = static_cast<uint32_t>(e.integer(0x0028, 0x0011, "Columns"));
   if (const int samples = e.integer(0x0028, 0x0002, "SamplesPerPixel", 1.0); samples != 1)
     fail(s.file, concat("SamplesPerPixel = ", samples, ": only grayscale images are supported"));
-  if (const int frames = e.integer(0x0028, 0x0008, "NumberOfFrames", 1.0); frames > 1)
-    fail(s.file, concat("NumberOfFrames = ", frames, ": multi-frame files are not supported"));
   s.bits_allocated = e.integer(0x0028, 0x0100, "BitsAllocated");
   if (s.bits_allocated != 8 && s.bits_allocated != 16)
     fail(s.file, concat("BitsAllocated = ", s.bits_allocated, ": only 8 and 16 are supported"));
   s.bits_stored = e.integer(0x0028, 0x0101, "BitsStored", s.bits_allocated);
   s.high_bit = e.integer(0x0028, 0x0102, "HighBit", s.bits_stored - 1);
   s.is_signed = e.integer(0x0028, 0x0103, "PixelRepresentation", 0.0) == 1;
-  s.rescale.slope = e.numbers(0x0028, 0x1053, "RescaleSlope", 1, 1.0)[0];
-  s.rescale.intercept = e.numbers(0x0028, 0x1052, "RescaleIntercept", 1, 0.0)[0];
 }
 
-// Native (uncompressed) pixel data must hold the whole slice; GDCM checks compressed data itself.
+// ---- enhanced multi-frame files
+
+// Calls read(item) with the first item of a sequence element; false when there is none. The
+// callback keeps GDCM's item alive while it is read (GetValueAsSQ may build it on the fly).
+template <class Read>
+bool with_first_item(const gdcm::DataSet& data_set, uint16_t group, uint16_t element, Read&& read) {
+  const gdcm::Tag tag(group, element);
+  if (!data_set.FindDataElement(tag)) return false;
+  const gdcm::SmartPointer<gdcm::SequenceOfItems> items =
+      data_set.GetDataElement(tag).GetValueAsSQ();
+  if (!items || items->GetNumberOfItems() == 0) return false;
+  read(items->GetItem(1).GetNestedDataSet());
+  return true;
+}
+
+// Per-frame and Shared Functional Groups Sequences: each item holds macros (PlanePosition,
+// PixelMeasures, ...), each macro a sequence of one item that holds the attributes.
+class FunctionalGroups {
+ public:
+  explicit FunctionalGroups(const gdcm::DataSet& data_set)
+      : per_frame_(sequence(data_set, 0x9230)), shared_(sequence(data_set, 0x9229)) {}
+  bool present() const { return per_frame_ || shared_; }
+  size_t per_frame_items() const { return per_frame_ ? per_frame_->GetNumberOfItems() : 0; }
+
+  // Calls read(attributes) with frame f's macro (group, element), from the frame's own item or
+  // else the shared one; false when neither has it.
+  template <class Read>
+  bool with_macro(size_t f, uint16_t group, uint16_t element, Read&& read) const {
+    if (f < per_frame_items() &&
+        with_first_item(per_frame_->GetItem(f + 1).GetNestedDataSet(), group, element, read))
+      return true;
+    return shared_ && shared_->GetNumberOfItems() > 0 &&
+           with_first_item(shared_->GetItem(1).GetNestedDataSet(), group, element, read);
+  }
+
+ private:
+  static gdcm::SmartPointer<gdcm::SequenceOfItems> sequence(const gdcm::DataSet& data_set,
+                                                            uint16_t element) {
+    const gdcm::Tag tag(0x5200, element);
+    if (!data_set.FindDataElement(tag)) return nullptr;
+    return data_set.GetDataElement(tag).GetValueAsSQ();
+  }
+  gdcm::SmartPointer<gdcm::SequenceOfItems> per_frame_, shared_;
+};
+
+// Frame f's slice: the file's pixel format (in `common`) and the frame's own attributes.
+Slice read_frame(const gdcm::File& file, const FunctionalGroups& groups, const Slice& common,
+                 size_t f) {
+  Slice s = common;
+  s.frame = f;
+  const std::string context = concat("frame ", f + 1, ": ");  // DICOM counts frames from 1
+  const Elements top(file, file.GetDataSet(), s.file, context);
+  const auto read = [&](uint16_t group, uint16_t element,
+                        void (*read_into)(const Elements&, Slice&)) {
+    const bool found = groups.with_macro(f, group, element, [&](const gdcm::DataSet& attributes) {
+      read_into(Elements(file, attributes, s.file, context), s);
+    });
+    if (!found) read_into(top, s);
+  };
+  read(0x0020, 0x9113, read_position);
+  read(0x0020, 0x9116, read_orientation);
+  read(0x0028, 0x9110, read_pixel_measures);
+  read(0x0028, 0x9145, read_rescale);
+  groups.with_macro(f, 0x0020, 0x9111, [&](const gdcm::DataSet& attributes) {
+    read_frame_content(Elements(file, attributes, s.file, context), s);
+  });
+  return s;
+}
+
+// One stack at one time: the frames must be slices of one volume.
+void check_one_volume(const fs::path& file, const std::vector<Slice>& frames) {
+  const Slice& first = frames.front();
+  for (const Slice& s : frames) {
+    if (s.stack != first.stack)
+      fail(file, concat("holds several stacks (frame 1 has StackID '", first.stack, "', frame ",
+                        s.frame + 1, " '", s.stack, "'): strata reads one stack of slices"));
+    if (s.time != first.time)
+      fail(file, concat("holds several time points (frame 1 has TemporalPositionIndex ", first.time,
+                        ", frame ", s.frame + 1, " ", s.time, "): strata reads one 3-D volume"));
+  }
+}
+
+std::vector<Slice> read_frames(const gdcm::File& file, const Elements& e, const Slice& common) {
+  const int count = e.integer(0x0028, 0x0008, "NumberOfFrames", 1.0);
+  if (count < 1) fail(common.file, concat("NumberOfFrames = ", count, ": must be positive"));
+  const FunctionalGroups groups(file.GetDataSet());
+  if (!groups.present()) {
+    if (count > 1)
+      fail(common.file, concat("NumberOfFrames = ", count,
+                               " without a Per-frame Functional Groups Sequence: only enhanced "
+                               "multi-frame images (CT, MR) are supported"));
+    Slice s = common;
+    read_position(e, s);
+    read_orientation(e, s);
+    read_pixel_measures(e, s);
+    read_rescale(e, s);
+    return {s};
+  }
+  if (groups.per_frame_items() != 0 && groups.per_frame_items() != size_t(count))
+    fail(common.file, concat("PerFrameFunctionalGroupsSequence has ", groups.per_frame_items(),
+                             " items, NumberOfFrames is ", count));
+  std::vector<Slice> frames;
+  for (size_t f = 0; f < size_t(count); ++f) {
+    frames.push_back(read_frame(file, groups, common, f));
+    frames.back().frames_in_file = size_t(count);
+  }
+  check_one_volume(common.file, frames);
+  return frames;
+}
+
+// ---- files
+
+// Native (uncompressed) pixel data must hold every frame; GDCM checks compressed data itself.
 void check_pixel_data_length(const Elements& e, const Slice& s) {
   const gdcm::DataElement& pixels = e.data_set().GetDataElement(pixel_data_tag);
   const gdcm::ByteValue* value = pixels.GetByteValue();
-  const uint64_t needed = uint64_t{s.rows} * s.columns * uint64_t(s.bits_allocated / 8);
+  const uint64_t needed =
+      uint64_t{s.rows} * s.columns * uint64_t(s.bits_allocated / 8) * s.frames_in_file;
   if (value && value->GetLength() < needed)
-    fail(s.file,
-         concat("PixelData has ", value->GetLength(), " bytes, Rows x Columns needs ", needed));
+    fail(s.file, concat("PixelData has ", value->GetLength(), " bytes, Rows x Columns",
+                        s.frames_in_file > 1 ? " x NumberOfFrames" : "", " needs ", needed));
 }
 
-// The slice's header, or nothing for files that are not DICOM images (skipped).
-std::optional<Slice> read_slice_header(const fs::path& file) {
+// GDCM refuses a transfer syntax it does not know without saying so; the meta header says which.
+[[noreturn]] void fail_to_parse(const fs::path& file, const gdcm::Reader& reader) {
+  const gdcm::FileMetaInformation& meta = reader.GetFile().GetHeader();
+  const gdcm::Tag syntax_tag(0x0002, 0x0010);
+  if (meta.FindDataElement(syntax_tag))
+    if (const gdcm::ByteValue* value = meta.GetDataElement(syntax_tag).GetByteValue()) {
+      const std::string uid(trim(std::string(value->GetPointer(), value->GetLength()).c_str()));
+      if (gdcm::TransferSyntax::GetTSType(uid.c_str()) == gdcm::TransferSyntax::TS_END)
+        fail(file, concat("TransferSyntaxUID ", printable(uid, 64),
+                          " is not supported (GDCM does not know it; strata reads uncompressed, "
+                          "RLE, JPEG, JPEG-LS and JPEG 2000 DICOM)"));
+    }
+  fail(file, "DICOM file cannot be parsed (truncated or malformed)");
+}
+
+// The file's slices (one, or one per frame), or none for files that are not DICOM images.
+std::vector<Slice> read_file_slices(const fs::path& file) {
   const Kind kind = file_kind(file);
-  if (kind == Kind::other) return std::nullopt;
+  if (kind == Kind::other) return {};
   try {
     check_structure(file, kind);
   } catch (const Error&) {
     if (kind == Kind::part10) throw;
-    return std::nullopt;  // a bare data set that does not hold together: probably not DICOM
+    return {};  // a bare data set that does not hold together: probably not DICOM
   }
   gdcm::Reader reader;
   reader.SetFileName(file.string().c_str());
@@ -155,44 +316,48 @@ std::optional<Slice> read_slice_header(const fs::path& file) {
     read = false;
   }
   if (!read) {
-    if (kind == Kind::part10) fail(file, "DICOM file cannot be parsed (truncated or malformed)");
-    return std::nullopt;
+    if (kind == Kind::part10) fail_to_parse(file, reader);
+    return {};
   }
-  const Elements e(reader.GetFile(), file);
+  const Elements e(reader.GetFile(), reader.GetFile().GetDataSet(), file);
   // DICOMDIRs, reports and other non-image objects may sit beside the slices.
-  if (!e.has(0x0028, 0x0010) || !e.has(0x0028, 0x0011)) return std::nullopt;
+  if (!e.has(0x0028, 0x0010) || !e.has(0x0028, 0x0011)) return {};
   if (!e.has(0x7fe0, 0x0010)) fail(file, "an image without PixelData (truncated?)");
-  Slice s{.file = file};
-  read_pixel_format(e, s);
-  read_geometry(e, s);
-  check_pixel_data_length(e, s);
-  s.series = e.text(0x0020, 0x000e);
-  return s;
+  Slice common{.file = file};
+  read_pixel_format(e, common);
+  common.series = e.text(0x0020, 0x000e);
+  const char* syntax = reader.GetFile().GetHeader().GetDataSetTransferSyntax().GetString();
+  common.syntax = syntax ? syntax : "";
+  std::vector<Slice> slices = read_frames(reader.GetFile(), e, common);
+  check_pixel_data_length(e, slices.front());
+  return slices;
 }
 
+// "2062", or "frame 5" inside a multi-frame file (whose name the error already gives).
 std::string name_of(const Slice& s) {
-  return s.file.filename().string();
+  return s.frames_in_file > 1 ? concat("frame ", s.frame + 1) : s.file.filename().string();
 }
 
-void check_consistent(const fs::path& folder, const Slice& first, const Slice& s) {
+void check_consistent(const fs::path& where, const Slice& first, const Slice& s) {
   if (s.rows != first.rows || s.columns != first.columns)
-    fail(folder, concat("mixed Rows/Columns: ", name_of(first), " is ", first.columns, "x",
-                        first.rows, ", ", name_of(s), " is ", s.columns, "x", s.rows));
+    fail(where, concat("mixed Rows/Columns: ", name_of(first), " is ", first.columns, "x",
+                       first.rows, ", ", name_of(s), " is ", s.columns, "x", s.rows));
   if (glm::length(s.row_cosine - first.row_cosine) > 1e-3 ||
       glm::length(s.column_cosine - first.column_cosine) > 1e-3)
-    fail(folder,
+    fail(where,
          concat("mixed ImageOrientationPatient: ", name_of(first), " and ", name_of(s), " differ"));
   if (glm::length(s.pixel_spacing - first.pixel_spacing) > 1e-3 * glm::length(first.pixel_spacing))
-    fail(folder, concat("mixed PixelSpacing: ", name_of(first), " and ", name_of(s), " differ"));
+    fail(where, concat("mixed PixelSpacing: ", name_of(first), " and ", name_of(s), " differ"));
   if (s.bits_allocated != first.bits_allocated || s.is_signed != first.is_signed ||
       s.bits_stored != first.bits_stored)
-    fail(folder, concat("mixed pixel formats: ", name_of(first), " and ", name_of(s), " differ"));
+    fail(where, concat("mixed pixel formats: ", name_of(first), " and ", name_of(s), " differ"));
   if (!s.series.empty() && !first.series.empty() && s.series != first.series)
-    fail(folder, concat("holds more than one series: ", name_of(first), " and ", name_of(s),
-                        " have different SeriesInstanceUIDs"));
+    fail(where, concat("holds more than one series: ", name_of(first), " and ", name_of(s),
+                       " have different SeriesInstanceUIDs"));
 }
 
-std::vector<Slice> read_headers(const fs::path& folder) {
+// Every image file's slices; a folder holds single-frame slices or one multi-frame file.
+std::vector<Slice> read_folder(const fs::path& folder) {
   std::vector<fs::path> files;
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(folder, error))
@@ -200,18 +365,28 @@ std::vector<Slice> read_headers(const fs::path& folder) {
   if (error) fail(folder, concat("cannot list the folder: ", error.message()));
   std::sort(files.begin(), files.end());
   std::vector<Slice> slices;
-  for (const fs::path& file : files)
-    if (auto slice = read_slice_header(file)) slices.push_back(std::move(*slice));
+  size_t images = 0;
+  std::string multi_frame;  // the name of a multi-frame file among them
+  for (const fs::path& file : files) {
+    std::vector<Slice> more = read_file_slices(file);
+    if (more.empty()) continue;
+    ++images;
+    if (more.front().frames_in_file > 1) multi_frame = file.filename().string();
+    if (!multi_frame.empty() && images > 1)
+      fail(folder, concat("holds the multi-frame file ", multi_frame,
+                          " and other images: strata reads a folder of single-frame slices or "
+                          "one multi-frame file"));
+    slices.insert(slices.end(), more.begin(), more.end());
+  }
   if (slices.empty())
     fail(folder, files.empty() ? std::string("no DICOM files (the folder is empty)")
                                : concat("no DICOM files (none of its ", files.size(),
                                         " files is a DICOM image)"));
-  for (const Slice& s : slices) check_consistent(folder, slices.front(), s);
   return slices;
 }
 
 // Sorts along the normal and returns the uniform distance between slices.
-double sort_and_space(const fs::path& folder, std::vector<Slice>& slices, glm::dvec3 normal) {
+double sort_and_space(const fs::path& where, std::vector<Slice>& slices, glm::dvec3 normal) {
   for (Slice& s : slices) s.along_normal = glm::dot(s.position, normal);
   std::stable_sort(slices.begin(), slices.end(),
                    [](const Slice& a, const Slice& b) { return a.along_normal < b.along_normal; });
@@ -220,20 +395,44 @@ double sort_and_space(const fs::path& folder, std::vector<Slice>& slices, glm::d
                       static_cast<double>(slices.size() - 1);
   for (size_t k = 0; k + 1 < slices.size(); ++k)
     if (slices[k + 1].along_normal - slices[k].along_normal < 1e-4)
-      fail(folder,
+      fail(where,
            concat(name_of(slices[k]), " and ", name_of(slices[k + 1]),
                   " are at the same position (", slices[k].along_normal, " mm along the normal)"));
   for (size_t k = 0; k + 1 < slices.size(); ++k) {
     const double step = slices[k + 1].along_normal - slices[k].along_normal;
     if (std::fabs(step - mean) > std::max(1e-3, 0.01 * mean))
-      fail(folder,
-           concat("slice spacing is not uniform: ", step, " mm between ", name_of(slices[k]),
-                  " and ", name_of(slices[k + 1]), ", ", mean, " mm on average"));
+      fail(where, concat("slice spacing is not uniform: ", step, " mm between ", name_of(slices[k]),
+                         " and ", name_of(slices[k + 1]), ", ", mean, " mm on average"));
   }
   return mean;
 }
 
-void decode_slice(const Slice& s, std::byte* destination, size_t bytes) {
+// ---- pixels
+
+// Decodes a file's pixel data (all its frames) into `bytes` bytes at destination.
+// Little-endian native pixel data is copied as it is: GDCM's raw codec goes through string
+// streams, up to four copies of a multi-frame file's pixels at once.
+bool copy_native(const Slice& s, std::byte* destination, size_t bytes) {
+  if (s.syntax != "1.2.840.10008.1.2" && s.syntax != "1.2.840.10008.1.2.1") return false;
+  gdcm::Reader reader;
+  reader.SetFileName(s.file.string().c_str());
+  bool read = false;
+  try {
+    read = reader.Read();
+  } catch (const std::exception&) {
+    read = false;
+  }
+  const gdcm::DataSet& data_set = reader.GetFile().GetDataSet();
+  const gdcm::ByteValue* value = read && data_set.FindDataElement(pixel_data_tag)
+                                     ? data_set.GetDataElement(pixel_data_tag).GetByteValue()
+                                     : nullptr;
+  if (!value || value->GetLength() < bytes) fail(s.file, "cannot read the pixel data");
+  std::memcpy(destination, value->GetPointer(), bytes);
+  return true;
+}
+
+void decode_file(const Slice& s, std::byte* destination, size_t bytes) {
+  if (copy_native(s, destination, bytes)) return;
   gdcm::ImageReader reader;
   reader.SetFileName(s.file.string().c_str());
   bool decoded = false;
@@ -244,7 +443,9 @@ void decode_slice(const Slice& s, std::byte* destination, size_t bytes) {
                              image.GetPixelFormat().GetBitsAllocated() == s.bits_allocated &&
                              image.GetBufferLength() == bytes;
       if (!same_size)
-        fail(s.file, "the decoded pixel data does not match Rows, Columns and BitsAllocated");
+        fail(s.file,
+             "the decoded pixel data does not match Rows, Columns, BitsAllocated and "
+             "NumberOfFrames");
       decoded = image.GetBuffer(reinterpret_cast<char*>(destination));
     }
   } catch (const Error&) {
@@ -252,7 +453,30 @@ void decode_slice(const Slice& s, std::byte* destination, size_t bytes) {
   } catch (const std::exception&) {
     decoded = false;
   }
-  if (!decoded) fail(s.file, "cannot decode the pixel data");
+  if (!decoded)
+    fail(s.file, concat("cannot decode the pixel data (transfer syntax ", s.syntax,
+                        ": corrupt, or a compression GDCM has no codec for)"));
+}
+
+// Puts frame slices[k].frame into slot k for every k, in place: each cycle of the permutation is
+// followed with one slice of scratch.
+void order_frames(std::vector<std::byte>& voxels, const std::vector<Slice>& slices,
+                  size_t slice_bytes) {
+  std::vector<bool> placed(slices.size(), false);
+  std::vector<std::byte> scratch(slice_bytes);
+  const auto slot = [&](size_t k) { return voxels.data() + k * slice_bytes; };
+  for (size_t start = 0; start < slices.size(); ++start) {
+    if (placed[start] || slices[start].frame == start) continue;
+    std::memcpy(scratch.data(), slot(start), slice_bytes);
+    size_t k = start;
+    while (slices[k].frame != start) {
+      std::memcpy(slot(k), slot(slices[k].frame), slice_bytes);
+      placed[k] = true;
+      k = slices[k].frame;
+    }
+    std::memcpy(slot(k), scratch.data(), slice_bytes);
+    placed[k] = true;
+  }
 }
 
 // Clears bits above BitsStored (overlays live there in old files) and sign-extends signed data.
@@ -279,41 +503,17 @@ std::vector<Rescale> rescales(const std::vector<Slice>& slices) {
   return result;
 }
 
-}  // namespace
-
-Volume load_dicom_series(const std::filesystem::path& folder) {
-  std::error_code error;
-  if (!fs::exists(folder, error)) fail(folder, "no such file");
-  if (!fs::is_directory(folder, error)) fail(folder, "not a folder (a DICOM series is a folder)");
-  // Files that are not DICOM are skipped on purpose; GDCM must not print about them.
-  gdcm::Trace::DebugOff();
-  gdcm::Trace::WarningOff();
-  gdcm::Trace::ErrorOff();
-
-  std::vector<Slice> slices = read_headers(folder);
-  const Slice& first = slices.front();
-  const glm::dvec3 normal = glm::normalize(glm::cross(first.row_cosine, first.column_cosine));
-  const double step = sort_and_space(folder, slices, normal);
-
-  const StoredType stored = first.bits_allocated == 8
-                                ? (first.is_signed ? StoredType::int8 : StoredType::uint8)
-                                : (first.is_signed ? StoredType::int16 : StoredType::uint16);
-  const std::array<int64_t, 3> dims{first.columns, first.rows, int64_t(slices.size())};
-  const size_t bytes =
-      checked_voxel_bytes(folder, "Columns x Rows x files", dims, stored_size(stored));
-  Volume volume;
-  volume.name = volume_name(folder);
-  volume.source = folder;
-  volume.dims = to_dims(dims);
-  volume.spacing = glm::vec3(first.pixel_spacing.x, first.pixel_spacing.y, step);
-  volume.origin = glm::vec3(slices.front().position);
-  volume.direction =
-      glm::mat3(glm::vec3(first.row_cosine), glm::vec3(first.column_cosine), glm::vec3(normal));
-
+void decode(Volume& volume, const std::vector<Slice>& slices, size_t bytes) {
   volume.voxels.resize(bytes);
   const size_t slice_bytes = bytes / slices.size();
-  for (size_t k = 0; k < slices.size(); ++k)
-    decode_slice(slices[k], volume.voxels.data() + k * slice_bytes, slice_bytes);
+  if (slices.front().frames_in_file > 1) {
+    decode_file(slices.front(), volume.voxels.data(), bytes);
+    order_frames(volume.voxels, slices, slice_bytes);
+  } else {
+    for (size_t k = 0; k < slices.size(); ++k)
+      decode_file(slices[k], volume.voxels.data() + k * slice_bytes, slice_bytes);
+  }
+  const Slice& first = slices.front();
   if (first.bits_stored < first.bits_allocated && first.bits_stored > 0 &&
       first.high_bit == first.bits_stored - 1) {
     if (first.bits_allocated == 16)
@@ -321,11 +521,75 @@ Volume load_dicom_series(const std::filesystem::path& folder) {
     else
       clean_unused_bits<uint8_t>(volume.voxels, first.bits_stored, first.is_signed);
   }
+}
+
+// The volume of checked slices; `where` (the folder or file) names it in errors.
+Volume assemble(const fs::path& where, std::vector<Slice> slices) {
+  for (const Slice& s : slices) check_consistent(where, slices.front(), s);
+  const Slice& first = slices.front();
+  const glm::dvec3 normal = glm::normalize(glm::cross(first.row_cosine, first.column_cosine));
+  const double step = sort_and_space(where, slices, normal);
+
+  const StoredType stored = first.bits_allocated == 8
+                                ? (first.is_signed ? StoredType::int8 : StoredType::uint8)
+                                : (first.is_signed ? StoredType::int16 : StoredType::uint16);
+  const std::array<int64_t, 3> dims{first.columns, first.rows, int64_t(slices.size())};
+  const size_t bytes = checked_voxel_bytes(
+      where,
+      first.frames_in_file > 1 ? "Columns x Rows x NumberOfFrames" : "Columns x Rows x files", dims,
+      stored_size(stored));
+  Volume volume;
+  volume.name = volume_name(where);
+  volume.source = where;
+  volume.dims = to_dims(dims);
+  volume.spacing = glm::vec3(first.pixel_spacing.x, first.pixel_spacing.y, step);
+  volume.origin = glm::vec3(slices.front().position);
+  volume.direction =
+      glm::mat3(glm::vec3(first.row_cosine), glm::vec3(first.column_cosine), glm::vec3(normal));
+  decode(volume, slices, bytes);
   finish_voxels(volume, {.stored = stored,
                          .big_endian = std::endian::native == std::endian::big,
                          .per_slice = rescales(slices),
                          .int16_when_exact = true});
   return volume;
+}
+
+// Files that are not DICOM are skipped on purpose; GDCM must not print about them.
+void quiet_gdcm() {
+  gdcm::Trace::DebugOff();
+  gdcm::Trace::WarningOff();
+  gdcm::Trace::ErrorOff();
+}
+
+}  // namespace
+
+Volume load_dicom_series(const std::filesystem::path& folder, const VolumeReadOptions& options,
+                         std::vector<std::string>& warnings) {
+  std::error_code error;
+  if (!fs::exists(folder, error)) fail(folder, "no such file");
+  if (!fs::is_directory(folder, error)) fail(folder, "not a folder (a DICOM series is a folder)");
+  choose_frame(folder, 1, options, warnings);
+  quiet_gdcm();
+  std::vector<Slice> slices = read_folder(folder);
+  // A folder holding one multi-frame file: errors about its frames name the file.
+  const fs::path where = slices.front().frames_in_file > 1 ? slices.front().file : folder;
+  Volume volume = assemble(where, std::move(slices));
+  volume.name = volume_name(folder);
+  volume.source = folder;
+  return volume;
+}
+
+Volume load_dicom_file(const std::filesystem::path& path, const VolumeReadOptions& options,
+                       std::vector<std::string>& warnings) {
+  existing_file_size(path);
+  choose_frame(path, 1, options, warnings);
+  quiet_gdcm();
+  if (file_kind(path) == Kind::other)
+    fail(path, "not a DICOM file (no 'DICM' after the 128-byte preamble, no data set)");
+  std::vector<Slice> slices = read_file_slices(path);
+  if (slices.empty())
+    fail(path, "not a DICOM image (no Rows and Columns: a DICOMDIR, report or other object)");
+  return assemble(path, std::move(slices));
 }
 
 }  // namespace strata

@@ -1,7 +1,9 @@
 // MetaImage (ITK's MetaIO): a text header of "Key = Value" lines whose last line,
 // ElementDataFile, names the raw data file or says LOCAL (.mha: the data follows the header).
 // Geometry is taken as ITK writes it: LPS+ patient space, TransformMatrix holding the direction
-// of i, then j, then k.
+// of i, then j, then k. NDims 2 is one slice; of NDims 4 (time last, as ITK writes it) one frame
+// is read, the fourth entry of every per-axis field ignored.
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -82,8 +84,6 @@ void check_image_kind(const MetaHeader& header) {
   const fs::path& path = header.path;
   if (const auto type = header.get({"ObjectType"}); type && lowercase(*type) != "image")
     fail(path, concat("ObjectType = ", *type, ": only Image is supported"));
-  const std::string_view ndims = header.require("NDims");
-  if (trim(ndims) != "3") fail(path, concat("NDims = ", ndims, ": only 3D images are supported"));
   if (const auto channels = header.get({"ElementNumberOfChannels"}); channels && *channels != "1")
     fail(path, concat("ElementNumberOfChannels = ", *channels, ": only 1 is supported"));
   if (const auto binary = header.get({"BinaryData"});
@@ -102,25 +102,44 @@ StoredType element_type(const MetaHeader& header) {
                            "MET_FLOAT)"));
 }
 
-void set_geometry(Volume& volume, const MetaHeader& header) {
+int dimensions(const MetaHeader& header) {
+  const std::string_view ndims = trim(header.require("NDims"));
+  if (ndims != "2" && ndims != "3" && ndims != "4")
+    fail(header.path, concat("NDims = ", ndims, ": expected 2, 3 or 4 (a 2-D, 3-D or 4-D image)"));
+  return ndims[0] - '0';
+}
+
+// A per-axis field's n numbers (n = NDims, or NDims² for the matrix).
+std::vector<float> numbers_of(const MetaHeader& header, std::string_view field,
+                              std::string_view text, size_t n) {
+  std::vector<float> values = parse_numbers<float>(header.path, field, text);
+  if (values.size() != n)
+    fail(header.path,
+         concat(field, ": expected ", n, " numbers, got '", printable(trim(text)), "'"));
+  return values;
+}
+
+void set_geometry(Volume& volume, const MetaHeader& header, int ndims) {
   const fs::path& path = header.path;
+  const size_t n = size_t(ndims), spatial = std::min<size_t>(n, 3);
   if (const auto text = header.get({"ElementSpacing", "ElementSize"})) {
-    const auto s = parse_exactly<float, 3>(path, "ElementSpacing", *text);
-    check_spacing(path, "ElementSpacing", {s[0], s[1], s[2]});
-    volume.spacing = glm::vec3(s[0], s[1], s[2]);
+    const auto s = numbers_of(header, "ElementSpacing", *text, n);
+    for (size_t axis = 0; axis < spatial; ++axis) volume.spacing[int(axis)] = s[axis];
+    check_spacing(path, "ElementSpacing", {volume.spacing.x, volume.spacing.y, volume.spacing.z});
   }
   if (const auto text = header.get({"Offset", "Position", "Origin"})) {
-    const auto o = parse_exactly<float, 3>(path, "Offset", *text);
-    volume.origin = glm::vec3(o[0], o[1], o[2]);
+    const auto o = numbers_of(header, "Offset", *text, n);
+    for (size_t axis = 0; axis < spatial; ++axis) volume.origin[int(axis)] = o[axis];
   }
   if (const auto text = header.get({"TransformMatrix", "Rotation", "Orientation"})) {
-    const auto m = parse_exactly<float, 9>(path, "TransformMatrix", *text);
-    for (int axis = 0; axis < 3; ++axis)
-      volume.direction[axis] = glm::vec3(m[3 * axis], m[3 * axis + 1], m[3 * axis + 2]);
+    const auto m = numbers_of(header, "TransformMatrix", *text, n * n);
+    for (size_t axis = 0; axis < spatial; ++axis)
+      for (size_t row = 0; row < spatial; ++row)
+        volume.direction[int(axis)][int(row)] = m[n * axis + row];
   }
 }
 
-InputFile::Source data_source(const MetaHeader& header, size_t bytes) {
+InputFile::Source data_source(const MetaHeader& header, uint64_t bytes) {
   const fs::path& path = header.path;
   InputFile::Source source{.file = path, .report_as = path};
   if (const auto text = header.get({"CompressedData"}))
@@ -233,24 +252,40 @@ void write_data(const fs::path& file, std::ios::openmode mode, const Volume& vol
 
 }  // namespace
 
-Volume load_metaimage(const std::filesystem::path& path) {
+Volume load_metaimage(const std::filesystem::path& path, const VolumeReadOptions& options,
+                      std::vector<std::string>& warnings) {
   existing_file_size(path);
   const MetaHeader header = parse_header(path);
   check_image_kind(header);
+  const int ndims = dimensions(header);
   const StoredType stored = element_type(header);
-  const auto dims = parse_exactly<int64_t, 3>(path, "DimSize", header.require("DimSize"));
+  const std::string_view dim_text = header.require("DimSize");
+  const auto sizes = parse_numbers<int64_t>(path, "DimSize", dim_text);
+  if (sizes.size() != size_t(ndims))
+    fail(path, concat("DimSize: expected ", ndims, " numbers (NDims = ", ndims, "), got '",
+                      printable(trim(dim_text)), "'"));
+  const std::array<int64_t, 3> dims{sizes[0], sizes[1], ndims > 2 ? sizes[2] : 1};
+  const int64_t frames = ndims == 4 ? sizes[3] : 1;
+  if (frames < 1) fail(path, concat("DimSize: the fourth size is ", frames, ": must be positive"));
   const size_t bytes = checked_voxel_bytes(path, "DimSize", dims, stored_size(stored));
+  uint64_t all_frames_bytes = 0;
+  if (__builtin_mul_overflow(uint64_t{bytes}, uint64_t(frames), &all_frames_bytes))
+    fail(path, "DimSize: voxel count overflows");
+  const uint64_t frame = choose_frame(path, uint64_t(frames), options, warnings);
 
   Volume volume;
   volume.name = volume_name(path);
   volume.source = path;
   volume.dims = to_dims(dims);
-  set_geometry(volume, header);
+  set_geometry(volume, header, ndims);
+  if (ndims == 2)  // one slice: k is its normal
+    volume.direction[2] = glm::normalize(glm::cross(volume.direction[0], volume.direction[1]));
   bool big_endian = false;
   if (const auto msb = header.get({"BinaryDataByteOrderMSB", "ElementByteOrderMSB"}))
     big_endian = parse_bool(path, "BinaryDataByteOrderMSB", *msb);
 
-  InputFile in(data_source(header, bytes));
+  InputFile in(data_source(header, all_frames_bytes));
+  skip_frames(in, frame, bytes);
   read_voxels(in, bytes, volume);
   finish_voxels(volume, {.stored = stored, .big_endian = big_endian, .per_slice = {Rescale{}}});
   return volume;

@@ -1,4 +1,6 @@
-// NIfTI-1 and NIfTI-2 (.nii, .nii.gz), either byte order.
+// NIfTI-1 and NIfTI-2 (.nii, .nii.gz), either byte order; 2-D images as one slice, and of a 4-D
+// image (fMRI, DCE) the one frame asked for: frames are stored one after the other, so the
+// frames before it are skipped (inflated and dropped when gzipped) and only its voxels are kept.
 //
 // The header is parsed by hand rather than with Debian's nifticlib: the format is one fixed
 // 348-byte (NIfTI-1) or 540-byte (NIfTI-2) struct, so the library would add little, and its
@@ -166,29 +168,40 @@ StoredType stored_type(const NiftiHeader& h, const fs::path& path) {
                     "int32, uint32, float64 as float32)"));
 }
 
-std::array<int64_t, 3> volume_dims(const NiftiHeader& h, const fs::path& path) {
+// A volume's three dimensions (a 2-D image is one slice) and the frame count (dim[4]).
+struct Extent {
+  std::array<int64_t, 3> dims{};
+  int64_t frames = 1;
+};
+
+Extent image_extent(const NiftiHeader& h, const fs::path& path) {
   const int64_t rank = h.dim[0];
-  if (rank < 2 || rank > 7) fail(path, concat("dim[0] = ", rank, ": expected 3 (a 3D volume)"));
-  for (int64_t axis = 4; axis <= rank; ++axis)
+  if (rank < 2 || rank > 7)
+    fail(path, concat("dim[0] = ", rank, ": expected 2, 3 or 4 (a 2-D, 3-D or 4-D image)"));
+  for (int64_t axis = 5; axis <= rank; ++axis)
     if (h.dim[static_cast<size_t>(axis)] != 1)
       fail(path, concat("dim[", axis, "] = ", h.dim[static_cast<size_t>(axis)],
-                        ": only 3D volumes are supported (one time point, one component)"));
-  return {h.dim[1], h.dim[2], rank >= 3 ? h.dim[3] : 1};
+                        ": images of more than 4 dimensions are not supported (one component)"));
+  const int64_t frames = rank >= 4 ? h.dim[4] : 1;
+  if (frames < 1) fail(path, concat("dim[4] = ", frames, ": the frame count must be positive"));
+  return {{h.dim[1], h.dim[2], rank >= 3 ? h.dim[3] : 1}, frames};
 }
 
 // Voxel index to RAS+ as a 3x4 matrix (rows x, y, z; the last column is the translation).
 using Affine = std::array<std::array<double, 4>, 3>;
 
-std::array<double, 3> pixdim_spacing(const NiftiHeader& h, const fs::path& path) {
-  const std::array<double, 3> spacing{h.pixdim[1], h.pixdim[2], h.pixdim[3]};
+// One slice may leave pixdim[3] at 0: it is then 1 mm.
+std::array<double, 3> pixdim_spacing(const NiftiHeader& h, const fs::path& path, bool one_slice) {
+  std::array<double, 3> spacing{h.pixdim[1], h.pixdim[2], h.pixdim[3]};
+  if (one_slice && !(spacing[2] > 0.0 && std::isfinite(spacing[2]))) spacing[2] = 1.0;
   check_spacing(path, "pixdim[1..3]", spacing);
   return spacing;
 }
 
 // The quaternion method (NIfTI-1 "method 2"): rotation from (b, c, d), a = sqrt(1 - b²-c²-d²),
 // qfac = pixdim[0] flips k.
-Affine qform_affine(const NiftiHeader& h, const fs::path& path) {
-  const std::array<double, 3> spacing = pixdim_spacing(h, path);
+Affine qform_affine(const NiftiHeader& h, const fs::path& path, bool one_slice) {
+  const std::array<double, 3> spacing = pixdim_spacing(h, path, one_slice);
   double b = h.quatern[0], c = h.quatern[1], d = h.quatern[2];
   double a = 1.0 - (b * b + c * c + d * d);
   if (a < 1e-7) {  // a 180° rotation written with |(b,c,d)| ~ 1: renormalise, as the spec says
@@ -213,23 +226,28 @@ Affine qform_affine(const NiftiHeader& h, const fs::path& path) {
   return m;
 }
 
-Affine orientation(const NiftiHeader& h, const fs::path& path) {
+Affine orientation(const NiftiHeader& h, const fs::path& path, bool one_slice) {
   if (h.sform_code > 0) return h.srow;
-  if (h.qform_code > 0) return qform_affine(h, path);
+  if (h.qform_code > 0) return qform_affine(h, path, one_slice);
   // Neither: ANALYZE-style, scale by pixdim only.
-  const std::array<double, 3> spacing = pixdim_spacing(h, path);
+  const std::array<double, 3> spacing = pixdim_spacing(h, path, one_slice);
   Affine m{};
   for (size_t axis = 0; axis < 3; ++axis) m[axis][axis] = spacing[axis];
   return m;
 }
 
 // Splits the affine into spacing (column lengths), direction and origin, converting RAS to LPS.
+// A 2-D image's sform may leave k's column zero: k is then the slice normal, 1 mm.
 void set_geometry(Volume& volume, const NiftiHeader& h, const fs::path& path) {
-  const Affine m = orientation(h, path);
+  const bool one_slice = volume.dims.z == 1;
+  const Affine m = orientation(h, path, one_slice);
   const double to_lps[3] = {-1.0, -1.0, 1.0};
   for (int col = 0; col < 3; ++col) {
     glm::dvec3 axis(0.0);
     for (int row = 0; row < 3; ++row) axis[row] = to_lps[row] * m[size_t(row)][size_t(col)];
+    if (col == 2 && one_slice && glm::length(axis) == 0.0)
+      axis = glm::normalize(
+          glm::cross(glm::dvec3(volume.direction[0]), glm::dvec3(volume.direction[1])));
     const double length = glm::length(axis);
     if (!std::isfinite(length) || length <= 0.0)
       fail(path, concat(h.sform_code > 0 ? "srow_x/y/z" : "qform", " column ", col,
@@ -243,20 +261,22 @@ void set_geometry(Volume& volume, const NiftiHeader& h, const fs::path& path) {
 
 }  // namespace
 
-Volume load_nifti(const std::filesystem::path& path) {
+Volume load_nifti(const std::filesystem::path& path, const VolumeReadOptions& options,
+                  std::vector<std::string>& warnings) {
   existing_file_size(path);
   InputFile in(
       {.file = path, .report_as = path, .what = "voxel data", .compressed = is_gzip_file(path)});
   const NiftiHeader h = read_header(in, path);
   check_magic(h, path);
   const StoredType stored = stored_type(h, path);
-  const std::array<int64_t, 3> dims = volume_dims(h, path);
-  const size_t bytes = checked_voxel_bytes(path, "dim[1..3]", dims, stored_size(stored));
+  const Extent extent = image_extent(h, path);
+  const size_t bytes = checked_voxel_bytes(path, "dim[1..3]", extent.dims, stored_size(stored));
+  const uint64_t frame = choose_frame(path, uint64_t(extent.frames), options, warnings);
 
   Volume volume;
   volume.name = volume_name(path);
   volume.source = path;
-  volume.dims = to_dims(dims);
+  volume.dims = to_dims(extent.dims);
   set_geometry(volume, h, path);
 
   // The upper bound only keeps the conversion defined; skip() finds offsets past the end.
@@ -265,6 +285,7 @@ Volume load_nifti(const std::filesystem::path& path) {
     fail(path, concat("vox_offset = ", h.vox_offset,
                       ": not between the header's end and the "
                       "file's end"));
+  skip_frames(in, frame, bytes);
   read_voxels(in, bytes, volume);
   finish_voxels(volume, {.stored = stored, .big_endian = h.big_endian, .per_slice = {h.rescale}});
   return volume;

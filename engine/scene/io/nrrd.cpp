@@ -1,8 +1,11 @@
 // NRRD (teem's "nearly raw raster data"): a "NRRD000N" magic line, "field: value" lines, then
 // either a blank line and the data (.nrrd, attached) or a "data file:" field (.nhdr, detached).
-// strata reads 3D scalar volumes with raw or gzip encoding. Positions in "space directions" and
+// strata reads scalar images with raw or gzip encoding: 3-D, 2-D (one slice) and of a 4-D image
+// whose fourth axis is the non-spatial one (time) one frame. Positions in "space directions" and
 // "space origin" are converted to strata's LPS+ patient space according to the "space" field.
+#include <algorithm>
 #include <bit>
+#include <sstream>
 
 #include "engine/scene/io/volume_io.h"
 #include "engine/scene/io/volume_loader.h"
@@ -98,14 +101,18 @@ StoredType element_type(const NrrdHeader& header) {
        concat("type '", type, "' is not supported (strata reads uchar, short, ushort, float)"));
 }
 
-// "(x,y,z) (x,y,z) ..." as the texts between the parentheses.
-std::vector<std::string_view> vectors(const fs::path& path, std::string_view field,
-                                      std::string_view text) {
-  std::vector<std::string_view> result;
+// "(x,y,z) (x,y,z) ..." as the texts between the parentheses; nothing for "none" (the entry of a
+// non-spatial axis).
+std::vector<std::optional<std::string_view>> vectors(const fs::path& path, std::string_view field,
+                                                     std::string_view text) {
+  std::vector<std::optional<std::string_view>> result;
   std::string_view rest = trim(text);
   while (!rest.empty()) {
-    if (rest.starts_with("none"))
-      fail(path, concat(field, ": 'none' (a non-spatial axis) is not supported"));
+    if (rest.starts_with("none")) {
+      result.push_back(std::nullopt);
+      rest = trim(rest.substr(4));
+      continue;
+    }
     const size_t close = rest.find(')');
     if (rest.front() != '(' || close == std::string_view::npos)
       fail(path, concat(field, ": '", printable(text), "' is not a list of (x,y,z) vectors"));
@@ -133,31 +140,97 @@ glm::dvec3 to_lps(const NrrdHeader& header) {
   fail(header.path, concat("space '", *space, "' is not a 3D space strata knows"));
 }
 
-void set_geometry(Volume& volume, const NrrdHeader& header) {
+// The axes "dimension" and "sizes" give: three of a 3-D image; a 2-D image is one slice; a 4-D
+// image's fourth axis counts frames.
+struct Extent {
+  int rank = 3;
+  std::array<int64_t, 3> dims{1, 1, 1};
+  int64_t frames = 1;
+};
+
+// A 4-D image is read a frame at a time only when its frames are stored one after the other: the
+// non-spatial axis ("none" in space directions, a kind other than domain or space) must be last.
+void check_frames_last(const NrrdHeader& header) {
+  const auto kinds = header.get("kinds");
+  if (!kinds) return;
+  std::istringstream words{std::string(*kinds)};
+  std::string kind;
+  for (int axis = 0; axis < 3 && words >> kind; ++axis)
+    if (const std::string k = lowercase(kind);
+        k != "domain" && k != "space" && k != "???" && k != "none")
+      fail(header.path, concat("kinds: axis ", axis, " is '", kind,
+                               "': strata reads 4-D images whose fourth axis is the non-spatial "
+                               "one (time)"));
+}
+
+Extent image_extent(const NrrdHeader& header) {
+  const fs::path& path = header.path;
+  const std::string_view dimension = trim(header.require("dimension"));
+  Extent e;
+  if (dimension == "2" || dimension == "3" || dimension == "4") {
+    e.rank = dimension[0] - '0';
+  } else {
+    fail(path, concat("dimension = ", dimension, ": expected 2, 3 or 4 (a 2-D, 3-D or 4-D image)"));
+  }
+  const std::string_view text = header.require("sizes");
+  const auto sizes = parse_numbers<int64_t>(path, "sizes", text);
+  if (sizes.size() != size_t(e.rank))
+    fail(path, concat("sizes: expected ", e.rank, " numbers (dimension ", e.rank, "), got '",
+                      printable(trim(text)), "'"));
+  for (size_t axis = 0; axis < std::min<size_t>(3, sizes.size()); ++axis)
+    e.dims[axis] = sizes[axis];
+  if (e.rank == 4) {
+    e.frames = sizes[3];
+    if (e.frames < 1)
+      fail(path, concat("sizes: axis 3 has ", e.frames, " frames: must be positive"));
+    check_frames_last(header);
+  }
+  return e;
+}
+
+void set_direction(Volume& volume, const NrrdHeader& header, int rank, std::string_view text) {
   const fs::path& path = header.path;
   const glm::dvec3 signs = to_lps(header);
+  const auto axes = vectors(path, "space directions", text);
+  if (axes.size() != size_t(rank))
+    fail(path, concat("space directions: expected ", rank, " entries (dimension ", rank, "), got ",
+                      axes.size()));
+  for (int axis = 0; axis < std::min(rank, 3); ++axis) {
+    if (!axes[size_t(axis)])
+      fail(path, concat("space directions: axis ", axis,
+                        " is 'none': strata reads 4-D images whose fourth axis is the non-spatial "
+                        "one (time)"));
+    const glm::dvec3 v = signs * vector3(path, "space directions", *axes[size_t(axis)]);
+    const double length = glm::length(v);
+    if (!(length > 0.0) || !std::isfinite(length))
+      fail(path,
+           concat("space directions: axis ", axis, " has zero length: spacing must be positive"));
+    volume.spacing[axis] = static_cast<float>(length);
+    volume.direction[axis] = glm::vec3(v / length);
+  }
+  if (rank == 4 && axes[3])
+    fail(path, "space directions: axis 3 is a vector: a 4-D image's fourth axis must be 'none'");
+  if (rank == 2)  // one slice: k is its normal
+    volume.direction[2] = glm::normalize(glm::cross(volume.direction[0], volume.direction[1]));
+}
+
+void set_geometry(Volume& volume, const NrrdHeader& header, int rank) {
+  const fs::path& path = header.path;
   if (const auto text = header.get("space directions")) {
-    const auto axes = vectors(path, "space directions", *text);
-    if (axes.size() != 3)
-      fail(path, concat("space directions: expected 3 vectors, got ", axes.size()));
-    for (int axis = 0; axis < 3; ++axis) {
-      const glm::dvec3 v = signs * vector3(path, "space directions", axes[size_t(axis)]);
-      const double length = glm::length(v);
-      if (!(length > 0.0) || !std::isfinite(length))
-        fail(path,
-             concat("space directions: axis ", axis, " has zero length: spacing must be positive"));
-      volume.spacing[axis] = static_cast<float>(length);
-      volume.direction[axis] = glm::vec3(v / length);
-    }
+    set_direction(volume, header, rank, *text);
   } else if (const auto spacings = header.get("spacings")) {
-    const auto s = parse_exactly<double, 3>(path, "spacings", *spacings);
-    check_spacing(path, "spacings", s);
-    volume.spacing = glm::vec3(glm::dvec3(s[0], s[1], s[2]));
+    const auto s = parse_numbers<double>(path, "spacings", *spacings);
+    if (s.size() != size_t(rank))
+      fail(path, concat("spacings: expected ", rank, " numbers (dimension ", rank, "), got '",
+                        printable(trim(*spacings)), "'"));
+    const std::array<double, 3> spatial{s[0], s[1], rank > 2 ? s[2] : 1.0};
+    check_spacing(path, "spacings", spatial);
+    volume.spacing = glm::vec3(glm::dvec3(spatial[0], spatial[1], spatial[2]));
   }
   if (const auto text = header.get("space origin")) {
     const auto origin = vectors(path, "space origin", *text);
-    if (origin.size() != 1) fail(path, "space origin: expected one (x,y,z) vector");
-    volume.origin = glm::vec3(signs * vector3(path, "space origin", origin[0]));
+    if (origin.size() != 1 || !origin[0]) fail(path, "space origin: expected one (x,y,z) vector");
+    volume.origin = glm::vec3(to_lps(header) * vector3(path, "space origin", *origin[0]));
   }
 }
 
@@ -210,36 +283,39 @@ InputFile::Source data_source(const NrrdHeader& header, bool gzip) {
 
 }  // namespace
 
-Volume load_nrrd(const std::filesystem::path& path) {
+Volume load_nrrd(const std::filesystem::path& path, const VolumeReadOptions& options,
+                 std::vector<std::string>& warnings) {
   existing_file_size(path);
   const NrrdHeader header = parse_header(path);
-  if (trim(header.require("dimension")) != "3")
-    fail(path,
-         concat("dimension = ", header.require("dimension"), ": only 3D volumes are supported"));
+  const Extent extent = image_extent(header);
   const StoredType stored = element_type(header);
-  const auto dims = parse_exactly<int64_t, 3>(path, "sizes", header.require("sizes"));
-  const size_t bytes = checked_voxel_bytes(path, "sizes", dims, stored_size(stored));
+  const size_t bytes = checked_voxel_bytes(path, "sizes", extent.dims, stored_size(stored));
+  uint64_t all_frames_bytes = 0;
+  if (__builtin_mul_overflow(uint64_t{bytes}, uint64_t(extent.frames), &all_frames_bytes))
+    fail(path, "sizes: voxel count overflows");
+  const uint64_t frame = choose_frame(path, uint64_t(extent.frames), options, warnings);
   const bool gzip = is_gzip_encoding(header);
 
   Volume volume;
   volume.name = volume_name(path);
   volume.source = path;
-  volume.dims = to_dims(dims);
-  set_geometry(volume, header);
+  volume.dims = to_dims(extent.dims);
+  set_geometry(volume, header, extent.rank);
 
   InputFile::Source source = data_source(header, gzip);
   const int64_t byte_skip = skip_field(header, "byte skip");
   if (byte_skip < -1 || (byte_skip == -1 && gzip))
     fail(path, concat("byte skip = ", byte_skip, ": expected >= 0 (or -1 for raw data)"));
-  if (byte_skip == -1) {  // the data is the last `bytes` of the file
+  if (byte_skip == -1) {  // the data (every frame) is at the end of the file
     const uint64_t size = fs::file_size(source.file);
-    source.offset = size >= bytes ? size - bytes : 0;
+    source.offset = size >= all_frames_bytes ? size - all_frames_bytes : 0;
   } else if (!gzip) {
     source.offset += static_cast<uint64_t>(byte_skip);
   }
   InputFile in(std::move(source));
   if (gzip && !in.skip(static_cast<uint64_t>(byte_skip)))
     fail(path, concat("byte skip = ", byte_skip, ": past the end of the data"));
+  skip_frames(in, frame, bytes);
   read_voxels(in, bytes, volume);
   finish_voxels(volume,
                 {.stored = stored, .big_endian = is_big_endian(header), .per_slice = {Rescale{}}});

@@ -15,9 +15,12 @@
 #include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
 #include "engine/scene/atlas.h"
+#include "engine/scene/fitted_camera.h"
+#include "engine/scene/io/label_file_loader.h"
 #include "engine/scene/io/mesh_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
 #include "engine/scene/io/volume_loader.h"
+#include "engine/scene/transfer_function_presets.h"
 
 namespace strata {
 
@@ -164,15 +167,21 @@ int SceneReader::transfer_function(const json& value, const Field& field) {
 
 // Every field is checked before the (slow) file is read, so a typo is reported at once.
 void SceneReader::volume(const json& object, const Field& field) {
-  check_keys(object, field, {"name", "file", "transfer_function", "transform"});
+  check_keys(object, field, {"name", "file", "frame", "transfer_function", "transform"});
   const std::filesystem::path path = resolve(required(object, field, "file"), field / "file");
+  VolumeReadOptions options;
+  if (const json* frame = optional(object, "frame")) {
+    options.frame = integer(*frame, field / "frame");
+    if (*options.frame < 0) (field / "frame").fail("expected an integer >= 0");
+  }
   const json* name = optional(object, "name");
   const std::string volume_name = name ? string(*name, field / "name") : base_name(path);
   const json* transform = optional(object, "transform");
   const glm::mat4 placement = transform ? matrix(*transform, field / "transform") : glm::mat4(1.0f);
   const json* tf = optional(object, "transfer_function");
   const int tf_index = tf ? transfer_function(*tf, field / "transfer_function") : -1;
-  Volume volume = (field / "file").wrap([&] { return load_volume(path); });
+  Volume volume =
+      (field / "file").wrap([&] { return load_volume(path, options, scene_.warnings); });
   volume.name = volume_name;
   volume.transform = placement;
   volume.transfer_function = tf_index;
@@ -340,7 +349,10 @@ void SceneReader::camera(const json& object, const Field& field) {
   if (const json* f = optional(object, "far")) camera.far_plane = number(*f, field / "far");
   if (!(camera.near_plane > 0.0f)) (field / "near").fail("expected a number > 0");
   if (!(camera.far_plane > camera.near_plane)) (field / "far").fail("expected a number > near");
-  if (const auto view = view_matrix(object, field)) camera.view = *view;
+  if (const auto view = view_matrix(object, field)) {
+    camera.view = *view;
+    scene_.has_camera = true;
+  }
   const json* positions = optional(object, "positions");
   if (!positions) return;
   if (!positions->is_array()) (field / "positions").fail("expected an array");
@@ -410,7 +422,14 @@ Scene SceneReader::read(const json& root) {
   each(root, field, "volumes", [&](const json& v, const Field& f) { volume(v, f); });
   each(root, field, "meshes", [&](const json& v, const Field& f) { mesh(v, f); });
   each(root, field, "atlas", [&](const json& v, const Field& f) { atlas(v, f); });
-  each(root, field, "labels", [&](const json& v, const Field& f) { label(v, f); });
+  if (const json* labels = optional(root, "labels"); labels && labels->is_string()) {
+    const std::filesystem::path path = resolve(*labels, field / "labels");
+    for (Label& l :
+         (field / "labels").wrap([&] { return load_label_file(path, next_label_id(scene_)); }))
+      scene_.labels.push_back(std::move(l));
+  } else {
+    each(root, field, "labels", [&](const json& v, const Field& f) { label(v, f); });
+  }
   if (const json* c = optional(root, "camera")) camera(*c, field / "camera");
   if (const json* s = optional(root, "settings")) settings(*s, field / "settings");
   // Placement keys its state by label id; two labels with one id would silently share it.
@@ -439,12 +458,68 @@ Scene load_scene_json(const std::filesystem::path& path) {
   return SceneReader(path).read(root);
 }
 
-Scene load_scene(const std::filesystem::path& path) {
+Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& options) {
   const std::string extension = path.extension().string();
-  if (extension == ".json") return load_scene_json(path);
-  if (extension == ".xml") return import_voly_scene(path);
-  throw Error(path.string() + ": unknown scene format '" + extension +
-              "' (expected .json, or .xml from the thesis program)");
+  Scene scene;
+  if (extension == ".json") {
+    scene = load_scene_json(path);
+  } else if (extension == ".xml") {
+    scene = import_voly_scene(path);
+  } else if (is_volume_path(path)) {
+    scene = scene_from_volume(path, options);
+  } else {
+    std::error_code error;
+    if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
+    throw Error(path.string() + ": unknown scene format '" + extension +
+                "' (expected a scene: .json, or .xml from the thesis program; or a volume: " +
+                kVolumeExtensions + ")");
+  }
+  if (!options.labels.empty()) {
+    for (Label& l : load_label_file(options.labels, next_label_id(scene)))
+      scene.labels.push_back(std::move(l));
+  }
+  complete_scene(scene, options.preset);
+  return scene;
+}
+
+int next_label_id(const Scene& scene) {
+  int id = 0;
+  for (const Label& l : scene.labels) id = std::max(id, l.id + 1);
+  return id;
+}
+
+Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOptions& options) {
+  Scene scene;
+  scene.source = path;
+  VolumeReadOptions read;
+  read.frame = options.frame;
+  scene.volumes.push_back(load_volume(path, read, scene.warnings));
+  Volume& volume = scene.volumes.back();
+  if (volume.name.empty()) volume.name = base_name(path.lexically_normal());
+  return scene;
+}
+
+void complete_scene(Scene& scene, const std::string& preset) {
+  for (Volume& volume : scene.volumes) {
+    if (preset.empty() && volume.transfer_function >= 0) continue;
+    std::string name = preset;
+    if (name.empty()) {
+      const PresetChoice choice = choose_transfer_function_preset(volume);
+      name = choice.name;
+      scene.warnings.push_back("volume '" + volume.name + "' has no transfer function; preset " +
+                               name + " (" + choice.reason + "; --preset NAME to choose)");
+    }
+    scene.transfer_functions.push_back(make_transfer_function_preset(name, volume));
+    volume.transfer_function = int(scene.transfer_functions.size()) - 1;
+  }
+  if (scene.has_camera) return;
+  FittedCamera fitted = fitted_camera(scene);
+  scene.camera = fitted.camera;
+  for (CameraPose& pose : fitted.positions) {
+    const bool taken = std::any_of(scene.camera_positions.begin(), scene.camera_positions.end(),
+                                   [&](const CameraPose& p) { return p.name == pose.name; });
+    if (!taken) scene.camera_positions.push_back(std::move(pose));
+  }
 }
 
 }  // namespace strata

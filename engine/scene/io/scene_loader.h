@@ -5,13 +5,35 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
+#include <string>
 
 #include "engine/scene/scene.h"
 
 namespace strata {
 
-// .json (strata) or .xml (thesis import), by extension.
-Scene load_scene(const std::filesystem::path& path);
+// What the command line adds to a scene (--preset, --labels, --frame).
+struct SceneOpenOptions {
+  std::string preset;            // every volume's transfer function: this preset
+  std::filesystem::path labels;  // labels from this file (load_label_file) added
+  std::optional<int> frame;      // a 4-D volume opened directly: this frame
+};
+
+// A scene file, .json (strata) or .xml (thesis import), or a volume file or DICOM folder opened
+// as a scene of its own; then completed (complete_scene) with the options.
+Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& options = {});
+
+// A scene holding the one volume, named after the file, with no transfer function or camera.
+Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOptions& options = {});
+
+// What a scene needs to render that its file may not give: each volume without a transfer
+// function gets the preset that suits its data (transfer_function_presets.h) and a warning
+// saying which; `preset`, when given, replaces every volume's. A scene without a camera gets the
+// fitted one and the six anatomical views as named positions (fitted_camera.h).
+void complete_scene(Scene& scene, const std::string& preset = "");
+
+// One more than the highest label id (0 for none): where added labels' ids start.
+int next_label_id(const Scene& scene);
 
 // strata scene JSON, version 1. Paths in it are relative to the scene file's folder. Unknown keys
 // are errors (they are almost always typos), and so is a referenced file that does not load.

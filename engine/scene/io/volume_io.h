@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "engine/core/error.h"
+#include "engine/scene/io/volume_loader.h"
 #include "engine/scene/scene.h"
 
 namespace strata::volume_io {
@@ -122,6 +123,18 @@ std::string read_prefix(const std::filesystem::path& file, size_t max_bytes);
 
 // Throws "<path>: no such file" when it does not exist; returns its size when it is a file.
 uint64_t existing_file_size(const std::filesystem::path& file);
+
+// ---- 4-D images
+
+// The frame of an image with `frames` frames (1 for a 3-D one) that options ask for, 0 when they
+// do not: out of range is an error that names the range, and a 4-D image adds the warning that
+// says which frame is shown.
+uint64_t choose_frame(const std::filesystem::path& file, uint64_t frames,
+                      const VolumeReadOptions& options, std::vector<std::string>& warnings);
+
+// Skips the frames before `frame` (frames are stored one after the other, the fourth dimension
+// slowest); "<what> ends before frame N" when the data does.
+void skip_frames(InputFile& in, uint64_t frame, size_t frame_bytes);
 
 // ---- voxel conversion
 

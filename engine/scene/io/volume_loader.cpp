@@ -6,29 +6,80 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <system_error>
 
 #include <zlib.h>
 
+#include "engine/scene/io/dicom_structure.h"
 #include "engine/scene/io/volume_io.h"
 
 namespace strata {
+namespace {
 
-Volume load_volume(const std::filesystem::path& path) {
+enum class Format { none, dicom_folder, nifti, metaimage, nrrd, dicom_file };
+
+Format format_of(const std::filesystem::path& path) {
   namespace fs = std::filesystem;
   std::error_code error;
-  if (!fs::exists(path, error)) volume_io::fail(path, "no such file");
-  if (fs::is_directory(path, error)) return load_dicom_series(path);
-
+  if (fs::is_directory(path, error)) return Format::dicom_folder;
   const std::string name = volume_io::lowercase(path.filename().string());
   const auto ends_with = [&](std::string_view suffix) { return name.ends_with(suffix); };
-  if (ends_with(".nii") || ends_with(".nii.gz")) return load_nifti(path);
-  if (ends_with(".mhd") || ends_with(".mha")) return load_metaimage(path);
-  if (ends_with(".nrrd") || ends_with(".nhdr")) return load_nrrd(path);
+  if (ends_with(".nii") || ends_with(".nii.gz")) return Format::nifti;
+  if (ends_with(".mhd") || ends_with(".mha")) return Format::metaimage;
+  if (ends_with(".nrrd") || ends_with(".nhdr")) return Format::nrrd;
+  // Scanners and PACS exports often write DICOM files without an extension.
+  if (ends_with(".dcm") || ends_with(".dicom")) return Format::dicom_file;
+  if (fs::is_regular_file(path, error) && dicom::file_kind(path) == dicom::Kind::part10)
+    return Format::dicom_file;
+  return Format::none;
+}
+
+Volume read_by_extension(const std::filesystem::path& path, const VolumeReadOptions& options,
+                         std::vector<std::string>& warnings) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) volume_io::fail(path, "no such file");
+  switch (format_of(path)) {
+    case Format::dicom_folder:
+      return load_dicom_series(path, options, warnings);
+    case Format::nifti:
+      return load_nifti(path, options, warnings);
+    case Format::metaimage:
+      return load_metaimage(path, options, warnings);
+    case Format::nrrd:
+      return load_nrrd(path, options, warnings);
+    case Format::dicom_file:
+      return load_dicom_file(path, options, warnings);
+    case Format::none:
+      break;
+  }
   volume_io::fail(path, "unknown volume extension '" + path.extension().string() +
-                            "' (strata reads .nii, .nii.gz, .mhd, .mha, .nrrd, .nhdr and DICOM "
-                            "folders)");
+                            "' (strata reads " + kVolumeExtensions + ")");
+}
+
+}  // namespace
+
+bool is_volume_path(const std::filesystem::path& path) {
+  return format_of(path) != Format::none;
+}
+
+Volume load_volume(const std::filesystem::path& path, const VolumeReadOptions& options,
+                   std::vector<std::string>& warnings) {
+  Volume volume = read_by_extension(path, options, warnings);
+  if (volume.dims.z == 1)
+    warnings.push_back(volume_io::concat(path.string(), ": 2-D image (one slice of ", volume.dims.x,
+                                         "x", volume.dims.y, "); shown as a volume one voxel (",
+                                         volume.spacing.z, " mm) thick"));
+  return volume;
+}
+
+Volume load_volume(const std::filesystem::path& path) {
+  std::vector<std::string> warnings;
+  Volume volume = load_volume(path, {}, warnings);
+  for (const std::string& warning : warnings)
+    std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
+  return volume;
 }
 
 }  // namespace strata
@@ -236,6 +287,30 @@ uint64_t existing_file_size(const std::filesystem::path& file) {
   return std::filesystem::file_size(file, error);
 }
 
+uint64_t choose_frame(const std::filesystem::path& file, uint64_t frames,
+                      const VolumeReadOptions& options, std::vector<std::string>& warnings) {
+  const int64_t frame = options.frame.value_or(0);
+  if (frame < 0 || uint64_t(frame) >= frames)
+    fail(file, frames == 1 ? concat("frame ", frame, " is out of range: the image has one frame, 0")
+                           : concat("frame ", frame, " is out of range: the image has ", frames,
+                                    " frames, 0 to ", frames - 1));
+  if (frames > 1)
+    warnings.push_back(concat(file.string(), ": 4-D image with ", frames, " frames; showing frame ",
+                              frame, " (choose with --frame)"));
+  return uint64_t(frame);
+}
+
+void skip_frames(InputFile& in, uint64_t frame, size_t frame_bytes) {
+  if (frame == 0) return;
+  uint64_t bytes = 0;
+  if (__builtin_mul_overflow(frame, uint64_t{frame_bytes}, &bytes) || !in.skip(bytes) ||
+      in.max_remaining() == 0) {
+    const InputFile::Source& source = in.source();
+    fail(source.report_as,
+         concat(source.what, " ends before frame ", frame, " (", frame_bytes, " bytes a frame)"));
+  }
+}
+
 // ---- voxel conversion
 
 void swap_bytes(std::span<std::byte> data, size_t element_size) {
@@ -421,7 +496,7 @@ std::string volume_name(const std::filesystem::path& path) {
   if (name.empty()) name = path.parent_path().filename();  // "folder/"
   if (lowercase(name.extension().string()) == ".gz") name = name.stem();
   const std::string extension = lowercase(name.extension().string());
-  for (const char* known : {".nii", ".mhd", ".mha", ".nrrd", ".nhdr"})
+  for (const char* known : {".nii", ".mhd", ".mha", ".nrrd", ".nhdr", ".dcm", ".dicom"})
     if (extension == known) return name.stem().string();
   return name.string();
 }

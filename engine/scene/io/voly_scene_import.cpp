@@ -121,6 +121,7 @@ std::optional<fs::path> VolyImporter::find_file(const std::string& reference) co
 void VolyImporter::camera(const Node& px) {
   Camera& camera = scene_.camera;
   camera.view = px.child("viewMatrix").matrix();
+  scene_.has_camera = true;
   const Node projection_node = px.child("projectionMatrix");
   const glm::mat4 p = projection_node.matrix();
   // An OpenGL perspective matrix: P[1][1] = 1 / tan(fov_y / 2), r2c2 = -(f + n) / (f - n),

@@ -1,0 +1,20 @@
+// Labels from other tools' files: 3D Slicer's markups JSON (.mrk.json), Slicer's older fiducial
+// list (.fcsv) and strata's plain CSV (.csv). docs/scene-format.md, "Labels from other tools",
+// describes what each format must hold and what is skipped.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "engine/scene/scene.h"
+
+namespace strata {
+
+// Labels from another tool's file, by extension: 3D Slicer markups (.mrk.json), Slicer's older
+// fiducial list (.fcsv) and plain CSV (.csv). Anchors are returned in strata's world space, DICOM's
+// LPS (x towards the patient's left, y posterior, z superior): RAS points get x and y negated.
+// Ids are first_id, first_id + 1, ... in file order. Errors: one strata::Error "<file>: <field or
+// line>: <reason>".
+std::vector<Label> load_label_file(const std::filesystem::path& path, int first_id = 0);
+
+}  // namespace strata

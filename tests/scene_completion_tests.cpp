@@ -1,0 +1,161 @@
+// What a scene gets that its file does not give: the fitted camera and anatomical views, and
+// transfer-function presets; and volumes and label files opened as scenes.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+
+#include "engine/scene/fitted_camera.h"
+#include "engine/scene/io/scene_loader.h"
+#include "engine/scene/scene_bounds.h"
+#include "engine/scene/transfer_function_presets.h"
+#include "test_files.h"
+
+namespace fs = std::filesystem;
+using strata::test::error_of;
+using strata::test::write_file;
+
+namespace {
+
+const fs::path cache = STRATA_DATA_CACHE;
+
+fs::path output_folder(const std::string& name) {
+  return strata::test::fresh_folder("scene_completion_tests", name);
+}
+
+const strata::CameraPose* position(const strata::Scene& scene, const std::string& name) {
+  for (const strata::CameraPose& p : scene.camera_positions) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+// A small int16 volume of Hounsfield-like values: air around a block of soft tissue.
+strata::Volume ct_block() {
+  strata::Volume v;
+  v.name = "block";
+  v.type = strata::VoxelType::int16;
+  v.dims = {8, 8, 8};
+  v.spacing = {2.0f, 2.0f, 2.0f};
+  std::vector<int16_t> values(v.voxel_count(), -1000);
+  for (uint32_t k = 2; k < 6; ++k)
+    for (uint32_t j = 2; j < 6; ++j)
+      for (uint32_t i = 2; i < 6; ++i) values[(k * 8 + j) * 8 + i] = 40;
+  values[0] = 1200;
+  v.voxels.resize(values.size() * 2);
+  std::memcpy(v.voxels.data(), values.data(), v.voxels.size());
+  v.value_range = {-1000.0f, 1200.0f};
+  return v;
+}
+
+}  // namespace
+
+TEST_SUITE("loaders") {
+  TEST_CASE("fitted_views_hold_the_content_and_look_from_the_patients_sides") {
+    strata::Scene scene;
+    scene.volumes.push_back(ct_block());
+    scene.volumes[0].origin = {-100.0f, 20.0f, 5.0f};
+    const strata::FittedCamera fitted = strata::fitted_camera(scene);
+    REQUIRE(fitted.positions.size() == 6);
+    const strata::Bounds bounds = strata::scene_bounds(scene);
+    const glm::vec3 centre = bounds.centre();
+    for (const strata::CameraPose& pose : fitted.positions) {
+      INFO(pose.name);
+      strata::Camera camera = fitted.camera;
+      camera.view = pose.view;
+      // Every corner of the box projects inside a square image, and not far inside (fitted).
+      float widest = 0.0f;
+      for (int c = 0; c < 8; ++c) {
+        const glm::vec3 p((c & 1) ? bounds.hi.x : bounds.lo.x, (c & 2) ? bounds.hi.y : bounds.lo.y,
+                          (c & 4) ? bounds.hi.z : bounds.lo.z);
+        const strata::ProjectedPoint projected = strata::project(camera, p, {100, 100});
+        CHECK(projected.visible);
+        widest = std::max(widest, glm::length(projected.pixel - glm::vec2(50.0f)));
+      }
+      CHECK(widest > 40.0f);
+      // The eye is on the named side of the centre (LPS: anterior is -y, left +x, superior +z).
+      const glm::vec3 eye = camera.eye() - centre;
+      const auto view = strata::anatomical_view_named(pose.name);
+      REQUIRE(view);
+      const glm::vec3 side(strata::side_of(*view).eye_direction);
+      CHECK(glm::dot(glm::normalize(eye), side) > 0.999f);
+    }
+    CHECK(fitted.camera.view == fitted.positions[0].view);  // anterior first
+    CHECK(fitted.positions[0].name == "anterior");
+  }
+
+  TEST_CASE("presets_follow_hounsfield_units_and_are_chosen_from_the_values") {
+    const strata::Volume ct = ct_block();
+    const strata::PresetChoice choice = strata::choose_transfer_function_preset(ct);
+    CHECK(choice.name == "ct-skin");
+    CHECK(choice.reason.find("Hounsfield") != std::string::npos);
+    const strata::TransferFunction bone = strata::make_transfer_function_preset("ct-bone", ct);
+    REQUIRE(bone.stops.size() >= 2);
+    CHECK(bone.stops.front().position == 0.0f);
+    CHECK(bone.stops.back().position == 1.0f);
+    CHECK(std::is_sorted(bone.stops.begin(), bone.stops.end(),
+                         [](const auto& a, const auto& b) { return a.position < b.position; }));
+    const auto at_hu = [&](const strata::TransferFunction& tf, float hu) {
+      return tf.sample((hu + 1000.0f) / 2200.0f);
+    };
+    CHECK(at_hu(bone, -1000.0f).a == 0.0f);  // air
+    CHECK(at_hu(bone, 40.0f).a == 0.0f);     // soft tissue: not bone
+    CHECK(at_hu(bone, 1000.0f).a > 0.3f);    // bone
+    const strata::TransferFunction skin = strata::make_transfer_function_preset("ct-skin", ct);
+    CHECK(at_hu(skin, -1000.0f).a == 0.0f);
+    CHECK(at_hu(skin, -100.0f).a > 0.05f);
+
+    strata::Volume mr = ct;
+    mr.value_range = {0.0f, 255.0f};
+    CHECK(strata::choose_transfer_function_preset(mr).name == "mr-head");
+    CHECK(error_of([&] { strata::make_transfer_function_preset("bone", ct); }) ==
+          "no transfer-function preset 'bone' (ct-skin, ct-soft-tissue, ct-bone, ct-lung, "
+          "mr-head, mr-brain)");
+  }
+
+  TEST_CASE("a_volume_opens_as_a_scene_with_a_preset_a_fitted_camera_and_named_views") {
+    const fs::path ch2 = cache / "mricron/ch2.nii.gz";
+    REQUIRE_MESSAGE(fs::exists(ch2), "run scripts/fetch-data.sh");
+    const strata::Scene scene = strata::load_scene(ch2);
+    REQUIRE(scene.volumes.size() == 1);
+    CHECK(scene.volumes[0].name == "ch2");
+    REQUIRE(scene.volumes[0].transfer_function == 0);
+    CHECK(scene.transfer_functions[0].name == "mr-head");
+    REQUIRE(scene.warnings.size() == 1);
+    CHECK(scene.warnings[0] ==
+          "volume 'ch2' has no transfer function; preset mr-head (values 0 to 254: not Hounsfield "
+          "units, taken as MR; --preset NAME to choose)");
+    CHECK_FALSE(scene.has_camera);
+    for (const char* name : strata::kAnatomicalViewNames) CHECK(position(scene, name));
+    // From the front: the eye in front of the face (LPS: anterior is -y).
+    CHECK(scene.camera.eye().y < strata::scene_bounds(scene).lo.y);
+
+    strata::SceneOpenOptions options;
+    options.preset = "mr-brain";
+    options.labels = STRATA_TEST_DATA "/labels/landmarks_ras.csv";
+    const strata::Scene chosen = strata::load_scene(ch2, options);
+    CHECK(chosen.warnings.empty());  // a preset given is no surprise
+    CHECK(chosen.transfer_functions[0].name == "mr-brain");
+    REQUIRE(chosen.labels.size() == 3);
+    CHECK(chosen.labels[0].text == "Ventricule latéral");
+  }
+
+  TEST_CASE("a_scene_with_a_camera_keeps_it_and_its_labels_may_come_from_a_label_file") {
+    const fs::path folder = output_folder("label_file");
+    const fs::path scene_path =
+        write_file(folder / "s.json", R"({"strata_scene": 1, "labels": ")" STRATA_TEST_DATA
+                                      R"(/labels/landmarks_lps.fcsv",
+          "camera": {"eye": [0, -500, 0], "target": [0, 0, 0], "up": [0, 0, 1]}})");
+    const strata::Scene scene = strata::load_scene(scene_path);
+    CHECK(scene.has_camera);
+    CHECK(scene.camera_positions.empty());  // no fitted views added
+    REQUIRE(scene.labels.size() == 3);
+    CHECK(scene.labels[0].id == 0);
+    CHECK(scene.labels[2].id == 2);
+
+    const fs::path bad =
+        write_file(folder / "bad.json", R"({"strata_scene": 1, "labels": "missing.mrk.json"})");
+    CHECK(error_of([&] { strata::load_scene(bad); }).starts_with(bad.string() + ": labels: "));
+  }
+}
