@@ -130,14 +130,16 @@ float table_at(uint, int, int) {
 #include "placement_cost.h"
 
 void view_setup() {
+  // Every field the shared code may read is set: an unset one is undefined, and a GPU compiler
+  // may fold it into anything (NVIDIA did, for `hard` in candidate_allowed).
+  params.weights = CostWeightsGpu(0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f);
+  params.hard = 0u;
+  params.write_constraints = 0u;
   params.width = view.width;
   params.height = view.height;
   params.layer_count = view.layer_count;
   params.label_count = view.label_count;
   params.margin = view.margin;
-  params.weights.label_shadow = 0.0f;
-  params.weights.connector_shadow = 0.0f;
-  params.weights.anchor_constraint = 0.0f;
   view_position = view.order_count;
   if (view.label >= view.label_count) return;
   view_label = label_at(view.label);
