@@ -132,20 +132,8 @@ std::string describe(const Scene& scene, bool whole_scene) {
   return out;
 }
 
-bool is_volume_file(const fs::path& path) {
-  if (fs::is_directory(path)) return true;  // a DICOM series
-  const std::string name = path.filename().string();
-  for (const char* ending : {".nii", ".nii.gz", ".mha", ".mhd", ".nrrd", ".nhdr"}) {
-    const std::string e = ending;
-    if (name.size() > e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0) {
-      return true;
-    }
-  }
-  return false;
-}
-
 bool is_scene_file(const fs::path& path) {
-  return !is_volume_file(path) && !is_transfer_function_file(path) &&
+  return !is_volume_path(path) && !is_transfer_function_file(path) &&
          (path.extension() == ".json" || path.extension() == ".xml");
 }
 
@@ -155,8 +143,8 @@ Scene load_single_file(const fs::path& path) {
   if (!fs::exists(path, ec)) throw Error(path.string() + ": no such file");
   Scene scene;
   scene.source = path;
-  if (is_volume_file(path)) {
-    scene.volumes.push_back(load_volume(path));
+  if (is_volume_path(path)) {
+    scene.volumes.push_back(load_volume(path, {}, scene.warnings));
   } else if (is_transfer_function_file(path)) {
     scene.transfer_functions.push_back(load_transfer_function(path));
   } else {

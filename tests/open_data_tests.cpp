@@ -147,6 +147,24 @@ TEST_SUITE("cli") {
     CHECK(contains(bad.output, "no transfer-function preset 'bone' (ct-skin,"));
   }
 
+  TEST_CASE("a_4d_nifti_shows_its_first_frame_or_the_one_asked_for_and_says_so") {
+    const std::string image = out_path("4d.png");
+    const std::string file = kCache + "/nibabel/example4d.nii.gz";
+    const auto first = run_strata("render " + file + " --size 48 -o " + image);
+    INFO(first.output);
+    CHECK(first.exit_code == 0);
+    CHECK(contains(first.output, "4-D image with 2 frames; showing frame 0 (choose with --frame)"));
+    const auto second = run_strata("render " + file + " --frame 1 --size 48 -o " + image);
+    CHECK(second.exit_code == 0);
+    CHECK(contains(second.output, "showing frame 1"));
+    const auto past = run_strata("render " + file + " --frame 2 --size 48 -o " + image);
+    CHECK(past.exit_code != 0);
+    CHECK(contains(past.output, "frame 2 is out of range: the image has 2 frames, 0 to 1"));
+    const auto info = run_strata("info " + kCache + "/dicom/CT_small.dcm");
+    CHECK(info.exit_code == 0);
+    CHECK(contains(info.output, "128x128x1"));
+  }
+
   TEST_CASE("a_scene_without_camera_or_transfer_function_is_fitted_and_given_a_preset") {
     const std::filesystem::path scene = out_path("bare.json");
     test::write_file(scene, R"({"strata_scene": 1,

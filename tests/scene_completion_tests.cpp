@@ -83,6 +83,15 @@ TEST_SUITE("loaders") {
     }
     CHECK(fitted.camera.view == fitted.positions[0].view);  // anterior first
     CHECK(fitted.positions[0].name == "anterior");
+
+    // One axial slice is seen from above, not edge-on from the front.
+    strata::Scene slice;
+    slice.volumes.push_back(ct_block());
+    slice.volumes[0].dims.z = 1;
+    slice.volumes[0].voxels.resize(8 * 8 * 2);
+    const strata::FittedCamera flat = strata::fitted_camera(slice);
+    CHECK(flat.positions[4].name == "superior");
+    CHECK(flat.camera.view == flat.positions[4].view);
   }
 
   TEST_CASE("presets_follow_hounsfield_units_and_are_chosen_from_the_values") {

@@ -148,7 +148,8 @@ TEST_SUITE("loaders") {
     strata::Volume dice;
     dice.dims = {4, 3, 2};
     dice.voxels.assign(24, std::byte{7});
-    dice.value_range = {7.0f, 7.0f};
+    dice.voxels[5] = std::byte{9};
+    dice.value_range = {7.0f, 9.0f};
     fs::create_directories(folder / "datasets");
     strata::write_metaimage(folder / "datasets/dice.mha", dice);
     fs::create_directories(folder / "transferfunctions");

@@ -103,7 +103,15 @@ FittedCamera fitted_camera(const Scene& scene) {
   // Room to zoom in to the centre and out to four times the distance (the viewer's wheel).
   camera.near_plane = float(std::max(0.01 * nearest, 0.1 * (nearest - radius)));
   camera.far_plane = float(4.0 * farthest + radius);
-  camera.view = fitted.positions.front().view;
+  // From the front, unless the content is flat (a single slice): then facing it, whatever its
+  // orientation, since a slice seen edge-on shows nothing.
+  const glm::vec3 extent = bounds.hi - bounds.lo;
+  const float largest = std::max({extent.x, extent.y, extent.z});
+  AnatomicalView facing = AnatomicalView::anterior;
+  if (extent.z < 0.1f * largest) facing = AnatomicalView::superior;
+  if (extent.y < 0.1f * largest) facing = AnatomicalView::anterior;
+  if (extent.x < 0.1f * largest) facing = AnatomicalView::left;
+  camera.view = fitted.positions[static_cast<size_t>(facing)].view;
   return fitted;
 }
 

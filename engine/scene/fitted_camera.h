@@ -36,8 +36,9 @@ ViewSide side_of(AnatomicalView view);
 // square (fov_y of `lens` both ways, 5% margin); near and far from `lens`.
 glm::mat4 fitted_view(const Scene& scene, AnatomicalView view, float fov_y_degrees);
 
-// A lens and the anterior view for a scene without a camera, near and far planes holding the
-// content from all six views with room to zoom out; and the six views as named positions.
+// A lens and a view for a scene without a camera: anterior, or for flat content (one slice)
+// the view facing it; near and far planes holding the content from all six views with room to
+// zoom out; and the six views as named positions.
 struct FittedCamera {
   Camera camera;
   std::vector<CameraPose> positions;

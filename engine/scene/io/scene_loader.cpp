@@ -266,7 +266,8 @@ void SceneReader::atlas(const json& object, const Field& field) {
   const std::vector<AtlasRegion> regions = atlas_regions(object, field);
   const std::filesystem::path labels_path =
       resolve(required(object, field, "labels"), field / "labels");
-  const Volume labels = (field / "labels").wrap([&] { return load_volume(labels_path); });
+  const Volume labels =
+      (field / "labels").wrap([&] { return load_volume(labels_path, {}, scene_.warnings); });
   // atlas_labels skips regions without voxels, so its result says which regions "limit" counts.
   const std::vector<Label> centroids = atlas_labels(labels, regions);
   int kept = 0;
@@ -501,6 +502,11 @@ Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOption
 
 void complete_scene(Scene& scene, const std::string& preset) {
   for (Volume& volume : scene.volumes) {
+    if (!(volume.value_range.y > volume.value_range.x)) {
+      scene.warnings.push_back("volume '" + volume.name + "' holds the one value " +
+                               json(volume.value_range.x).dump() +
+                               " everywhere: no transfer function can show it");
+    }
     if (preset.empty() && volume.transfer_function >= 0) continue;
     std::string name = preset;
     if (name.empty()) {

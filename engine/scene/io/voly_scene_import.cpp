@@ -181,7 +181,7 @@ void VolyImporter::volume(const Node& px) {
   if (!path) return warn("volume '" + reference + "' not found; skipped");
   Volume volume;
   try {
-    volume = load_volume(*path);
+    volume = load_volume(*path, {}, scene_.warnings);
   } catch (const Error& e) {
     path_node.fail(e.what());
   }
