@@ -94,22 +94,10 @@ void check_unique_ids(const std::vector<LayoutLabel>& labels, const Field& field
   }
 }
 
-json parse_json(const std::filesystem::path& path) {
-  try {
-    return json::parse(read_text_file(path));
-  } catch (const json::parse_error& e) {
-    // nlohmann's message starts with "[json.exception.parse_error.101] "; the rest already says
-    // "parse error at line L, column C: ...".
-    const std::string what = e.what();
-    const size_t end = what.find("] ");
-    throw Error(path.string() + ": " + (end == std::string::npos ? what : what.substr(end + 2)));
-  }
-}
-
 }  // namespace
 
 Layout read_layout(const std::filesystem::path& path) {
-  const json root = parse_json(path);
+  const json root = read_json_file(path);
   const std::string file = path.string();
   const Field top{file, ""};
   if (!root.is_object()) top.fail("expected an object");

@@ -3,12 +3,14 @@
 #pragma once
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
+#include "engine/core/text_file.h"
 
 namespace strata {
 
@@ -61,6 +63,18 @@ inline std::vector<double> json_numbers(const nlohmann::json& value, const JsonF
     result.push_back(v.get<double>());
   }
   return result;
+}
+
+// The JSON document in `path`. A syntax error is one Error "<file>: parse error at line L,
+// column C: ..." (nlohmann's message without its "[json.exception.parse_error.101] " prefix).
+inline nlohmann::json read_json_file(const std::filesystem::path& path) {
+  try {
+    return nlohmann::json::parse(read_text_file(path));
+  } catch (const nlohmann::json::parse_error& e) {
+    const std::string what = e.what();
+    const size_t end = what.find("] ");
+    throw Error(path.string() + ": " + (end == std::string::npos ? what : what.substr(end + 2)));
+  }
 }
 
 }  // namespace strata

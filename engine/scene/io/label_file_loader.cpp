@@ -406,18 +406,6 @@ std::string string(const json& value, const Field& field) {
   return value.get<std::string>();
 }
 
-json parse_json(const fs::path& path) {
-  try {
-    return json::parse(read_text_file(path));
-  } catch (const json::parse_error& e) {
-    // nlohmann's message starts with "[json.exception.parse_error.101] "; the rest already says
-    // "parse error at line L, column C: ...".
-    const std::string what = e.what();
-    const size_t end = what.find("] ");
-    throw Error(path.string() + ": " + (end == std::string::npos ? what : what.substr(end + 2)));
-  }
-}
-
 // Slicer reads every schema version 1.x.y: control points kept their shape since 1.0.0.
 void check_schema(const json& root, const Field& field) {
   if (!root.is_object() || !root.contains("@schema"))
@@ -504,7 +492,7 @@ void read_markup(const json& markup, const Field& field, const std::string& file
 
 std::vector<Label> read_markups(const fs::path& path) {
   const std::string file = path.string();
-  const json root = parse_json(path);
+  const json root = read_json_file(path);
   const Field field{file, ""};
   check_schema(root, field);
   const json& markups = required(root, field, "markups");

@@ -446,17 +446,7 @@ Scene SceneReader::read(const json& root) {
 }  // namespace
 
 Scene load_scene_json(const std::filesystem::path& path) {
-  json root;
-  try {
-    root = json::parse(read_text_file(path));
-  } catch (const json::parse_error& e) {
-    // nlohmann's message starts with "[json.exception.parse_error.101] "; the rest already says
-    // "parse error at line L, column C: ...".
-    const std::string what = e.what();
-    const size_t end = what.find("] ");
-    throw Error(path.string() + ": " + (end == std::string::npos ? what : what.substr(end + 2)));
-  }
-  return SceneReader(path).read(root);
+  return SceneReader(path).read(read_json_file(path));
 }
 
 Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& options) {

@@ -9,6 +9,7 @@
 #include <pugixml.hpp>
 
 #include "engine/core/error.h"
+#include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
 
 namespace strata {
@@ -28,14 +29,6 @@ std::string child(const std::string& field, const std::string& key) {
 
 std::string element(const std::string& field, size_t index) {
   return field + "[" + std::to_string(index) + "]";
-}
-
-// nlohmann's message starts with "[json.exception.parse_error.101] "; the rest already says
-// "parse error at line L, column C: ...".
-std::string without_exception_id(const std::string& what) {
-  const size_t end = what.find("] ");
-  return what.rfind("[json.exception.", 0) == 0 && end != std::string::npos ? what.substr(end + 2)
-                                                                            : what;
 }
 
 float unit_number(const json& value, const std::string& file, const std::string& field) {
@@ -166,12 +159,7 @@ nlohmann::ordered_json transfer_function_to_json(const TransferFunction& tf) {
 
 TransferFunction load_transfer_function_json(const std::filesystem::path& path) {
   const std::string file = path.string();
-  json object;
-  try {
-    object = json::parse(read_text_file(path));
-  } catch (const json::parse_error& e) {
-    fail(file, "", without_exception_id(e.what()));
-  }
+  const json object = read_json_file(path);
   if (!object.is_object() || !object.contains("strata_transfer_function")) {
     fail(file, "", "not a strata transfer function (no \"strata_transfer_function\": 1)");
   }
