@@ -335,7 +335,7 @@ TEST_SUITE("cli") {
     CHECK(file.exit_code == 1);
     CHECK(file.output.find("/nonexistent-dir/out.png: cannot write PNG") != std::string::npos);
     const auto usage = run_strata("frobnicate");
-    CHECK(usage.exit_code != 0);
+    CHECK(usage.exit_code == 2);
   }
 }
 

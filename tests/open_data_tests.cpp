@@ -213,6 +213,22 @@ TEST_SUITE("cli") {
     CHECK(contains(missing.output, "none.nii.gz: no such file"));
   }
 
+  TEST_CASE("usage_errors_exit_2_and_a_write_that_fails_is_an_error") {
+    const auto usage = run_strata("render --bogus");
+    CHECK(usage.exit_code == 2);
+    CHECK(
+        contains(usage.output, "strata: error: The following argument was not expected: --bogus"));
+    const auto range = run_strata("render --layers 9");
+    CHECK(range.exit_code == 2);
+    CHECK(contains(range.output, "strata: error: --layers"));
+    CHECK(run_strata("--help").exit_code == 0);
+    // A full disk: the write is checked, not reported as done.
+    const auto full = run_strata("render --size 16 -o /dev/full");
+    CHECK(full.exit_code == 1);
+    CHECK(contains(full.output, "/dev/full: cannot write PNG: No space left on device"));
+    CHECK_FALSE(contains(full.output, "wrote /dev/full"));
+  }
+
   TEST_CASE("dump_layers_leaves_the_labelled_image_as_it_is") {
     const std::string head = STRATA_SOURCE_DIR "/assets/scenes/head.json";
     const std::string plain = out_path("plain.png"), dumped = out_path("dumped.png");

@@ -134,6 +134,15 @@ TEST_SUITE("loaders") {
     CHECK(error_of([&] { strata::load_transfer_function(out_of_range); }) ==
           out_of_range.string() + ": stopData[0]: position is '1.5', expected a number in [0, 1]");
 
+    // NaN compares false with both bounds; it is no position (it overran the table when sampled).
+    const fs::path nan = write_file(
+        "nan.gra", std::string(gradient_head) +
+                       "<stopData position=\"0\"><colorData r=\"1\" g=\"2\" b=\"3\" a=\"4\"/>"
+                       "</stopData><stopData position=\"nan\"><colorData r=\"1\" g=\"2\" "
+                       "b=\"3\" a=\"nan\"/></stopData></gradientData>");
+    CHECK(error_of([&] { strata::load_transfer_function(nan); }) ==
+          nan.string() + ": stopData[1]: position is 'nan', expected a number in [0, 1]");
+
     const fs::path channel = write_file(
         "channel.gra", std::string(gradient_head) +
                            "<stopData position=\"0\"><colorData r=\"256\" g=\"2\" b=\"3\" a=\"4\"/>"

@@ -161,9 +161,12 @@ void write_image(const std::filesystem::path& path, uint32_t width, uint32_t hei
     for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = rgba[p * 4 + c];
   }
   constexpr int kQuality = 92;
-  if (!stbi_write_jpg(path.c_str(), int(width), int(height), 3, rgb.data(), kQuality)) {
-    throw Error(path.string() + ": cannot write JPEG (does the folder exist and is it writable?)");
+  std::vector<uint8_t> encoded;
+  if (!stbi_write_jpg_to_func(append_encoded, &encoded, int(width), int(height), 3, rgb.data(),
+                              kQuality)) {
+    throw Error(path.string() + ": cannot encode JPEG");
   }
+  write_file_checked(path.string(), encoded, "JPEG");
 }
 
 namespace {

@@ -7,6 +7,12 @@
 
 namespace strata {
 
+// Writes `bytes` to the file, checking every write and the close (a full disk is an error);
+// throws Error "<file>: cannot write <what>: <reason>".
+void write_file_checked(const std::string& path, std::span<const uint8_t> bytes, const char* what);
+// stb's write callback: appends to the std::vector<uint8_t> at `bytes`.
+void append_encoded(void* bytes, void* data, int size);
+
 // Writes tightly packed rgba8 pixels; throws Error naming the file when it cannot.
 void write_png(const std::string& path, uint32_t width, uint32_t height,
                std::span<const uint8_t> rgba);

@@ -75,7 +75,8 @@ float gra_channel(const pugi::xml_node& color, const char* name, const std::stri
   const pugi::xml_attribute attribute = color.attribute(name);
   if (!attribute) fail(file, field, std::string("missing attribute '") + name + "'");
   double value = -1.0;
-  if (!parse_double(attribute.value(), value) || value < 0.0 || value > 255.0) {
+  // (written so that NaN, which compares false with everything, fails too)
+  if (!parse_double(attribute.value(), value) || !(value >= 0.0 && value <= 255.0)) {
     fail(file, field,
          std::string("attribute '") + name + "' is '" + attribute.value() +
              "', expected a number 0..255");
@@ -89,7 +90,7 @@ TransferFunction::Stop gra_stop(const pugi::xml_node& node, const std::string& f
   const pugi::xml_attribute position = node.attribute("position");
   if (!position) fail(file, field, "missing attribute 'position'");
   double value = 0.0;
-  if (!parse_double(position.value(), value) || value < 0.0 || value > 1.0) {
+  if (!parse_double(position.value(), value) || !(value >= 0.0 && value <= 1.0)) {
     fail(file, field,
          std::string("position is '") + position.value() + "', expected a number in [0, 1]");
   }
