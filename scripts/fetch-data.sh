@@ -6,7 +6,8 @@
 # Idempotent: files already in place and verified are kept.
 #   mricron-data:   ch2.nii.gz (Colin27 T1 head MRI), aal.nii.gz + aal.nii.txt (116 AAL regions)
 #   python3-pydicom: its DICOM test series dicomdirtests/98892001/CT5N (5 CT slices) and
-#                    CT_small.dcm (one 128x128 CT slice)
+#                    CT_small.dcm (one 128x128 CT slice), MR_small.dcm and MR_small_implicit.dcm
+#                    (one MR slice, explicit and implicit VR little endian)
 #   python3-nibabel: philips_mprage.dcm (an enhanced multi-frame MR: 176 frames of 256x256 in one
 #                    file; its pixels are zeros) and example4d.nii.gz (4-D NIfTI, 2 frames)
 set -euo pipefail
@@ -29,6 +30,8 @@ files+=(
   "python3-pydicom $ct5n/3023 dicom/CT5N/3023 4f7f4f2b3c79acdd5e0fc23fdd9f6bae6e6da9dccfadd1f9147b7bff53756653"
   "python3-pydicom $ct5n/3353 dicom/CT5N/3353 5eaa662118b8d87601a14231893cb7ecf1737a434c95120cfb4076cfce667b18"
   "python3-pydicom $pydicom/CT_small.dcm dicom/CT_small.dcm 3dd31e5cc835b3f2cdd46c9da1982f59251e78518fefa8163d914631c66437d6"
+  "python3-pydicom $pydicom/MR_small.dcm dicom/MR_small.dcm 3f27d1c22f1a66e80d7bb7c911e8610fd0bb70325a76746a7adb1c0ddefcf2bb"
+  "python3-pydicom $pydicom/MR_small_implicit.dcm dicom/MR_small_implicit.dcm 6077442c42a56fc7fcc7db8411a657dded9fc109e6d3275765c4de358292b299"
 )
 nibabel=usr/lib/python3/dist-packages/nibabel
 files+=(

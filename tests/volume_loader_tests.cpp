@@ -638,6 +638,30 @@ TEST_SUITE("loaders") {
     CHECK(strata::load_volume(folder).dims == glm::uvec3(16, 16, 5));
   }
 
+  // The default transfer syntax (implicit VR little endian) and zero padding after the last
+  // element, which scanners and pydicom write: the structure check must let them through.
+  TEST_CASE("dicom_implicit_vr_and_zero_padded_files_open_like_their_explicit_twins") {
+    const fs::path explicit_file = cache / "dicom/MR_small.dcm";
+    const fs::path implicit_file = cache / "dicom/MR_small_implicit.dcm";
+    REQUIRE_MESSAGE(fs::exists(implicit_file), "run scripts/fetch-data.sh");
+    std::vector<std::string> warnings;
+    const Volume e = strata::load_volume(explicit_file, {}, warnings);
+    const Volume i = strata::load_volume(implicit_file, {}, warnings);
+    CHECK(i.dims == glm::uvec3(64, 64, 1));
+    CHECK(i.dims == e.dims);
+    CHECK(i.voxels == e.voxels);
+    CHECK(i.index_to_patient() == e.index_to_patient());
+
+    const fs::path padded = output_folder("dicom_padded") / "padded.dcm";
+    write_file(padded, strata::test::read_file(explicit_file) + std::string(64, '\0'));
+    CHECK(strata::load_volume(padded, {}, warnings).voxels == e.voxels);
+    // Padding that is not all zero is still an error.
+    write_file(padded, strata::test::read_file(explicit_file) + std::string(8, '\0') + "x");
+    CHECK(strata::test::error_of([&] {
+            strata::load_volume(padded, {}, warnings);
+          }).find("DICOM file is") != std::string::npos);
+  }
+
   TEST_CASE("dicom_bad_series_give_one_error_naming_the_folder_or_file") {
     const fs::path same = copy_ct5n("dicom_same_position", {"2062", "2392"});
     fs::copy_file(ct5n / "2062", same / "2062-copy");

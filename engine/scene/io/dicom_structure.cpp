@@ -1,5 +1,6 @@
 #include "engine/scene/io/dicom_structure.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <fstream>
 #include <set>
@@ -46,8 +47,10 @@ class StructureCheck {
     uint64_t pos = 132;
     std::string transfer_syntax;
     while (pos < size_) {
+      // The group first: the data set after the meta group may be implicit VR, whose header
+      // must not be read by the meta group's explicit-VR rules.
+      if (number(read_bytes(pos, 2), 0, 2, false) != 0x0002) break;
       const Header h = header_at(pos, meta);
-      if (h.group != 0x0002) break;
       const uint64_t next = value_end(h, size_);
       if (h.element == 0x0010) transfer_syntax = read_bytes(h.value_start, size_t(h.length));
       pos = next;
@@ -102,6 +105,20 @@ class StructureCheck {
     return bytes;
   }
 
+  // Whether [pos, end) holds only zero bytes (read in blocks; false at the first other byte).
+  bool zeros_from(uint64_t pos, uint64_t end) {
+    if (number(read_bytes(pos, std::min<uint64_t>(4, end - pos)), 0,
+               size_t(std::min<uint64_t>(4, end - pos)), false) != 0) {
+      return false;
+    }
+    constexpr uint64_t kBlock = 1 << 16;
+    for (uint64_t at = pos; at < end; at += kBlock) {
+      const std::string block = read_bytes(at, size_t(std::min(kBlock, end - at)));
+      if (block.find_first_not_of('\0') != std::string::npos) return false;
+    }
+    return true;
+  }
+
   uint32_t number(const std::string& bytes, size_t at, size_t n, bool big_endian) const {
     uint32_t value = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -143,6 +160,8 @@ class StructureCheck {
   uint64_t walk(uint64_t pos, uint64_t end, Syntax s, int depth, bool until_item_end) {
     if (depth > 32) fail(file_, "DICOM file is malformed: sequences nested too deeply");
     while (pos < end) {
+      // Zero bytes after the last element (some writers pad files) end the data set.
+      if (depth == 0 && zeros_from(pos, end)) return end;
       const Header h = header_at(pos, s);
       if (h.group == 0xfffe) {
         if (until_item_end && h.is(0xfffe, 0xe00d)) return h.value_start;
