@@ -370,6 +370,23 @@ TEST_SUITE("loaders") {
               "connector_direction, previous_position, leader_crossing, illegible)");
     CHECK(load(R"({"strata_scene": 1, "settings": {"layers": 0}})") ==
           prefix + "settings.layers: expected an integer >= 1");
+    // Numbers that would wrap or turn infinite, and matrices that flatten the scene.
+    CHECK(load(R"({"strata_scene": 1, "labels": [{"id": 2147483648, "text": "a",
+                   "anchor": [0, 0, 0]}]})") ==
+          prefix +
+              "labels[0].id: expected an integer from -2147483648 to 2147483647, got "
+              "2147483648");
+    CHECK(load(R"({"strata_scene": 1, "labels": [{"id": -1099511627776, "text": "a",
+                   "anchor": [0, 0, 0]}]})")
+              .find("labels[0].id: expected an integer from") != std::string::npos);
+    CHECK(load(R"({"strata_scene": 1, "camera": {"far": 1e39}})") ==
+          prefix + "camera.far: expected a number of at most 3.4e38");
+    CHECK(load(R"({"strata_scene": 1, "labels": [{"id": 1, "text": "a",
+                   "anchor": [1e39, 0, 0]}]})") ==
+          prefix + "labels[0].anchor: expected numbers of at most 3.4e38");
+    CHECK(load(R"({"strata_scene": 1, "camera": {"view": [0, 0, 0, 0, 0, 0, 0, 0,
+                   0, 0, 0, 0, 0, 0, 0, 0]}})") ==
+          prefix + "camera.view: the matrix is singular (determinant 0.0)");
     CHECK(load(R"({"strata_scene": 1, "atlas": [{"make": ["meshes"]}]})") ==
           prefix + "atlas[0].make[0]: 'meshes' is not one of labels, masks, surfaces");
     const fs::path missing = folder / "missing.json";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -42,6 +43,8 @@ void check_keys(const json& object, const Field& field, std::initializer_list<co
 
 float number(const json& value, const Field& field) {
   if (!value.is_number() || !std::isfinite(value.get<double>())) field.fail("expected a number");
+  // (1e39 is a finite double but no float)
+  if (!std::isfinite(value.get<float>())) field.fail("expected a number of at most 3.4e38");
   return value.get<float>();
 }
 
@@ -53,6 +56,11 @@ float non_negative(const json& value, const Field& field) {
 
 int integer(const json& value, const Field& field) {
   if (!value.is_number_integer()) field.fail("expected an integer");
+  const bool fits = value.is_number_unsigned()
+                        ? value.get<uint64_t>() <= uint64_t(std::numeric_limits<int>::max())
+                        : value.get<int64_t>() >= std::numeric_limits<int>::min() &&
+                              value.get<int64_t>() <= std::numeric_limits<int>::max();
+  if (!fits) field.fail("expected an integer from -2147483648 to 2147483647, got " + value.dump());
   return value.get<int>();
 }
 
@@ -63,6 +71,9 @@ std::string string(const json& value, const Field& field) {
 
 std::vector<float> numbers(const json& value, const Field& field, size_t count) {
   const std::vector<double> read = json_numbers(value, field, count);
+  for (double d : read) {
+    if (!std::isfinite(float(d))) field.fail("expected numbers of at most 3.4e38");
+  }
   return {read.begin(), read.end()};
 }
 
@@ -86,6 +97,10 @@ glm::mat4 matrix(const json& value, const Field& field) {
   for (int row = 0; row < 4; ++row) {
     for (int col = 0; col < 4; ++col) m[col][row] = v[size_t(row * 4 + col)];
   }
+  // A transform or view of zeros (or of infinities) would give a black picture without a word.
+  const float determinant = glm::determinant(m);
+  if (!std::isfinite(determinant) || std::abs(determinant) < 1e-12f)
+    field.fail("the matrix is singular (determinant " + json(determinant).dump() + ")");
   return m;
 }
 
