@@ -27,8 +27,7 @@ struct SceneInput {
   std::string labels;   // --labels: a label file (.mrk.json, .fcsv, .csv) added
   int frame = -1;       // --frame: a 4-D volume's frame (-1: the first, with a warning)
   uint32_t layers = 0;  // --layers: 0 keeps the scene's settings.layers
-  // The depth layers asked for: --layers, else the scene's (an Error naming the limit when the
-  // scene's is above kMaxLayers).
+  // The depth layers asked for: --layers, else the scene's.
   uint32_t layer_count(const Scene& scene) const;
 };
 // --preset, --labels, --frame and --layers (the positional FILE is the command's own).

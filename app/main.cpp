@@ -8,7 +8,6 @@
 #include "engine/core/error.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/transfer_function_presets.h"
-#include "shaders/shared/volume_render.h"
 
 namespace strata::app {
 
@@ -40,13 +39,7 @@ Scene load_scene_reporting(const std::string& path) {
 }
 
 uint32_t SceneInput::layer_count(const Scene& scene) const {
-  if (layers > 0) return layers;
-  if (scene.settings.layer_count < 1 || scene.settings.layer_count > VR_MAX_LAYERS) {
-    throw Error(scene.source.string() +
-                ": settings: layers: " + std::to_string(scene.settings.layer_count) +
-                " is not 1 to " + std::to_string(VR_MAX_LAYERS));
-  }
-  return uint32_t(scene.settings.layer_count);
+  return layers > 0 ? layers : uint32_t(scene.settings.layer_count);  // (the loader checked it)
 }
 
 void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
@@ -62,9 +55,9 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
   cmd->add_option("--frame", in.frame, "a 4-D volume's frame, from 0 (default: the first)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--layers", in.layers,
-                  "depth layers, 1 to " + std::to_string(VR_MAX_LAYERS) +
+                  "depth layers, 1 to " + std::to_string(kMaxLayers) +
                       " (default: the scene's settings.layers, else 4)")
-      ->check(CLI::Range(1u, uint32_t(VR_MAX_LAYERS)));
+      ->check(CLI::Range(1u, uint32_t(kMaxLayers)));
 }
 
 std::string find_data_file(const std::string& relative) {

@@ -1,8 +1,6 @@
 #include <cstdio>
 #include <filesystem>
 
-#include <glm/gtc/packing.hpp>
-
 #include "app/commands.h"
 #include "app/progress.h"
 #include "engine/core/image.h"
@@ -40,17 +38,6 @@ struct RenderOptions {
 // --dump-graph: the frame's compiled graph (passes, their uses and barriers) on stdout.
 void print_graph(const RenderOptions& o, graph::GraphRunner& runner) {
   if (o.dump_graph) std::fputs(graph::describe(runner.graph(), runner.compiled()).c_str(), stdout);
-}
-
-// The layers' premultiplied rgba16f, as floats.
-std::vector<glm::vec4> layer_pixels(graph::GraphRunner& runner, graph::ResourceId layers) {
-  const std::vector<std::byte> bytes = runner.download_image(layers);
-  const auto* half = reinterpret_cast<const uint16_t*>(bytes.data());
-  std::vector<glm::vec4> out(bytes.size() / 8);
-  for (size_t i = 0; i < out.size(); ++i) {
-    for (int ch = 0; ch < 4; ++ch) out[i][ch] = glm::unpackHalf1x16(half[i * 4 + ch]);
-  }
-  return out;
 }
 
 // Layer images (premultiplied) written as straight-alpha PNGs.
@@ -226,7 +213,8 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
         still.image.c_str(), size.width, size.height, settings.layer_count, stats.fragments,
         stats.load_factor(), double(stats.samples) / (double(size.width) * size.height));
     if (!still.layers.empty()) {
-      dump_layers(layer_pixels(runner, out.layers), size, settings.layer_count, still.layers);
+      dump_layers(download_layer_images(runner, out.layers), size, settings.layer_count,
+                  still.layers);
     }
   }
 }

@@ -350,15 +350,19 @@ void LabelledRenderer::run(const std::function<void(uint32_t done, uint32_t tota
 }
 
 // The layer images of the last frame (rgba16f, layer after layer), waited for.
-std::vector<glm::vec4> LabelledRenderer::download_layers() const {
-  const std::vector<std::byte> bytes = runner_->download_image(layers_id_);
-  std::vector<glm::vec4> layers(bytes.size() / sizeof(uint64_t));
-  for (size_t i = 0; i < layers.size(); ++i) {
+std::vector<glm::vec4> download_layer_images(graph::GraphRunner& runner, graph::ResourceId layers) {
+  const std::vector<std::byte> bytes = runner.download_image(layers);
+  std::vector<glm::vec4> out(bytes.size() / sizeof(uint64_t));
+  for (size_t i = 0; i < out.size(); ++i) {
     uint64_t half4 = 0;
     std::memcpy(&half4, bytes.data() + i * sizeof(uint64_t), sizeof half4);
-    layers[i] = glm::unpackHalf4x16(half4);
+    out[i] = glm::unpackHalf4x16(half4);
   }
-  return layers;
+  return out;
+}
+
+std::vector<glm::vec4> LabelledRenderer::download_layers() const {
+  return download_layer_images(*runner_, layers_id_);
 }
 
 LabelledFrame LabelledRenderer::result(bool measure_visibility) const {

@@ -44,6 +44,9 @@ struct LabellingSettings {
   RenderSettings render;      // its layer_count and splits come from the layering
 };
 
+// A layer image array (rgba16f, premultiplied) read back after the frame: layer after layer.
+std::vector<glm::vec4> download_layer_images(graph::GraphRunner& runner, graph::ResourceId layers);
+
 // One label of the result, for --layout and for tests.
 struct LabelLayout {
   int id = 0;

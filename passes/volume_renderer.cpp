@@ -17,6 +17,8 @@ namespace strata {
 using graph::ResourceId;
 using graph::Use;
 
+static_assert(VR_MAX_LAYERS == kMaxLayers, "the scene side's layer limit is the renderer's");
+
 namespace {
 
 // Volumes live in one 3D atlas, stacked along z with replicated borders: one sampler, no

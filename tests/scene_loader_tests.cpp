@@ -369,7 +369,9 @@ TEST_SUITE("loaders") {
               "anchor_constraint, connector_shadow, integral_costs, distance_to_anchor, "
               "connector_direction, previous_position, leader_crossing, illegible)");
     CHECK(load(R"({"strata_scene": 1, "settings": {"layers": 0}})") ==
-          prefix + "settings.layers: expected an integer >= 1");
+          prefix + "settings.layers: expected an integer from 1 to 8");
+    CHECK(load(R"({"strata_scene": 1, "settings": {"layers": 9}})") ==
+          prefix + "settings.layers: expected an integer from 1 to 8");
     // Numbers that would wrap or turn infinite, and matrices that flatten the scene.
     CHECK(load(R"({"strata_scene": 1, "labels": [{"id": 2147483648, "text": "a",
                    "anchor": [0, 0, 0]}]})") ==

@@ -109,8 +109,12 @@ struct CostWeights {
   float illegible = 1000.0f;
 };
 
+// Depth layers a frame can have (VR_MAX_LAYERS in shaders/shared/volume_render.h, asserted equal
+// in passes/volume_renderer.cpp): the scene side checks settings against it without the shaders.
+inline constexpr int kMaxLayers = 8;
+
 struct SceneSettings {
-  int layer_count = 4;
+  int layer_count = 4;  // 1 to kMaxLayers
   CostWeights weights;
 };
 

@@ -389,7 +389,8 @@ void SceneReader::settings(const json& object, const Field& field) {
   check_keys(object, field, {"layers", "weights"});
   if (const json* layers = optional(object, "layers")) {
     scene_.settings.layer_count = integer(*layers, field / "layers");
-    if (scene_.settings.layer_count < 1) (field / "layers").fail("expected an integer >= 1");
+    if (scene_.settings.layer_count < 1 || scene_.settings.layer_count > kMaxLayers)
+      (field / "layers").fail("expected an integer from 1 to " + std::to_string(kMaxLayers));
   }
   const json* weights = optional(object, "weights");
   if (!weights) return;
