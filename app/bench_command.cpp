@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/soak_command.h"
 #include "app/viewer.h"
 #include "engine/gpu/resources.h"
 #include "engine/graph/graph_runner.h"
@@ -366,6 +367,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   ViewerOptions options;
   options.scene_path = o.scene;
   options.optimize_on_idle = false;
+  options.keep_frame_spans = true;
   Viewer viewer(ctx, scene, cameras.front(), settings, options, output, nullptr);
   for (int i = 0; i < 10; ++i) viewer.frame(1.0 / fps);  // warm up: the HA-Buffer grows
   // The path three times: with a timestamp around every pass (the time of each), with stamps only
@@ -497,6 +499,8 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
       ->capture_default_str();
   view_cmd->callback([&device, view] { bench_view(device, *view); });
+
+  add_soak_command(cmd, device);
 }
 
 }  // namespace strata::app

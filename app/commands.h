@@ -12,6 +12,13 @@
 
 namespace strata::app {
 
+// An option's value that cannot be used (--size 0, --fps 1000, --camera ','): like CLI11's own
+// parse errors, main prints it with the error prefix and exits 2, the usage-error code.
+class UsageError : public Error {
+ public:
+  using Error::Error;
+};
+
 // Options every subcommand that opens a device shares.
 struct DeviceOptions {
   std::string device;     // --device NAME|INDEX
@@ -36,6 +43,9 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in);
 // Loads the scene (load_scene with the input's options) and prints its warnings (missing data
 // files, a transfer-function preset chosen, ...) to stderr.
 Scene load_scene_reporting(const SceneInput& in);
+// The same, each volume checked against what the device can render (device_volume_limits) from
+// its header, before its voxels are read.
+Scene load_scene_reporting(const SceneInput& in, const Context& ctx);
 Scene load_scene_reporting(const std::string& path);
 
 // A file of strata's data (a demo scene): under the working folder if it is there, else beside
@@ -49,10 +59,10 @@ struct LabelLookOptions {
 };
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o);
 
-// "1024" or "1024x768"; throws Error naming the option when it is neither or a side is outside 1
-// to 16384 (the device's own limit is checked when it is open: check_image_size).
+// "1024" or "1024x768"; throws UsageError naming the option when it is neither or a side is outside
+// 1 to 16384 (the device's own limit is checked when it is open: check_image_size).
 graph::Extent parse_size(const std::string& text, const char* option);
-// An Error naming the option and the device's limit when `size` is over maxImageDimension2D.
+// A UsageError naming the option and the device's limit when `size` is over maxImageDimension2D.
 void check_image_size(const Context& ctx, graph::Extent size, const char* option);
 
 void add_devices_command(CLI::App& app, DeviceOptions& device);

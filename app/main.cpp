@@ -8,6 +8,7 @@
 #include "engine/core/error.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/transfer_function_presets.h"
+#include "passes/volume_renderer.h"
 
 namespace strata::app {
 
@@ -23,8 +24,11 @@ ContextOptions DeviceOptions::context() const {
   return options;
 }
 
-Scene load_scene_reporting(const SceneInput& in) {
+namespace {
+
+Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
   SceneOpenOptions options;
+  options.limits = limits;
   options.preset = in.preset;
   options.labels = in.labels;
   if (in.frame >= 0) options.frame = in.frame;
@@ -32,6 +36,16 @@ Scene load_scene_reporting(const SceneInput& in) {
   for (const std::string& warning : scene.warnings)
     std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
   return scene;
+}
+
+}  // namespace
+
+Scene load_scene_reporting(const SceneInput& in) {
+  return load_scene_reporting(in, VolumeLimits{});
+}
+
+Scene load_scene_reporting(const SceneInput& in, const Context& ctx) {
+  return load_scene_reporting(in, device_volume_limits(ctx));
 }
 
 Scene load_scene_reporting(const std::string& path) {
@@ -82,9 +96,9 @@ std::string find_data_file(const std::string& relative) {
 void check_image_size(const Context& ctx, graph::Extent size, const char* option) {
   const uint32_t limit = ctx.properties().limits.maxImageDimension2D;
   if (size.width > limit || size.height > limit) {
-    throw Error(std::string(option) + ": " + std::to_string(size.width) + "x" +
-                std::to_string(size.height) + " is larger than the device's " +
-                std::to_string(limit) + " pixels a side (maxImageDimension2D)");
+    throw UsageError(std::string(option) + ": " + std::to_string(size.width) + "x" +
+                     std::to_string(size.height) + " is larger than the device's " +
+                     std::to_string(limit) + " pixels a side (maxImageDimension2D)");
   }
 }
 
@@ -94,8 +108,7 @@ graph::Extent parse_size(const std::string& text, const char* option) {
   const int n = std::sscanf(text.c_str(), "%u%c%u%c", &w, &x, &h, &extra);
   if (n == 1) h = w;
   if ((n != 1 && !(n == 3 && x == 'x')) || w == 0 || h == 0 || w > 16384 || h > 16384) {
-    throw strata::Error(std::string(option) + ": '" + text +
-                        "' is not a size (N or WxH, 1 to 16384)");
+    throw UsageError(std::string(option) + ": '" + text + "' is not a size (N or WxH, 1 to 16384)");
   }
   return {w, h};
 }
@@ -133,6 +146,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // --help and --version end here too (exit code 0); anything else is a usage error: 2.
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+    std::fprintf(stderr, "strata: error: %s (see strata --help or strata COMMAND --help)\n",
+                 e.what());
+    return 2;
+  } catch (const UsageError& e) {
     std::fprintf(stderr, "strata: error: %s (see strata --help or strata COMMAND --help)\n",
                  e.what());
     return 2;

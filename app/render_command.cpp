@@ -92,7 +92,7 @@ std::vector<Still> stills(const Scene& scene, const RenderOptions& o) {
   std::vector<Still> out;
   for (size_t i = 0; i < names.size(); ++i) {
     if (names[i].empty()) {
-      throw Error("--camera '" + o.camera + "': part " + std::to_string(i + 1) + " is empty");
+      throw UsageError("--camera '" + o.camera + "': part " + std::to_string(i + 1) + " is empty");
     }
     std::string layers = o.dump_layers;
     while (layers.size() > 1 && layers.back() == '/') layers.pop_back();
@@ -164,11 +164,11 @@ void check_outputs(const std::vector<Still>& all) {
 // strata's main job: the labelled image (labeling/labelled_render.h), once per position.
 void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
-  const Scene scene = load_scene_reporting(o.scene);
-  const std::vector<Still> all = stills(scene, o);
-  check_outputs(all);
   Context ctx(device.context());
   check_image_size(ctx, size, "--size");
+  const Scene scene = load_scene_reporting(o.scene, ctx);
+  const std::vector<Still> all = stills(scene, o);
+  check_outputs(all);
   for (const Still& still : all) render_labelled_still(ctx, scene, o, size, still);
 }
 
@@ -189,11 +189,11 @@ RenderStats render_until_clean(VolumeRenderer& renderer, graph::GraphRunner& run
 // The label-free image; the renderer and its graph are built once and run for each position.
 void render_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
-  const Scene scene = load_scene_reporting(o.scene);
-  const std::vector<Still> all = stills(scene, o);
-  check_outputs(all);
   Context ctx(device.context());
   check_image_size(ctx, size, "--size");
+  const Scene scene = load_scene_reporting(o.scene, ctx);
+  const std::vector<Still> all = stills(scene, o);
+  check_outputs(all);
   const RenderSettings settings = render_settings(o, scene);
   VolumeRenderer renderer(ctx, scene, settings);
   HeadlessTarget target(ctx);

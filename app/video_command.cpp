@@ -39,9 +39,11 @@ struct VideoOptions {
 };
 
 CameraPath camera_path(const Scene& scene, const VideoOptions& o) {
-  if (!o.path.empty() && o.orbit != 0.0) throw Error("video: give --path or --orbit, not both");
+  if (!o.path.empty() && o.orbit != 0.0)
+    throw UsageError("video: give --path or --orbit, not both");
   if (!o.path.empty()) return parse_camera_path(scene, o.path);
-  if (o.orbit == 0.0) throw Error("video: give a camera path (--path) or a turntable (--orbit)");
+  if (o.orbit == 0.0)
+    throw UsageError("video: give a camera path (--path) or a turntable (--orbit)");
   const double seconds = o.seconds > 0.0 ? o.seconds : std::abs(o.orbit) / 30.0;
   return orbit_path(scene, camera_for(scene, o.camera), o.orbit, seconds);
 }
@@ -54,8 +56,9 @@ std::string frame_name(size_t frame, const char* extension) {
 
 void video(DeviceOptions& device, const VideoOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
-  if (!(o.fps > 0.0 && o.fps <= 240.0)) throw Error("--fps: expected 0 < fps <= 240");
-  const Scene scene = load_scene_reporting(o.scene);
+  if (!(o.fps > 0.0 && o.fps <= 240.0)) throw UsageError("--fps: expected 0 < fps <= 240");
+  Context ctx(device.context());
+  const Scene scene = load_scene_reporting(o.scene, ctx);
   const std::vector<Camera> cameras = sample(camera_path(scene, o), o.fps);
   const std::filesystem::path output = o.output;
   const bool mp4 = output.extension() == ".mp4";  // anything else names a folder
@@ -67,7 +70,6 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   }
   if (!o.layout_dir.empty()) std::filesystem::create_directories(o.layout_dir);
 
-  Context ctx(device.context());
   LabellingSettings settings;
   settings.layer_count = o.scene.layer_count(scene);
   settings.placement.weights = scene.settings.weights;

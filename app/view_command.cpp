@@ -308,16 +308,15 @@ void print_summary(const Viewer& viewer, const std::string& scene) {
 }
 
 void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size) {
-  Scene scene = load_scene_reporting(o.scene);
-  const Camera camera = camera_for(scene, o.camera);
-  std::optional<Script> script;
-  if (!o.script.empty()) script.emplace(o.script, read_script(o.script));
-
   Glfw glfw;
   ContextOptions context = device.context();
   context.instance_extensions = glfw.instance_extensions();
   context.presentation = true;
   Context ctx(context);
+  Scene scene = load_scene_reporting(o.scene, ctx);  // volumes checked against the device
+  const Camera camera = camera_for(scene, o.camera);
+  std::optional<Script> script;
+  if (!o.script.empty()) script.emplace(o.script, read_script(o.script));
   const std::string title = "strata - " + std::filesystem::path(o.scene.file).filename().string();
   Window window(size, o.size, title);
   float scale_x = 1.0f, scale_y = 1.0f;

@@ -13,6 +13,7 @@
 #include "engine/core/png.h"
 #include "engine/core/text_file.h"
 #include "engine/gpu/context.h"
+#include "engine/gpu/vulkan_check.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/transfer_function_presets.h"
 #include "labeling/camera_path.h"
@@ -202,8 +203,12 @@ Viewer::Viewer(Context& ctx, Scene& scene, const Camera& camera, const Labelling
 }
 
 Viewer::~Viewer() {
-  output_.wait_idle();
-  if (video_) stop_recording();
+  try {
+    output_.wait_idle();
+    if (video_) stop_recording();
+  } catch (const std::exception&) {
+    // (a lost or hung device, a full disk: the error that ended the run is being reported)
+  }
 }
 
 // The viewer's end of the frame's graph: the picture (or a debug view) copied into the display
@@ -565,7 +570,7 @@ void Viewer::read_slot(uint32_t slot) {
     gpu += t.ms;
   }
   ++summary_.timed_frames;
-  if (!last_timings_.empty()) {
+  if (options_.keep_frame_spans && !last_timings_.empty()) {
     summary_.gpu_span_ms.push_back(last_timings_.back().end_ms - last_timings_.front().begin_ms);
   }
   gpu_times_.push_back(float(gpu));
@@ -641,7 +646,23 @@ graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double 
   return labelled_->runner();
 }
 
+void Viewer::set_habuffer_slots(uint32_t slots) {
+  output_.wait_idle();
+  labelled_->renderer().set_table_size(slots);
+  labelled_->runner().reallocate();
+  changed();
+}
+
 void Viewer::frame(std::optional<double> step) {
+  try {
+    draw_frame(step);
+  } catch (const DeviceLost& lost) {
+    throw DeviceLost("during frame " + std::to_string(summary_.frames + 1) + " (" + lost.when() +
+                     ")");
+  }
+}
+
+void Viewer::draw_frame(std::optional<double> step) {
   const Clock::time_point now = Clock::now();
   double seconds = std::min(seconds_between(last_frame_, now), kMaxStep);
   if (video_) seconds = 1.0 / options_.record_fps;

@@ -52,6 +52,8 @@ class HeadlessOutput : public ViewerOutput {
   bool draw(const WindowTarget::Prepare& prepare) override;
   void wait_idle() override { slots_.wait_all(); }
   graph::Extent extent() const override { return size_; }
+  // The picture's size from the next frame on (a window resized; the viewer follows).
+  void resize(graph::Extent size) { size_ = size; }
   uint32_t frames_in_flight() const override { return slots_.count(); }
 
  private:
@@ -91,6 +93,9 @@ struct ViewerOptions {
   double record_fps = 30.0;
   float ui_scale = 1.0f;
   bool show_panel = true;
+  // ViewerSummary::gpu_span_ms gets every frame's span (for `bench view`'s quantiles); off, a
+  // viewer left running for hours keeps no per-frame list.
+  bool keep_frame_spans = false;
 };
 
 // Totals over a run, printed when the viewer closes and by `strata bench view`.
@@ -99,7 +104,7 @@ struct ViewerSummary {
   double busy_seconds = 0.0;             // wall-clock time spent in frames
   std::map<std::string, double> gpu_ms;  // per pass: summed over the frames read back
   uint64_t timed_frames = 0;             // frames whose timings were read
-  std::vector<double> gpu_span_ms;       // per frame read: first pass's start to last pass's end
+  std::vector<double> gpu_span_ms;  // per frame read (keep_frame_spans): first to last pass's end
   uint64_t trials = 0;                   // optimisation on idle: orders tried ...
   uint64_t adopted = 0;                  // ... and kept
 };
@@ -128,6 +133,7 @@ class Viewer {
   std::optional<double> wake_in() const;
   // One frame: UI, camera, labels, drawn and handed to the output. `seconds`: the time step
   // (default: the wall clock since the last frame, at most 0.1 s; a recording's 1 / fps).
+  // A lost device is a DeviceLost naming the frame; a wait past the GPU timeout a GpuTimeout.
   void frame(std::optional<double> seconds = {});
   bool quit_requested() const { return quit_; }
   void request_quit() { quit_ = true; }
@@ -166,6 +172,9 @@ class Viewer {
   const ViewerSummary& summary() const { return summary_; }
   // The renderer's counters of the last frame read back.
   const RenderStats& render_stats() const { return labelled_->stats(); }
+  // The HA-Buffer's slots from the next frame on (it grows from there when fragments overflow;
+  // tests and `strata bench soak --habuffer-slots`). Waits for the frames in flight.
+  void set_habuffer_slots(uint32_t slots);
   bool settled() const { return settled_; }
   // The picture's size now.
   graph::Extent extent() const { return output_.extent(); }
@@ -196,6 +205,7 @@ class Viewer {
   void settings_changed(bool reproject);
   void extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds& ids);
   void read_latest();
+  void draw_frame(std::optional<double> seconds);
   std::vector<uint8_t> download(graph::ResourceId image);
 
   Context& ctx_;

@@ -54,6 +54,7 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
       previous_(ctx, "label_previous.comp"),
       tables_(ctx),
       readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu)) {
+  static_assert(LABEL_MAX == kMaxLabels, "the scene side's label limit is the placement's");
   if (label_count > LABEL_MAX) {
     throw Error("placement: " + std::to_string(label_count) + " labels; strata places at most " +
                 std::to_string(LABEL_MAX));

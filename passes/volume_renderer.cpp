@@ -92,7 +92,29 @@ VkDeviceSize at_least(VkDeviceSize bytes) {
 
 }  // namespace
 
-RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d) {
+VolumeLimits device_volume_limits(const Context& ctx) {
+  VkPhysicalDeviceMaintenance3Properties maintenance{
+      .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
+  VkPhysicalDeviceProperties2 properties{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2,
+                                         .pNext = &maintenance};
+  vkGetPhysicalDeviceProperties2(ctx.physical_device(), &properties);
+  VkPhysicalDeviceMemoryProperties memory{};
+  vkGetPhysicalDeviceMemoryProperties(ctx.physical_device(), &memory);
+  VkDeviceSize largest_heap = 0;
+  for (uint32_t i = 0; i < memory.memoryHeapCount; ++i)
+    if (memory.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      largest_heap = std::max(largest_heap, memory.memoryHeaps[i].size);
+  const uint64_t bytes = std::min<uint64_t>(maintenance.maxMemoryAllocationSize, largest_heap);
+  constexpr uint32_t voxel_bytes = 4 * sizeof(int16_t);  // kAtlasFormat
+  const uint32_t side = properties.properties.limits.maxImageDimension3D;
+  return {.max_side = side > 2 * VR_ATLAS_BORDER ? side - 2 * VR_ATLAS_BORDER : 0,
+          .max_device_voxels = bytes / voxel_bytes,
+          .device_voxel_bytes = voxel_bytes,
+          .device = properties.properties.deviceName};
+}
+
+RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d,
+                                   uint64_t max_bytes) {
   if (scene.volumes.size() > VR_MAX_VOLUMES) {
     throw Error(scene.source.string() + ": " + std::to_string(scene.volumes.size()) +
                 " volumes; strata renders at most " + std::to_string(VR_MAX_VOLUMES));
@@ -120,6 +142,13 @@ RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimens
                 std::to_string(dims.y) + "x" + std::to_string(dims.z) +
                 " atlas; this device allows " + std::to_string(max_image_dimension_3d) +
                 " per side");
+  }
+  const uint64_t atlas_bytes = 4 * sizeof(int16_t) * uint64_t(dims.x) * dims.y * dims.z;
+  if (atlas_bytes > max_bytes) {
+    throw Error(scene.source.string() + ": the volumes need a " + std::to_string(dims.x) + "x" +
+                std::to_string(dims.y) + "x" + std::to_string(dims.z) + " atlas of " +
+                std::to_string(atlas_bytes >> 20) + " MiB; this device takes at most " +
+                std::to_string(max_bytes >> 20) + " MiB in one allocation");
   }
   in.atlas_dims = dims;
   in.atlas.assign(4 * size_t(dims.x) * dims.y * dims.z, 0);
@@ -300,7 +329,11 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
     : ctx_(ctx),
       settings_(std::move(settings)),
       camera_(camera_for(scene, "")),
-      inputs_(prepare_render_inputs(scene, ctx.properties().limits.maxImageDimension3D)),
+      inputs_([&] {
+        const VolumeLimits limits = device_volume_limits(ctx);
+        return prepare_render_inputs(scene, ctx.properties().limits.maxImageDimension3D,
+                                     limits.max_device_voxels * limits.device_voxel_bytes);
+      }()),
       counters_readback_(ctx, VR_COUNTER_COUNT * sizeof(uint32_t)),
       build_(ctx, "habuffer_build.vert", "habuffer_build.frag", {}),
       resolve_(ctx, "habuffer_resolve.comp") {
@@ -472,11 +505,14 @@ RenderStats VolumeRenderer::collect(graph::GraphRunner& runner) {
   stats.samples = c[VR_COUNTER_SAMPLES];
   stats.shaded = c[VR_COUNTER_SHADED];
   stats.fetches = c[VR_COUNTER_FETCHES];
-  stats.table_size = slots_for(runner.viewport());
-  if (stats.overflow > 0 || stats.fragments > 0.75 * stats.table_size) {
+  const uint32_t now = slots_for(runner.viewport());
+  stats.table_size = now;
+  // Counters of a frame made with a smaller table (in flight when the table last grew) say
+  // nothing about the table now: growing again for them doubled the table twice.
+  const bool current = c[VR_COUNTER_TABLE_SIZE] >= now;
+  if (current && (stats.overflow > 0 || stats.fragments > 0.75 * now)) {
     const double needed = (double(stats.fragments) + stats.overflow) / settings_.load_factor;
-    forced_slots_ =
-        static_cast<uint32_t>(std::min(std::max(needed, 2.0 * stats.table_size), 4.0e9));
+    forced_slots_ = static_cast<uint32_t>(std::min(std::max(needed, 2.0 * now), 4.0e9));
     runner.reallocate();
   }
   return stats;

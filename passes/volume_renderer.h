@@ -13,6 +13,7 @@
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/readback.h"
 #include "engine/graph/render_graph.h"
+#include "engine/scene/io/volume_loader.h"
 #include "engine/scene/scene.h"
 #include "shared/volume_render.h"
 
@@ -69,7 +70,15 @@ struct RenderInputs {
   void update_transfer();
 };
 
-RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d);
+// What the renderer can place on this device, as limits for reading volumes (load_scene checks
+// each volume's header against them before reading a voxel): the atlas's side and its size in
+// one allocation (VolumeLimits::device_voxel_bytes a voxel).
+VolumeLimits device_volume_limits(const Context& ctx);
+
+// The atlas, transfer table, occupancy and mesh arrays of a scene; an Error naming the limit when
+// the atlas has a side over max_image_dimension_3d or more than max_bytes.
+RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d,
+                                   uint64_t max_bytes = UINT64_MAX);
 
 // The transfer table as the resolve reads it: each entry's alpha corrected for samples `step`
 // world units apart (corrected_alpha with the volume's reference distance), once per frame.

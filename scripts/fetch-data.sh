@@ -10,6 +10,8 @@
 #                    (one MR slice, explicit and implicit VR little endian)
 #   python3-nibabel: philips_mprage.dcm (an enhanced multi-frame MR: 176 frames of 256x256 in one
 #                    file; its pixels are zeros) and example4d.nii.gz (4-D NIfTI, 2 frames)
+#   assimp-testmodels: invalid/OutOfMemory.off (309 bytes whose header claims 3.5 million vertices:
+#                    Assimp runs for minutes and takes gigabytes; the parser limits' test)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cache=assets/cache
@@ -37,6 +39,9 @@ nibabel=usr/lib/python3/dist-packages/nibabel
 files+=(
   "python3-nibabel $nibabel/nicom/tests/data/philips_mprage.dcm.gz dicom/philips_mprage.dcm 00058b3a5141b839493c21393c317e1cfe12ca912be8edf2f856ad3ea69fb6e3"
   "python3-nibabel $nibabel/tests/data/example4d.nii.gz nibabel/example4d.nii.gz 42097dfbab9d2a036b41ae5c97a359591cf2cf5c3f8dc6ca6455c0b8a7f22696"
+)
+files+=(
+  "assimp-testmodels usr/share/assimp/models/invalid/OutOfMemory.off assimp/OutOfMemory.off 4e337750dcd6b28e6c68392126a93d5756ef0f0d4f7d69c3c1c6ec413aefef7d"
 )
 
 verified() { [[ -f $1 ]] && echo "$2  $1" | sha256sum --check --status; }

@@ -21,6 +21,8 @@ packages=(
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
   # window tests without a display
   xvfb xauth xdotool
+  # fuzzing (scripts/fuzz.sh): clang and its runtime libraries, libFuzzer among them
+  clang libclang-rt-14-dev
 )
 
 cd "$(dirname "$0")/.."

@@ -73,6 +73,9 @@ void main() {
   const uint samples = subgroupAdd(inside ? r.samples : 0u);
   const uint shaded = subgroupAdd(inside ? r.shaded : 0u);
   const uint fetches = subgroupAdd(inside ? r.fetches : 0u);
+  // With frames in flight the counters read back are a frame or two old: they say which table
+  // they were counted in, so a table already grown is not grown again for the same overflow.
+  if (gl_GlobalInvocationID.xy == uvec2(0)) counters[VR_COUNTER_TABLE_SIZE] = frame.table_size;
   if (subgroupElect()) {
     atomicAdd(counters[VR_COUNTER_FRAGMENTS], found);
     if (lost > 0u) atomicAdd(counters[VR_COUNTER_RESOLVE_OVERFLOW], lost);

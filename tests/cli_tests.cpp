@@ -154,10 +154,10 @@ TEST_SUITE("cli") {
   TEST_CASE("video_with_two_paths_or_none_is_one_clear_error") {
     const auto both = run_strata("video " STRATA_SOURCE_DIR
                                  "/assets/scenes/head.json --orbit 10 --path front -o x.mp4");
-    CHECK(both.exit_code == 1);
+    CHECK(both.exit_code == 2);
     CHECK(both.output.find("give --path or --orbit, not both") != std::string::npos);
     const auto none = run_strata("video " STRATA_SOURCE_DIR "/assets/scenes/head.json -o x.mp4");
-    CHECK(none.exit_code == 1);
+    CHECK(none.exit_code == 2);
     CHECK(none.output.find("give a camera path") != std::string::npos);
   }
 
@@ -329,7 +329,7 @@ TEST_SUITE("cli") {
 
   TEST_CASE("bad_sizes_and_unwritable_outputs_are_errors_naming_the_culprit") {
     const auto size = run_strata("render --size 0x10 -o /dev/null");
-    CHECK(size.exit_code == 1);
+    CHECK(size.exit_code == 2);
     CHECK(size.output.find("--size: '0x10' is not a size") != std::string::npos);
     const auto file = run_strata("render --size 8 -o /nonexistent-dir/out.png");
     CHECK(file.exit_code == 1);

@@ -286,4 +286,29 @@ TEST_SUITE("loaders") {
               "markups[0].controlPoints[0].positionStatus: 'placed' is not one of defined, "
               "preview, undefined, missing");
   }
+
+  // Found with fuzz_markups_json (a 60 KB "@schema" string): std::regex matched it by recursion,
+  // a stack frame per character, and overflowed the stack instead of loading or failing.
+  TEST_CASE("label_file_mrk_json_reads_a_schema_of_any_length_without_overflowing_the_stack") {
+    const fs::path folder = test_folder("mrk_json_long_schema");
+    const auto load = [&](const std::string& schema) {
+      const fs::path path = write_file(
+          folder / "m.mrk.json",
+          R"({"@schema": ")" + schema +
+              R"(", "markups": [{"type": "Fiducial", "controlPoints": [{"position": [1, 2, 3]}]}]})");
+      return error_of([&] { strata::load_label_file(path); });
+    };
+    const std::string long_prefix(1 << 20, 'a');
+    CHECK(load(long_prefix + "/markups-schema-v1.10.22.json##") == "(no error)");
+    const std::string refused = load(long_prefix);
+    CHECK(refused.find("@schema: 'aaaa") != std::string::npos);
+    CHECK(
+        refused.ends_with("is not a Slicer markups schema this strata reads "
+                          "(markups-schema-v1.x.y.json)"));
+    CHECK(load("markups-schema-v1.0.3.json") == "(no error)");
+    CHECK(load("markups-schema-v1.0.json") != "(no error)");
+    CHECK(load("markups-schema-v1..3.json") != "(no error)");
+    CHECK(load("markups-schema-v1.0.3.jsonx") != "(no error)");
+    CHECK(load("markups-schema-v11.0.3.json") != "(no error)");
+  }
 }

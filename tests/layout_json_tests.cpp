@@ -1,6 +1,8 @@
 // `strata render --layout`'s file: valid JSON whatever the label texts hold, numbers as placed.
 #include <doctest/doctest.h>
 
+#include <limits>
+
 #include <nlohmann/json.hpp>
 
 #include "labeling/labelled_render.h"
@@ -55,6 +57,23 @@ TEST_SUITE("cpu") {
     CHECK(as_float(l["cost"]) == label.cost);
     CHECK(layout["labels"][1]["text"] == "");
     CHECK(layout["labels"][1]["shown"] == false);
+  }
+
+  TEST_CASE("layout_json_writes_non_finite_numbers_as_null") {
+    // JSON has no inf or NaN: a label that was never placed must not make the file unreadable.
+    LabelledFrame frame;
+    frame.size = {64, 64};
+    LabelLayout label;
+    label.cost = std::numeric_limits<float>::infinity();
+    label.box_origin = {std::numeric_limits<float>::quiet_NaN(), 1.0f};
+    frame.labels = {label};
+    const std::string text = layout_json(frame);
+    CHECK(text.find("inf") == std::string::npos);
+    CHECK(text.find("nan") == std::string::npos);
+    const nlohmann::json layout = nlohmann::json::parse(text);
+    CHECK(layout["labels"][0]["cost"].is_null());
+    CHECK(layout["labels"][0]["box"][0].is_null());
+    CHECK(layout["labels"][0]["box"][1] == 1.0);
   }
 }
 

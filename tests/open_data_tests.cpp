@@ -3,6 +3,7 @@
 // must do what they say (scene settings, limits, output formats, --dump-layers, progress).
 #include <doctest/doctest.h>
 
+#include <cstring>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
@@ -222,6 +223,21 @@ TEST_SUITE("cli") {
     CHECK(range.exit_code == 2);
     CHECK(contains(range.output, "strata: error: --layers"));
     CHECK(run_strata("--help").exit_code == 0);
+    // Option values strata checks itself are usage errors too.
+    const std::string head = STRATA_SOURCE_DIR "/assets/scenes/head.json";
+    for (const std::string& args :
+         {std::string("render --size 0"),
+          "render " + head + " --size 16 --camera front,,left -o " + out_path("never.png"),
+          std::string("video --fps 1000 --orbit 90"), std::string("video --size 16")}) {
+      const auto value = run_strata(args);
+      INFO(args, ": ", value.output);
+      CHECK(value.exit_code == 2);
+      CHECK(contains(value.output, "strata: error: "));
+    }
+    // Input errors: 1.
+    const auto input = run_strata("render /nonexistent/scene.json --size 16");
+    CHECK(input.exit_code == 1);
+    CHECK(contains(input.output, "strata: error: /nonexistent/scene.json: no such file"));
     // A full disk: the write is checked, not reported as done.
     const auto full = run_strata("render --size 16 -o /dev/full");
     CHECK(full.exit_code == 1);
@@ -258,6 +274,31 @@ TEST_SUITE("cli") {
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     CHECK(contains(r.output, "insertion order 8/8"));
+  }
+
+  TEST_CASE("a_volume_the_device_cannot_hold_is_refused_from_its_header") {
+    // NIfTI-1 headers alone (no voxels): the device's limits are checked before any is read.
+    const auto header = [](int16_t x, int16_t y, int16_t z) {
+      std::string h(352, '\0');
+      const auto put = [&](size_t at, auto v) { std::memcpy(h.data() + at, &v, sizeof v); };
+      put(0, int32_t{348}), put(40, int16_t{3}), put(42, x), put(44, y), put(46, z);
+      put(70, int16_t{2}), put(108, 352.0f);
+      for (size_t i = 0; i < 4; ++i) put(76 + 4 * i, 1.0f);
+      h.replace(344, 4, std::string("n+1\0", 4));
+      return h;
+    };
+    const std::string wide = out_path("wide.nii"), many = out_path("many.nii");
+    test::write_file(wide, header(30000, 2, 2));
+    test::write_file(many, header(2048, 2048, 1024));
+    const auto a = run_strata("render " + wide + " --size 32 -o " + out_path("wide.png"));
+    CHECK(a.exit_code == 1);
+    INFO(a.output);
+    CHECK(contains(a.output, "strata: error: " + wide + ": dim[1..3] = 30000x2x2: the device ("));
+    CHECK(contains(a.output, ") renders at most "));
+    const auto b = run_strata("render " + many + " --size 32 -o " + out_path("many.png"));
+    CHECK(b.exit_code == 1);
+    INFO(b.output);
+    CHECK((contains(b.output, "voxels; the device (") || contains(b.output, "of memory")));
   }
 }
 

@@ -499,4 +499,60 @@ TEST_SUITE("loaders") {
     CHECK(back.meshes[0].transform == scene.meshes[0].transform);
     CHECK(back.settings.weights.integral_costs == 3.5f);
   }
+
+  TEST_CASE("scenes_with_more_labels_than_placement_holds_are_refused_when_they_load") {
+    const fs::path folder = test_folder("label_limit");
+    std::string labels, csv = "label,l,p,s\n";
+    for (int i = 0; i < 257; ++i) {
+      labels += std::string(i ? "," : "") + "{\"id\": " + std::to_string(i) +
+                ", \"text\": \"L\", \"anchor\": [0, 0, 0]}";
+      csv += "L," + std::to_string(i) + ",0,0\n";
+    }
+    const fs::path scene =
+        write_file(folder / "many.json", "{\"strata_scene\": 1, \"labels\": [" + labels + "]}");
+    CHECK(strata::test::error_of([&] { strata::load_scene(scene); }) ==
+          scene.string() + ": 257 labels; strata places at most 256 in a scene");
+    // The same through a label file added on the command line.
+    const fs::path one = write_file(folder / "one.json", "{\"strata_scene\": 1}");
+    const fs::path file = write_file(folder / "many.csv", csv);
+    CHECK(strata::test::error_of([&] {
+            strata::load_scene(one, {.labels = file});
+          }).find("257 labels; strata places at most 256") != std::string::npos);
+  }
+
+  // Found beside the fuzz targets (their inputs, at most 64 KiB, nest too shallowly): the version's
+  // error message dumped the value, and nlohmann's dump() recurses once per level of nesting.
+  TEST_CASE("json_scene_with_a_deeply_nested_version_is_an_error_not_a_stack_overflow") {
+    const fs::path folder = test_folder("deep_version");
+    const size_t depth = 1'000'000;
+    const fs::path path =
+        write_file(folder / "s.json", R"({"strata_scene": )" + std::string(depth, '[') +
+                                          std::string(depth, ']') + "}");
+    CHECK(error_of([&] { strata::load_scene(path); }) ==
+          path.string() +
+              ": strata_scene: version [...] is not supported (this strata reads "
+              "version 1)");
+  }
+
+  // Found by fuzz_thesis_xml: a label id of 8.1e40 became inf as a float and its conversion to
+  // int was undefined (UBSan); 3e9 fits a float but not an int.
+  TEST_CASE("xml_import_refuses_numbers_beyond_float_and_ids_beyond_int") {
+    const fs::path folder = test_folder("xml_numbers");
+    const std::string dice = read_text(voly_scenes / "dice.xml");
+    const auto load = [&](const std::string& from, const std::string& to) {
+      std::string text = dice;
+      const size_t at = text.find(from);
+      REQUIRE(at != std::string::npos);
+      text.replace(at, from.size(), to);
+      const fs::path path = write_file(folder / "dice.xml", text);
+      return error_of([&] { strata::load_scene(path); });
+    };
+    CHECK(load("<label.id>8</label.id>", "<label.id>81e39</label.id>")
+              .ends_with("label.id: expected a number, got '81e39'"));
+    CHECK(load("<label.id>8</label.id>", "<label.id>3e9</label.id>")
+              .ends_with("label.id: expected an integer from -2147483648 to 2147483647"));
+    CHECK(load("<label.id>8</label.id>", "<label.id>-2147483648</label.id>") == "(no error)");
+    CHECK(load("<r0c0>-9.624520540e-01</r0c0>", "<r0c0>1e300</r0c0>")
+              .ends_with("r0c0: expected a number, got '1e300'"));
+  }
 }

@@ -201,4 +201,27 @@ TEST_SUITE("loaders") {
     CHECK(error_of([&] { strata::load_transfer_function(unknown); }) ==
           unknown.string() + ": unknown transfer-function format '.txt' (expected .json or .gra)");
   }
+
+  // Found by fuzz_transfer_function_json: nlohmann-json throws out_of_range, not parse_error, for
+  // a number beyond a double's range, and that escaped as an exception other than strata::Error.
+  TEST_CASE("transfer_function_json_with_a_number_beyond_double_range_is_an_error") {
+    const fs::path path = write_file(
+        "huge.json",
+        R"({"strata_transfer_function": 1, "stops": [{"position": 1e400, "color": [0, 0, 0, 0]}]})");
+    CHECK(error_of([&] { strata::load_transfer_function(path); }) ==
+          path.string() + ": number overflow parsing '1e400'");
+  }
+
+  // Found beside the fuzz targets (their inputs, at most 64 KiB, nest too shallowly): the version's
+  // error message dumped the value, and nlohmann's dump() recurses once per level of nesting.
+  TEST_CASE("transfer_function_json_with_a_deeply_nested_version_is_an_error") {
+    const size_t depth = 1'000'000;
+    const fs::path path =
+        write_file("deep.json", R"({"strata_transfer_function": )" + std::string(depth, '[') +
+                                    std::string(depth, ']') + R"(, "stops": []})");
+    CHECK(error_of([&] { strata::load_transfer_function(path); }) ==
+          path.string() +
+              ": strata_transfer_function: version [...] is not supported (this strata reads "
+              "version 1)");
+  }
 }

@@ -3,6 +3,7 @@
 // hold: each must give one strata::Error naming the file and the reason.
 #include <doctest/doctest.h>
 #include <malloc.h>
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <new>
 #include <optional>
 #include <set>
@@ -916,7 +918,9 @@ TEST_SUITE("loaders") {
     REQUIRE_MESSAGE(fs::exists(path), "run scripts/fetch-data.sh");
     const size_t before = heap_in_use.load();
     heap_peak.store(before);
-    const Loaded loaded = load_with_warnings(path);
+    // In this process (load_volume reads DICOM in a child process, whose heap is not counted).
+    Loaded loaded;
+    loaded.volume = strata::load_dicom_file(path, {}, loaded.warnings);
     const size_t peak = heap_peak.load() - before;
     const Volume& v = loaded.volume;
     CHECK(loaded.warnings.empty());
@@ -1206,6 +1210,186 @@ TEST_SUITE("loaders") {
     CHECK(load_error(missing) == missing.string() + ": no such file");
     CHECK(load_error(folder / "missing_folder/") ==
           (folder / "missing_folder/").string() + ": no such file");
+  }
+
+  // ---- numbers checked where they enter, limits checked before reading
+
+  namespace {
+
+  // Replaces a short-VR element's value with one of any even length (explicit VR little endian;
+  // CT5N has no group lengths to fix).
+  void patch_any_length(std::string& bytes, uint16_t group, uint16_t element, const char* vr,
+                        std::string value) {
+    if (value.size() % 2) value += ' ';
+    const std::string tag = element_bytes<uint16_t>({group, element}) + vr;
+    const size_t at = bytes.find(tag);
+    REQUIRE(at != std::string::npos);
+    uint16_t length = 0;
+    std::memcpy(&length, bytes.data() + at + 6, 2);
+    bytes.replace(at + 6, 2u + length, element_bytes<uint16_t>({uint16_t(value.size())}) + value);
+  }
+
+  // CT5N with one element of every file replaced.
+  fs::path ct5n_with(const std::string& name, uint16_t group, uint16_t element,
+                     const std::string& value) {
+    const fs::path folder = output_folder(name);
+    for (const char* file : {"2062", "2392", "2693"}) {
+      std::string bytes = read_file(ct5n / file);
+      patch_any_length(bytes, group, element, "DS", value);
+      write_file(folder / file, bytes);
+    }
+    return folder;
+  }
+
+  }  // namespace
+
+  TEST_CASE("non_finite_or_singular_geometry_is_an_error_naming_the_field") {
+    const fs::path folder = output_folder("geometry");
+    const std::string data(3 * 4 * 5, '\0');
+    const auto nifti = [&](const char* name, const Header& h) {
+      return write_file(folder / name, h.bytes + data);
+    };
+    const float inf = std::numeric_limits<float>::infinity();
+    Header qform = nifti1(false, 2, {3, 4, 5});
+    qform.put<int16_t>(252, 1).put<float>(268, inf);  // qform_code 1, qoffset_x inf
+    CHECK_LOAD_ERROR(nifti("qoffset.nii", qform), "qoffset_x/y/z = ");
+    CHECK(load_error(folder / "qoffset.nii").find("must be finite") != std::string::npos);
+    Header sform = nifti1(false, 2, {3, 4, 5});
+    sform.put<int16_t>(254, 1);  // sform_code 1; i and j both along x: no volume
+    for (size_t col = 0; col < 2; ++col) sform.put<float>(280 + 4 * col, 1.0f);
+    sform.put<float>(312 + 8, 1.0f);
+    CHECK_LOAD_ERROR(nifti("singular.nii", sform),
+                     "srow_x/y/z: the axes' directions lie in one plane");
+    // NIfTI-2 keeps the sform in doubles: a column of length 1e100 is finite there, not in float.
+    Header wide = nifti2(2, {3, 4, 5});
+    wide.put<int32_t>(348, 1);  // sform_code
+    wide.put<double>(400, 1e100).put<double>(432 + 8, 1.0).put<double>(464 + 16, 1.0);
+    CHECK_LOAD_ERROR(nifti("wide.nii", wide),
+                     "srow_x/y/z: spacing inf 1 1 must be positive and finite");
+    wide.put<double>(400, 1e300);  // its square overflows the double too
+    CHECK_LOAD_ERROR(nifti("wider.nii", wide),
+                     "srow_x/y/z column 0: the column's length is not a finite");
+    Header good_sform = sform;
+    good_sform.put<float>(284, 0.0f).put<float>(296 + 4, 1.0f);
+    CHECK(strata::load_volume(nifti("sform.nii", good_sform)).dims == glm::uvec3(3, 4, 5));
+
+    const auto mha = [&](const char* name, const std::string& fields) {
+      return write_file(folder / name,
+                        "ObjectType = Image\nNDims = 3\nDimSize = 2 2 2\n"
+                        "ElementType = MET_UCHAR\n" +
+                            fields + "ElementDataFile = LOCAL\n" + std::string(8, '\0'));
+    };
+    CHECK_LOAD_ERROR(mha("nan.mha", "Offset = nan 0 0\n"),
+                     "Offset = nan 0 0: the origin must be finite");
+    CHECK_LOAD_ERROR(mha("zero.mha", "TransformMatrix = 0 0 0 0 0 0 0 0 0\n"),
+                     "TransformMatrix: the direction of axis 0 (0 0 0) is not a unit vector");
+    CHECK_LOAD_ERROR(mha("flat.mha", "TransformMatrix = 1 0 0 1 0 0 0 0 1\n"),
+                     "TransformMatrix: the axes' directions lie in one plane");
+    CHECK(strata::load_volume(
+              mha("fine.mha", "Offset = 1 2 3\nTransformMatrix = 0 1 0 1 0 0 0 0 1\n"))
+              .origin == glm::vec3(1, 2, 3));
+
+    const std::string nrrd =
+        "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n"
+        "space: left-posterior-superior\nspace directions: (1,0,0) (0,1,0) "
+        "(0,0,1)\n";
+    CHECK_LOAD_ERROR(write_file(folder / "inf.nrrd",
+                                nrrd + "space origin: (inf,0,0)\n\n" + std::string(8, '\0')),
+                     "space origin = inf 0 0: the origin must be finite");
+    // Finite as a double, not as the float the volume keeps.
+    CHECK_LOAD_ERROR(write_file(folder / "far.nrrd",
+                                nrrd + "space origin: (1e39,0,0)\n\n" + std::string(8, '\0')),
+                     "the origin must be finite");
+
+    CHECK_LOAD_ERROR(ct5n_with("dicom_position_nan", 0x0020, 0x0032, "NaN\\-143\\8.7625"),
+                     "ImagePositionPatient = nan -143 8.7625: the position must be finite");
+  }
+
+  TEST_CASE("rescales_that_are_not_numbers_or_overflow_are_errors") {
+    CHECK_LOAD_ERROR(ct5n_with("dicom_slope_zero", 0x0028, 0x1053, "0"),
+                     "RescaleSlope = 0: expected a finite, non-zero number");
+    CHECK_LOAD_ERROR(ct5n_with("dicom_slope_nan", 0x0028, 0x1053, "NaN"),
+                     "RescaleSlope = nan: expected a finite, non-zero number");
+    CHECK_LOAD_ERROR(ct5n_with("dicom_intercept_inf", 0x0028, 0x1052, "inf"),
+                     "RescaleIntercept = inf: expected a finite number");
+    const fs::path huge = ct5n_with("dicom_slope_huge", 0x0028, 0x1053, "1e300");
+    CHECK_LOAD_ERROR(huge, "RescaleSlope, RescaleIntercept = 1e+300, -1024: the stored value");
+    CHECK_LOAD_ERROR(huge, "outside the range of a 32-bit float");
+    // NIfTI: scl_slope 0 means "no scaling" by the standard (nibabel writes NaN for the same);
+    // a slope that takes the values past float is an error.
+    const fs::path folder = output_folder("nifti_slope");
+    const std::string values = element_bytes<int16_t>({100, -3});
+    Header h = nifti1(false, 4, {2, 1, 1});
+    write_file(folder / "none.nii", Header{h}.put<float>(112, 0.0f).bytes + values);
+    CHECK(strata::load_volume(folder / "none.nii").value(0, 0, 0) == 100.0f);
+    write_file(folder / "huge.nii", Header{h}.put<float>(112, 1e38f).bytes + values);
+    CHECK_LOAD_ERROR(folder / "huge.nii", "scl_slope, scl_inter = ");
+    CHECK_LOAD_ERROR(folder / "huge.nii", "the stored value 100 becomes 1e+40");
+  }
+
+  TEST_CASE("volumes_too_big_for_the_memory_or_the_device_are_refused_from_the_header") {
+    // Headers only: the limits are checked before any voxel is read (the data is not there).
+    const fs::path folder = output_folder("limits");
+    write_file(folder / "big.nii", nifti1(false, 4, {1024, 1024, 512}).bytes);  // 1 GiB
+    std::vector<std::string> warnings;
+    const auto message = [&](const strata::VolumeLimits& limits) {
+      return strata::test::error_of(
+          [&] { strata::load_volume(folder / "big.nii", {.limits = limits}, warnings); });
+    };
+    CHECK(message({.memory_bytes = uint64_t{1} << 30})
+              .find("dim[1..3] = 1024x1024x512: the voxels need 1.0 GiB twice while loading; this "
+                    "machine has 1.0 GiB of memory") != std::string::npos);
+    CHECK(message({.max_side = 800, .device = "Test GPU"})
+              .find("1024x1024x512: the device (Test GPU) renders at most 800 voxels per side") !=
+          std::string::npos);
+    CHECK(message({.max_device_voxels = 1000000, .device_voxel_bytes = 8, .device = "Test GPU"})
+              .find("536870912 voxels; the device (Test GPU) holds at most 1000000") !=
+          std::string::npos);
+    // Within every limit: the reader goes on and finds the data missing.
+    CHECK(message({}).find("voxel data has 0 bytes") != std::string::npos);
+    // The DICOM reader checks them too, after reading the headers, before the pixels.
+    std::vector<std::string> w;
+    CHECK(strata::test::error_of([&] {
+            strata::load_volume(ct5n, {.limits = {.max_side = 8, .device = "Test GPU"}}, w);
+          }).find("Columns x Rows x files = 16x16x5: the device (Test GPU) renders at most 8") !=
+          std::string::npos);
+  }
+
+  TEST_CASE("fifos_and_folders_are_refused_where_a_file_is_read") {
+    const fs::path folder = output_folder("fifo");
+    const fs::path fifo = folder / "pipe.nii";
+    REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+    // Opening a FIFO for reading blocks until a writer comes: these must return at once.
+    CHECK_LOAD_ERROR(fifo, "is not a regular file (a FIFO, device or socket)");
+    const fs::path mhd = write_file(folder / "a.mhd",
+                                    "ObjectType = Image\nNDims = 3\nDimSize = 1 1 1\n"
+                                    "ElementType = MET_UCHAR\nElementDataFile = pipe.raw\n");
+    REQUIRE(mkfifo((folder / "pipe.raw").c_str(), 0600) == 0);
+    CHECK_LOAD_ERROR(mhd, "pipe.raw: is not a regular file");
+    const fs::path scene_fifo = folder / "scene.json";
+    REQUIRE(mkfifo(scene_fifo.c_str(), 0600) == 0);
+    CHECK(strata::test::error_of([&] { strata::load_scene(scene_fifo); }) ==
+          scene_fifo.string() +
+              ": is not a regular file (a FIFO, device or socket); strata reads only files");
+    CHECK(strata::test::error_of([&] {
+            strata::load_scene("/dev/zero.json");
+          }).find("no such file") != std::string::npos);
+    fs::create_directories(folder / "dir.json");
+    CHECK(strata::test::error_of([&] { strata::load_scene(folder / "dir.json"); }) ==
+          (folder / "dir.json").string() + ": is a folder, not a file");
+  }
+
+  TEST_CASE("text_files_have_a_size_limit_and_no_nul_bytes") {
+    const fs::path folder = output_folder("text_limits");
+    // 65 MiB, sparse: a valid scene's start and then zeros, as a broken copy would leave it.
+    const fs::path big = write_file(folder / "big.json", "{\"strata_scene\": 1, \"volumes\": []");
+    fs::resize_file(big, (uint64_t{65} << 20));
+    CHECK(strata::test::error_of([&] { strata::load_scene(big); }) ==
+          big.string() + ": is 65 MiB; files of this kind may have at most 64 MiB");
+    const fs::path nul = write_file(folder / "nul.json",
+                                    std::string("{\"strata_scene\": 1}\n\0{\"volumes\": 3}", 34));
+    CHECK(strata::test::error_of([&] { strata::load_scene(nul); }) ==
+          nul.string() + ": a NUL byte at line 2, column 1 (offset 20): not a text file");
   }
 
 }  // TEST_SUITE("loaders")

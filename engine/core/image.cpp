@@ -106,7 +106,7 @@ bool decode_jpeg(const std::string& bytes, Rgba8Image& image, JpegErrors& errors
 }  // namespace
 
 Rgba8Image read_image(const std::filesystem::path& path) {
-  const std::string bytes = read_text_file(path);
+  const std::string bytes = read_file_bytes(path);
   try {
     if (starts_with(bytes, "\x89PNG\r\n\x1a\n")) return decode_png(bytes);
     if (starts_with(bytes, "\xFF\xD8\xFF")) {

@@ -65,12 +65,23 @@ inline std::vector<double> json_numbers(const nlohmann::json& value, const JsonF
   return result;
 }
 
+// A value as an error message shows it: a number, string, bool or null as JSON, an array or an
+// object as "[...]" or "{...}", since dump() recurses once per level of nesting and a deeply
+// nested value ("[[[[...]]]]") overflowed the stack.
+inline std::string json_for_message(const nlohmann::json& value) {
+  if (value.is_array()) return "[...]";
+  if (value.is_object()) return "{...}";
+  return value.dump();
+}
+
 // The JSON document in `path`. A syntax error is one Error "<file>: parse error at line L,
 // column C: ..." (nlohmann's message without its "[json.exception.parse_error.101] " prefix).
+// nlohmann reports a number too large for a double ("1e400") as out_of_range, not as a parse
+// error, so every exception of its own is caught.
 inline nlohmann::json read_json_file(const std::filesystem::path& path) {
   try {
     return nlohmann::json::parse(read_text_file(path));
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
     const std::string what = e.what();
     const size_t end = what.find("] ");
     throw Error(path.string() + ": " + (end == std::string::npos ? what : what.substr(end + 2)));

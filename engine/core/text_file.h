@@ -2,13 +2,30 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
 namespace strata {
 
-// The file's bytes; Error "<file>: no such file" or "<file>: cannot read the file".
-std::string read_text_file(const std::filesystem::path& path);
+// Text files (scenes, transfer functions, label lists, scripts) are read whole; none of strata's
+// is near this size, and a limit means a wrong or hostile file cannot take the machine's memory.
+inline constexpr uint64_t kMaxTextFileBytes = uint64_t{64} << 20;
+
+// The size of a file strata is about to read, after checking that it is one: Error "<file>: no
+// such file", "<file>: is a folder, not a file" or "<file>: is not a regular file (a FIFO, device
+// or socket)". Reading a FIFO or a device could block forever or never end, so every reader
+// checks its inputs here first.
+uint64_t check_input_file(const std::filesystem::path& path);
+
+// The file's bytes after check_input_file and a check against max_bytes ("<file>: is N MiB; ...
+// at most M MiB"); Error "<file>: cannot read the file" when reading fails.
+std::string read_file_bytes(const std::filesystem::path& path,
+                            uint64_t max_bytes = kMaxTextFileBytes);
+// read_file_bytes for text: a NUL byte is an Error naming its line and column (parsers would
+// stop there and silently drop the rest of the file).
+std::string read_text_file(const std::filesystem::path& path,
+                           uint64_t max_bytes = kMaxTextFileBytes);
 // Writes `text` to `path` (replacing it); an Error naming the path when it cannot.
 void write_text_file(const std::filesystem::path& path, const std::string& text);
 

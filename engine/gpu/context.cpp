@@ -135,6 +135,20 @@ std::string unusable(const DeviceReport& d) {
          "' lacks what strata needs: " + join(d.missing);
 }
 
+// 10 s on GPUs, 300 s on CPU devices, or STRATA_GPU_TIMEOUT seconds (Context::gpu_timeout()).
+std::chrono::nanoseconds gpu_timeout_for(VkPhysicalDeviceType type) {
+  double seconds = type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 300.0 : 10.0;
+  if (const char* env = std::getenv("STRATA_GPU_TIMEOUT")) {
+    char* end = nullptr;
+    seconds = std::strtod(env, &end);
+    if (end == env || *end != '\0' || !(seconds > 0.0 && seconds < 1e6)) {
+      throw Error(std::string("STRATA_GPU_TIMEOUT: '") + env +
+                  "' is not a number of seconds (above 0, below 1000000)");
+    }
+  }
+  return std::chrono::nanoseconds(static_cast<int64_t>(seconds * 1e9));
+}
+
 }  // namespace
 
 std::vector<std::string> missing_requirements(const DeviceCapabilities& caps) {
@@ -270,6 +284,7 @@ Instance::Instance(bool validation, const std::vector<const char*>& extensions) 
 }
 
 Instance::~Instance() {
+  if (abandoned_) return;
   if (messenger_) {
     auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
         vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
@@ -302,8 +317,17 @@ Context::Context(const ContextOptions& options)
   std::vector<VkPhysicalDevice> handles(count);
   vkEnumeratePhysicalDevices(instance_.handle(), &count, handles.data());
   physical_ = handles[index];
-  vkGetPhysicalDeviceProperties(physical_, &properties_);
+  VkPhysicalDeviceVulkan13Properties p13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES};
+  VkPhysicalDeviceVulkan11Properties p11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES,
+                                         &p13};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &p11};
+  vkGetPhysicalDeviceProperties2(physical_, &props);
+  properties_ = props.properties;
+  max_allocation_ = p11.maxMemoryAllocationSize;
+  max_buffer_ = p13.maxBufferSize;
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+  heap_bytes_.assign(memory_.memoryHeapCount, 0);
+  timeout_ = gpu_timeout_for(report_.type);
   queue_family_ = static_cast<uint32_t>(graphics_compute_family(physical_));
   if (!options.quiet) {
     std::fprintf(stderr, "strata: device %u: %s (%s)\n", index, report_.name.c_str(),
@@ -324,6 +348,8 @@ Context::Context(const ContextOptions& options)
 
   std::vector<const char*> extensions = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
   if (options.presentation) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+  memory_budget_ = has_device_extension(physical_, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+  if (memory_budget_) extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
   VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executables{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
   if (report_.caps.pipeline_statistics) {
@@ -352,11 +378,15 @@ Context::Context(const ContextOptions& options)
 }
 
 Context::~Context() {
-  if (device_) {
-    vkDeviceWaitIdle(device_);
-    vkDestroyCommandPool(device_, pool_, nullptr);
-    vkDestroyDevice(device_, nullptr);
+  if (!device_) return;
+  if (!drain() && !lost_) {
+    // A wait timed out: the GPU may still run work that uses the device. It is left to the
+    // process's end (which follows: the error is being reported), not destroyed under the work.
+    instance_.abandon();
+    return;
   }
+  vkDestroyCommandPool(device_, pool_, nullptr);
+  vkDestroyDevice(device_, nullptr);
 }
 
 uint32_t Context::memory_type(uint32_t allowed_types, VkMemoryPropertyFlags wanted) const {
@@ -406,10 +436,124 @@ void Context::submit_and_wait(VkCommandBuffer cmd) {
   submit.commandBufferInfoCount = 1;
   submit.pCommandBufferInfos = &cmd_info;
   const VkResult result = vkQueueSubmit2(queue_, 1, &submit, fence);
-  if (result == VK_SUCCESS) STRATA_VK(vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX));
-  vkDestroyFence(device_, fence, nullptr);
-  vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+  if (result == VK_ERROR_DEVICE_LOST) lost_ = true;
+  const auto release = [&] {
+    vkDestroyFence(device_, fence, nullptr);
+    vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+  };
+  try {
+    if (result == VK_SUCCESS) wait_for(fence, "a one-off submission (an upload, a readback)");
+  } catch (...) {
+    if (may_destroy()) release();  // (else the GPU may still use them)
+    throw;
+  }
+  release();
   check_vk(result, "vkQueueSubmit2");
+}
+
+void Context::wait_for(VkFence fence, const std::string& what) {
+  const VkResult result =
+      vkWaitForFences(device_, 1, &fence, VK_TRUE, static_cast<uint64_t>(timeout_.count()));
+  if (result == VK_SUCCESS) {
+    hung_ = false;
+    return;
+  }
+  if (result == VK_TIMEOUT) {
+    hung_ = true;
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, "%g", std::chrono::duration<double>(timeout_).count());
+    throw GpuTimeout("the GPU did not finish " + what + " within " + seconds +
+                     " s (VK_TIMEOUT): the device seems hung (STRATA_GPU_TIMEOUT=SECONDS waits "
+                     "longer)");
+  }
+  if (result == VK_ERROR_DEVICE_LOST) {
+    lost_ = true;
+    throw DeviceLost("while waiting for " + what);
+  }
+  check_vk(result, "vkWaitForFences");
+}
+
+void Context::wait_idle(const std::string& what) {
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence = VK_NULL_HANDLE;
+  STRATA_VK(vkCreateFence(device_, &fence_info, nullptr, &fence));
+  // (no command buffers: the fence signals once everything submitted before it has finished)
+  const VkResult result = vkQueueSubmit2(queue_, 0, nullptr, fence);
+  if (result == VK_ERROR_DEVICE_LOST) lost_ = true;
+  try {
+    check_vk(result, "vkQueueSubmit2");
+    wait_for(fence, what);
+  } catch (...) {
+    if (may_destroy()) vkDestroyFence(device_, fence, nullptr);
+    throw;
+  }
+  vkDestroyFence(device_, fence, nullptr);
+}
+
+bool Context::drain() noexcept {
+  if (lost_ || hung_) return false;
+  try {
+    wait_idle("the work in flight");
+    return true;
+  } catch (...) {
+    return false;
+  }
+}
+
+void Context::check_allocation(VkDeviceSize bytes, uint32_t type, const char* what) const {
+  const std::string amount = std::string(what) + " of " + std::to_string(bytes) + " bytes";
+  if (max_allocation_ != 0 && bytes > max_allocation_) {
+    throw Error(amount + " is more than device '" + report_.name +
+                "' allocates at once (maxMemoryAllocationSize: " + std::to_string(max_allocation_) +
+                " bytes)");
+  }
+  const uint32_t heap = memory_.memoryTypes[type].heapIndex;
+  const VkDeviceSize size = memory_.memoryHeaps[heap].size;
+  VkDeviceSize held = 0;
+  {
+    std::lock_guard lock(memory_mutex_);
+    held = heap_bytes_[heap];
+  }
+  if (held + bytes > size) {
+    throw Error(amount + ", with the " + std::to_string(held) +
+                " bytes strata holds already, is more than device '" + report_.name +
+                "' has in memory heap " + std::to_string(heap) + " (" + std::to_string(size) +
+                " bytes)");
+  }
+}
+
+void Context::count_allocation(uint32_t type, VkDeviceSize bytes) noexcept {
+  std::lock_guard lock(memory_mutex_);
+  heap_bytes_[memory_.memoryTypes[type].heapIndex] += bytes;
+  use_.bytes += bytes;
+  ++use_.allocations;
+  use_.peak = std::max(use_.peak, use_.bytes);
+}
+
+void Context::count_free(uint32_t type, VkDeviceSize bytes) noexcept {
+  std::lock_guard lock(memory_mutex_);
+  heap_bytes_[memory_.memoryTypes[type].heapIndex] -= bytes;
+  use_.bytes -= bytes;
+  --use_.allocations;
+}
+
+DeviceMemoryUse Context::memory_use() const {
+  std::lock_guard lock(memory_mutex_);
+  return use_;
+}
+
+std::optional<VkDeviceSize> Context::heap_usage() const {
+  if (!memory_budget_) return std::nullopt;
+  VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
+  VkPhysicalDeviceMemoryProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2,
+                                          &budget};
+  vkGetPhysicalDeviceMemoryProperties2(physical_, &props);
+  VkDeviceSize used = 0;
+  for (uint32_t h = 0; h < props.memoryProperties.memoryHeapCount; ++h) {
+    used += budget.heapUsage[h];
+  }
+  return used;
 }
 
 }  // namespace strata

@@ -6,9 +6,11 @@
 // and a device that lacks any of it is refused with one message that lists everything missing.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -85,11 +87,21 @@ class Instance {
   VkInstance handle() const { return instance_; }
   std::vector<DeviceReport> devices() const;
   ValidationLog& validation_log() { return log_; }
+  // Left to the process's end, not destroyed (a device that may still run work is left with it).
+  void abandon() { abandoned_ = true; }
 
  private:
+  bool abandoned_ = false;
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   ValidationLog log_;
+};
+
+// What strata's own Buffers and Images hold in device memory (VkDeviceMemory), live now.
+struct DeviceMemoryUse {
+  VkDeviceSize bytes = 0;    // all heaps
+  uint64_t allocations = 0;  // VkDeviceMemory objects
+  VkDeviceSize peak = 0;     // the most `bytes` has been
 };
 
 class Context {
@@ -121,6 +133,39 @@ class Context {
   VkCommandBuffer begin_commands();
   void submit_and_wait(VkCommandBuffer cmd);
 
+  // Every wait for the GPU ends within this, or it is a GpuTimeout naming what was waited for:
+  // a hung device ends with a message, not a hang. 10 s on GPUs (their drivers reset a hung
+  // device sooner, which is VK_ERROR_DEVICE_LOST); 300 s on CPU devices, where one frame of a
+  // large image takes tens of seconds. STRATA_GPU_TIMEOUT (seconds) sets it.
+  std::chrono::nanoseconds gpu_timeout() const { return timeout_; }
+  void set_gpu_timeout(std::chrono::nanoseconds timeout) { timeout_ = timeout; }
+  // Waits for `fence`; GpuTimeout or DeviceLost naming `what` ("frame 12") when it does not end.
+  void wait_for(VkFence fence, const std::string& what);
+  // Waits until the queue has finished all work submitted so far (a fence submitted behind it:
+  // one queue, so it signals after everything before it), like wait_for.
+  void wait_idle(const std::string& what);
+  // For destructors: wait_idle that never throws. False when the device is lost or a wait timed
+  // out; then nothing is waited for, and objects the GPU may still use are left, not destroyed.
+  bool drain() noexcept;
+  // The device was lost, or the last wait timed out (a later wait that finishes clears it).
+  bool lost() const { return lost_; }
+  bool hung() const { return hung_; }
+  // Whether objects may be destroyed: the GPU is not still running work that uses them.
+  bool may_destroy() const { return lost_ || !hung_; }
+
+  // Device memory: a check before each allocation, and the running count (Buffer, Image).
+  // Throws an Error naming the limit when `bytes` of memory type `type` can never be had: more
+  // than maxMemoryAllocationSize, or with what strata holds already more than the type's heap.
+  void check_allocation(VkDeviceSize bytes, uint32_t type, const char* what) const;
+  void count_allocation(uint32_t type, VkDeviceSize bytes) noexcept;
+  void count_free(uint32_t type, VkDeviceSize bytes) noexcept;
+  DeviceMemoryUse memory_use() const;
+  // The driver's own count of the device memory this process uses, all heaps (ImGui's buffers
+  // and driver-internal memory included), when the device has VK_EXT_memory_budget.
+  std::optional<VkDeviceSize> heap_usage() const;
+  VkDeviceSize max_allocation() const { return max_allocation_; }
+  VkDeviceSize max_buffer() const { return max_buffer_; }
+
  private:
   Instance instance_;
   DeviceReport report_;
@@ -131,6 +176,13 @@ class Context {
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
   VkCommandPool pool_ = VK_NULL_HANDLE;
+  std::chrono::nanoseconds timeout_{0};
+  bool lost_ = false, hung_ = false;
+  bool memory_budget_ = false;  // VK_EXT_memory_budget enabled
+  VkDeviceSize max_allocation_ = 0, max_buffer_ = 0;
+  mutable std::mutex memory_mutex_;
+  std::vector<VkDeviceSize> heap_bytes_;  // per heap: strata's live allocations
+  DeviceMemoryUse use_;
 };
 
 }  // namespace strata

@@ -20,18 +20,25 @@ VkMemoryPropertyFlags properties_for(MemoryKind kind) {
   return 0;
 }
 
-VkDeviceMemory allocate(Context& ctx, const VkMemoryRequirements& req,
-                        VkMemoryPropertyFlags props) {
+// Memory for a buffer or an image (`what`), checked against the device's limits first and
+// counted; `type` is set to the memory type taken.
+VkDeviceMemory allocate(Context& ctx, const VkMemoryRequirements& req, VkMemoryPropertyFlags props,
+                        const char* what, uint32_t& type) {
   VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   info.allocationSize = req.size;
-  info.memoryTypeIndex = ctx.memory_type(req.memoryTypeBits, props);
+  info.memoryTypeIndex = type = ctx.memory_type(req.memoryTypeBits, props);
+  ctx.check_allocation(req.size, type, what);
   VkDeviceMemory memory = VK_NULL_HANDLE;
   const VkResult result = vkAllocateMemory(ctx.device(), &info, nullptr, &memory);
   if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) {
-    throw Error("out of memory allocating " + std::to_string(req.size) + " bytes on '" +
-                ctx.report().name + "'");
+    const DeviceMemoryUse held = ctx.memory_use();
+    throw Error(std::string(what) + " of " + std::to_string(req.size) +
+                " bytes: " + to_string(result) + " from device '" + ctx.report().name +
+                "' (strata holds " + std::to_string(held.bytes) + " bytes in " +
+                std::to_string(held.allocations) + " allocations)");
   }
   check_vk(result, "vkAllocateMemory");
+  ctx.count_allocation(type, req.size);
   return memory;
 }
 
@@ -60,7 +67,14 @@ void copy_to_host_barrier(VkCommandBuffer cmd) {
 }  // namespace
 
 Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind)
-    : device_(ctx.device()), size_(size) {
+    : size_(size) {
+  // (past maxBufferSize, vkCreateBuffer itself would be invalid usage)
+  if (ctx.max_buffer() != 0 && size > ctx.max_buffer()) {
+    throw Error("a buffer of " + std::to_string(size) + " bytes is more than device '" +
+                ctx.report().name + "' allows (maxBufferSize: " + std::to_string(ctx.max_buffer()) +
+                " bytes)");
+  }
+  const VkDevice device = ctx.device();
   if (kind == MemoryKind::device_local) {
     usage |= VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
   }
@@ -68,14 +82,21 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
   info.size = size;
   info.usage = usage;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  STRATA_VK(vkCreateBuffer(device_, &info, nullptr, &buffer_));
+  STRATA_VK(vkCreateBuffer(device, &info, nullptr, &buffer_));
   VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(device_, buffer_, &req);
-  memory_ = allocate(ctx, req, properties_for(kind));
-  STRATA_VK(vkBindBufferMemory(device_, buffer_, memory_, 0));
+  vkGetBufferMemoryRequirements(device, buffer_, &req);
+  try {
+    memory_ = allocate(ctx, req, properties_for(kind), "a buffer", memory_type_);
+  } catch (...) {
+    vkDestroyBuffer(device, buffer_, nullptr);
+    throw;
+  }
+  ctx_ = &ctx;  // (owns both from here: release() frees them)
+  allocated_ = req.size;
+  STRATA_VK(vkBindBufferMemory(device, buffer_, memory_, 0));
   if (kind != MemoryKind::device_local) {
     void* ptr = nullptr;
-    STRATA_VK(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &ptr));
+    STRATA_VK(vkMapMemory(device, memory_, 0, VK_WHOLE_SIZE, 0, &ptr));
     mapped_ = static_cast<std::byte*>(ptr);
   }
 }
@@ -91,23 +112,30 @@ Buffer::Buffer(Buffer&& other) noexcept {
 Buffer& Buffer::operator=(Buffer&& other) noexcept {
   if (this != &other) {
     release();
-    device_ = std::exchange(other.device_, VK_NULL_HANDLE);
+    ctx_ = std::exchange(other.ctx_, nullptr);
     buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
     memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
     size_ = std::exchange(other.size_, 0);
+    allocated_ = std::exchange(other.allocated_, 0);
+    memory_type_ = other.memory_type_;
     mapped_ = std::exchange(other.mapped_, nullptr);
   }
   return *this;
 }
 
 void Buffer::release() {
-  if (!device_) return;
-  vkDestroyBuffer(device_, buffer_, nullptr);
-  vkFreeMemory(device_, memory_, nullptr);
-  device_ = VK_NULL_HANDLE;
+  if (!ctx_) return;
+  // (after a wait that timed out the GPU may still use it: left to the process's end)
+  if (ctx_->may_destroy()) {
+    vkDestroyBuffer(ctx_->device(), buffer_, nullptr);
+    vkFreeMemory(ctx_->device(), memory_, nullptr);
+    ctx_->count_free(memory_type_, allocated_);
+  }
+  ctx_ = nullptr;
 }
 
-Image::Image(Context& ctx, const ImageDesc& desc) : device_(ctx.device()), desc_(desc) {
+Image::Image(Context& ctx, const ImageDesc& desc) : desc_(desc) {
+  const VkDevice device = ctx.device();
   VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   info.imageType = desc.type;
   info.format = desc.format;
@@ -118,11 +146,18 @@ Image::Image(Context& ctx, const ImageDesc& desc) : device_(ctx.device()), desc_
   info.tiling = VK_IMAGE_TILING_OPTIMAL;
   info.usage = desc.usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
   info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  STRATA_VK(vkCreateImage(device_, &info, nullptr, &image_));
+  STRATA_VK(vkCreateImage(device, &info, nullptr, &image_));
   VkMemoryRequirements req;
-  vkGetImageMemoryRequirements(device_, image_, &req);
-  memory_ = allocate(ctx, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  STRATA_VK(vkBindImageMemory(device_, image_, memory_, 0));
+  vkGetImageMemoryRequirements(device, image_, &req);
+  try {
+    memory_ = allocate(ctx, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "an image", memory_type_);
+  } catch (...) {
+    vkDestroyImage(device, image_, nullptr);
+    throw;
+  }
+  ctx_ = &ctx;
+  allocated_ = req.size;
+  STRATA_VK(vkBindImageMemory(device, image_, memory_, 0));
 
   VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
   view.image = image_;
@@ -131,7 +166,7 @@ Image::Image(Context& ctx, const ImageDesc& desc) : device_(ctx.device()), desc_
                                                   : VK_IMAGE_VIEW_TYPE_2D;
   view.format = desc.format;
   view.subresourceRange = {aspect_of(desc.format), 0, 1, 0, desc.layers};
-  STRATA_VK(vkCreateImageView(device_, &view, nullptr, &view_));
+  STRATA_VK(vkCreateImageView(device, &view, nullptr, &view_));
 }
 
 Image::~Image() {
@@ -145,21 +180,26 @@ Image::Image(Image&& other) noexcept {
 Image& Image::operator=(Image&& other) noexcept {
   if (this != &other) {
     release();
-    device_ = std::exchange(other.device_, VK_NULL_HANDLE);
+    ctx_ = std::exchange(other.ctx_, nullptr);
     image_ = std::exchange(other.image_, VK_NULL_HANDLE);
     view_ = std::exchange(other.view_, VK_NULL_HANDLE);
     memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    allocated_ = std::exchange(other.allocated_, 0);
+    memory_type_ = other.memory_type_;
     desc_ = other.desc_;
   }
   return *this;
 }
 
 void Image::release() {
-  if (!device_) return;
-  vkDestroyImageView(device_, view_, nullptr);
-  vkDestroyImage(device_, image_, nullptr);
-  vkFreeMemory(device_, memory_, nullptr);
-  device_ = VK_NULL_HANDLE;
+  if (!ctx_) return;
+  if (ctx_->may_destroy()) {
+    vkDestroyImageView(ctx_->device(), view_, nullptr);
+    vkDestroyImage(ctx_->device(), image_, nullptr);
+    vkFreeMemory(ctx_->device(), memory_, nullptr);
+    ctx_->count_free(memory_type_, allocated_);
+  }
+  ctx_ = nullptr;
 }
 
 uint32_t texel_size(VkFormat format) {

@@ -1,6 +1,8 @@
 // Buffers and images with their own memory, moved not copied, freed with their owner.
 // Device-local resources are filled through a staging buffer (upload) and read back through one
 // (download); both wait on the GPU and are meant for setup and tests, never inside a frame.
+// Each allocation is checked against the device's limits first (an Error naming the limit and
+// the bytes, not a driver failure) and counted in the Context (`Context::memory_use()`).
 #pragma once
 
 #include <cstddef>
@@ -32,10 +34,12 @@ class Buffer {
 
  private:
   void release();
-  VkDevice device_ = VK_NULL_HANDLE;
+  Context* ctx_ = nullptr;
   VkBuffer buffer_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   VkDeviceSize size_ = 0;
+  VkDeviceSize allocated_ = 0;  // the memory's size (counted in the Context)
+  uint32_t memory_type_ = 0;
   std::byte* mapped_ = nullptr;
 };
 
@@ -62,10 +66,12 @@ class Image {
 
  private:
   void release();
-  VkDevice device_ = VK_NULL_HANDLE;
+  Context* ctx_ = nullptr;
   VkImage image_ = VK_NULL_HANDLE;
   VkImageView view_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkDeviceSize allocated_ = 0;
+  uint32_t memory_type_ = 0;
   ImageDesc desc_;
 };
 

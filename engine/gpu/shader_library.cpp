@@ -139,7 +139,8 @@ ShaderReflection merge(const ShaderReflection& a, const ShaderReflection& b,
 
 Pipeline::Pipeline(Context& ctx, std::string name, ShaderReflection reflection,
                    VkShaderStageFlags stages, VkPipelineBindPoint bind_point)
-    : device_(ctx.device()),
+    : ctx_(&ctx),
+      device_(ctx.device()),
       name_(std::move(name)),
       reflection_(std::move(reflection)),
       stages_(stages),
@@ -162,6 +163,7 @@ Pipeline::Pipeline(Context& ctx, std::string name, ShaderReflection reflection,
 }
 
 Pipeline::~Pipeline() {
+  if (!ctx_->may_destroy()) return;  // (a wait timed out: the GPU may still run it)
   vkDestroyPipeline(device_, pipeline_, nullptr);
   vkDestroyPipelineLayout(device_, layout_, nullptr);
   vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);

@@ -68,6 +68,7 @@ class Pipeline {
            VkPipelineBindPoint bind_point);
   VkShaderModule create_module(std::span<const uint32_t> code) const;
 
+  Context* ctx_ = nullptr;
   VkDevice device_ = VK_NULL_HANDLE;
   std::string name_;
   ShaderReflection reflection_;

@@ -32,8 +32,20 @@ const char* to_string(VkResult result) {
   }
 }
 
+DeviceLost::DeviceLost(const std::string& when)
+    : Error("the GPU device was lost (VK_ERROR_DEVICE_LOST) " + when +
+            "; the driver gave it up after a hang or a fault (the kernel log, e.g. `journalctl "
+            "-k`, may say which), and nothing submitted to it will finish"),
+      when_(when) {}
+
 void check_vk(VkResult result, const char* what) {
-  if (result != VK_SUCCESS) throw Error(std::string(what) + " failed: " + to_string(result));
+  if (result == VK_SUCCESS) return;
+  if (result == VK_ERROR_DEVICE_LOST) {
+    // (the call's name up to its argument list: "in vkQueueSubmit2")
+    const std::string call(what);
+    throw DeviceLost("in " + call.substr(0, call.find('(')));
+  }
+  throw Error(std::string(what) + " failed: " + to_string(result));
 }
 
 }  // namespace strata

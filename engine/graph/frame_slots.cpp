@@ -26,15 +26,23 @@ FrameSlots::FrameSlots(Context& ctx, uint32_t count) : ctx_(ctx) {
 }
 
 FrameSlots::~FrameSlots() {
-  wait_all();
+  // (never throws; after a device loss or a wait that timed out nothing is waited for, and
+  // what the GPU may still use is left alone)
+  if (!ctx_.drain() && !ctx_.may_destroy()) return;
   for (Slot& s : slots_) vkDestroyFence(ctx_.device(), s.done, nullptr);
   vkDestroyCommandPool(ctx_.device(), pool_, nullptr);
 }
 
+void FrameSlots::wait(Slot& slot) {
+  if (!slot.pending) return;
+  ctx_.wait_for(slot.done, "frame " + std::to_string(slot.frame));
+  slot.pending = false;
+}
+
 uint32_t FrameSlots::next() {
   const uint32_t slot = turn_;
+  wait(slots_[slot]);
   turn_ = (turn_ + 1) % count();
-  STRATA_VK(vkWaitForFences(ctx_.device(), 1, &slots_[slot].done, VK_TRUE, UINT64_MAX));
   return slot;
 }
 
@@ -61,13 +69,16 @@ void FrameSlots::submit(uint32_t slot, std::span<const VkSemaphoreSubmitInfo> wa
   submit.pCommandBufferInfos = &cmd_info;
   submit.signalSemaphoreInfoCount = static_cast<uint32_t>(signal.size());
   submit.pSignalSemaphoreInfos = signal.data();
-  STRATA_VK(vkQueueSubmit2(ctx_.queue(), 1, &submit, s.done));
+  s.frame = ++submitted_;
+  const VkResult result = vkQueueSubmit2(ctx_.queue(), 1, &submit, s.done);
+  if (result == VK_ERROR_DEVICE_LOST)
+    throw DeviceLost("submitting frame " + std::to_string(s.frame));
+  check_vk(result, "vkQueueSubmit2");
+  s.pending = true;
 }
 
 void FrameSlots::wait_all() {
-  for (Slot& s : slots_) {
-    STRATA_VK(vkWaitForFences(ctx_.device(), 1, &s.done, VK_TRUE, UINT64_MAX));
-  }
+  for (Slot& s : slots_) wait(s);
 }
 
 }  // namespace strata

@@ -21,25 +21,32 @@ class FrameSlots {
   FrameSlots& operator=(const FrameSlots&) = delete;
 
   uint32_t count() const { return static_cast<uint32_t>(slots_.size()); }
-  // The next slot in turn, once the frame it last held has finished (waits for it).
+  // The next slot in turn, once the frame it last held has finished (waits for it, at most the
+  // Context's gpu_timeout(): GpuTimeout or DeviceLost naming that frame otherwise).
   uint32_t next();
   // The slot's command buffer, reset and begun.
   VkCommandBuffer begin(uint32_t slot);
   // Ends and submits the slot's command buffer; its fence signals when the frame has finished.
   void submit(uint32_t slot, std::span<const VkSemaphoreSubmitInfo> wait = {},
               std::span<const VkSemaphoreSubmitInfo> signal = {});
-  // Waits until every submitted frame has finished.
+  // Waits until every submitted frame has finished (like next()).
   void wait_all();
+  // Frames submitted so far; frame N (from 1) is the Nth.
+  uint64_t submitted() const { return submitted_; }
 
  private:
   struct Slot {
     VkCommandBuffer cmd = VK_NULL_HANDLE;
     VkFence done = VK_NULL_HANDLE;
+    uint64_t frame = 0;    // the frame it last held (0: none)
+    bool pending = false;  // submitted, not yet waited for (a failed submission never signals)
   };
+  void wait(Slot& slot);
   Context& ctx_;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   std::vector<Slot> slots_;
   uint32_t turn_ = 0;
+  uint64_t submitted_ = 0;
 };
 
 }  // namespace strata

@@ -116,14 +116,15 @@ GraphRunner::GraphRunner(Context& ctx, Graph graph)
 }
 
 GraphRunner::~GraphRunner() {
-  if (frames_in_flight() > 1) vkDeviceWaitIdle(ctx_.device());  // frames may still run
+  // (frames may still run; never throws, and leaves what a hung GPU may still use)
+  if (frames_in_flight() > 1 && !ctx_.drain() && !ctx_.may_destroy()) return;
   vkDestroySampler(ctx_.device(), linear_sampler_, nullptr);
   for (VkQueryPool pool : queries_) vkDestroyQueryPool(ctx_.device(), pool, nullptr);
 }
 
 void GraphRunner::set_frames_in_flight(uint32_t frames) {
   if (frames == 0) throw Error("render graph: no frames in flight");
-  if (!queries_.empty()) vkDeviceWaitIdle(ctx_.device());
+  if (!queries_.empty()) ctx_.wait_idle("the frames in flight (their query pools are replaced)");
   for (VkQueryPool pool : queries_) vkDestroyQueryPool(ctx_.device(), pool, nullptr);
   queries_.assign(frames, VK_NULL_HANDLE);
   VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
@@ -139,22 +140,35 @@ void GraphRunner::set_viewport(Extent viewport) {
   if (viewport == viewport_) return;
   if (viewport.width == 0 || viewport.height == 0) throw Error("render graph: empty viewport");
   // (resources of frames still in flight are replaced: those frames finish first)
-  if (viewport_.width != 0 && frames_in_flight() > 1) vkDeviceWaitIdle(ctx_.device());
+  if (viewport_.width != 0 && frames_in_flight() > 1) {
+    ctx_.wait_idle("the frames in flight (the graph's resources are replaced)");
+  }
   viewport_ = viewport;
   for (size_t i = 0; i < graph_.resources().size(); ++i) {
     const ResourceInfo& r = graph_.resources()[i];
     if (r.imported) continue;
-    if (r.is_image) {
-      const Extent e = r.image.fixed.width ? r.image.fixed : viewport;
-      ImageDesc desc{r.image.format,     {e.width, e.height, 1}, VK_IMAGE_TYPE_2D,
-                     compiled_.usage[i], r.image.layers,         r.image.array};
-      Image& image = owned_[i].emplace<Image>(ctx_, desc);
-      bound_[i] = {VK_NULL_HANDLE, image.handle(), image.view(), r.image.format};
-    } else {
-      const VkDeviceSize size = std::max<VkDeviceSize>(4, r.buffer.size(viewport));
-      Buffer& buffer =
-          owned_[i].emplace<Buffer>(ctx_, size, compiled_.usage[i], MemoryKind::device_local);
-      bound_[i] = {buffer.handle()};
+    try {
+      if (r.is_image) {
+        const Extent e = r.image.fixed.width ? r.image.fixed : viewport;
+        ImageDesc desc{r.image.format,     {e.width, e.height, 1}, VK_IMAGE_TYPE_2D,
+                       compiled_.usage[i], r.image.layers,         r.image.array};
+        Image& image = owned_[i].emplace<Image>(ctx_, desc);
+        bound_[i] = {VK_NULL_HANDLE, image.handle(), image.view(), r.image.format};
+      } else {
+        const VkDeviceSize size = std::max<VkDeviceSize>(4, r.buffer.size(viewport));
+        Buffer& buffer =
+            owned_[i].emplace<Buffer>(ctx_, size, compiled_.usage[i], MemoryKind::device_local);
+        bound_[i] = {buffer.handle()};
+      }
+    } catch (const DeviceLost&) {
+      throw;
+    } catch (const Error& e) {
+      // Which resource could not be had, at which size (the HA-Buffer is render.keys and
+      // render.payload): the graph is left without it, so it cannot run until a set_viewport()
+      // that succeeds.
+      viewport_ = {};
+      throw Error("render graph: '" + r.name + "' for a " + std::to_string(viewport.width) + "x" +
+                  std::to_string(viewport.height) + " viewport: " + e.what());
     }
   }
 }
@@ -162,7 +176,9 @@ void GraphRunner::set_viewport(Extent viewport) {
 void GraphRunner::reallocate() {
   const Extent viewport = viewport_;
   // (resources of frames still in flight are replaced: those frames finish first)
-  if (frames_in_flight() > 1) vkDeviceWaitIdle(ctx_.device());
+  if (frames_in_flight() > 1) {
+    ctx_.wait_idle("the frames in flight (the graph's resources are replaced)");
+  }
   viewport_ = {};
   set_viewport(viewport);
 }

@@ -69,7 +69,7 @@ WindowTarget::WindowTarget(Context& ctx, GLFWwindow* window, uint32_t frames_in_
 
 WindowTarget::~WindowTarget() {
   VkDevice device = ctx_.device();
-  vkDeviceWaitIdle(device);
+  if (!ctx_.drain() && !ctx_.may_destroy()) return;  // (a hung GPU may still use them)
   destroy_swapchain_images();
   vkDestroySwapchainKHR(device, swapchain_, nullptr);
   for (VkSemaphore s : acquired_) vkDestroySemaphore(device, s, nullptr);
@@ -107,7 +107,7 @@ void WindowTarget::destroy_swapchain_images() {
 
 void WindowTarget::create_swapchain(graph::Extent framebuffer) {
   VkDevice device = ctx_.device();
-  vkDeviceWaitIdle(device);
+  ctx_.wait_idle("the frames in flight (the swapchain is replaced)");
   VkSurfaceCapabilitiesKHR caps;
   STRATA_VK(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(ctx_.physical_device(), surface_, &caps));
   const VkSurfaceFormatKHR format = choose_format(ctx_.physical_device(), surface_);
@@ -167,8 +167,15 @@ bool WindowTarget::draw(const Prepare& prepare) {
   const uint32_t slot = slots_.next();
   VkDevice device = ctx_.device();
   uint32_t index = 0;
-  const VkResult acquired = vkAcquireNextImageKHR(device, swapchain_, UINT64_MAX, acquired_[slot],
-                                                  VK_NULL_HANDLE, &index);
+  const VkResult acquired =
+      vkAcquireNextImageKHR(device, swapchain_, static_cast<uint64_t>(ctx_.gpu_timeout().count()),
+                            acquired_[slot], VK_NULL_HANDLE, &index);
+  if (acquired == VK_TIMEOUT || acquired == VK_NOT_READY) {
+    throw GpuTimeout(
+        "the window's presentation engine gave no image to draw into within the GPU "
+        "timeout (" +
+        std::string(to_string(acquired)) + ")");
+  }
   if (acquired == VK_ERROR_OUT_OF_DATE_KHR) {
     out_of_date_ = true;
     return false;

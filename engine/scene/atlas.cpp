@@ -4,12 +4,12 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <sstream>
 #include <unordered_map>
 
 #include "engine/core/error.h"
+#include "engine/core/text_file.h"
 
 namespace strata {
 namespace {
@@ -194,8 +194,7 @@ std::vector<glm::vec3> vertex_normals(const std::vector<glm::vec3>& positions,
 }  // namespace
 
 std::vector<AtlasRegion> load_atlas_names(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path.string() + ": cannot open atlas names file");
+  std::istringstream in(read_text_file(path));
   std::vector<AtlasRegion> regions;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {

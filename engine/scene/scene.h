@@ -112,6 +112,9 @@ struct CostWeights {
 // Depth layers a frame can have (VR_MAX_LAYERS in shaders/shared/volume_render.h, asserted equal
 // in passes/volume_renderer.cpp): the scene side checks settings against it without the shaders.
 inline constexpr int kMaxLayers = 8;
+// Labels a scene can have (LABEL_MAX in shaders/shared/labels.h, asserted equal in
+// passes/placement.cpp): placement keeps each label's state in fixed GPU arrays of this size.
+inline constexpr int kMaxLabels = 256;
 
 struct SceneSettings {
   int layer_count = 4;  // 1 to kMaxLayers

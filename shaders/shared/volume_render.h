@@ -1,6 +1,7 @@
 // Rendering of transparent meshes and volumes through the HA-Buffer (a hashed A-buffer of mesh
 // fragments) and its resolve, which adds each volume's box by a ray-box test, ray-casts every
-// volume active between consecutive fragments and writes one image per depth layer. Constants, bindings and GPU structs are written once here for C++ and GLSL.
+// volume active between consecutive fragments and writes one image per depth layer. Constants,
+// bindings and GPU structs are written once here for C++ and GLSL.
 #ifndef STRATA_SHARED_VOLUME_RENDER_H
 #define STRATA_SHARED_VOLUME_RENDER_H
 
@@ -10,10 +11,10 @@
 #define VR_MAX_LAYERS 8
 #define VR_MAX_MESH_FRAGMENTS 16  // per pixel in the resolve; more are counted, not drawn
 #define VR_MAX_FRAGMENTS (VR_MAX_MESH_FRAGMENTS + 2 * VR_MAX_VOLUMES)  // with the boxes' faces
-#define VR_MAX_AGE 255       // probes per insertion before a fragment counts as overflow
-#define VR_TF_SIZE 256       // entries per transfer-function row
-#define VR_BRICK 8           // voxels per brick edge for empty-space skipping
-#define VR_RESOLVE_GROUP 8   // resolve workgroup is 8 x 8 pixels
+#define VR_MAX_AGE 255      // probes per insertion before a fragment counts as overflow
+#define VR_TF_SIZE 256      // entries per transfer-function row
+#define VR_BRICK 8          // voxels per brick edge for empty-space skipping
+#define VR_RESOLVE_GROUP 8  // resolve workgroup is 8 x 8 pixels
 
 // Payload kinds (bits 8..9 of payload.y); bit 10: the fragment enters its volume.
 #define VR_KIND_MESH 0u
@@ -26,7 +27,8 @@
 #define VR_COUNTER_SAMPLES 3           // ray positions sampled
 #define VR_COUNTER_SHADED 4            // volume samples shaded (alpha > 0)
 #define VR_COUNTER_FETCHES 5           // atlas fetches (one per live volume per sample)
-#define VR_COUNTER_COUNT 6
+#define VR_COUNTER_TABLE_SIZE 6        // the table's slots in the frame these counters count
+#define VR_COUNTER_COUNT 7
 
 #define VR_BINDING_FRAME 0
 #define VR_BINDING_VOLUMES 1

@@ -117,6 +117,10 @@ glm::dvec3 unit(const fs::path& file, const std::vector<double>& v, size_t first
 void read_position(const Elements& e, Slice& s) {
   const auto position = e.numbers(0x0020, 0x0032, "ImagePositionPatient", 3);
   s.position = glm::dvec3(position[0], position[1], position[2]);
+  if (!std::isfinite(float(s.position.x)) || !std::isfinite(float(s.position.y)) ||
+      !std::isfinite(float(s.position.z)))
+    fail(e.path(), concat("ImagePositionPatient = ", position[0], " ", position[1], " ",
+                          position[2], ": the position must be finite numbers"));
 }
 
 void read_orientation(const Elements& e, Slice& s) {
@@ -139,6 +143,13 @@ void read_pixel_measures(const Elements& e, Slice& s) {
 void read_rescale(const Elements& e, Slice& s) {
   s.rescale.slope = e.numbers(0x0028, 0x1053, "RescaleSlope", 1, 1.0)[0];
   s.rescale.intercept = e.numbers(0x0028, 0x1052, "RescaleIntercept", 1, 0.0)[0];
+  // Unlike NIfTI's scl_slope, DICOM has no "0 means none": such a value is a broken file.
+  if (!std::isfinite(s.rescale.slope) || s.rescale.slope == 0.0)
+    fail(e.path(),
+         concat("RescaleSlope = ", s.rescale.slope, ": expected a finite, non-zero number"));
+  if (!std::isfinite(s.rescale.intercept))
+    fail(e.path(),
+         concat("RescaleIntercept = ", s.rescale.intercept, ": expected a finite number"));
 }
 
 void read_frame_content(const Elements& e, Slice& s) {
@@ -524,7 +535,7 @@ void decode(Volume& volume, const std::vector<Slice>& slices, size_t bytes) {
 }
 
 // The volume of checked slices; `where` (the folder or file) names it in errors.
-Volume assemble(const fs::path& where, std::vector<Slice> slices) {
+Volume assemble(const fs::path& where, std::vector<Slice> slices, const VolumeLimits& limits) {
   for (const Slice& s : slices) check_consistent(where, slices.front(), s);
   const Slice& first = slices.front();
   const glm::dvec3 normal = glm::normalize(glm::cross(first.row_cosine, first.column_cosine));
@@ -537,7 +548,7 @@ Volume assemble(const fs::path& where, std::vector<Slice> slices) {
   const size_t bytes = checked_voxel_bytes(
       where,
       first.frames_in_file > 1 ? "Columns x Rows x NumberOfFrames" : "Columns x Rows x files", dims,
-      stored_size(stored));
+      stored_size(stored), limits);
   Volume volume;
   volume.name = volume_name(where);
   volume.source = where;
@@ -550,7 +561,8 @@ Volume assemble(const fs::path& where, std::vector<Slice> slices) {
   finish_voxels(volume, {.stored = stored,
                          .big_endian = std::endian::native == std::endian::big,
                          .per_slice = rescales(slices),
-                         .int16_when_exact = true});
+                         .int16_when_exact = true,
+                         .rescale_field = "RescaleSlope, RescaleIntercept"});
   return volume;
 }
 
@@ -573,7 +585,7 @@ Volume load_dicom_series(const std::filesystem::path& folder, const VolumeReadOp
   std::vector<Slice> slices = read_folder(folder);
   // A folder holding one multi-frame file: errors about its frames name the file.
   const fs::path where = slices.front().frames_in_file > 1 ? slices.front().file : folder;
-  Volume volume = assemble(where, std::move(slices));
+  Volume volume = assemble(where, std::move(slices), options.limits);
   volume.name = volume_name(folder);
   volume.source = folder;
   return volume;
@@ -589,7 +601,7 @@ Volume load_dicom_file(const std::filesystem::path& path, const VolumeReadOption
   std::vector<Slice> slices = read_file_slices(path);
   if (slices.empty())
     fail(path, "not a DICOM image (no Rows and Columns: a DICOMDIR, report or other object)");
-  return assemble(path, std::move(slices));
+  return assemble(path, std::move(slices), options.limits);
 }
 
 }  // namespace strata

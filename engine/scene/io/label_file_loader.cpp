@@ -10,7 +10,6 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
-#include <regex>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -406,14 +405,31 @@ std::string string(const json& value, const Field& field) {
   return value.get<std::string>();
 }
 
+// Whether `schema` ends "markups-schema-v1.X.Y.json", then any '#'. Read from the end by hand:
+// std::regex matched ".*" by recursion, a stack frame per character, and a long "@schema"
+// overflowed the stack.
+bool is_schema_v1(std::string_view schema) {
+  while (schema.ends_with('#')) schema.remove_suffix(1);
+  if (!schema.ends_with(".json")) return false;
+  schema.remove_suffix(5);
+  for (int number = 0; number < 2; ++number) {  // Y, then X, each after a dot
+    // All digits: find_last_not_of gives npos, and npos + 1 wraps to 0.
+    const size_t digits = schema.size() - (schema.find_last_not_of("0123456789") + 1);
+    if (digits == 0) return false;
+    schema.remove_suffix(digits);
+    if (!schema.ends_with('.')) return false;
+    schema.remove_suffix(1);
+  }
+  return schema.ends_with("markups-schema-v1");
+}
+
 // Slicer reads every schema version 1.x.y: control points kept their shape since 1.0.0.
 void check_schema(const json& root, const Field& field) {
   if (!root.is_object() || !root.contains("@schema"))
     field.fail("not a 3D Slicer markups file (no \"@schema\")");
   const Field schema_field = field / "@schema";
   const std::string schema = string(root["@schema"], schema_field);
-  static const std::regex version_1(R"(.*markups-schema-v1\.[0-9]+\.[0-9]+\.json#*)");
-  if (!std::regex_match(schema, version_1)) {
+  if (!is_schema_v1(schema)) {
     schema_field.fail("'" + schema +
                       "' is not a Slicer markups schema this strata reads "
                       "(markups-schema-v1.x.y.json)");

@@ -5,6 +5,9 @@
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
+#include <fstream>
+#include <string_view>
+
 #include "engine/core/error.h"
 
 namespace strata {
@@ -86,15 +89,89 @@ void collect(const aiScene& scene, const aiNode& node, const glm::mat4& parent,
   }
 }
 
-}  // namespace
+uint32_t little_endian_u32(const unsigned char* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
 
-std::vector<Mesh> load_meshes(const std::filesystem::path& path) {
+// Binary glTF: Assimp allocates what a chunk header claims before it reads it (a 4 GB claim in a
+// 2 KB file: 30 s and 4 GB of memory, then "No suitable reader found"). Every chunk must fit.
+void check_glb(const std::string& file, std::ifstream& in, uint64_t size) {
+  unsigned char header[12];
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(header), sizeof header))
+    throw Error(file + ": GLB header: 12 bytes needed, the file has " + std::to_string(size));
+  const uint32_t version = little_endian_u32(header + 4), length = little_endian_u32(header + 8);
+  if (length > size)
+    throw Error(file + ": GLB header: length " + std::to_string(length) + " bytes, the file has " +
+                std::to_string(size));
+  if (version != 2) return;  // glTF 1's binary container has one content length, checked above
+  uint64_t offset = sizeof header;
+  for (int chunk = 0; offset + 8 <= length; ++chunk) {
+    unsigned char chunk_header[8];
+    in.seekg(std::streamoff(offset));
+    if (!in.read(reinterpret_cast<char*>(chunk_header), sizeof chunk_header)) break;
+    const uint32_t bytes = little_endian_u32(chunk_header);
+    const uint32_t type = little_endian_u32(chunk_header + 4);
+    const std::string name = type == 0x4E4F534Au ? " (JSON)" : type == 0x004E4942u ? " (BIN)" : "";
+    const uint64_t after = length - offset - 8;
+    if (bytes > after)
+      throw Error(file + ": GLB chunk " + std::to_string(chunk) + name + ": length " +
+                  std::to_string(bytes) + " bytes, the file has " + std::to_string(after) +
+                  " after the chunk header");
+    offset += 8 + uint64_t{bytes};
+  }
+}
+
+// PLY: a header without its "end_header" line (a file cut inside it) sends Assimp's reader into
+// an endless loop. The line is searched for through the whole file, in pieces.
+void check_ply(const std::string& file, std::ifstream& in) {
+  static constexpr std::string_view line = "\nend_header";
+  in.seekg(0);
+  std::string window;
+  std::vector<char> piece(1 << 16);
+  while (in.read(piece.data(), std::streamsize(piece.size())) || in.gcount() > 0) {
+    window.append(piece.data(), size_t(in.gcount()));
+    for (size_t at = window.find(line); at != std::string::npos; at = window.find(line, at + 1)) {
+      size_t end = at + line.size();
+      while (end < window.size() &&
+             (window[end] == ' ' || window[end] == '\t' || window[end] == '\r'))
+        ++end;
+      if (end < window.size() && window[end] == '\n') return;
+      if (end == window.size()) break;  // the rest of the line is in the next piece
+    }
+    // Keep a tail long enough for a line that straddles two pieces.
+    if (window.size() > 4096) window.erase(0, window.size() - 4096);
+    if (!in) break;
+  }
+  throw Error(file + ": PLY header: no 'end_header' line (the file is cut short or damaged)");
+}
+
+// Structural checks of what Assimp would take badly, where a check is complete and cheap: the
+// errors name the field instead of a parser going down.
+void check_structure(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[5] = {};
+  in.read(magic, 4);
+  in.clear();
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  if (std::string_view(magic, 4) == "glTF") check_glb(path.string(), in, size);
+  if (std::string_view(magic, 4) == "ply\n" || std::string_view(magic, 4) == "ply\r")
+    check_ply(path.string(), in);
+}
+
+void check_file(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
     throw Error(file + ": " + (std::filesystem::exists(path, ec) ? "not a file" : "no such file"));
   }
   if (std::filesystem::file_size(path, ec) == 0) throw Error(file + ": empty file");
+  check_structure(path);
+}
+
+std::vector<Mesh> read_with_assimp(const std::filesystem::path& path) {
+  const std::string file = path.string();
   Assimp::Importer importer;
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -110,6 +187,23 @@ std::vector<Mesh> load_meshes(const std::filesystem::path& path) {
     if (meshes[i].name.empty()) meshes[i].name = path.stem().string() + "#" + std::to_string(i);
   }
   return meshes;
+}
+
+}  // namespace
+
+std::vector<Mesh> load_meshes(const std::filesystem::path& path, const ParserLimits& limits) {
+  check_file(path);
+  return read_meshes_isolated(path, "the mesh reader (Assimp)", limits,
+                              [&] { return read_with_assimp(path); });
+}
+
+std::vector<Mesh> load_meshes(const std::filesystem::path& path) {
+  return load_meshes(path, {});
+}
+
+std::vector<Mesh> load_meshes_in_process(const std::filesystem::path& path) {
+  check_file(path);
+  return read_with_assimp(path);
 }
 
 }  // namespace strata

@@ -157,9 +157,7 @@ InputFile::Source data_source(const MetaHeader& header, uint64_t bytes) {
     fail(path, concat("ElementDataFile = ", name, ": file lists and patterns are not supported"));
   source.file = path.parent_path() / name;
   source.what = concat("ElementDataFile '", name, "'");
-  std::error_code error;
-  const uint64_t size = fs::file_size(source.file, error);
-  if (error) fail(path, concat(source.what, ": no such file (", source.file.string(), ")"));
+  const uint64_t size = data_file_size(path, source.what, source.file);
   if (const auto text = header.get({"HeaderSize"})) {
     const int64_t skip = parse_exactly<int64_t, 1>(path, "HeaderSize", *text)[0];
     // -1 means "the data is at the end of the file, after a header of unknown size".
@@ -267,7 +265,8 @@ Volume load_metaimage(const std::filesystem::path& path, const VolumeReadOptions
   const std::array<int64_t, 3> dims{sizes[0], sizes[1], ndims > 2 ? sizes[2] : 1};
   const int64_t frames = ndims == 4 ? sizes[3] : 1;
   if (frames < 1) fail(path, concat("DimSize: the fourth size is ", frames, ": must be positive"));
-  const size_t bytes = checked_voxel_bytes(path, "DimSize", dims, stored_size(stored));
+  const size_t bytes =
+      checked_voxel_bytes(path, "DimSize", dims, stored_size(stored), options.limits);
   uint64_t all_frames_bytes = 0;
   if (__builtin_mul_overflow(uint64_t{bytes}, uint64_t(frames), &all_frames_bytes))
     fail(path, "DimSize: voxel count overflows");
@@ -280,6 +279,7 @@ Volume load_metaimage(const std::filesystem::path& path, const VolumeReadOptions
   set_geometry(volume, header, ndims);
   if (ndims == 2)  // one slice: k is its normal
     volume.direction[2] = glm::normalize(glm::cross(volume.direction[0], volume.direction[1]));
+  check_geometry(path, "Offset", "TransformMatrix", volume);
   bool big_endian = false;
   if (const auto msb = header.get({"BinaryDataByteOrderMSB", "ElementByteOrderMSB"}))
     big_endian = parse_bool(path, "BinaryDataByteOrderMSB", *msb);

@@ -251,12 +251,17 @@ void set_geometry(Volume& volume, const NiftiHeader& h, const fs::path& path) {
     const double length = glm::length(axis);
     if (!std::isfinite(length) || length <= 0.0)
       fail(path, concat(h.sform_code > 0 ? "srow_x/y/z" : "qform", " column ", col,
-                        ": spacing must be positive (the column has zero length)"));
+                        length > 0.0 ? ": the column's length is not a finite number"
+                                     : ": spacing must be positive (the column has zero length)"));
     volume.spacing[col] = static_cast<float>(length);
     volume.direction[col] = glm::vec3(axis / length);
   }
   for (int row = 0; row < 3; ++row)
     volume.origin[row] = static_cast<float>(to_lps[row] * m[size_t(row)][3]);
+  if (h.sform_code > 0)
+    check_geometry(path, "srow_x/y/z[3]", "srow_x/y/z", volume);
+  else
+    check_geometry(path, "qoffset_x/y/z", "quatern_b/c/d", volume);
 }
 
 }  // namespace
@@ -270,7 +275,8 @@ Volume load_nifti(const std::filesystem::path& path, const VolumeReadOptions& op
   check_magic(h, path);
   const StoredType stored = stored_type(h, path);
   const Extent extent = image_extent(h, path);
-  const size_t bytes = checked_voxel_bytes(path, "dim[1..3]", extent.dims, stored_size(stored));
+  const size_t bytes =
+      checked_voxel_bytes(path, "dim[1..3]", extent.dims, stored_size(stored), options.limits);
   const uint64_t frame = choose_frame(path, uint64_t(extent.frames), options, warnings);
 
   Volume volume;
@@ -287,7 +293,10 @@ Volume load_nifti(const std::filesystem::path& path, const VolumeReadOptions& op
                       "file's end"));
   skip_frames(in, frame, bytes);
   read_voxels(in, bytes, volume);
-  finish_voxels(volume, {.stored = stored, .big_endian = h.big_endian, .per_slice = {h.rescale}});
+  finish_voxels(volume, {.stored = stored,
+                         .big_endian = h.big_endian,
+                         .per_slice = {h.rescale},
+                         .rescale_field = "scl_slope, scl_inter"});
   return volume;
 }
 

@@ -232,6 +232,7 @@ void set_geometry(Volume& volume, const NrrdHeader& header, int rank) {
     if (origin.size() != 1 || !origin[0]) fail(path, "space origin: expected one (x,y,z) vector");
     volume.origin = glm::vec3(to_lps(header) * vector3(path, "space origin", *origin[0]));
   }
+  check_geometry(path, "space origin", "space directions", volume);
 }
 
 bool is_gzip_encoding(const NrrdHeader& header) {
@@ -262,9 +263,7 @@ InputFile::Source data_source(const NrrdHeader& header, bool gzip) {
       fail(path, concat("data file: '", *name, "': file lists and patterns are not supported"));
     source.file = path.parent_path() / *name;
     source.what = concat("data file '", *name, "'");
-    std::error_code error;
-    if (!fs::is_regular_file(source.file, error))
-      fail(path, concat(source.what, ": no such file (", source.file.string(), ")"));
+    data_file_size(path, source.what, source.file);
   } else {
     source.what = "the data after the header";
     source.offset = header.data_offset;
@@ -289,7 +288,8 @@ Volume load_nrrd(const std::filesystem::path& path, const VolumeReadOptions& opt
   const NrrdHeader header = parse_header(path);
   const Extent extent = image_extent(header);
   const StoredType stored = element_type(header);
-  const size_t bytes = checked_voxel_bytes(path, "sizes", extent.dims, stored_size(stored));
+  const size_t bytes =
+      checked_voxel_bytes(path, "sizes", extent.dims, stored_size(stored), options.limits);
   uint64_t all_frames_bytes = 0;
   if (__builtin_mul_overflow(uint64_t{bytes}, uint64_t(extent.frames), &all_frames_bytes))
     fail(path, "sizes: voxel count overflows");

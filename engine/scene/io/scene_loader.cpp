@@ -134,8 +134,8 @@ std::string base_name(const std::filesystem::path& path) {
 
 class SceneReader {
  public:
-  explicit SceneReader(const std::filesystem::path& path)
-      : file_(path.string()), folder_(path.parent_path()) {
+  SceneReader(const std::filesystem::path& path, const VolumeLimits& limits)
+      : file_(path.string()), folder_(path.parent_path()), limits_(limits) {
     scene_.source = path;
   }
 
@@ -158,6 +158,7 @@ class SceneReader {
 
   std::string file_;
   std::filesystem::path folder_;
+  VolumeLimits limits_;
   Scene scene_;
   std::map<std::filesystem::path, int> transfer_function_by_file_;
 };
@@ -184,7 +185,7 @@ int SceneReader::transfer_function(const json& value, const Field& field) {
 void SceneReader::volume(const json& object, const Field& field) {
   check_keys(object, field, {"name", "file", "frame", "transfer_function", "transform"});
   const std::filesystem::path path = resolve(required(object, field, "file"), field / "file");
-  VolumeReadOptions options;
+  VolumeReadOptions options{.limits = limits_};
   if (const json* frame = optional(object, "frame")) {
     options.frame = integer(*frame, field / "frame");
     if (*options.frame < 0) (field / "frame").fail("expected an integer >= 0");
@@ -281,8 +282,9 @@ void SceneReader::atlas(const json& object, const Field& field) {
   const std::vector<AtlasRegion> regions = atlas_regions(object, field);
   const std::filesystem::path labels_path =
       resolve(required(object, field, "labels"), field / "labels");
-  const Volume labels =
-      (field / "labels").wrap([&] { return load_volume(labels_path, {}, scene_.warnings); });
+  const Volume labels = (field / "labels").wrap([&] {
+    return load_volume(labels_path, {.limits = limits_}, scene_.warnings);
+  });
   // atlas_labels skips regions without voxels, so its result says which regions "limit" counts.
   const std::vector<Label> centroids = atlas_labels(labels, regions);
   int kept = 0;
@@ -431,7 +433,7 @@ Scene SceneReader::read(const json& root) {
   }
   if (root["strata_scene"] != 1) {
     (field / "strata_scene")
-        .fail("version " + root["strata_scene"].dump() +
+        .fail("version " + json_for_message(root["strata_scene"]) +
               " is not supported (this strata reads version 1)");
   }
   check_keys(root, field,
@@ -461,17 +463,17 @@ Scene SceneReader::read(const json& root) {
 
 }  // namespace
 
-Scene load_scene_json(const std::filesystem::path& path) {
-  return SceneReader(path).read(read_json_file(path));
+Scene load_scene_json(const std::filesystem::path& path, const VolumeLimits& limits) {
+  return SceneReader(path, limits).read(read_json_file(path));
 }
 
 Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& options) {
   const std::string extension = path.extension().string();
   Scene scene;
   if (extension == ".json") {
-    scene = load_scene_json(path);
+    scene = load_scene_json(path, options.limits);
   } else if (extension == ".xml") {
-    scene = import_voly_scene(path);
+    scene = import_voly_scene(path, options.limits);
   } else if (is_volume_path(path)) {
     scene = scene_from_volume(path, options);
   } else {
@@ -485,6 +487,9 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
     for (Label& l : load_label_file(options.labels, next_label_id(scene)))
       scene.labels.push_back(std::move(l));
   }
+  if (scene.labels.size() > size_t(kMaxLabels))
+    throw Error(path.string() + ": " + std::to_string(scene.labels.size()) +
+                " labels; strata places at most " + std::to_string(kMaxLabels) + " in a scene");
   complete_scene(scene, options.preset);
   return scene;
 }
@@ -498,8 +503,7 @@ int next_label_id(const Scene& scene) {
 Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOptions& options) {
   Scene scene;
   scene.source = path;
-  VolumeReadOptions read;
-  read.frame = options.frame;
+  const VolumeReadOptions read{.frame = options.frame, .limits = options.limits};
   scene.volumes.push_back(load_volume(path, read, scene.warnings));
   Volume& volume = scene.volumes.back();
   if (volume.name.empty()) volume.name = base_name(path.lexically_normal());

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "engine/scene/io/volume_loader.h"
 #include "engine/scene/scene.h"
 
 namespace strata {
@@ -17,6 +18,7 @@ struct SceneOpenOptions {
   std::string preset;            // every volume's transfer function: this preset
   std::filesystem::path labels;  // labels from this file (load_label_file) added
   std::optional<int> frame;      // a 4-D volume opened directly: this frame
+  VolumeLimits limits;           // every volume read, checked from its header (volume_loader.h)
 };
 
 // A scene file, .json (strata) or .xml (thesis import), or a volume file or DICOM folder opened
@@ -37,13 +39,13 @@ int next_label_id(const Scene& scene);
 
 // strata scene JSON, version 1. Paths in it are relative to the scene file's folder. Unknown keys
 // are errors (they are almost always typos), and so is a referenced file that does not load.
-Scene load_scene_json(const std::filesystem::path& path);
+Scene load_scene_json(const std::filesystem::path& path, const VolumeLimits& limits = {});
 
 // A voly-labeller scene (Boost serialization XML): camera, named camera positions, labels,
 // volumes and meshes. Referenced files are looked up relative to the scene's folder and its
 // ancestors (the thesis program resolved them from its working folder); one that is found
 // nowhere is skipped with a warning. Implemented in voly_scene_import.cpp.
-Scene import_voly_scene(const std::filesystem::path& path);
+Scene import_voly_scene(const std::filesystem::path& path, const VolumeLimits& limits = {});
 
 // Writes strata scene JSON, version 1, with paths relative to the new file's folder and transfer
 // functions inline. Volumes and meshes without a source file (atlas masks and surfaces) cannot

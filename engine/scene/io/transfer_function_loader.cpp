@@ -125,7 +125,7 @@ TransferFunction transfer_function_from_json(const json& object, const std::stri
   }
   if (object.contains("strata_transfer_function") && object["strata_transfer_function"] != 1) {
     fail(file, child(field, "strata_transfer_function"),
-         "version " + object["strata_transfer_function"].dump() +
+         "version " + json_for_message(object["strata_transfer_function"]) +
              " is not supported (this strata reads version 1)");
   }
   TransferFunction tf;

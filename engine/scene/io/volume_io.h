@@ -52,9 +52,14 @@ inline constexpr uint64_t max_voxel_bytes = uint64_t{1} << 34;  // 16 GiB
 
 // The byte count of dims[0] x dims[1] x dims[2] elements, after checking that every dimension is
 // positive and fits Volume::dims, that the product does not overflow and stays under
-// max_voxel_bytes. `field` names the header field in errors ("dim[1..3]", "DimSize", "sizes").
+// max_voxel_bytes, and that the volume fits the limits (the machine's memory, the device).
+// `field` names the header field in errors ("dim[1..3]", "DimSize", "sizes").
 size_t checked_voxel_bytes(const std::filesystem::path& file, std::string_view field,
-                           const std::array<int64_t, 3>& dims, size_t element_size);
+                           const std::array<int64_t, 3>& dims, size_t element_size,
+                           const VolumeLimits& limits);
+
+// The machine's physical memory in bytes.
+uint64_t physical_memory_bytes();
 
 // Dimensions that passed checked_voxel_bytes, as Volume holds them.
 inline glm::uvec3 to_dims(const std::array<int64_t, 3>& dims) {
@@ -65,6 +70,14 @@ inline glm::uvec3 to_dims(const std::array<int64_t, 3>& dims) {
 // Spacing must be finite and positive; `field` names where it came from.
 void check_spacing(const std::filesystem::path& file, std::string_view field,
                    const std::array<double, 3>& spacing);
+
+// The volume's spacing, origin and direction as a reader set them: spacing positive, every number
+// finite (in float range),
+// each direction column of unit length (within 10%; then made exact) and the three columns
+// spanning space, not lying in a plane. `origin_field` and `direction_field` name the header
+// fields in errors ("qoffset_x/y/z", "TransformMatrix", ...).
+void check_geometry(const std::filesystem::path& file, std::string_view origin_field,
+                    std::string_view direction_field, Volume& volume);
 
 // ---- reading
 
@@ -121,8 +134,12 @@ void read_voxels(InputFile& in, size_t bytes, Volume& volume);
 // Up to max_bytes from the start of a file (headers of text formats).
 std::string read_prefix(const std::filesystem::path& file, size_t max_bytes);
 
-// Throws "<path>: no such file" when it does not exist; returns its size when it is a file.
+// check_input_file (engine/core/text_file.h): the size of a regular file, else one Error.
 uint64_t existing_file_size(const std::filesystem::path& file);
+// The size of a data file a header names (a FIFO there would block the reader): errors name the
+// header and `what` ("ElementDataFile 'a.raw': no such file (<file>)").
+uint64_t data_file_size(const std::filesystem::path& header, std::string_view what,
+                        const std::filesystem::path& file);
 
 // ---- 4-D images
 
@@ -158,6 +175,8 @@ struct Conversion {
   bool big_endian = false;
   std::vector<Rescale> per_slice;
   bool int16_when_exact = false;
+  // Names the slope and intercept in errors (a rescale that overflows float is one).
+  const char* rescale_field = "slope, intercept";
 };
 void finish_voxels(Volume& volume, const Conversion& conversion);
 

@@ -10,8 +10,11 @@
 #include <cstring>
 #include <system_error>
 
+#include <unistd.h>
+
 #include <zlib.h>
 
+#include "engine/core/text_file.h"
 #include "engine/scene/io/dicom_structure.h"
 #include "engine/scene/io/volume_io.h"
 
@@ -36,13 +39,19 @@ Format format_of(const std::filesystem::path& path) {
   return Format::none;
 }
 
+constexpr std::string_view kDicomReader = "the DICOM reader (GDCM)";
+
 Volume read_by_extension(const std::filesystem::path& path, const VolumeReadOptions& options,
                          std::vector<std::string>& warnings) {
   std::error_code error;
   if (!std::filesystem::exists(path, error)) volume_io::fail(path, "no such file");
   switch (format_of(path)) {
+    // GDCM reads in a child process: its assertions abort (a PALETTE COLOR image without a
+    // palette), and an abort there must be an Error here. The whole series is one child.
     case Format::dicom_folder:
-      return load_dicom_series(path, options, warnings);
+      return read_volume_isolated(
+          path, kDicomReader, options.parser, warnings,
+          [&](auto& child_warnings) { return load_dicom_series(path, options, child_warnings); });
     case Format::nifti:
       return load_nifti(path, options, warnings);
     case Format::metaimage:
@@ -50,7 +59,9 @@ Volume read_by_extension(const std::filesystem::path& path, const VolumeReadOpti
     case Format::nrrd:
       return load_nrrd(path, options, warnings);
     case Format::dicom_file:
-      return load_dicom_file(path, options, warnings);
+      return read_volume_isolated(
+          path, kDicomReader, options.parser, warnings,
+          [&](auto& child_warnings) { return load_dicom_file(path, options, child_warnings); });
     case Format::none:
       break;
   }
@@ -116,8 +127,44 @@ const char* to_string(StoredType type) {
   return names[static_cast<int>(type)];
 }
 
+uint64_t physical_memory_bytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page_size = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page_size > 0 ? uint64_t(pages) * uint64_t(page_size) : 0;
+}
+
+namespace {
+
+std::string gibibytes(uint64_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f GiB", double(bytes) / double(uint64_t{1} << 30));
+  return text;
+}
+
+void check_limits(const std::filesystem::path& file, const std::string& shown,
+                  const std::array<int64_t, 3>& dims, uint64_t bytes, const VolumeLimits& limits) {
+  // Loading holds the voxels and, while converting them, at most one more copy of their size.
+  const uint64_t memory = limits.memory_bytes ? limits.memory_bytes : physical_memory_bytes();
+  if (memory > 0 && bytes > memory / 2)
+    fail(file, concat(shown, ": the voxels need ", gibibytes(bytes),
+                      " twice while loading; this machine has ", gibibytes(memory), " of memory"));
+  if (limits.max_side > 0) {
+    for (int64_t d : dims)
+      if (uint64_t(d) > limits.max_side)
+        fail(file, concat(shown, ": the device (", limits.device, ") renders at most ",
+                          limits.max_side, " voxels per side"));
+  }
+  const uint64_t voxels = uint64_t(dims[0]) * uint64_t(dims[1]) * uint64_t(dims[2]);
+  if (limits.max_device_voxels > 0 && voxels > limits.max_device_voxels)
+    fail(file, concat(shown, ": ", voxels, " voxels; the device (", limits.device,
+                      ") holds at most ", limits.max_device_voxels, " (", limits.device_voxel_bytes,
+                      " bytes a voxel in the renderer's volume atlas, in its largest allocation)"));
+}
+
+}  // namespace
+
 size_t checked_voxel_bytes(const std::filesystem::path& file, std::string_view field,
-                           const std::array<int64_t, 3>& dims, size_t element_size) {
+                           const std::array<int64_t, 3>& dims, size_t element_size,
+                           const VolumeLimits& limits) {
   const std::string shown = concat(field, " = ", dims[0], "x", dims[1], "x", dims[2]);
   for (int64_t d : dims)
     if (d < 1) fail(file, shown + ": dimensions must be positive");
@@ -132,6 +179,7 @@ size_t checked_voxel_bytes(const std::filesystem::path& file, std::string_view f
       fail(file, shown + ": a dimension exceeds 4294967295");
   if (bytes > max_voxel_bytes)
     fail(file, concat(shown, ": ", bytes, " bytes of voxels, more than the 16 GiB strata accepts"));
+  check_limits(file, shown, dims, bytes, limits);
   return static_cast<size_t>(bytes);
 }
 
@@ -141,6 +189,34 @@ void check_spacing(const std::filesystem::path& file, std::string_view field,
     if (!std::isfinite(s) || s <= 0.0)
       fail(file, concat(field, " = ", spacing[0], " ", spacing[1], " ", spacing[2],
                         ": spacing must be positive"));
+}
+
+void check_geometry(const std::filesystem::path& file, std::string_view origin_field,
+                    std::string_view direction_field, Volume& volume) {
+  // Spacing taken from a matrix's column lengths (NIfTI sform, NRRD directions) is checked here;
+  // a length finite as a double can still overflow the float the volume keeps.
+  const glm::vec3 sp = volume.spacing;
+  if (!(std::isfinite(sp.x) && std::isfinite(sp.y) && std::isfinite(sp.z) && sp.x > 0.0f &&
+        sp.y > 0.0f && sp.z > 0.0f))
+    fail(file, concat(direction_field, ": spacing ", sp.x, " ", sp.y, " ", sp.z,
+                      " must be positive and finite"));
+  const glm::vec3 o = volume.origin;
+  if (!std::isfinite(o.x) || !std::isfinite(o.y) || !std::isfinite(o.z))
+    fail(file, concat(origin_field, " = ", o.x, " ", o.y, " ", o.z,
+                      ": the origin must be finite numbers"));
+  for (int axis = 0; axis < 3; ++axis) {
+    const glm::vec3 d = volume.direction[axis];
+    const float length = glm::length(d);
+    if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z) || !(length > 0.9f) ||
+        !(length < 1.1f))
+      fail(file, concat(direction_field, ": the direction of axis ", axis, " (", d.x, " ", d.y, " ",
+                        d.z, ") is not a unit vector"));
+    volume.direction[axis] = d / length;
+  }
+  if (!(std::fabs(glm::determinant(volume.direction)) > 1e-3f))
+    fail(file, concat(direction_field,
+                      ": the axes' directions lie in one plane (a singular matrix): the voxels "
+                      "have no place in space"));
 }
 
 // ---- reading
@@ -155,10 +231,11 @@ struct InputFile::Inflater {
 };
 
 InputFile::InputFile(Source source) : source_(std::move(source)) {
-  std::error_code error;
-  const uint64_t size = std::filesystem::file_size(source_.file, error);
+  const uint64_t size = source_.file == source_.report_as
+                            ? check_input_file(source_.file)
+                            : data_file_size(source_.report_as, source_.what, source_.file);
   in_.open(source_.file, std::ios::binary);
-  if (error || !in_) fail(source_.report_as, concat(source_.what, ": cannot open ", source_.file));
+  if (!in_) fail(source_.report_as, concat(source_.what, ": cannot open ", source_.file));
   file_bytes_left_ = source_.offset < size ? size - source_.offset : 0;
   in_.seekg(static_cast<std::streamoff>(std::min(source_.offset, size)));
   if (!source_.compressed) return;
@@ -274,17 +351,31 @@ void read_voxels(InputFile& in, size_t bytes, Volume& volume) {
 std::string read_prefix(const std::filesystem::path& file, size_t max_bytes) {
   std::ifstream in(file, std::ios::binary);
   if (!in) fail(file, "cannot open");
-  std::string text(max_bytes, '\0');
-  in.read(text.data(), static_cast<std::streamsize>(max_bytes));
+  // Headers are a few hundred bytes: allocating (and zeroing) the whole limit for each one made
+  // a header read cost a millisecond.
+  std::error_code error;
+  const uint64_t size = std::filesystem::file_size(file, error);
+  std::string text(error ? max_bytes : static_cast<size_t>(std::min<uint64_t>(size, max_bytes)),
+                   '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
   text.resize(static_cast<size_t>(in.gcount()));
   return text;
 }
 
-uint64_t existing_file_size(const std::filesystem::path& file) {
+uint64_t data_file_size(const std::filesystem::path& header, std::string_view what,
+                        const std::filesystem::path& file) {
   std::error_code error;
-  if (!std::filesystem::exists(file, error)) fail(file, "no such file");
-  if (!std::filesystem::is_regular_file(file, error)) fail(file, "not a file");
-  return std::filesystem::file_size(file, error);
+  if (!std::filesystem::exists(file, error))
+    fail(header, concat(what, ": no such file (", file.string(), ")"));
+  try {
+    return check_input_file(file);
+  } catch (const Error& e) {
+    fail(header, concat(what, ": ", e.what()));
+  }
+}
+
+uint64_t existing_file_size(const std::filesystem::path& file) {
+  return check_input_file(file);
 }
 
 uint64_t choose_frame(const std::filesystem::path& file, uint64_t frames,
@@ -452,6 +543,28 @@ void apply_rescale(Volume& volume, const std::vector<Rescale>& per_slice, bool i
 
 }  // namespace
 
+namespace {
+
+// A rescale that takes the stored values out of float's range would leave infinities in every
+// voxel it touches.
+void check_rescale(const Volume& volume, const Conversion& conversion) {
+  const auto applies = [](const Rescale& r) { return r.applies(); };
+  if (std::none_of(conversion.per_slice.begin(), conversion.per_slice.end(), applies)) return;
+  const glm::vec2 stored = compute_value_range(volume);
+  for (const Rescale& r : conversion.per_slice) {
+    if (!r.applies()) continue;
+    for (const double v : {double(stored.x), double(stored.y)}) {
+      const double result = r.slope * v + r.intercept;
+      if (!(std::fabs(result) <= double(std::numeric_limits<float>::max())))
+        fail(volume.source, concat(conversion.rescale_field, " = ", r.slope, ", ", r.intercept,
+                                   ": the stored value ", v, " becomes ", result,
+                                   ", outside the range of a 32-bit float"));
+    }
+  }
+}
+
+}  // namespace
+
 void finish_voxels(Volume& volume, const Conversion& conversion) {
   const size_t size = stored_size(conversion.stored);
   if (conversion.big_endian != (std::endian::native == std::endian::big))
@@ -465,6 +578,7 @@ void finish_voxels(Volume& volume, const Conversion& conversion) {
                                    [](Src v, size_t) { return static_cast<float>(v); });
     });
   }
+  check_rescale(volume, conversion);
   apply_rescale(volume, conversion.per_slice, conversion.int16_when_exact);
   volume.value_range = compute_value_range(volume);
 }

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/scene/io/isolated_read.h"
 #include "engine/scene/scene.h"
 
 namespace strata {
@@ -22,8 +23,21 @@ inline constexpr const char* kVolumeExtensions =
 // or a file that starts as DICOM does. Says nothing of whether it loads.
 bool is_volume_path(const std::filesystem::path& path);
 
+// What a volume may take, checked against its header before a voxel is read, so that a volume
+// that cannot fit is refused at once with the limit named instead of after minutes of reading.
+struct VolumeLimits {
+  uint64_t memory_bytes = 0;  // host memory for the voxels; 0: the machine's physical memory
+  // The device that will render it (set by the programs once it is open; 0 and "": none known).
+  uint32_t max_side = 0;            // voxels per side
+  uint64_t max_device_voxels = 0;   // voxels in one volume
+  uint32_t device_voxel_bytes = 0;  // bytes a voxel takes there (named in the message)
+  std::string device;
+};
+
 struct VolumeReadOptions {
   std::optional<int> frame;  // 4-D images: which frame (default 0)
+  VolumeLimits limits;
+  ParserLimits parser;  // DICOM: GDCM's child process (isolated_read.h)
 };
 
 // Picks the reader by extension (a folder is a DICOM series; a file with a DICOM preamble is

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -54,8 +55,9 @@ struct Node {
                 : value.substr(begin, value.find_last_not_of(" \t\r\n") + 1 - begin);
     double result = 0.0;
     const auto [rest, error] = std::from_chars(value.data(), value.data() + value.size(), result);
+    // Beyond float's range the conversion below is undefined (and gave inf).
     if (error != std::errc() || rest != value.data() + value.size() || value.empty() ||
-        !std::isfinite(result)) {
+        !(std::fabs(result) <= double(std::numeric_limits<float>::max()))) {
       fail("expected a number, got '" + value + "'");
     }
     return static_cast<float>(result);
@@ -77,7 +79,8 @@ struct Node {
 
 class VolyImporter {
  public:
-  explicit VolyImporter(const fs::path& path) : file_(path.string()) {
+  VolyImporter(const fs::path& path, const VolumeLimits& limits)
+      : file_(path.string()), limits_(limits) {
     scene_.source = path;
     for (fs::path folder = fs::absolute(path).parent_path();; folder = folder.parent_path()) {
       ancestors_.push_back(folder);
@@ -96,6 +99,7 @@ class VolyImporter {
   void warn(const std::string& what) { scene_.warnings.push_back(file_ + ": " + what); }
 
   std::string file_;
+  VolumeLimits limits_;
   std::vector<fs::path> ancestors_;  // the scene's folder, its parent, ..., the root
   Scene scene_;
 };
@@ -151,7 +155,9 @@ void VolyImporter::label(const Node& px) {
   Label label;
   const Node id = node.child("label.id");
   const float id_value = id.number();
-  if (id_value != std::floor(id_value)) id.fail("expected an integer");
+  // 2^31 is the first float past int's range; converting it or beyond is undefined.
+  if (id_value != std::floor(id_value) || !(id_value >= -0x1p31f && id_value < 0x1p31f))
+    id.fail("expected an integer from -2147483648 to 2147483647");
   label.id = int(id_value);
   label.text = node.child("label.text").text();
   label.anchor = node.child("label.anchorPosition").vec3();
@@ -181,7 +187,7 @@ void VolyImporter::volume(const Node& px) {
   if (!path) return warn("volume '" + reference + "' not found; skipped");
   Volume volume;
   try {
-    volume = load_volume(*path, {}, scene_.warnings);
+    volume = load_volume(*path, {.limits = limits_}, scene_.warnings);
   } catch (const Error& e) {
     path_node.fail(e.what());
   }
@@ -251,7 +257,7 @@ Scene VolyImporter::import(const pugi::xml_node& data) {
 
 }  // namespace
 
-Scene import_voly_scene(const fs::path& path) {
+Scene import_voly_scene(const fs::path& path, const VolumeLimits& limits) {
   const std::string file = path.string();
   const std::string text = read_text_file(path);
   pugi::xml_document document;
@@ -262,7 +268,7 @@ Scene import_voly_scene(const fs::path& path) {
   }
   const pugi::xml_node data = document.child("boost_serialization").child("data");
   if (!data) throw Error(file + ": not a voly-labeller scene (no <boost_serialization><data>)");
-  return VolyImporter(path).import(data);
+  return VolyImporter(path, limits).import(data);
 }
 
 }  // namespace strata
