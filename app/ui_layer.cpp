@@ -86,7 +86,8 @@ UiLayer::UiLayer(Context& ctx, GLFWwindow* window, float scale, uint32_t frames_
 }
 
 UiLayer::~UiLayer() {
-  vkDeviceWaitIdle(ctx_.device());
+  // A lost or hung device: what the GPU may still use is left, not destroyed (Context::drain).
+  if (!ctx_.drain()) return;
   for (VkFramebuffer f : framebuffers_) vkDestroyFramebuffer(ctx_.device(), f, nullptr);
   ImGui_ImplVulkan_Shutdown();
   if (window_) ImGui_ImplGlfw_Shutdown();

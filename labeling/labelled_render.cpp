@@ -116,7 +116,7 @@ void LabelledRenderer::set_label_scale(float scale) {
 
 void LabelledRenderer::set_label_text(float pixels, float scale) {
   check_label_text(pixels, scale);
-  vkDeviceWaitIdle(ctx_.device());  // the glyphs and the drawing's atlas are replaced
+  ctx_.wait_idle("a new label font");  // the glyphs and the drawing's atlas are replaced
   settings_.font_pixels = pixels;
   settings_.label_scale = scale;
   for (size_t i = 0; i < labels_.size(); ++i) labels_[i].size = scene_.labels[i].size;
