@@ -44,12 +44,15 @@ using Clock = std::chrono::steady_clock;
 constexpr uint64_t kMiB = uint64_t{1} << 20;
 constexpr uint64_t kGiB = uint64_t{1} << 30;
 
-// The result crosses the process boundary field by field (write_mesh, write_volume): a field
+// The result crosses the process boundary field by field (mesh_fields, volume_fields): a field
 // added to Mesh or Volume must be added there too, or it is silently lost for meshes and DICOM.
-static_assert(sizeof(Mesh) == 224,
-              "Mesh changed: update write_mesh and read_mesh (isolated_read.cpp)");
-static_assert(sizeof(Volume) == 256,
-              "Volume changed: update write_volume and read_volume (isolated_read.cpp)");
+static_assert(sizeof(Mesh) == 224, "Mesh changed: update mesh_fields (isolated_read.cpp)");
+static_assert(sizeof(Volume) == 256, "Volume changed: update volume_fields (isolated_read.cpp)");
+
+template <class T>
+constexpr bool is_vector = false;
+template <class T>
+constexpr bool is_vector<std::vector<T>> = true;
 
 enum class Outcome : uint8_t { value = 1, error = 2, out_of_memory = 3 };
 
@@ -137,6 +140,19 @@ struct Writer {
   void outcome(Outcome o) {
     outcome_sent = true;
     pod(o);
+  }
+  // One field of a result, by its type (mesh_fields, volume_fields).
+  template <class T>
+  void field(const T& value) {
+    if constexpr (std::is_same_v<T, std::string>) {
+      text(value);
+    } else if constexpr (std::is_same_v<T, std::filesystem::path>) {
+      text(value.string());
+    } else if constexpr (is_vector<T>) {
+      array(value);
+    } else {
+      pod(value);
+    }
   }
 };
 
@@ -304,6 +320,17 @@ class Child {
     v.resize(pod<uint64_t>());
     read(v.data(), v.size() * sizeof(T));
   }
+  // One field of a result, as Writer::field sent it.
+  template <class T>
+  void field(T& value) {
+    if constexpr (std::is_same_v<T, std::string> || std::is_same_v<T, std::filesystem::path>) {
+      value = text();
+    } else if constexpr (is_vector<T>) {
+      array(value);
+    } else {
+      value = pod<T>();
+    }
+  }
 
   // After the whole result: the child is ending on its own.
   void finish() {
@@ -441,56 +468,32 @@ void run_isolated(const fs::path& file, std::string_view parser, const ParserLim
   throw Error(file.string() + ": " + std::string(parser) + " sent an unreadable result");
 }
 
-void write_mesh(Writer& w, const Mesh& mesh) {
-  w.text(mesh.name);
-  w.text(mesh.source.string());
-  w.array(mesh.positions);
-  w.array(mesh.normals);
-  w.array(mesh.indices);
-  w.pod(mesh.color);
-  w.pod(mesh.transform);
+// Every field of a result, in one order for both ends: Writer::field in the child, Child::field
+// in strata.
+template <class Io, class M>
+void mesh_fields(Io& io, M& mesh) {
+  io.field(mesh.name);
+  io.field(mesh.source);
+  io.field(mesh.positions);
+  io.field(mesh.normals);
+  io.field(mesh.indices);
+  io.field(mesh.color);
+  io.field(mesh.transform);
 }
 
-Mesh read_mesh(Child& child) {
-  Mesh mesh;
-  mesh.name = child.text();
-  mesh.source = child.text();
-  child.array(mesh.positions);
-  child.array(mesh.normals);
-  child.array(mesh.indices);
-  mesh.color = child.pod<glm::vec4>();
-  mesh.transform = child.pod<glm::mat4>();
-  return mesh;
-}
-
-void write_volume(Writer& w, const Volume& volume) {
-  w.text(volume.name);
-  w.text(volume.source.string());
-  w.pod(volume.type);
-  w.pod(volume.dims);
-  w.pod(volume.spacing);
-  w.pod(volume.origin);
-  w.pod(volume.direction);
-  w.pod(volume.transform);
-  w.array(volume.voxels);
-  w.pod(volume.value_range);
-  w.pod(volume.transfer_function);
-}
-
-Volume read_volume(Child& child) {
-  Volume volume;
-  volume.name = child.text();
-  volume.source = child.text();
-  volume.type = child.pod<VoxelType>();
-  volume.dims = child.pod<glm::uvec3>();
-  volume.spacing = child.pod<glm::vec3>();
-  volume.origin = child.pod<glm::vec3>();
-  volume.direction = child.pod<glm::mat3>();
-  volume.transform = child.pod<glm::mat4>();
-  child.array(volume.voxels);
-  volume.value_range = child.pod<glm::vec2>();
-  volume.transfer_function = child.pod<int>();
-  return volume;
+template <class Io, class V>
+void volume_fields(Io& io, V& volume) {
+  io.field(volume.name);
+  io.field(volume.source);
+  io.field(volume.type);
+  io.field(volume.dims);
+  io.field(volume.spacing);
+  io.field(volume.origin);
+  io.field(volume.direction);
+  io.field(volume.transform);
+  io.field(volume.voxels);
+  io.field(volume.value_range);
+  io.field(volume.transfer_function);
 }
 
 }  // namespace
@@ -518,11 +521,11 @@ std::vector<Mesh> read_meshes_isolated(const std::filesystem::path& file, std::s
         const std::vector<Mesh> result = read();
         w.outcome(Outcome::value);
         w.pod(uint64_t{result.size()});
-        for (const Mesh& mesh : result) write_mesh(w, mesh);
+        for (const Mesh& mesh : result) mesh_fields(w, mesh);
       },
       [&](Child& child) {
         meshes.resize(child.pod<uint64_t>());
-        for (Mesh& mesh : meshes) mesh = read_mesh(child);
+        for (Mesh& mesh : meshes) mesh_fields(child, mesh);
       });
   return meshes;
 }
@@ -537,12 +540,12 @@ Volume read_volume_isolated(const std::filesystem::path& file, std::string_view 
         std::vector<std::string> child_warnings;
         const Volume result = read(child_warnings);
         w.outcome(Outcome::value);
-        write_volume(w, result);
+        volume_fields(w, result);
         w.pod(uint64_t{child_warnings.size()});
         for (const std::string& warning : child_warnings) w.text(warning);
       },
       [&](Child& child) {
-        volume = read_volume(child);
+        volume_fields(child, volume);
         const auto count = child.pod<uint64_t>();
         for (uint64_t i = 0; i < count; ++i) warnings.push_back(child.text());
       });
