@@ -151,8 +151,9 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
   b.tidy = graph.add_buffer("placement.tidy", fixed(n * sizeof(gpu::TidyGpu)));
   b.tidy_rounds =
       graph.add_buffer("placement.tidy_rounds", fixed((TIDY_ROUNDS_MAX + 1) * sizeof(uint32_t)));
-  b.regions = graph.add_buffer("placement.regions",
-                               fixed(VkDeviceSize{n} * n * sizeof(gpu::PairRegionsGpu)));
+  b.regions = graph.add_buffer(
+      "placement.regions",
+      fixed(VkDeviceSize{gpu::placement_pair_count(n)} * sizeof(gpu::PairRegionsGpu)));
   b.readback = readback_.import(graph, "placement.readback");
   return b;
 }
@@ -168,8 +169,7 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                    {b.buckets, Use::transfer_dst},
                    {b.lower, Use::transfer_dst},
                    {b.speculative, Use::transfer_dst},
-                   {b.samples, Use::transfer_dst},
-                   {b.regions, Use::transfer_dst}},
+                   {b.samples, Use::transfer_dst}},
                   [this, b](graph::PassContext& pc) {
                     if (!labels_.empty()) {
                       vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.labels), 0,
@@ -189,7 +189,9 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                     // (each speculative workgroup writes its tile's entry before anything reads it)
                     fill(b.speculative, 0xFFFFFFFFu);
                     fill(b.samples, 0xFFFFFFFFu);
-                    fill(b.regions, 0);  // a label that is never placed constrains nobody
+                    // (placement.regions needs none: the loop writes each pair, from the placed
+                    // label's result, before a later label reads it; a label never placed
+                    // writes regions that constrain nobody)
                   },
                   "placement"});
 }
@@ -278,7 +280,8 @@ graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
       {b.tiles, Use::storage_read_write, PLACEMENT_BINDING_TILES},
       {b.args, Use::storage_read_write, PLACEMENT_BINDING_ARGS},
       {b.speculative, Use::storage_read_write, PLACEMENT_BINDING_SPECULATIVE},
-      {b.regions, Use::storage_read_write, PLACEMENT_BINDING_REGIONS},
+      // (written: the loop writes every pair before it reads it, ARCHITECTURE.md)
+      {b.regions, Use::storage_write, PLACEMENT_BINDING_REGIONS},
       {b.samples, Use::storage_read_write, PLACEMENT_BINDING_SAMPLES}};
   // (direct: the sizes are still written, but nothing waits for them)
   if (indirect_) uses.push_back({b.args, Use::indirect});
@@ -341,7 +344,9 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
              const uint32_t threads = phase == TIDY_PHASE_SEARCH ? changes * TIDY_SEARCH_LANES
                                       : per_label_group          ? n * 64
                                                                  : n;
-             pc.dispatch(finalize_, p, {threads, 1, 1});
+             // (the search's workgroups pass 65535 from about 900 labels: rows of them)
+             const uint32_t groups = (threads + 63) / 64;
+             pc.dispatch_groups(finalize_, p, gpu::placement_dispatch_size(groups));
            }
          }
          pc.barrier();

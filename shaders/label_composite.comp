@@ -27,6 +27,7 @@ void main() {
   const vec2 tile_hi = tile_lo + float(LABEL_DRAW_GROUP - 1u);
   const uint count = min(min(params.label_count, LABEL_MAX),
                          uint(min(labels.length(), placements.length())));
+  const uint words = (count + 31u) / 32u;  // (the bit set's words in use)
   const uint layer_count = min(params.layer_count, uint(VR_MAX_LAYERS));
   for (uint i = lane; i < count; i += lanes) {
     const LabelGpu label = labels[i];
@@ -52,7 +53,7 @@ void main() {
   }
   vec4 result = label_over_background(accumulated, params.background.rgb);
   const vec2 p = vec2(px) + 0.5;
-  for (uint w = 0u; w < LABEL_MAX / 32u; ++w) {
+  for (uint w = 0u; w < words; ++w) {
     uint bits = tile_labels[w];
     while (bits != 0u) {
       const uint i = w * 32u + uint(findLSB(bits));

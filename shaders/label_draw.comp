@@ -45,6 +45,7 @@ void main() {
   const vec2 tile_lo = vec2(gl_WorkGroupID.xy * LABEL_DRAW_GROUP) + 0.5f;
   const vec2 tile_hi = tile_lo + float(LABEL_DRAW_GROUP - 1u);
   const uint count = min(label_count(), LABEL_MAX);
+  const uint words = (count + 31u) / 32u;  // (the bit sets' words in use)
   for (uint i = lane; i < count; i += lanes) {
     const LabelGpu label = labels[i];
     if ((label.flags & LABEL_ENABLED) == 0u || label.layer >= layer_count) continue;
@@ -62,12 +63,12 @@ void main() {
   const vec2 p = vec2(id) + 0.5;
   for (uint layer = 0u; layer < layer_count; ++layer) {
     uint any_label = 0u;
-    for (uint w = 0u; w < LABEL_MAX / 32u; ++w) any_label |= tile_labels[layer][w];
+    for (uint w = 0u; w < words; ++w) any_label |= tile_labels[layer][w];
     if (any_label == 0u) continue;  // (most tiles of a layer hold no label: left unread)
     const ivec3 texel = ivec3(id, layer);
     const vec4 content = imageLoad(layers, texel);
     vec4 drawn = content;
-    for (uint w = 0u; w < LABEL_MAX / 32u; ++w) {
+    for (uint w = 0u; w < words; ++w) {
       uint bits = tile_labels[layer][w];
       while (bits != 0u) {
         const uint b = uint(findLSB(bits));

@@ -53,15 +53,17 @@ layout(push_constant) uniform Push { PlacementParams params; };
 uint position;
 uint placed;
 
-// The placed labels and anchors this tile's candidates can reach (culled once per tile).
-shared uint tile_placed[LABEL_MAX];
+// The placed labels and anchors this tile's candidates can reach, culled by chunks of
+// PLACE_CULL_CHUNK labels (one chunk up to that many labels; more take turns through the lists).
+#define PLACE_CULL_CHUNK (PLACE_GROUP_X * PLACE_GROUP_Y)
+shared uint tile_placed[PLACE_CULL_CHUNK];
 shared uint tile_placed_count;
-shared vec2 tile_anchors[LABEL_MAX];
+shared vec2 tile_anchors[PLACE_CULL_CHUNK];
 shared uint tile_anchor_count;
 shared uint tile_bits;  // constraints every candidate of the tile has
 
 // The regions of the label at order position s against the one placed at order position t.
-PairRegionsGpu regions_of(uint s, uint t) { return regions[s * params.label_count + t]; }
+PairRegionsGpu regions_of(uint s, uint t) { return regions[placement_pair_slot(s, t)]; }
 uint placed_count() { return tile_placed_count; }
 PairRegionsGpu placed_regions(uint k) { return regions_of(position, tile_placed[k]); }
 uint anchor_count() { return tile_anchor_count; }
@@ -145,13 +147,15 @@ bool anchor_covers_rectangle(vec2 a, vec2 c, vec2 e, vec2 h) {
   return covers;
 }
 
-// The tile's candidate-reaching placed labels and anchors, and the constraints all of its
-// candidates have (the shared counts start at 0; a barrier follows).
-void cull(LabelGpu me, uvec2 tile) {
+// The tile's candidate-reaching placed labels and anchors of the chunk from `from` (order
+// positions of placed labels, indices of anchors), and the constraints all of its candidates have
+// (the shared counts start at 0; a barrier follows).
+void cull(LabelGpu me, uvec2 tile, uint from) {
   vec2 centre, extent;
   tile_centres(me, tile, centre, extent);
   const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
-  for (uint s = gl_LocalInvocationIndex; s < placed; s += threads) {
+  const uint placed_end = min(placed, from + PLACE_CULL_CHUNK);
+  for (uint s = from + gl_LocalInvocationIndex; s < placed_end; s += threads) {
     uint touch, full;
     region_reach(regions_of(position, s), centre, extent, touch, full);
     if (full != 0u) atomicOr(tile_bits, full);
@@ -159,7 +163,8 @@ void cull(LabelGpu me, uvec2 tile) {
   }
   // Anchors: a candidate's box (margin included) covering one.
   const vec2 h = constraint_half_size(me, params.margin);
-  for (uint k = gl_LocalInvocationIndex; k < params.label_count; k += threads) {
+  const uint anchors_end = min(params.label_count, from + PLACE_CULL_CHUNK);
+  for (uint k = from + gl_LocalInvocationIndex; k < anchors_end; k += threads) {
     if ((labels[k].flags & LABEL_ENABLED) == 0u) continue;
     const vec2 d = abs(labels[k].anchor - centre);
     if (d.x > extent.x + h.x + 1.0 || d.y > extent.y + h.y + 1.0) continue;
@@ -227,7 +232,7 @@ void classify(uint j, uint group, uint first, uint end) {
   uint bits = 0u;
   // (the labels placed up to j - 2, as for the speculative pass)
   for (uint s = lane; valid && s + 2u <= j; s += lanes) {
-    const uint pair = j * params.label_count + s;
+    const uint pair = placement_pair_slot(j, s);
     // (both halves are tested before their presence is known: no load waits for another)
     const uint info = regions[pair].info.x;
     const uint held_halves[2] = {classify_region(pair, false, centre, extent, sample_centres),
@@ -288,7 +293,7 @@ void write_regions(uint s, uint first, uint last, LabelGpu placed_label, vec3 pl
   const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
   for (uint u = gl_LocalInvocationIndex; first + u / 2u < last; u += threads) {
     const uint k_pos = first + u / 2u;
-    const uint slot = k_pos * params.label_count + s;
+    const uint slot = placement_pair_slot(k_pos, s);
     const LabelGpu k = labels[order[k_pos]];
     if ((u & 1u) == 0u) {
       const PairBoxRegion r = pair_box_region(k, placed_label, placed, params.margin);
@@ -439,21 +444,22 @@ uvec2 candidate_pixel(uvec2 base, uint q) {
   return base + uvec2(q % PLACE_SPAN_X, q / PLACE_SPAN_X) * uvec2(PLACE_GROUP_X, PLACE_GROUP_Y);
 }
 
-// constraint_bits() for the invocation's candidates (bit q of `wanted`) at once: one pass over
-// the tile's culled labels and anchors, each region loaded once for all of them (four passes
-// made a chain of four times as many dependent loads). A candidate leaves the pass when it has
-// both shadow bits or weighs more than its budget, as constraint_bits() returns there; the bits
-// that decide (rejected, or the cost's weight) are the same, and with an infinite budget all.
+// constraint_bits() for the invocation's candidates (bit q of `wanted`) at once, over the
+// culled chunk in the tile's lists (the bits and the rejected candidates carry over from the
+// chunks before): one pass over its labels and anchors, each region loaded once for all
+// candidates (four passes made a chain of four times as many dependent loads). A candidate leaves
+// the pass when it has both shadow bits or weighs more than its budget, as constraint_bits()
+// returns there; the bits that decide (rejected, or the cost's weight) are the same, whatever
+// the chunks, since each kind of bit is found or not; with an infinite budget all of them.
 void candidate_bits(LabelGpu me, vec2 centres[PLACE_SPAN_X * PLACE_SPAN_Y], uint wanted,
                     float budgets[PLACE_SPAN_X * PLACE_SPAN_Y],
-                    out uint bits[PLACE_SPAN_X * PLACE_SPAN_Y]) {
+                    inout uint bits[PLACE_SPAN_X * PLACE_SPAN_Y], inout uint rejected) {
   const uint shadows = CONSTRAINT_LABEL | CONSTRAINT_CONNECTOR;
   uint open = 0u;  // candidates still taking the placed labels
   [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
-    bits[q] = tile_bits;
-    if ((wanted & (1u << q)) != 0u && (tile_bits & shadows) != shadows) open |= 1u << q;
+    bits[q] |= tile_bits;
+    if ((wanted & ~rejected & (1u << q)) != 0u && (bits[q] & shadows) != shadows) open |= 1u << q;
   }
-  uint rejected = 0u;
   for (uint k = 0u; k < placed_count() && open != 0u; ++k) {
     const PairRegionsGpu r = placed_regions(k);
     [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
@@ -482,6 +488,7 @@ void candidate_bits(LabelGpu me, vec2 centres[PLACE_SPAN_X * PLACE_SPAN_Y], uint
       if ((seeking & (1u << q)) != 0u && d.x <= h.x && d.y <= h.y) {
         bits[q] |= CONSTRAINT_ANCHOR;
         seeking &= ~(1u << q);
+        if (constraint_weight(bits[q]) > budgets[q]) rejected |= 1u << q;
       }
     }
   }
@@ -520,7 +527,7 @@ uint64_t evaluate_tile(uint label, uvec2 tile, uint known, float bound, bool pru
       if (allowed && !(free_costs[q] > best)) candidates |= 1u << q;
     }
     if (subgroupOr(candidates) != 0u && subgroupElect()) atomicOr(tile_hope, 1u);
-    cull(me, tile);
+    cull(me, tile, 0u);
   }
   barrier();
   hopeless = tile_hope == 0u ||
@@ -539,7 +546,23 @@ uint64_t evaluate_tile(uint label, uvec2 tile, uint known, float bound, bool pru
                                      : (best - free_costs[q]) / 0.999;
   }
   uint all_bits[PLACE_SPAN_X * PLACE_SPAN_Y];
-  candidate_bits(me, centres, hopeless ? 0u : candidates, budgets, all_bits);
+  [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) all_bits[q] = 0u;
+  uint rejected = 0u;
+  const uint wanted = hopeless ? 0u : candidates;
+  candidate_bits(me, centres, wanted, budgets, all_bits, rejected);
+  // Past PLACE_CULL_CHUNK labels, the next chunks in turn (`hopeless` is the workgroup's).
+  for (uint from = PLACE_CULL_CHUNK; !hopeless && from < params.label_count;
+       from += PLACE_CULL_CHUNK) {
+    barrier();  // (the lists are read)
+    if (gl_LocalInvocationIndex == 0u) {
+      tile_placed_count = 0u;
+      tile_anchor_count = 0u;
+    }
+    barrier();
+    cull(me, tile, from);
+    barrier();
+    candidate_bits(me, centres, wanted, budgets, all_bits, rejected);
+  }
   [[unroll]] for (uint q = 0u; q < PLACE_SPAN_X * PLACE_SPAN_Y; ++q) {
     if (hopeless) break;
     if ((candidates & (1u << q)) == 0u) continue;

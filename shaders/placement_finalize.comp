@@ -26,28 +26,40 @@ float table_at(uint layer, int x, int y) {
 #include "shared/layout_tidy.h"
 
 // A round's dispatches read every label's state many times over (each change is weighed against
-// all labels): each workgroup copies what its phase reads into shared memory first. (Read from
-// the buffer, a round took 40 us or more on an H100, latency-bound.)
-shared TidyLabel s_label[LABEL_MAX];
-shared TidyLabel s_next[LABEL_MAX];
-shared uint64_t s_best[LABEL_MAX];
-shared float s_free[LABEL_MAX];
-shared uint s_rank[LABEL_MAX];
-shared uint s_partner[LABEL_MAX];
+// all labels): with up to TIDY_SHARED_MAX labels each workgroup copies what its phase reads into
+// shared memory first. (Read from the buffer, a round took 40 us or more on an H100,
+// latency-bound.) With more, the phases read the buffer: no phase writes what it reads (the
+// search writes the bests, the owners the partners and next states, the apply states it does
+// not read), so the copy is only a cache.
+#define TIDY_SHARED_MAX 256u
+shared TidyLabel s_label[TIDY_SHARED_MAX];
+shared TidyLabel s_next[TIDY_SHARED_MAX];
+shared uint64_t s_best[TIDY_SHARED_MAX];
+shared float s_free[TIDY_SHARED_MAX];
+shared uint s_rank[TIDY_SHARED_MAX];
+shared uint s_partner[TIDY_SHARED_MAX];
 shared uint s_any;
 
+bool cached() { return params.label_count <= TIDY_SHARED_MAX; }
 uint tidy_count() { return params.label_count; }
 LabelGpu tidy_input(uint k) { return labels[k]; }
-TidyLabel tidy_state(uint k) { return s_label[k]; }
-float tidy_free(uint k) { return s_free[k]; }
-uint tidy_rank(uint k) { return s_rank[k]; }
-uint64_t tidy_best(uint k) { return s_best[k]; }
-TidyLabel tidy_next(uint k) { return s_next[k]; }
-uint tidy_partner(uint k) { return s_partner[k]; }
+// (if/else, not ?:: glslang's select between a shared and a buffer struct is invalid SPIR-V)
+TidyLabel tidy_state(uint k) {
+  if (cached()) return s_label[k];
+  return tidy[k].label;
+}
+float tidy_free(uint k) { return cached() ? s_free[k] : tidy[k].free; }
+uint tidy_rank(uint k) { return cached() ? s_rank[k] : tidy[k].rank; }
+uint64_t tidy_best(uint k) { return cached() ? s_best[k] : tidy[k].best; }
+TidyLabel tidy_next(uint k) {
+  if (cached()) return s_next[k];
+  return tidy[k].next;
+}
+uint tidy_partner(uint k) { return cached() ? s_partner[k] : tidy[k].partner; }
 
 // The workgroup's copy of the labels' states (the bests only after the search has them).
 void load_states(uint n, uint phase) {
-  for (uint k = gl_LocalInvocationID.x; k < n; k += gl_WorkGroupSize.x) {
+  for (uint k = gl_LocalInvocationID.x; cached() && k < n; k += gl_WorkGroupSize.x) {
     s_label[k] = tidy[k].label;
     s_free[k] = tidy[k].free;
     s_rank[k] = tidy[k].rank;
@@ -63,7 +75,7 @@ void load_states(uint n, uint phase) {
 #include "shared/layout_tidy_search.h"
 
 bool movable(uint k) {
-  return (s_label[k].flags & (TIDY_PLACED | TIDY_MOVABLE)) == (TIDY_PLACED | TIDY_MOVABLE);
+  return (tidy_state(k).flags & (TIDY_PLACED | TIDY_MOVABLE)) == (TIDY_PLACED | TIDY_MOVABLE);
 }
 
 // TIDY_PHASE_SEARCH: item q is (label, move or hiding) below n x TIDY_SWAP, a pair of labels
@@ -91,7 +103,7 @@ void search(uint t, uint n) {
     const uint j = i + 1u + p;
     change = TIDY_SWAP + j;
     if (movable(i) && movable(j)) {
-      const ivec4 c = tidy_conflicts(s_label[i], s_label[j]);
+      const ivec4 c = tidy_conflicts(tidy_state(i), tidy_state(j));
       live = c.x + c.y != 0;
     }
   }
@@ -120,7 +132,9 @@ void search(uint t, uint n) {
 }
 
 void main() {
-  const uint t = gl_GlobalInvocationID.x;
+  // (the search's items can pass 65535 workgroups across: its dispatch is two-dimensional)
+  const uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
+                 gl_LocalInvocationID.x;
   const uint n = params.label_count;
   const uint phase = params.phase;
   if (phase == TIDY_PHASE_START) {
@@ -128,7 +142,7 @@ void main() {
     if (t >= n) return;
     tidy[t].label = tidy_label(labels[t], results[t]);
     tidy[t].free = tidy_free_cost(tidy[t].label, labels[t]);
-    tidy[t].rank = LABEL_MAX;
+    tidy[t].rank = LABEL_MAX;  // (not in the order)
     for (uint k = 0u; k < params.order_count; ++k) {
       if (order[k] == t) tidy[t].rank = k;
     }
@@ -156,7 +170,7 @@ void main() {
     if (phase == TIDY_PHASE_CONFLICTS) {
       any = movable(i) && tidy_conflicted(i, lane, gl_WorkGroupSize.x);
     } else {
-      any = s_partner[i] != TIDY_NO_PARTNER && tidy_blocked(i, lane, gl_WorkGroupSize.x);
+      any = tidy_partner(i) != TIDY_NO_PARTNER && tidy_blocked(i, lane, gl_WorkGroupSize.x);
     }
     if (any) atomicOr(s_any, 1u);
     barrier();
@@ -165,7 +179,7 @@ void main() {
       tidy[i].best = TIDY_NONE;
       tidy[i].conflicted = s_any;
     } else {
-      tidy[i].applied = s_partner[i] != TIDY_NO_PARTNER && s_any == 0u ? 1u : 0u;
+      tidy[i].applied = tidy_partner(i) != TIDY_NO_PARTNER && s_any == 0u ? 1u : 0u;
     }
     return;
   }

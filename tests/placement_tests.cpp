@@ -450,6 +450,39 @@ TEST_SUITE("gpu") {
     check_placements_across(ctx, in, cpu, {0.01f, 1.0f, 1e9f});
   }
 
+  // More labels than a workgroup culls at once (256) and than the tidy-up keeps in shared memory:
+  // 300 small labels crowd the disc scene, so the last ones meet constraints from both chunks of
+  // placed labels and anchors. The greedy positions and the tidied ones are the reference's,
+  // dispatched directly and indirectly.
+  TEST_CASE_FIXTURE(test::GpuTest, "more_labels_than_one_cull_chunk_match_the_reference") {
+    Inputs in = disc_scene(0);
+    for (uint32_t i = 0; i < 300; ++i) {
+      const glm::vec2 anchor(float(14 + (i * 37) % 68), float(10 + (i * 23) % 52));
+      in.labels.push_back(label(anchor, {float(6 + i % 5), 3.0f}, i % 2));
+      in.order.push_back(i);
+    }
+    // (a round of the tidy-up with the labels' states read from the buffer; the dispatch only
+    // matters to the greedy loop)
+    for (const uint32_t rounds : {0u, 1u}) {
+      CAPTURE(rounds);
+      PlacementSettings settings;
+      settings.tidy_rounds = rounds;
+      const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                     in.labels, in.order, settings, in.size);
+      for (const LabelDispatch dispatch : {LabelDispatch::direct, LabelDispatch::indirect}) {
+        if (rounds > 0 && dispatch == LabelDispatch::indirect) continue;
+        CAPTURE(int(dispatch));
+        check_placements(place_on_gpu(ctx, in, settings, {.dispatch = dispatch}), cpu);
+      }
+      // (crowded: most labels past the first chunk pay for constraints)
+      size_t constrained = 0;
+      for (size_t i = 256; i < cpu.placements.size(); ++i) {
+        constrained += cpu.placements[i].cost >= settings.weights.connector_shadow;
+      }
+      CHECK(constrained > 20);
+    }
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "classified_tiles_that_cannot_hold_the_best_are_left_out") {
     // Twelve labels crowd the disc: the later ones' lists hold tiles every candidate of which
     // lies in an earlier label's shadow, and their main passes must leave those out, with the

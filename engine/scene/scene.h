@@ -113,8 +113,9 @@ struct CostWeights {
 // in passes/volume_renderer.cpp): the scene side checks settings against it without the shaders.
 inline constexpr int kMaxLayers = 8;
 // Labels a scene can have (LABEL_MAX in shaders/shared/labels.h, asserted equal in
-// passes/placement.cpp): placement keeps each label's state in fixed GPU arrays of this size.
-inline constexpr int kMaxLabels = 256;
+// passes/placement.cpp): the constraint regions placement keeps grow with its square (4096 labels:
+// 1.4 GiB, docs/scene-format.md).
+inline constexpr int kMaxLabels = 4096;
 
 struct SceneSettings {
   int layer_count = 4;  // 1 to kMaxLayers

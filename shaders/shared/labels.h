@@ -5,7 +5,9 @@
 
 #include "common.h"
 
-#define LABEL_MAX 256
+// Labels a frame can have: placement's pair regions grow with its square (see
+// placement_pair_slot), the tidy-up's and the label drawing's per-label arrays with it.
+#define LABEL_MAX 4096
 
 // LabelGpu.flags
 #define LABEL_ENABLED 1u   // the anchor is in view and in front of the camera: place and draw it
