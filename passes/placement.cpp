@@ -50,7 +50,9 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
       integral_costs_(ctx, "integral_costs.comp"),
       bounds_(ctx, "placement_bounds.comp"),
       place_(ctx, "place_label.comp"),
-      finalize_(ctx, "placement_finalize.comp"),
+      // (more labels than a workgroup's shared memory holds: states read from the buffer)
+      finalize_(ctx, label_count > TIDY_SHARED_MAX ? "placement_finalize_large.comp"
+                                                   : "placement_finalize.comp"),
       previous_(ctx, "label_previous.comp"),
       tables_(ctx),
       readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu)) {

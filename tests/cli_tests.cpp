@@ -89,12 +89,64 @@ TEST_SUITE("cli") {
     CHECK(report["label_loop_with_readback_per_label_ms"].get<double>() > 0.0);
   }
 
+  // Label counts swept in one run (issue 18): one report, an entry per count with the whole
+  // placement, the loop and every pass's and group's median; the slow readback baseline skipped
+  // (null). 12 is more than head.json's 11 labels: they are repeated.
+  TEST_CASE("bench_placement_sweeps_label_counts_into_one_report") {
+    const auto r = run_strata("bench placement --scene " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --size 64 --labels 5,12 --runs 1 "
+                              "--no-baseline");
+    REQUIRE(r.exit_code == 0);
+    const nlohmann::json report = bench_report(r.output);
+    CHECK(report["benchmark"] == "placement");
+    CHECK(report["readback_baseline"] == false);
+    const nlohmann::json& sweep = report["sweep"];
+    REQUIRE(sweep.size() == 2);
+    for (size_t i = 0; i < sweep.size(); ++i) {
+      CAPTURE(i);
+      const nlohmann::json& entry = sweep[i];
+      CHECK(entry["labels"] == (i == 0 ? 5 : 12));
+      CHECK(entry["placement_ms"].get<double>() > 0.0);
+      CHECK(entry["label_loop_ms"].get<double>() > 0.0);
+      CHECK(entry["label_loop_us_per_label"].get<double>() > 0.0);
+      CHECK(entry["finalize_ms"].get<double>() > 0.0);
+      CHECK(entry["passes"]["placement.labels"].get<double>() > 0.0);
+      CHECK(entry["groups"]["placement"].get<double>() > 0.0);
+      CHECK(entry["label_loop_with_readback_per_label_ms"].is_null());
+      CHECK(entry["speedup"].is_null());
+    }
+    // The table for people on stderr: a header and a row per count.
+    CHECK(r.output.find("labels  shown") != std::string::npos);
+  }
+
+  // The viewer's whole frame with the labels asked for, and each group's total in it.
+  TEST_CASE("bench_view_measures_the_frame_with_the_labels_asked_for") {
+    const auto r = run_strata("bench view " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --size 64 --frames 3 --labels 12");
+    REQUIRE(r.exit_code == 0);
+    const nlohmann::json report = bench_report(r.output);
+    CHECK(report["labels"] == 12);
+    for (const char* run :
+         {"gpu_frame_ms", "gpu_frame_ms_stamped_per_group", "gpu_frame_ms_stamped_per_pass"}) {
+      CAPTURE(run);
+      CHECK(report[run]["median"].get<double>() > 0.0);
+      CHECK(report[run]["p95"].get<double>() >= report[run]["median"].get<double>());
+    }
+    for (const char* group : {"render", "placement", "labels", "ui"}) {
+      CAPTURE(group);
+      CHECK(report["mean_group_total_ms"][group].get<double>() > 0.0);
+      CHECK(report["mean_group_total_ms_stamped_per_pass"][group].get<double>() > 0.0);
+    }
+    CHECK(report["mean_pass_ms"]["placement.labels"].get<double>() > 0.0);
+    CHECK(r.output.find("bench view: 12 labels") != std::string::npos);
+  }
+
   TEST_CASE("dump_graph_prints_the_frame_passes_and_barriers") {
     const auto r = run_strata("render " STRATA_SOURCE_DIR
                               "/assets/scenes/head.json --size 48 --dump-graph -o /dev/null");
     CHECK(r.exit_code == 0);
     CHECK(r.output.find("pass 13 'placement.labels' (compute, placement)") != std::string::npos);
-    CHECK(r.output.find("21 passes, 55 barriers") != std::string::npos);
+    CHECK(r.output.find("21 passes, 54 barriers") != std::string::npos);
   }
 
   // The thesis program's screenshots: one still per named position, named after it.

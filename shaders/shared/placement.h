@@ -108,6 +108,7 @@
 #define TIDY_NONE 0xFFFFFFFFFFFFFFFFul
 #define TIDY_NO_PARTNER 0xFFFFFFFFu
 #define TIDY_ROUNDS_MAX 256u  // PlacementParams::tidy_rounds at most
+#define TIDY_SHARED_MAX 256u  // labels whose states a tidy-up workgroup keeps in shared memory
 #define TIDY_SEARCH_LANES 8u  // invocations weighing one change (placement_finalize.comp)
 
 // TidyLabel.flags

@@ -1,0 +1,194 @@
+// The layout tidy-up (shared/layout_tidy.h) and the placements' output, one phase per dispatch
+// (params.phase; params.step: the round): its start from the label loop's (cost, pixel) results,
+// five dispatches per round, and each label's placement (box centre, cost, shown). A round whose
+// round before applied nothing leaves at once. Included by placement_finalize.comp (up to
+// TIDY_SHARED_MAX labels) and placement_finalize_large.comp (more: TIDY_STATES_IN_BUFFER).
+layout(local_size_x = 64) in;
+layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
+layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
+layout(binding = PLACEMENT_BINDING_ORDER, std430) readonly buffer Order { uint order[]; };
+layout(binding = PLACEMENT_BINDING_RESULTS, std430) readonly buffer Results { uint64_t results[]; };
+layout(binding = PLACEMENT_BINDING_PLACEMENTS, std430) writeonly buffer Placements { PlacementGpu placements[]; };
+layout(binding = PLACEMENT_BINDING_TIDY, std430) buffer Tidy { TidyGpu tidy[]; };
+layout(binding = PLACEMENT_BINDING_TIDY_ROUNDS, std430) buffer Rounds { uint rounds[]; };
+layout(push_constant) uniform Push { PlacementParams params; };
+
+float table_at(uint layer, int x, int y) {
+  if (x < 0 || y < 0) return 0.0f;
+  return tables[(layer * params.height + uint(y)) * params.width + uint(x)];
+}
+
+#include "shared/layout_tidy.h"
+
+// A round's dispatches read every label's state many times over (each change is weighed against
+// all labels): with up to TIDY_SHARED_MAX labels (placement_finalize.comp) each workgroup copies
+// what its phase reads into shared memory first. (Read from the buffer, a round took 40 us or
+// more on an H100, latency-bound.) With more (placement_finalize_large.comp, TIDY_STATES_IN_BUFFER)
+// the phases read the buffer: no phase writes what it reads (the search writes the bests, the
+// owners the partners and next states, the apply states it does not read), so the copy is only a
+// cache. (One shader choosing per access at run time cost the small case its speed: 0.2 -> 6.6
+// ms for 64 rounds of 100 labels on an H100, as if every read went to the buffer.)
+uint tidy_count() { return params.label_count; }
+LabelGpu tidy_input(uint k) { return labels[k]; }
+#ifdef TIDY_STATES_IN_BUFFER
+TidyLabel tidy_state(uint k) { return tidy[k].label; }
+float tidy_free(uint k) { return tidy[k].free; }
+uint tidy_rank(uint k) { return tidy[k].rank; }
+uint64_t tidy_best(uint k) { return tidy[k].best; }
+TidyLabel tidy_next(uint k) { return tidy[k].next; }
+uint tidy_partner(uint k) { return tidy[k].partner; }
+void load_states(uint n, uint phase) {}
+#else
+shared TidyLabel s_label[TIDY_SHARED_MAX];
+shared TidyLabel s_next[TIDY_SHARED_MAX];
+shared uint64_t s_best[TIDY_SHARED_MAX];
+shared float s_free[TIDY_SHARED_MAX];
+shared uint s_rank[TIDY_SHARED_MAX];
+shared uint s_partner[TIDY_SHARED_MAX];
+TidyLabel tidy_state(uint k) { return s_label[k]; }
+float tidy_free(uint k) { return s_free[k]; }
+uint tidy_rank(uint k) { return s_rank[k]; }
+uint64_t tidy_best(uint k) { return s_best[k]; }
+TidyLabel tidy_next(uint k) { return s_next[k]; }
+uint tidy_partner(uint k) { return s_partner[k]; }
+
+// The workgroup's copy of the labels' states (the bests only after the search has them).
+void load_states(uint n, uint phase) {
+  for (uint k = gl_LocalInvocationID.x; k < n; k += gl_WorkGroupSize.x) {
+    s_label[k] = tidy[k].label;
+    s_free[k] = tidy[k].free;
+    s_rank[k] = tidy[k].rank;
+    if (phase != TIDY_PHASE_CONFLICTS && phase != TIDY_PHASE_SEARCH) s_best[k] = tidy[k].best;
+    if (phase == TIDY_PHASE_SELECT) {
+      s_next[k] = tidy[k].next;
+      s_partner[k] = tidy[k].partner;
+    }
+  }
+  barrier();
+}
+#endif
+shared uint s_any;
+
+#include "shared/layout_tidy_search.h"
+
+bool movable(uint k) {
+  return (tidy_state(k).flags & (TIDY_PLACED | TIDY_MOVABLE)) == (TIDY_PLACED | TIDY_MOVABLE);
+}
+
+// TIDY_PHASE_SEARCH: item q is (label, move or hiding) below n x TIDY_SWAP, a pair of labels
+// (i < j) above; TIDY_SEARCH_LANES invocations take an item, splitting the other labels.
+shared ivec4 s_counts[64 / TIDY_SEARCH_LANES];
+shared uint s_hide[64 / TIDY_SEARCH_LANES];
+
+void search(uint t, uint n) {
+  const uint q = t / TIDY_SEARCH_LANES, lane = t % TIDY_SEARCH_LANES;
+  const uint slot = gl_LocalInvocationID.x / TIDY_SEARCH_LANES;
+  const uint singles = n * TIDY_SWAP;
+  uint i = 0u, change = 0u;
+  bool live = false;
+  if (q < singles) {
+    i = q / TIDY_SWAP;
+    change = q % TIDY_SWAP;
+    live = tidy[i].conflicted != 0u;
+  } else if (q < singles + n * (n - 1u) / 2u) {
+    // the pair at position p of (0, 1), (0, 2) ... (0, n - 1), (1, 2) ...
+    uint p = q - singles;
+    while (p >= n - 1u - i) {
+      p -= n - 1u - i;
+      ++i;
+    }
+    const uint j = i + 1u + p;
+    change = TIDY_SWAP + j;
+    if (movable(i) && movable(j)) {
+      const ivec4 c = tidy_conflicts(tidy_state(i), tidy_state(j));
+      live = c.x + c.y != 0;
+    }
+  }
+  live = live && tidy_change_possible(i, change);
+  if (lane == 0u) {
+    s_counts[slot] = ivec4(0);
+    s_hide[slot] = 0u;
+  }
+  barrier();
+  if (live) {
+    const ivec4 c = tidy_change_conflicts(i, change, lane, TIDY_SEARCH_LANES);
+    if (c != ivec4(0)) {
+      atomicAdd(s_counts[slot].x, c.x);
+      atomicAdd(s_counts[slot].y, c.y);
+      atomicAdd(s_counts[slot].z, c.z);
+      atomicAdd(s_counts[slot].w, c.w);
+    }
+    if (change == TIDY_HIDE && tidy_may_hide(i, lane, TIDY_SEARCH_LANES)) atomicOr(s_hide[slot], 1u);
+  }
+  barrier();
+  if (!live || lane != 0u || (change == TIDY_HIDE && s_hide[slot] == 0u)) return;
+  const float delta = tidy_change_delta(i, change, s_counts[slot]);
+  if (delta >= 0.0f) return;
+  atomicMin(tidy[i].best, tidy_key(delta, change));
+  if (change >= TIDY_SWAP) atomicMin(tidy[change - TIDY_SWAP].best, tidy_key(delta, TIDY_SWAP + i));
+}
+
+void main() {
+  // (the search's items can pass 65535 workgroups across: its dispatch is two-dimensional)
+  const uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
+                 gl_LocalInvocationID.x;
+  const uint n = params.label_count;
+  const uint phase = params.phase;
+  if (phase == TIDY_PHASE_START) {
+    if (t <= params.tidy_rounds) rounds[t] = t == 0u ? 1u : 0u;
+    if (t >= n) return;
+    tidy[t].label = tidy_label(labels[t], results[t]);
+    tidy[t].free = tidy_free_cost(tidy[t].label, labels[t]);
+    tidy[t].rank = LABEL_MAX;  // (not in the order)
+    for (uint k = 0u; k < params.order_count; ++k) {
+      if (order[k] == t) tidy[t].rank = k;
+    }
+    return;
+  }
+  if (phase == TIDY_PHASE_OUTPUT) {
+    load_states(n, phase);
+    if (t < n) placements[t] = tidy_placement(t, results[t]);
+    return;
+  }
+  // A round: nothing to do once the round before applied nothing.
+  const uint r = params.step;
+  if (rounds[r] == 0u) return;  // (the same for the whole dispatch)
+  load_states(n, phase);
+  if (phase == TIDY_PHASE_SEARCH) {
+    search(t, n);
+    return;
+  }
+  if (phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_SELECT) {
+    // One workgroup per label, its invocations splitting the other labels between them.
+    const uint i = gl_WorkGroupID.x, lane = gl_LocalInvocationID.x;
+    if (lane == 0u) s_any = 0u;
+    barrier();
+    bool any = false;
+    if (phase == TIDY_PHASE_CONFLICTS) {
+      any = movable(i) && tidy_conflicted(i, lane, gl_WorkGroupSize.x);
+    } else {
+      any = tidy_partner(i) != TIDY_NO_PARTNER && tidy_blocked(i, lane, gl_WorkGroupSize.x);
+    }
+    if (any) atomicOr(s_any, 1u);
+    barrier();
+    if (lane != 0u) return;
+    if (phase == TIDY_PHASE_CONFLICTS) {
+      tidy[i].best = TIDY_NONE;
+      tidy[i].conflicted = s_any;
+    } else {
+      tidy[i].applied = tidy_partner(i) != TIDY_NO_PARTNER && s_any == 0u ? 1u : 0u;
+    }
+    return;
+  }
+  if (t >= n) return;
+  if (phase == TIDY_PHASE_OWNERS) {
+    tidy[t].partner = tidy_owned_partner(t);
+    tidy[t].next = tidy_after(t);
+  } else if (phase == TIDY_PHASE_APPLY) {
+    const uint owner = tidy_owner(t);
+    if (owner == TIDY_NO_PARTNER || tidy[owner].applied == 0u) return;
+    tidy[t].label = tidy[t].next;
+    tidy[t].free = tidy_free_cost(tidy[t].next, labels[t]);
+    if (owner == t) atomicAdd(rounds[r + 1u], 1u);
+  }
+}
