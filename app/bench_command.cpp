@@ -73,7 +73,6 @@ struct RenderBenchOptions {
   uint32_t layers = 4;
   bool no_skipping = false;
   float step = 0.0f;
-  uint32_t sample_batch = VR_SAMPLE_BATCH;
 };
 
 void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t runs) {
@@ -85,7 +84,6 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
   settings.layer_count = o.layers;
   settings.skip_empty = !o.no_skipping;
   settings.step = o.step;
-  settings.sample_batch = o.sample_batch;
   VolumeRenderer renderer(ctx, scene, settings);
   renderer.set_camera(camera_for(scene, o.camera));
   graph::Graph graph;
@@ -111,7 +109,6 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
                               {"height", size.height},
                               {"layers", o.layers},
                               {"empty_space_skipping", !o.no_skipping},
-                              {"sample_batch", o.sample_batch},
                               {"step", shortest_double(step)}};
   ordered_json results = {{"samples_per_ray", double(last.samples) / rays},
                           {"shaded_samples_per_ray", double(last.shaded) / rays},
@@ -304,12 +301,6 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       ->check(CLI::Range(1u, 8u))
       ->capture_default_str();
   render_cmd->add_flag("--no-skipping", render->no_skipping, "turn empty-space skipping off");
-  render_cmd
-      ->add_option("--sample-batch", render->sample_batch,
-                   "samples of a ray fetched together before shading (the picture is the "
-                   "same)")
-      ->check(CLI::Range(1u, uint32_t(VR_SAMPLE_BATCH)))
-      ->capture_default_str();
   render_cmd->add_option("--step", render->step,
                          "sampling distance in world units (0: half a voxel)");
   render_cmd->add_option("--runs", options->runs, "timed runs after 3 warm-up runs")

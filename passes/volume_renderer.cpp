@@ -317,7 +317,6 @@ gpu::FrameGpu frame_data(const RenderInputs& in, const Camera& camera,
   f.table_size = table_size;
   f.skip_empty = settings.skip_empty ? 1u : 0u;
   f.mesh_count = static_cast<uint32_t>(in.meshes.size());
-  f.sample_batch = std::clamp<uint32_t>(settings.sample_batch, 1u, VR_SAMPLE_BATCH);
   f.near_depth = camera.near_plane;
   f.far_depth = camera.far_plane;
   f.step = settings.step > 0.0f ? settings.step : 0.5f * in.finest_spacing;

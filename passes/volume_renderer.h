@@ -24,9 +24,6 @@ struct RenderSettings {
   std::vector<float> splits;  // layer_count - 1 eye depths; empty: even over the scene's depth
   float step = 0.0f;          // world units between samples; 0: half the finest voxel spacing
   bool skip_empty = true;     // empty-space skipping with the per-volume brick grids
-  // Samples of a one-volume ray fetched together before any is shaded (1 to VR_SAMPLE_BATCH):
-  // the fetches' latencies overlap. The picture does not depend on it.
-  uint32_t sample_batch = VR_SAMPLE_BATCH;
   float termination_alpha = 0.99f;
   float depth_alpha = 0.5f;
   glm::vec3 background{0.0f};

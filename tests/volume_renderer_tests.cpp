@@ -247,45 +247,6 @@ TEST_SUITE("gpu") {
     CHECK(a.stats.samples < b.stats.samples);
   }
 
-  // Samples fetched together (1, 2, 3 or 4) are composited as one by one: the same picture,
-  // layers and counts, with skipping on and off and with a mesh splitting the rays; and the
-  // reference agrees with each.
-  TEST_CASE_FIXTURE(test::GpuTest, "samples_fetched_in_batches_give_the_same_picture") {
-    Scene scene;
-    add_volume(scene, ball({40, 40, 40}, glm::vec3(-20.0f), 12.0f), ramp({1.0f, 0.6f, 0.3f}));
-    scene.meshes = {quad(0.0f, {0.2f, 0.9f, 0.3f, 0.4f}, 9.0f)};
-    const Camera camera = camera_at({10.0f, 7.0f, 45.0f});
-    for (const bool skip : {true, false}) {
-      CAPTURE(skip);
-      RenderSettings one;
-      one.skip_empty = skip;
-      one.sample_batch = 1;
-      const GpuResult a = render_gpu(ctx, scene, camera, one, {48, 48});
-      REQUIRE(a.stats.shaded > 1000);
-      for (const uint32_t batch : {2u, 3u, 4u}) {
-        CAPTURE(batch);
-        RenderSettings settings = one;
-        settings.sample_batch = batch;
-        const GpuResult b = render_gpu(ctx, scene, camera, settings, {48, 48});
-        // (the same arithmetic; a GPU compiler may still contract it differently per path)
-        test::check_close(b.final, a.final, {48, 48}, "batch", 1);
-        REQUIRE(b.layers.size() == a.layers.size());
-        float worst = 0.0f;
-        for (size_t i = 0; i < a.layers.size(); ++i) {
-          const glm::vec4 d = glm::abs(b.layers[i] - a.layers[i]);
-          worst = std::max(worst, std::max(std::max(d.x, d.y), std::max(d.z, d.w)));
-        }
-        CHECK(worst <= 1.0f / 512.0f);
-        CHECK(b.stats.samples == a.stats.samples);
-        CHECK(b.stats.shaded == a.stats.shaded);
-        CHECK(b.stats.fetches == a.stats.fetches);
-      }
-      RenderSettings four = one;
-      four.sample_batch = 4;
-      check_against_reference(ctx, scene, camera, skip ? "batch-skip" : "batch", four);
-    }
-  }
-
   TEST_CASE_FIXTURE(test::GpuTest,
                     "habuffer_overflow_is_counted_and_the_picture_is_right_by_the_second_frame") {
     Scene scene;

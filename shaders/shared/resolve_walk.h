@@ -25,13 +25,6 @@ struct PixelResult {
 uint shaded_samples = 0u;
 uint atlas_fetches = 0u;
 
-// (loops over a sample batch are unrolled on the GPU, so its arrays stay in registers)
-#ifdef __cplusplus
-#define VR_UNROLL
-#else
-#define VR_UNROLL [[unroll]]
-#endif
-
 // The ray leaves layer `from` (its colour `acc`) for layer `to`: those in between stay empty.
 void close_layers(uint from, uint to, vec4 acc) {
   emit_layer(from, acc);
@@ -61,10 +54,13 @@ bool inside_unit_box(vec3 tc) {
          tc.z <= 1.0f;
 }
 
-// Volume v's shaded sample (premultiplied; zero outside its box or where
+// Volume v's shaded sample at texture coordinate tc (premultiplied; zero outside its box or where
 // its transfer function is transparent). The table's alpha is already corrected for the step:
 // the per-sample power this would take otherwise cost the resolve a fifth of its time.
-vec4 shade_volume_sample(uint v, VolumeGpu vol, vec4 s, vec3 to_eye) {
+vec4 sample_volume(uint v, VolumeGpu vol, vec3 tc, vec3 to_eye) {
+  if (!inside_unit_box(tc)) return vec4(0.0f);
+  vec4 s = volume_sample(v, tc);
+  atlas_fetches += 1u;
   vec4 c = transfer(v, s.w);
   if (c.a <= 0.0f) return vec4(0.0f);
   vec3 normal = mat3(vol.gradient_to_world) * vec3(s);
@@ -76,14 +72,6 @@ vec4 shade_volume_sample(uint v, VolumeGpu vol, vec4 s, vec3 to_eye) {
                                                      normal * inversesqrt(length2), to_eye)
                                  : vec4(vec3(c), 1.0f);
   return vec4(vec3(shaded) * alpha, alpha);
-}
-
-// ... from its raw sample s (the atlas's gradient and intensity).
-vec4 sample_volume(uint v, VolumeGpu vol, vec3 tc, vec3 to_eye) {
-  if (!inside_unit_box(tc)) return vec4(0.0f);
-  vec4 s = volume_sample(v, tc);
-  atlas_fetches += 1u;
-  return shade_volume_sample(v, vol, s, to_eye);
 }
 
 // The sum of every live (entered, not yet left) volume's sample at p (premultiplied).
@@ -258,40 +246,6 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
           continue;
         }
         checked_until = bricks.x;
-      }
-      if (one_volume && frame.sample_batch > 1u) {
-        // The samples from here on before the next fragment, layer split and unchecked brick
-        // (at most sample_batch): fetched together so that their latencies overlap, then
-        // composited one by one as below, stopping where the slab turns opaque.
-        float limit = min(z_end, next_split);
-        if (frame.skip_empty != 0u) limit = min(limit, checked_until);
-        uint n = 1u;
-        VR_UNROLL for (uint j = 1u; j < VR_SAMPLE_BATCH; ++j) {
-          if (j < frame.sample_batch && n == j && grid_depth(k + float(j), dz) < limit) n = j + 1u;
-        }
-        vec4 raw[VR_SAMPLE_BATCH];
-        bool in_box[VR_SAMPLE_BATCH];
-        VR_UNROLL for (uint j = 0u; j < VR_SAMPLE_BATCH; ++j) {
-          vec3 tc = first_origin + first_direction * grid_depth(k + float(j), dz);
-          in_box[j] = j < n && inside_unit_box(tc);
-          raw[j] = in_box[j] ? volume_sample(0u, tc) : vec4(0.0f);
-        }
-        VR_UNROLL for (uint j = 0u; j < VR_SAMPLE_BATCH; ++j) {
-          if (j >= n || (j > 0u && acc.a >= frame.termination_alpha)) break;
-          float zj = grid_depth(k, dz);
-          vec4 c = vec4(0.0f);
-          if (in_box[j]) {
-            atlas_fetches += 1u;
-            c = shade_volume_sample(0u, first, raw[j], to_eye);
-          }
-          r.samples += 1u;
-          acc = over(acc, c);
-          float before = total;
-          total = total + (1.0f - total) * c.a;
-          if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = zj;
-          k += 1.0f;
-        }
-        continue;
       }
       vec4 c = one_volume ? sample_volume(0u, first, first_origin + first_direction * zs, to_eye)
                           : sample_volumes(live, origin + direction * zs, to_eye);

@@ -15,7 +15,6 @@
 #define VR_TF_SIZE 256      // entries per transfer-function row
 #define VR_BRICK 8          // voxels per brick edge for empty-space skipping
 #define VR_RESOLVE_GROUP 8  // resolve workgroup is 8 x 8 pixels
-#define VR_SAMPLE_BATCH 4   // most samples the resolve fetches at once (FrameGpu::sample_batch)
 
 // Payload kinds (bits 8..9 of payload.y); bit 10: the fragment enters its volume.
 #define VR_KIND_MESH 0u
@@ -73,8 +72,8 @@ struct FrameGpu {
   uint volume_count;
   uint table_size;  // HA-Buffer slots
   uint skip_empty;  // 1: empty-space skipping
-  uint mesh_count;    // 0: the table is empty and the resolve does not read it
-  uint sample_batch;  // 1 to VR_SAMPLE_BATCH: samples of one volume fetched before shading any
+  uint mesh_count;  // 0: the table is empty and the resolve does not read it
+  uint pad1;
   float near_depth;  // eye depth of the near and far planes
   float far_depth;
   float step;               // sampling distance along rays, world units
