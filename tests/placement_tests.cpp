@@ -194,6 +194,29 @@ FrameMetrics metrics_of(const Inputs& in, const std::vector<gpu::PlacementGpu>& 
 
 }  // namespace
 
+TEST_SUITE("cpu") {
+  // Past 256 labels a round of the tidy-up weighs every conflicted label's moves and every
+  // crossing pair against all labels: the rounds asked for are capped, 64 (256 / n)^2 at most
+  // and at least one, so a frame of 4096 labels ends; up to 256 labels, as asked.
+  TEST_CASE("tidy_up_rounds_are_capped_past_256_labels") {
+    PlacementSettings settings;  // 64 rounds
+    const auto rounds = [&](uint32_t labels) {
+      return placement_params(settings, {1024, 1024}, 4, labels, 0).tidy_rounds;
+    };
+    CHECK(rounds(100) == 64);
+    CHECK(rounds(256) == 64);
+    CHECK(rounds(500) == 16);
+    CHECK(rounds(1000) == 4);
+    CHECK(rounds(4096) == 1);
+    settings.tidy_rounds = 2;
+    CHECK(rounds(500) == 2);
+    settings.tidy_rounds = 300;
+    CHECK(rounds(100) == TIDY_ROUNDS_MAX);
+    settings.hard = true;
+    CHECK(rounds(100) == 0);
+  }
+}
+
 TEST_SUITE("gpu") {
   // Labels pulled by eq. 3.1's eta term to previous positions on the far side of each other's
   // anchors, with no cost for crossing an earlier leader: the greedy placement leaves two pairs of
