@@ -75,6 +75,7 @@ struct PlacementRun {
   double loop_ms = 0.0, finalize_ms = 0.0, forces_ms = 0.0;
   std::optional<double> baseline_loop_ms;  // the label loop with a readback after every label
   double first_tiles = 0.0, rest_tiles = 0.0;
+  uint32_t tidy_rounds = 0, tidy_rounds_run = 0;  // asked (after the cap), and that ran
   ordered_json pipelines;
 
   // The stages before the loop (per-pass stamps) plus the loop with a readback per label.
@@ -146,6 +147,18 @@ std::pair<double, double> tiles_per_label(LabelledRenderer& frame) {
   return {first / double(placed), rest / double(placed)};
 }
 
+// How many of the tidy-up's rounds ran in the last frame (a round runs when the one before it
+// applied a change; the rest leave at once).
+uint32_t tidy_rounds_run(LabelledRenderer& frame, uint32_t rounds) {
+  graph::GraphRunner& runner = frame.runner();
+  const std::vector<std::byte> bytes = runner.download_buffer(frame.placement().tidy_rounds);
+  std::vector<uint32_t> applied(bytes.size() / sizeof(uint32_t));
+  std::memcpy(applied.data(), bytes.data(), applied.size() * sizeof(uint32_t));
+  uint32_t run = 0;
+  for (uint32_t r = 0; r < rounds && r < applied.size(); ++r) run += applied[r] != 0;
+  return run;
+}
+
 PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& camera,
                                graph::Extent size, uint32_t runs, bool baseline) {
   LabellingSettings settings;
@@ -171,7 +184,10 @@ PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& c
   r.finalize_ms = r.ms_per_pass("placement.finalize");  // the layout's tidy-up
   r.forces_ms = r.ms_per_pass("labels.forces");         // thesis 3.4: one invocation per label
   if (baseline) r.baseline_loop_ms = label_loop_with_readback_per_label(frame, runs);
-  std::tie(r.first_tiles, r.rest_tiles) = tiles_per_label(frame);
+  std::tie(r.first_tiles, r.rest_tiles) = tiles_per_label(frame);  // (runs a frame)
+  r.tidy_rounds =
+      placement_params(settings.placement, size, 1, uint32_t(scene.labels.size()), 0).tidy_rounds;
+  r.tidy_rounds_run = tidy_rounds_run(frame, r.tidy_rounds);
   const LabelledFrame last = frame.result(false);
   r.labels = uint32_t(scene.labels.size());
   for (const LabelLayout& l : last.labels) r.labels_shown += l.placed;
@@ -208,6 +224,8 @@ ordered_json sweep_entry(const PlacementRun& r) {
   entry.update(placement_results(r));
   entry["label_loop_us_per_label"] = std::round(loop_us_per_label(r) * 1e3) / 1e3;
   entry["finalize_ms"] = ms_json(r.finalize_ms);
+  entry["tidy_rounds"] = r.tidy_rounds;
+  entry["tidy_rounds_run"] = r.tidy_rounds_run;
   entry["placement_rest_ms"] = ms_json(r.stamped_ms - r.loop_ms - r.finalize_ms);
   entry["tiles_per_label_speculative"] = r.first_tiles;
   entry["tiles_per_label_main_beyond_speculative"] = r.rest_tiles;
@@ -223,16 +241,19 @@ ordered_json sweep_entry(const PlacementRun& r) {
 // a while): the whole placement, then its parts from the run with a stamp around every pass.
 void print_placement_row(const PlacementRun* r) {
   if (!r) {
-    std::fprintf(stderr, "%6s %6s %12s %10s %9s %12s %9s %9s %12s\n", "labels", "shown",
-                 "placement", "loop", "us/label", "finalize", "rest", "forces", "baseline");
+    std::fprintf(stderr, "%6s %6s %12s %10s %9s %12s %9s %9s %9s %12s\n", "labels", "shown",
+                 "placement", "loop", "us/label", "finalize", "tidy", "rest", "forces", "baseline");
     return;
   }
   const std::optional<double> baseline = r->baseline_ms();
   char base[32] = "-";
   if (baseline) std::snprintf(base, sizeof base, "%.3f", *baseline);
-  std::fprintf(stderr, "%6u %6u %12.3f %10.3f %9.2f %12.3f %9.3f %9.4f %12s   (ms)\n", r->labels,
-               r->labels_shown, r->whole_ms, r->loop_ms, loop_us_per_label(*r), r->finalize_ms,
-               r->stamped_ms - r->loop_ms - r->finalize_ms, r->forces_ms, base);
+  char tidy[32];  // (rounds that ran of those asked)
+  std::snprintf(tidy, sizeof tidy, "%u/%u", r->tidy_rounds_run, r->tidy_rounds);
+  std::fprintf(stderr, "%6u %6u %12.3f %10.3f %9.2f %12.3f %9s %9.3f %9.4f %12s   (ms)\n",
+               r->labels, r->labels_shown, r->whole_ms, r->loop_ms, loop_us_per_label(*r),
+               r->finalize_ms, tidy, r->stamped_ms - r->loop_ms - r->finalize_ms, r->forces_ms,
+               base);
 }
 
 void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
@@ -265,6 +286,8 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
     results["tiles"] = tiles.x * tiles.y;
     results["tiles_per_label_speculative"] = r.first_tiles;
     results["tiles_per_label_main_beyond_speculative"] = r.rest_tiles;
+    results["tidy_rounds"] = r.tidy_rounds;
+    results["tidy_rounds_run"] = r.tidy_rounds_run;
     if (!r.pipelines.empty()) results["pipelines"] = r.pipelines;
     print_json(ctx, setup, o.runs, r.timings, results);
     return;
@@ -300,7 +323,7 @@ void add_placement_bench(CLI::App* bench_cmd, DeviceOptions& device) {
                         "repeated");
   place_cmd->add_flag("--no-baseline", place->no_baseline,
                       "skip the baseline with a readback after every label (slow with many)");
-  place_cmd->add_option("--runs", place->runs, "timed runs after 1 warm-up run")
+  place_cmd->add_option("--runs", place->runs, "timed runs after 3 warm-up runs")
       ->capture_default_str()
       ->check(CLI::Range(1u, 100000u));
   place_cmd->callback([&device, place] { bench::bench_placement(device, *place); });

@@ -68,6 +68,8 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
       // (more labels than a workgroup's shared memory holds: states read from the buffer)
       finalize_(ctx, label_count > TIDY_SHARED_MAX ? "placement_finalize_large.comp"
                                                    : "placement_finalize.comp"),
+      search_(ctx, label_count > TIDY_SHARED_MAX ? "placement_finalize_large.comp"
+                                                 : "placement_tidy_search.comp"),
       previous_(ctx, "label_previous.comp"),
       tables_(ctx),
       readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu)) {
@@ -139,8 +141,8 @@ Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
   add_bounds(graph, b);
   const graph::PassId loop = add_label_loop(graph, b);
   add_finalize(graph, b);
-  return {b.labels,      b.placements, b.saliency, b.costs, b.tables,
-          b.constraints, b.results,    b.buckets,  b.order, loop};
+  return {b.labels,  b.placements, b.saliency,    b.costs, b.tables, b.constraints,
+          b.results, b.buckets,    b.tidy_rounds, b.order, loop};
 }
 
 Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
@@ -363,7 +365,8 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
                                                                  : n;
              // (the search's workgroups pass 65535 from about 900 labels: rows of them)
              const uint32_t groups = (threads + 63) / 64;
-             pc.dispatch_groups(finalize_, p, gpu::placement_dispatch_size(groups));
+             pc.dispatch_groups(phase == TIDY_PHASE_SEARCH ? search_ : finalize_, p,
+                                gpu::placement_dispatch_size(groups));
            }
          }
          pc.barrier();
@@ -383,7 +386,7 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
 
 std::vector<PipelineReport> Placement::pipeline_statistics() const {
   std::vector<PipelineReport> out;
-  for (const ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &finalize_}) {
+  for (const ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &finalize_, &search_}) {
     out.push_back({p->name(), p->statistics()});
   }
   return out;

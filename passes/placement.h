@@ -86,8 +86,11 @@ class Placement {
   struct Outputs {
     graph::ResourceId labels, placements, saliency, costs, tables, constraints, results;
     graph::ResourceId buckets;  // PlacementBucketsGpu per order position (benchmark statistics)
-    graph::ResourceId order;    // uint[]: the frame's insertion order (label indices)
-    graph::PassId label_loop;   // the pass that places the labels one by one
+    // uint per tidy-up round r: 1 for round 0, then the changes round r - 1 applied (round r runs
+    // only when that is not 0; benchmark statistics)
+    graph::ResourceId tidy_rounds;
+    graph::ResourceId order;   // uint[]: the frame's insertion order (label indices)
+    graph::PassId label_loop;  // the pass that places the labels one by one
   };
 
   // `label_count` sizes the per-label buffers; a frame may enable fewer labels.
@@ -135,7 +138,7 @@ class Placement {
   std::vector<gpu::LabelGpu> labels_;
   std::vector<uint32_t> order_;
   PlacementSettings settings_;
-  ComputePipeline integral_costs_, bounds_, place_, finalize_, previous_;
+  ComputePipeline integral_costs_, bounds_, place_, finalize_, search_, previous_;
   SummedAreaTable tables_;
   graph::Readback readback_;
 };
