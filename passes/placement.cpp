@@ -170,6 +170,8 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
   b.tidy = graph.add_buffer("placement.tidy", fixed(n * sizeof(gpu::TidyGpu)));
   b.tidy_rounds =
       graph.add_buffer("placement.tidy_rounds", fixed((TIDY_ROUNDS_MAX + 1) * sizeof(uint32_t)));
+  b.tidy_args =
+      graph.add_buffer("placement.tidy_args", fixed(TIDY_ROUNDS_MAX * 5 * 3 * sizeof(uint32_t)));
   b.regions = graph.add_buffer(
       "placement.regions",
       fixed(VkDeviceSize{gpu::placement_pair_count(n)} * sizeof(gpu::PairRegionsGpu)));
@@ -188,7 +190,8 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                    {b.buckets, Use::transfer_dst},
                    {b.lower, Use::transfer_dst},
                    {b.speculative, Use::transfer_dst},
-                   {b.samples, Use::transfer_dst}},
+                   {b.samples, Use::transfer_dst},
+                   {b.tidy_args, Use::transfer_dst}},
                   [this, b](graph::PassContext& pc) {
                     if (!labels_.empty()) {
                       vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.labels), 0,
@@ -208,6 +211,7 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                     // (each speculative workgroup writes its tile's entry before anything reads it)
                     fill(b.speculative, 0xFFFFFFFFu);
                     fill(b.samples, 0xFFFFFFFFu);
+                    fill(b.tidy_args, 0);  // (no round runs until the one before sizes it)
                     // (placement.regions needs none: the loop writes each pair, from the placed
                     // label's result, before a later label reads it; a label never placed
                     // writes regions that constrain nobody)
@@ -331,9 +335,9 @@ glm::uvec3 Placement::direct_groups(graph::Extent viewport) const {
       gpu::placement_classify_groups(tile_count, classify_tiles(viewport)) + tiles + 1);
 }
 
-// The layout tidy-up (its rounds: five dispatches each, those after a round that changed nothing
-// leaving at once) and each label's position and whether it is shown, copied to the host after
-// the frame.
+// The layout tidy-up (its rounds: five indirect dispatches each, sized by the round before: none
+// after a round that changed nothing) and each label's position and whether it is shown, copied
+// to the host after the frame.
 void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
   graph.add_pass(
       {"placement.finalize",
@@ -344,11 +348,12 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
         {b.results, Use::storage_read, PLACEMENT_BINDING_RESULTS},
         {b.tidy, Use::storage_write, PLACEMENT_BINDING_TIDY},
         {b.tidy_rounds, Use::storage_write, PLACEMENT_BINDING_TIDY_ROUNDS},
+        {b.tidy_args, Use::storage_read_write, PLACEMENT_BINDING_TIDY_ARGS},
+        {b.tidy_args, Use::indirect},
         {b.placements, Use::storage_write, PLACEMENT_BINDING_PLACEMENTS}},
-       [this](graph::PassContext& pc) {
+       [this, args = b.tidy_args](graph::PassContext& pc) {
          gpu::PlacementParams p = params(pc.viewport, 0);
          const uint32_t n = label_count_;
-         const uint32_t changes = n * TIDY_SWAP + n * (n - 1) / 2;  // moves, hidings, swaps
          p.phase = TIDY_PHASE_START;
          pc.dispatch(finalize_, p, {std::max(n, p.tidy_rounds + 1), 1, 1});
          for (uint32_t round = 0; round < p.tidy_rounds; ++round) {
@@ -357,16 +362,12 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
                                         TIDY_PHASE_SELECT, TIDY_PHASE_APPLY}) {
              pc.barrier();
              p.phase = phase;
-             // (conflicts and selection: a workgroup of 64 per label)
-             const bool per_label_group =
-                 phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_SELECT;
-             const uint32_t threads = phase == TIDY_PHASE_SEARCH ? changes * TIDY_SEARCH_LANES
-                                      : per_label_group          ? n * 64
-                                                                 : n;
-             // (the search's workgroups pass 65535 from about 900 labels: rows of them)
-             const uint32_t groups = (threads + 63) / 64;
-             pc.dispatch_groups(phase == TIDY_PHASE_SEARCH ? search_ : finalize_, p,
-                                gpu::placement_dispatch_size(groups));
+             // (tidy_phase_groups, written by the round before; the search's workgroups pass
+             // 65535 from about 900 labels: rows of them)
+             const VkDeviceSize offset =
+                 (VkDeviceSize{round} * 5 + (phase - TIDY_PHASE_CONFLICTS)) * 3 * sizeof(uint32_t);
+             pc.dispatch_indirect(phase == TIDY_PHASE_SEARCH ? search_ : finalize_, p, args,
+                                  offset);
            }
          }
          pc.barrier();

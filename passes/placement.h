@@ -115,7 +115,7 @@ class Placement {
   struct Buffers {
     graph::ResourceId labels, order, results, placements, saliency, costs, tables, constraints;
     graph::ResourceId bounds, tiles, buckets, lower, args, speculative, samples, regions, tidy,
-        tidy_rounds;
+        tidy_rounds, tidy_args;
     graph::ResourceId readback;
   };
   Buffers add_buffers(graph::Graph& graph);

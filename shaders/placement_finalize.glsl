@@ -11,7 +11,22 @@ layout(binding = PLACEMENT_BINDING_RESULTS, std430) readonly buffer Results { ui
 layout(binding = PLACEMENT_BINDING_PLACEMENTS, std430) writeonly buffer Placements { PlacementGpu placements[]; };
 layout(binding = PLACEMENT_BINDING_TIDY, std430) buffer Tidy { TidyGpu tidy[]; };
 layout(binding = PLACEMENT_BINDING_TIDY_ROUNDS, std430) buffer Rounds { uint rounds[]; };
+// The rounds' dispatch sizes: zero workgroups for a round after one that changed nothing (such a
+// round cost 13 us on an H100 with its workgroups leaving at once, five dispatches of them).
+layout(binding = PLACEMENT_BINDING_TIDY_ARGS, std430) buffer Args { uint tidy_args[]; };
+
 layout(push_constant) uniform Push { PlacementParams params; };
+
+// Round r runs: its steps' dispatch sizes.
+void write_round_args(uint r) {
+  for (uint k = 0u; k < 5u; ++k) {
+    const uvec3 size = tidy_phase_groups(TIDY_PHASE_CONFLICTS + k, params.label_count);
+    for (uint c = 0u; c < 3u; ++c) {
+      // (every owner that applied a change writes the same sizes)
+      atomicMax(tidy_args[(r * 5u + k) * 3u + c], size[c]);
+    }
+  }
+}
 
 float table_at(uint layer, int x, int y) {
   if (x < 0 || y < 0) return 0.0f;
@@ -91,8 +106,22 @@ shared uint s_any;
 
 #include "shared/layout_tidy_search.h"
 
-bool movable(uint k) {
-  return (tidy_state(k).flags & (TIDY_PLACED | TIDY_MOVABLE)) == (TIDY_PLACED | TIDY_MOVABLE);
+bool movable_state(TidyLabel s) {
+  return (s.flags & (TIDY_PLACED | TIDY_MOVABLE)) == (TIDY_PLACED | TIDY_MOVABLE);
+}
+bool movable(uint k) { return movable_state(tidy_state(k)); }
+
+// The pair at position p of (0, 1), (0, 2) ... (0, n - 1), (1, 2) ...: row i starts at
+// i (2n - i - 1) / 2. (The root gives the row to within one or two; integers settle it. A loop
+// over the rows cost an invocation up to n steps.)
+uvec2 pair_at(uint p, uint n) {
+  const float b = float(2u * n - 1u);
+  int i = int(floor((b - sqrt(max(b * b - 8.0 * float(p), 0.0))) * 0.5));
+  i = clamp(i, 0, int(n) - 2);
+  while (i > 0 && uint(i) * (2u * n - uint(i) - 1u) / 2u > p) --i;
+  while (uint(i) + 2u < n && (uint(i) + 1u) * (2u * n - uint(i) - 2u) / 2u <= p) ++i;
+  const uint row = uint(i);
+  return uvec2(row, row + 1u + p - row * (2u * n - row - 1u) / 2u);
 }
 
 // TIDY_PHASE_SEARCH: item q is (label, move or hiding) below n x TIDY_SWAP, a pair of labels
@@ -106,24 +135,29 @@ void search(uint t, uint n) {
   const uint singles = n * TIDY_SWAP;
   uint i = 0u, change = 0u;
   bool live = false;
+  // Whether the item can change anything, from the buffer: most items cannot (a label in no
+  // conflict, a pair whose leaders neither cross nor enter the other's box), and a workgroup
+  // with none of those leaves before it copies every label's state.
+  if (gl_LocalInvocationID.x == 0u) s_any = 0u;
+  barrier();
   if (q < singles) {
     i = q / TIDY_SWAP;
     change = q % TIDY_SWAP;
     live = tidy[i].conflicted != 0u;
   } else if (q < singles + n * (n - 1u) / 2u) {
-    // the pair at position p of (0, 1), (0, 2) ... (0, n - 1), (1, 2) ...
-    uint p = q - singles;
-    while (p >= n - 1u - i) {
-      p -= n - 1u - i;
-      ++i;
-    }
-    const uint j = i + 1u + p;
-    change = TIDY_SWAP + j;
-    if (movable(i) && movable(j)) {
-      const ivec4 c = tidy_conflicts(tidy_state(i), tidy_state(j));
+    const uvec2 pair = pair_at(q - singles, n);
+    i = pair.x;
+    change = TIDY_SWAP + pair.y;
+    const TidyLabel a = tidy[pair.x].label, b = tidy[pair.y].label;
+    if (movable_state(a) && movable_state(b)) {
+      const ivec4 c = tidy_conflicts(a, b);
       live = c.x + c.y != 0;
     }
   }
+  if (live) atomicOr(s_any, 1u);
+  barrier();
+  if (s_any == 0u) return;  // (the workgroup's)
+  load_states(n, TIDY_PHASE_SEARCH);
   live = live && tidy_change_possible(i, change);
   if (lane == 0u) {
     s_counts[slot] = ivec4(0);
@@ -156,6 +190,7 @@ void main() {
   const uint phase = params.phase;
   if (phase == TIDY_PHASE_START) {
     if (t <= params.tidy_rounds) rounds[t] = t == 0u ? 1u : 0u;
+    if (t == 0u && params.tidy_rounds > 0u) write_round_args(0u);  // (the rest start at zero)
     if (t >= n) return;
     tidy[t].label = tidy_label(labels[t], results[t]);
     tidy[t].free = tidy_free_cost(tidy[t].label, labels[t]);
@@ -173,11 +208,11 @@ void main() {
   // A round: nothing to do once the round before applied nothing.
   const uint r = params.step;
   if (rounds[r] == 0u) return;  // (the same for the whole dispatch)
-  load_states(n, phase);
   if (phase == TIDY_PHASE_SEARCH) {
-    search(t, n);
+    search(t, n);  // (it copies the states only if it has something to weigh)
     return;
   }
+  load_states(n, phase);
   if (phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_SELECT) {
     // One workgroup per label, its invocations splitting the other labels between them.
     const uint i = gl_WorkGroupID.x, lane = gl_LocalInvocationID.x;
@@ -209,6 +244,9 @@ void main() {
     if (owner == TIDY_NO_PARTNER || tidy[owner].applied == 0u) return;
     tidy[t].label = tidy[t].next;
     tidy[t].free = tidy_free_cost(tidy[t].next, labels[t]);
-    if (owner == t) atomicAdd(rounds[r + 1u], 1u);
+    if (owner == t) {
+      atomicAdd(rounds[r + 1u], 1u);
+      if (r + 1u < params.tidy_rounds) write_round_args(r + 1u);
+    }
   }
 }

@@ -134,7 +134,7 @@ TEST_SUITE("gpu") {
       LabelledRenderer renderer(ctx, scene, camera_for(scene, "front"), {64, 64}, {});
       const graph::GraphRunner& runner = renderer.runner();
       CHECK(runner.graph().passes().size() == 21);
-      CHECK(graph::barrier_count(runner.compiled()) == 54);
+      CHECK(graph::barrier_count(runner.compiled()) == 55);
       const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
       CHECK(loop.name == "placement.labels");
     }

@@ -57,6 +57,7 @@
 #define PLACEMENT_BINDING_SAMPLES 17      // uint64_t per tile-list position: a sampled candidate
 #define PLACEMENT_BINDING_TIDY 18         // TidyGpu per label: the layout tidy-up's state
 #define PLACEMENT_BINDING_TIDY_ROUNDS 19  // uint per tidy-up round + 1: changes applied before it
+#define PLACEMENT_BINDING_TIDY_ARGS 20    // uint[3] per tidy-up round and step: its workgroups
 
 // PlacementParams.phase of placement_finalize.comp: the tidy-up's start, the five steps of each
 // round (params.step), and the placements' output.
@@ -256,6 +257,18 @@ STRATA_INLINE uint placement_label_groups(uint main_tiles, uint spec_tiles, uint
 // The workgroup counts of an indirect dispatch over `count` tiles (x is limited to 65535).
 STRATA_INLINE uvec3 placement_dispatch_size(uint count) {
   return uvec3(min(count, 65535u), (count + 65534u) / 65535u, 1u);
+}
+
+// The workgroups (of 64 invocations) of tidy-up step `phase` for n labels: one per label for the
+// conflicts and the selection, TIDY_SEARCH_LANES invocations per change for the search (moves and
+// hidings, n TIDY_SWAP, and swaps, n (n - 1) / 2) in rows of at most 65535, an invocation per
+// label for the others. The host sizes the rounds' indirect dispatches with it, and the tidy-up
+// writes it for each round that runs (the rest stay at zero workgroups).
+STRATA_INLINE uvec3 tidy_phase_groups(uint phase, uint n) {
+  if (phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_SELECT) return uvec3(n, 1u, 1u);
+  uint threads = n;
+  if (phase == TIDY_PHASE_SEARCH) threads = (n * TIDY_SWAP + n * (n - 1u) / 2u) * TIDY_SEARCH_LANES;
+  return placement_dispatch_size((threads + 63u) / 64u);
 }
 
 // How many 32 x 32 tiles cover the viewport across and down.
