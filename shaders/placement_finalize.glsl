@@ -11,8 +11,8 @@ layout(binding = PLACEMENT_BINDING_RESULTS, std430) readonly buffer Results { ui
 layout(binding = PLACEMENT_BINDING_PLACEMENTS, std430) writeonly buffer Placements { PlacementGpu placements[]; };
 layout(binding = PLACEMENT_BINDING_TIDY, std430) buffer Tidy { TidyGpu tidy[]; };
 layout(binding = PLACEMENT_BINDING_TIDY_ROUNDS, std430) buffer Rounds { uint rounds[]; };
-// The rounds' dispatch sizes: zero workgroups for a round after one that changed nothing (such a
-// round cost 13 us on an H100 with its workgroups leaving at once, five dispatches of them).
+// The rounds' dispatch sizes where they are indirect (CPU devices, Placement::add_finalize): zero
+// workgroups for a round after one that changed nothing.
 layout(binding = PLACEMENT_BINDING_TIDY_ARGS, std430) buffer Args { uint tidy_args[]; };
 
 layout(push_constant) uniform Push { PlacementParams params; };
