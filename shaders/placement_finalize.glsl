@@ -41,8 +41,8 @@ float table_at(uint layer, int x, int y) {
 // more on an H100, latency-bound.) With more (placement_finalize_large.comp, TIDY_STATES_IN_BUFFER)
 // the phases read the buffer: no phase writes what it reads (the search writes the bests, the
 // owners the partners and next states, the apply states it does not read), so the copy is only a
-// cache. (One shader choosing per access at run time cost the small case its speed: 0.2 -> 6.6
-// ms for 64 rounds of 100 labels on an H100, as if every read went to the buffer.)
+// cache. (Two shaders, so that the small case's reads are plain shared-memory loads with no
+// choice made per read.)
 uint tidy_count() { return params.label_count; }
 LabelGpu tidy_input(uint k) { return labels[k]; }
 #ifdef TIDY_STATES_IN_BUFFER
