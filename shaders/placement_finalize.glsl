@@ -53,39 +53,27 @@ uint64_t tidy_best(uint k) { return tidy[k].best; }
 TidyLabel tidy_next(uint k) { return tidy[k].next; }
 uint tidy_partner(uint k) { return tidy[k].partner; }
 void load_states(uint n, uint phase) {}
-#elif defined(TIDY_SEARCH_ONLY)
-// (placement_tidy_search.comp: the search reads only the states, free costs and ranks, so its
-// workgroups keep 10 KB of shared memory instead of 21.5 and more of them fit an SM)
+#else
 shared TidyLabel s_label[TIDY_SHARED_MAX];
 shared float s_free[TIDY_SHARED_MAX];
 shared uint s_rank[TIDY_SHARED_MAX];
 TidyLabel tidy_state(uint k) { return s_label[k]; }
 float tidy_free(uint k) { return s_free[k]; }
 uint tidy_rank(uint k) { return s_rank[k]; }
+#ifdef TIDY_SEARCH_ONLY
+// (placement_tidy_search.comp: the search reads only the states, free costs and ranks, so its
+// workgroups keep 10 KB of shared memory instead of 21.5 and more of them fit an SM)
 uint64_t tidy_best(uint k) { return tidy[k].best; }
 TidyLabel tidy_next(uint k) { return tidy[k].next; }
 uint tidy_partner(uint k) { return tidy[k].partner; }
-void load_states(uint n, uint phase) {
-  for (uint k = gl_LocalInvocationID.x; k < n; k += gl_WorkGroupSize.x) {
-    s_label[k] = tidy[k].label;
-    s_free[k] = tidy[k].free;
-    s_rank[k] = tidy[k].rank;
-  }
-  barrier();
-}
 #else
-shared TidyLabel s_label[TIDY_SHARED_MAX];
 shared TidyLabel s_next[TIDY_SHARED_MAX];
 shared uint64_t s_best[TIDY_SHARED_MAX];
-shared float s_free[TIDY_SHARED_MAX];
-shared uint s_rank[TIDY_SHARED_MAX];
 shared uint s_partner[TIDY_SHARED_MAX];
-TidyLabel tidy_state(uint k) { return s_label[k]; }
-float tidy_free(uint k) { return s_free[k]; }
-uint tidy_rank(uint k) { return s_rank[k]; }
 uint64_t tidy_best(uint k) { return s_best[k]; }
 TidyLabel tidy_next(uint k) { return s_next[k]; }
 uint tidy_partner(uint k) { return s_partner[k]; }
+#endif
 
 // The workgroup's copy of the labels' states (the bests only after the search has them).
 void load_states(uint n, uint phase) {
@@ -93,11 +81,13 @@ void load_states(uint n, uint phase) {
     s_label[k] = tidy[k].label;
     s_free[k] = tidy[k].free;
     s_rank[k] = tidy[k].rank;
+#ifndef TIDY_SEARCH_ONLY
     if (phase != TIDY_PHASE_CONFLICTS && phase != TIDY_PHASE_SEARCH) s_best[k] = tidy[k].best;
     if (phase == TIDY_PHASE_SELECT) {
       s_next[k] = tidy[k].next;
       s_partner[k] = tidy[k].partner;
     }
+#endif
   }
   barrier();
 }
