@@ -209,7 +209,11 @@ ordered_json placement_results(const PlacementRun& r) {
           {"forces_ms", ms_json(r.forces_ms)},
           {"label_loop_with_readback_per_label_ms", optional_ms(r.baseline_loop_ms)},
           {"placement_with_readback_per_label_ms", optional_ms(baseline)},
-          {"speedup", speedup}};
+          {"speedup", speedup},
+          {"tiles_per_label_speculative", r.first_tiles},
+          {"tiles_per_label_main_beyond_speculative", r.rest_tiles},
+          {"tidy_rounds", r.tidy_rounds},
+          {"tidy_rounds_run", r.tidy_rounds_run}};
 }
 
 // The label loop's time per label asked for, in µs: how the loop's chain of dispatches grows.
@@ -224,11 +228,7 @@ ordered_json sweep_entry(const PlacementRun& r) {
   entry.update(placement_results(r));
   entry["label_loop_us_per_label"] = std::round(loop_us_per_label(r) * 1e3) / 1e3;
   entry["finalize_ms"] = ms_json(r.finalize_ms);
-  entry["tidy_rounds"] = r.tidy_rounds;
-  entry["tidy_rounds_run"] = r.tidy_rounds_run;
   entry["placement_rest_ms"] = ms_json(r.stamped_ms - r.loop_ms - r.finalize_ms);
-  entry["tiles_per_label_speculative"] = r.first_tiles;
-  entry["tiles_per_label_main_beyond_speculative"] = r.rest_tiles;
   for (const auto& [key, list] :
        {std::pair{"groups", &r.timings.groups}, std::pair{"passes", &r.timings.passes}}) {
     ordered_json& medians = entry[key] = ordered_json::object();
@@ -284,10 +284,6 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
                                 {"layers", r.layers}};
     ordered_json results = placement_results(r);
     results["tiles"] = tiles.x * tiles.y;
-    results["tiles_per_label_speculative"] = r.first_tiles;
-    results["tiles_per_label_main_beyond_speculative"] = r.rest_tiles;
-    results["tidy_rounds"] = r.tidy_rounds;
-    results["tidy_rounds_run"] = r.tidy_rounds_run;
     if (!r.pipelines.empty()) results["pipelines"] = r.pipelines;
     print_json(ctx, setup, o.runs, r.timings, results);
     return;

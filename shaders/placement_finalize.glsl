@@ -12,7 +12,8 @@ layout(binding = PLACEMENT_BINDING_PLACEMENTS, std430) writeonly buffer Placemen
 layout(binding = PLACEMENT_BINDING_TIDY, std430) buffer Tidy { TidyGpu tidy[]; };
 layout(binding = PLACEMENT_BINDING_TIDY_ROUNDS, std430) buffer Rounds { uint rounds[]; };
 // The rounds' dispatch sizes where they are indirect (CPU devices, Placement::add_finalize): zero
-// workgroups for a round after one that changed nothing.
+// workgroups for a round after one that changed nothing. (Written on every device, unread where
+// the rounds are direct: 15 atomics per owner that applied a change.)
 layout(binding = PLACEMENT_BINDING_TIDY_ARGS, std430) buffer Args { uint tidy_args[]; };
 
 layout(push_constant) uniform Push { PlacementParams params; };
