@@ -2,6 +2,7 @@
 #include "app/bench_timings.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -19,10 +20,19 @@ Timings measure(graph::GraphRunner& runner, uint32_t warmup, uint32_t runs,
                 const std::function<void()>& after_run) {
   std::map<std::string, std::vector<double>> passes, groups;
   std::vector<std::string> pass_order, group_order;
-  for (uint32_t i = 0; i < warmup + runs; ++i) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto warming = [&](uint32_t i) {
+    return i < warmup ||
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
+               kWarmupSeconds;
+  };
+  for (uint32_t i = 0; warming(i); ++i) {
     runner.run_now();
     if (after_run) after_run();
-    if (i < warmup) continue;
+  }
+  for (uint32_t i = 0; i < runs; ++i) {
+    runner.run_now();
+    if (after_run) after_run();
     std::map<std::string, std::pair<double, double>> spans;
     for (const graph::PassTiming& t : runner.timings()) {
       if (!passes.count(t.name)) pass_order.push_back(t.name);

@@ -7,6 +7,7 @@
 #include "engine/gpu/context.h"
 #include "shared/tidy_gpu.h"
 
+static_assert(sizeof(strata::gpu::TidyGpu) == 112, "TidyGpu: the layout GLSL's std430 gives it");
 static_assert(PLACEMENT_BOUNDS_TILES * (PLACEMENT_TILE / PLACEMENT_CELL) *
                       (PLACEMENT_TILE / PLACEMENT_CELL) ==
                   PLACEMENT_BOUNDS_GROUP,

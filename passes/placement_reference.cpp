@@ -60,6 +60,7 @@ struct Tidier {
   std::vector<float> frees;
   std::vector<uint64_t> bests;
   std::vector<uint> partners;
+  std::vector<ivec4> currents;  // each label's conflicts this round
 
   float table_at(uint layer, int x, int y) const {
     return table_value(tables, params, layer, x, y);
@@ -72,6 +73,7 @@ struct Tidier {
   uint64_t tidy_best(uint k) const { return bests[k]; }
   TidyLabel tidy_next(uint k) const { return nexts[k]; }
   uint tidy_partner(uint k) const { return partners[k]; }
+  ivec4 tidy_conflicts_now(uint k) const { return currents[k]; }
 
 #include "shared/layout_tidy.h"
 #include "shared/layout_tidy_search.h"
@@ -88,7 +90,11 @@ struct Tidier {
   bool round() {
     const uint n = tidy_count();
     std::vector<bool> conflicted(n);
-    for (uint i = 0; i < n; ++i) conflicted[i] = movable(i) && tidy_conflicted(i, 0, 1);
+    currents.resize(n);
+    for (uint i = 0; i < n; ++i) {
+      currents[i] = tidy_conflicts_of(i, 0, 1);
+      conflicted[i] = movable(i) && currents[i] != ivec4(0);
+    }
     bests.assign(n, TIDY_NONE);
     for (uint i = 0; i < n; ++i) {
       if (!conflicted[i]) continue;

@@ -46,6 +46,8 @@ float table_at(uint layer, int x, int y) {
 // choice made per read.)
 uint tidy_count() { return params.label_count; }
 LabelGpu tidy_input(uint k) { return labels[k]; }
+// (read once per change weighed, by one invocation: from the buffer in both shaders)
+ivec4 tidy_conflicts_now(uint k) { return tidy[k].conflicts; }
 #ifdef TIDY_STATES_IN_BUFFER
 TidyLabel tidy_state(uint k) { return tidy[k].label; }
 float tidy_free(uint k) { return tidy[k].free; }
@@ -94,6 +96,7 @@ void load_states(uint n, uint phase) {
 }
 #endif
 shared uint s_any;
+shared ivec4 s_conflicts;  // TIDY_PHASE_CONFLICTS: the workgroup's label's, summed
 
 #include "shared/layout_tidy_search.h"
 
@@ -199,11 +202,20 @@ void main() {
   if (phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_SELECT) {
     // One workgroup per label, its invocations splitting the other labels between them.
     const uint i = gl_WorkGroupID.x, lane = gl_LocalInvocationID.x;
-    if (lane == 0u) s_any = 0u;
+    if (lane == 0u) {
+      s_any = 0u;
+      s_conflicts = ivec4(0);
+    }
     barrier();
     bool any = false;
     if (phase == TIDY_PHASE_CONFLICTS) {
-      any = movable(i) && tidy_conflicted(i, lane, gl_WorkGroupSize.x);
+      const ivec4 c = tidy_conflicts_of(i, lane, gl_WorkGroupSize.x);
+      if (c != ivec4(0)) {
+        atomicAdd(s_conflicts.x, c.x);
+        atomicAdd(s_conflicts.y, c.y);
+        atomicAdd(s_conflicts.z, c.z);
+        atomicAdd(s_conflicts.w, c.w);
+      }
     } else {
       any = tidy_partner(i) != TIDY_NO_PARTNER && tidy_blocked(i, lane, gl_WorkGroupSize.x);
     }
@@ -212,7 +224,8 @@ void main() {
     if (lane != 0u) return;
     if (phase == TIDY_PHASE_CONFLICTS) {
       tidy[i].best = TIDY_NONE;
-      tidy[i].conflicted = s_any;
+      tidy[i].conflicts = s_conflicts;
+      tidy[i].conflicted = movable(i) && s_conflicts != ivec4(0) ? 1u : 0u;
     } else {
       tidy[i].applied = tidy_partner(i) != TIDY_NO_PARTNER && s_any == 0u ? 1u : 0u;
     }

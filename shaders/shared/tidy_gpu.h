@@ -10,6 +10,8 @@ STRATA_BEGIN
 struct TidyGpu {
   TidyLabel label;  // this round
   TidyLabel next;   // after its owner's change (TIDY_PHASE_OWNERS)
+  ivec4 conflicts;  // its conflicts with all others this round (TIDY_PHASE_CONFLICTS; 16-byte
+                    // aligned here for GLSL, with no padding in C++)
   uint64_t best;    // tidy_key of its best change, or TIDY_NONE
   float free;       // tidy_free_cost of `label`
   uint rank;        // insertion order position
