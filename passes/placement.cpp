@@ -171,8 +171,8 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
   b.tidy = graph.add_buffer("placement.tidy", fixed(n * sizeof(gpu::TidyGpu)));
   b.tidy_rounds =
       graph.add_buffer("placement.tidy_rounds", fixed((TIDY_ROUNDS_MAX + 1) * sizeof(uint32_t)));
-  b.tidy_args =
-      graph.add_buffer("placement.tidy_args", fixed(TIDY_ROUNDS_MAX * 5 * 3 * sizeof(uint32_t)));
+  b.tidy_args = graph.add_buffer("placement.tidy_args",
+                                 fixed(TIDY_ROUNDS_MAX * TIDY_ROUND_STEPS * 3 * sizeof(uint32_t)));
   b.regions = graph.add_buffer(
       "placement.regions",
       fixed(VkDeviceSize{gpu::placement_pair_count(n)} * sizeof(gpu::PairRegionsGpu)));
@@ -336,7 +336,7 @@ glm::uvec3 Placement::direct_groups(graph::Extent viewport) const {
       gpu::placement_classify_groups(tile_count, classify_tiles(viewport)) + tiles + 1);
 }
 
-// The layout tidy-up (its rounds: five dispatches each; a round after one that changed nothing
+// The layout tidy-up (its rounds: four dispatches each; a round after one that changed nothing
 // has nothing to do) and each label's position and whether it is shown, copied to the host after
 // the frame. On CPU devices the rounds are indirect dispatches sized by the round before, none
 // once nothing changes (lavapipe, head.json at 128²: 266 -> 43 ms); on an H100 that made them
@@ -364,8 +364,8 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
          pc.dispatch(finalize_, p, {std::max(n, p.tidy_rounds + 1), 1, 1});
          for (uint32_t round = 0; round < p.tidy_rounds; ++round) {
            p.step = round;
-           for (const uint32_t phase : {TIDY_PHASE_CONFLICTS, TIDY_PHASE_SEARCH, TIDY_PHASE_OWNERS,
-                                        TIDY_PHASE_SELECT, TIDY_PHASE_APPLY}) {
+           for (const uint32_t phase :
+                {TIDY_PHASE_CONFLICTS, TIDY_PHASE_SEARCH, TIDY_PHASE_OWNERS, TIDY_PHASE_SELECT}) {
              pc.barrier();
              p.phase = phase;
              // (tidy_phase_groups; the search's workgroups pass 65535 from about 900 labels: rows
@@ -373,7 +373,7 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
              const ComputePipeline& pipeline = phase == TIDY_PHASE_SEARCH ? search_ : finalize_;
              if (indirect_) {
                const VkDeviceSize offset =
-                   (VkDeviceSize{round} * 5 + (phase - TIDY_PHASE_CONFLICTS)) * 3 *
+                   (VkDeviceSize{round} * TIDY_ROUND_STEPS + (phase - TIDY_PHASE_CONFLICTS)) * 3 *
                    sizeof(uint32_t);
                pc.dispatch_indirect(pipeline, p, b.tidy_args, offset);
              } else {

@@ -1,7 +1,10 @@
 // The layout tidy-up (shared/layout_tidy.h) and the placements' output, one phase per dispatch
 // (params.phase; params.step: the round): its start from the label loop's (cost, pixel) results,
-// five dispatches per round, and each label's placement (box centre, cost, shown). A round whose
-// round before applied nothing leaves at once. Included by placement_finalize.comp (up to
+// four dispatches per round, and each label's placement (box centre, cost, shown). A round whose
+// round before applied nothing leaves at once. The changes a round applies are taken up by the
+// next round's conflicts step (each label's workgroup stores its own; every workgroup reads the
+// others' as `take` says), or by the output: a fifth dispatch per round only for that cost an
+// H100 about 2 us a round even when the round had nothing to do. Included by placement_finalize.comp (up to
 // TIDY_SHARED_MAX labels) and placement_finalize_large.comp (more: TIDY_STATES_IN_BUFFER).
 layout(local_size_x = 64) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
@@ -13,18 +16,18 @@ layout(binding = PLACEMENT_BINDING_TIDY, std430) buffer Tidy { TidyGpu tidy[]; }
 layout(binding = PLACEMENT_BINDING_TIDY_ROUNDS, std430) buffer Rounds { uint rounds[]; };
 // The rounds' dispatch sizes where they are indirect (CPU devices, Placement::add_finalize): zero
 // workgroups for a round after one that changed nothing. (Written on every device, unread where
-// the rounds are direct: 15 atomics per owner that applied a change.)
+// the rounds are direct: 12 atomics per owner that applied a change.)
 layout(binding = PLACEMENT_BINDING_TIDY_ARGS, std430) buffer Args { uint tidy_args[]; };
 
 layout(push_constant) uniform Push { PlacementParams params; };
 
 // Round r runs: its steps' dispatch sizes.
 void write_round_args(uint r) {
-  for (uint k = 0u; k < 5u; ++k) {
+  for (uint k = 0u; k < TIDY_ROUND_STEPS; ++k) {
     const uvec3 size = tidy_phase_groups(TIDY_PHASE_CONFLICTS + k, params.label_count);
     for (uint c = 0u; c < 3u; ++c) {
       // (every owner that applied a change writes the same sizes)
-      atomicMax(tidy_args[(r * 5u + k) * 3u + c], size[c]);
+      atomicMax(tidy_args[(r * TIDY_ROUND_STEPS + k) * 3u + c], size[c]);
     }
   }
 }
@@ -48,9 +51,19 @@ uint tidy_count() { return params.label_count; }
 LabelGpu tidy_input(uint k) { return labels[k]; }
 // (read once per change weighed, by one invocation: from the buffer in both shaders)
 ivec4 tidy_conflicts_now(uint k) { return tidy[k].conflicts; }
+// The conflicts step and the output see the changes the round before applied (TidyGpu::take).
+bool tidy_takes(uint phase) { return phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_OUTPUT; }
 #ifdef TIDY_STATES_IN_BUFFER
-TidyLabel tidy_state(uint k) { return tidy[k].label; }
-float tidy_free(uint k) { return tidy[k].free; }
+// (if, not ?: a selection between two buffer structs stored elsewhere makes glslang write
+// invalid SPIR-V)
+TidyLabel tidy_state(uint k) {
+  if (tidy_takes(params.phase) && tidy[k].take != 0u) return tidy[k].next;
+  return tidy[k].label;
+}
+float tidy_free(uint k) {
+  return tidy_takes(params.phase) && tidy[k].take != 0u ? tidy_free_cost(tidy[k].next, labels[k])
+                                                        : tidy[k].free;
+}
 uint tidy_rank(uint k) { return tidy[k].rank; }
 uint64_t tidy_best(uint k) { return tidy[k].best; }
 TidyLabel tidy_next(uint k) { return tidy[k].next; }
@@ -81,8 +94,20 @@ uint tidy_partner(uint k) { return s_partner[k]; }
 // The workgroup's copy of the labels' states (the bests only after the search has them).
 void load_states(uint n, uint phase) {
   for (uint k = gl_LocalInvocationID.x; k < n; k += gl_WorkGroupSize.x) {
+#ifdef TIDY_SEARCH_ONLY
     s_label[k] = tidy[k].label;
     s_free[k] = tidy[k].free;
+#else
+    const bool taken = tidy_takes(phase) && tidy[k].take != 0u;
+    if (taken) {  // (not ?: as in tidy_state of the buffer variant)
+      s_label[k] = tidy[k].next;
+    } else {
+      s_label[k] = tidy[k].label;
+    }
+    // (the conflicts step reads no free costs)
+    s_free[k] = taken && phase == TIDY_PHASE_OUTPUT ? tidy_free_cost(tidy[k].next, labels[k])
+                                                    : tidy[k].free;
+#endif
     s_rank[k] = tidy[k].rank;
 #ifndef TIDY_SEARCH_ONLY
     if (phase != TIDY_PHASE_CONFLICTS && phase != TIDY_PHASE_SEARCH) s_best[k] = tidy[k].best;
@@ -181,6 +206,7 @@ void main() {
     tidy[t].label = tidy_label(labels[t], results[t]);
     tidy[t].free = tidy_free_cost(tidy[t].label, labels[t]);
     tidy[t].rank = LABEL_MAX;  // (not in the order)
+    tidy[t].take = 0u;
     for (uint k = 0u; k < params.order_count; ++k) {
       if (order[k] == t) tidy[t].rank = k;
     }
@@ -223,26 +249,27 @@ void main() {
     barrier();
     if (lane != 0u) return;
     if (phase == TIDY_PHASE_CONFLICTS) {
+      // (the label's state after the round before, stored: the steps after this one read
+      // `label`; `take` stays until the owners step, so every workgroup of this one sees the same)
+      if (tidy[i].take != 0u) {
+        tidy[i].label = tidy[i].next;
+        tidy[i].free = tidy_free_cost(tidy[i].next, labels[i]);
+      }
       tidy[i].best = TIDY_NONE;
       tidy[i].conflicts = s_conflicts;
       tidy[i].conflicted = movable(i) && s_conflicts != ivec4(0) ? 1u : 0u;
-    } else {
-      tidy[i].applied = tidy_partner(i) != TIDY_NO_PARTNER && s_any == 0u ? 1u : 0u;
+    } else if (tidy_partner(i) != TIDY_NO_PARTNER && s_any == 0u) {
+      // Owner i's change is applied: its labels take their next states.
+      tidy[i].take = 1u;
+      tidy[tidy_partner(i)].take = 1u;
+      atomicAdd(rounds[r + 1u], 1u);
+      if (r + 1u < params.tidy_rounds) write_round_args(r + 1u);
     }
     return;
   }
   if (t >= n) return;
-  if (phase == TIDY_PHASE_OWNERS) {
-    tidy[t].partner = tidy_owned_partner(t);
-    tidy[t].next = tidy_after(t);
-  } else if (phase == TIDY_PHASE_APPLY) {
-    const uint owner = tidy_owner(t);
-    if (owner == TIDY_NO_PARTNER || tidy[owner].applied == 0u) return;
-    tidy[t].label = tidy[t].next;
-    tidy[t].free = tidy_free_cost(tidy[t].next, labels[t]);
-    if (owner == t) {
-      atomicAdd(rounds[r + 1u], 1u);
-      if (r + 1u < params.tidy_rounds) write_round_args(r + 1u);
-    }
-  }
+  // TIDY_PHASE_OWNERS
+  tidy[t].partner = tidy_owned_partner(t);
+  tidy[t].next = tidy_after(t);
+  tidy[t].take = 0u;
 }

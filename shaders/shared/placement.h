@@ -59,14 +59,15 @@
 #define PLACEMENT_BINDING_TIDY_ROUNDS 19  // uint per tidy-up round + 1: changes applied before it
 #define PLACEMENT_BINDING_TIDY_ARGS 20    // uint[3] per tidy-up round and step: its workgroups
 
-// PlacementParams.phase of placement_finalize.comp: the tidy-up's start, the five steps of each
-// round (params.step), and the placements' output.
+// PlacementParams.phase of placement_finalize.comp: the tidy-up's start, the four steps of each
+// round (params.step), and the placements' output. The changes a round applies are taken up by
+// the next round's conflicts step, or by the output (TidyGpu::take).
 #define TIDY_PHASE_START 0u
 #define TIDY_PHASE_CONFLICTS 1u  // per label: in some conflict? best change reset
 #define TIDY_PHASE_SEARCH 2u     // per (label, move or hiding) and pair: the best changes
 #define TIDY_PHASE_OWNERS 3u     // per label: owned change, state after it
 #define TIDY_PHASE_SELECT 4u     // per owner: applied unless a better owner's change interacts
-#define TIDY_PHASE_APPLY 5u      // per label: take the state after the applied changes
+#define TIDY_ROUND_STEPS 4u      // dispatches per round
 #define TIDY_PHASE_OUTPUT 6u     // per label: the placement
 
 // The tile lists are in bucket order; an entry's x has this bit when its tile is in bucket 0 (the

@@ -17,7 +17,8 @@ struct TidyGpu {
   uint rank;        // insertion order position
   uint partner;     // as owner: its swap partner, itself, or TIDY_NO_PARTNER (not an owner)
   uint conflicted;  // 1: in some conflict (moves and hiding are searched)
-  uint applied;     // 1: its owner's change is applied this round
+  uint take;        // 1: its owner's change was applied: `next` is its state (set by the
+                    // selection, taken into `label` by the next round's conflicts step)
   uint pad;
 };
 STRATA_END
