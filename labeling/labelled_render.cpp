@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <future>
 #include <optional>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -48,8 +49,14 @@ std::vector<ProjectedPoint> project_anchors(const Scene& scene, const Camera& ca
 
 struct LabelledRenderer::Parts {
   Parts(Context& ctx, const Scene& scene, const RenderSettings& render, uint32_t label_count)
+      : Parts(ctx, scene, render, label_count, std::async(std::launch::async, [&ctx, label_count] {
+                return Placement::create_pipelines(ctx, label_count);
+              })) {}
+  // (the placement's pipelines compile while the renderer prepares the volumes)
+  Parts(Context& ctx, const Scene& scene, const RenderSettings& render, uint32_t label_count,
+        std::future<std::vector<ComputePipeline>> placement_pipelines)
       : renderer(ctx, scene, render),
-        placement(ctx, label_count),
+        placement(ctx, label_count, {}, placement_pipelines.get()),
         forces(ctx, label_count),
         target(ctx) {}
   VolumeRenderer renderer;

@@ -1,7 +1,10 @@
 #include "passes/placement.h"
 
+#include <array>
 #include <cstddef>
 #include <cstring>
+#include <string_view>
+#include <utility>
 
 #include "engine/core/error.h"
 #include "engine/gpu/context.h"
@@ -56,22 +59,37 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   return p;
 }
 
+std::vector<ComputePipeline> Placement::create_pipelines(Context& ctx, uint32_t label_count) {
+  // (more labels than a workgroup's shared memory holds: the tidy-up's states are read from the
+  // buffer)
+  const bool large = label_count > TIDY_SHARED_MAX;
+  const std::array<std::string_view, 6> shaders{
+      "integral_costs.comp",
+      "placement_bounds.comp",
+      "place_label.comp",
+      large ? "placement_finalize_large.comp" : "placement_finalize.comp",
+      large ? "placement_tidy_search_large.comp" : "placement_tidy_search.comp",
+      "label_previous.comp"};
+  return create_compute_pipelines(ctx, shaders);
+}
+
 Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
+    : Placement(ctx, label_count, layout, create_pipelines(ctx, label_count)) {}
+
+Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
+                     std::vector<ComputePipeline> pipelines)
     : ctx_(ctx),
       label_count_(label_count),
       indirect_(layout.dispatch == LabelDispatch::indirect ||
                 (layout.dispatch == LabelDispatch::automatic &&
                  ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)),
       layout_(layout),
-      integral_costs_(ctx, "integral_costs.comp"),
-      bounds_(ctx, "placement_bounds.comp"),
-      place_(ctx, "place_label.comp"),
-      // (more labels than a workgroup's shared memory holds: states read from the buffer)
-      finalize_(ctx, label_count > TIDY_SHARED_MAX ? "placement_finalize_large.comp"
-                                                   : "placement_finalize.comp"),
-      search_(ctx, label_count > TIDY_SHARED_MAX ? "placement_finalize_large.comp"
-                                                 : "placement_tidy_search.comp"),
-      previous_(ctx, "label_previous.comp"),
+      integral_costs_(std::move(pipelines[0])),
+      bounds_(std::move(pipelines[1])),
+      place_(std::move(pipelines[2])),
+      finalize_(std::move(pipelines[3])),
+      search_(std::move(pipelines[4])),
+      previous_(std::move(pipelines[5])),
       tables_(ctx),
       readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu)) {
   static_assert(LABEL_MAX == kMaxLabels, "the scene side's label limit is the placement's");

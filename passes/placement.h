@@ -95,6 +95,11 @@ class Placement {
 
   // `label_count` sizes the per-label buffers; a frame may enable fewer labels.
   Placement(Context& ctx, uint32_t label_count, PlacementLayout layout = {});
+  // The same with its compute pipelines made beforehand by create_pipelines: they take a while on
+  // drivers that compile at creation (lavapipe: 0.3 s), so a caller may create them meanwhile.
+  Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
+            std::vector<ComputePipeline> pipelines);
+  static std::vector<ComputePipeline> create_pipelines(Context& ctx, uint32_t label_count);
 
   // Adds the placement's passes: upload, costs, bounds, the label loop, finalize and readback.
   Outputs add_to(graph::Graph& graph, const Inputs& in);

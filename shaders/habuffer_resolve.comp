@@ -36,7 +36,8 @@ void emit_layer(uint l, vec4 colour) {
 #include "shared/resolve_walk.h"
 
 void main() {
-  const uvec2 px = gl_GlobalInvocationID.xy;
+  const uvec2 group = uvec2(gl_WorkGroupID.x, resolve_group_row(gl_WorkGroupID.y, gl_NumWorkGroups.y));
+  const uvec2 px = group * gl_WorkGroupSize.xy + gl_LocalInvocationID.xy;
   const bool inside = px.x < frame.width && px.y < frame.height;
   uint count = 0u, dropped = 0u;
   float depths[VR_MAX_FRAGMENTS];
@@ -75,7 +76,7 @@ void main() {
   const uint fetches = subgroupAdd(inside ? r.fetches : 0u);
   // With frames in flight the counters read back are a frame or two old: they say which table
   // they were counted in, so a table already grown is not grown again for the same overflow.
-  if (gl_GlobalInvocationID.xy == uvec2(0)) counters[VR_COUNTER_TABLE_SIZE] = frame.table_size;
+  if (px == uvec2(0)) counters[VR_COUNTER_TABLE_SIZE] = frame.table_size;
   if (subgroupElect()) {
     atomicAdd(counters[VR_COUNTER_FRAGMENTS], found);
     if (lost > 0u) atomicAdd(counters[VR_COUNTER_RESOLVE_OVERFLOW], lost);

@@ -6,7 +6,10 @@
 // others' as `take` says), or by the output: a fifth dispatch per round for that alone cost an
 // H100 about 3 us a round, even a round with nothing to do (10 labels: 0.90 -> 0.73 ms without).
 // Included by placement_finalize.comp (up to TIDY_SHARED_MAX labels) and
-// placement_finalize_large.comp (more: TIDY_STATES_IN_BUFFER).
+// placement_finalize_large.comp (more: TIDY_STATES_IN_BUFFER), and with TIDY_SEARCH_ONLY by
+// placement_tidy_search.comp and placement_tidy_search_large.comp: the search step in a pipeline
+// of its own, the other steps without it. (One pipeline for all of them took lavapipe 420 ms to
+// create, the two together 190; on a GPU, registers are allocated for a pipeline's largest step.)
 layout(local_size_x = 64) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
 layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
@@ -143,6 +146,7 @@ uvec2 pair_at(uint p, uint n) {
   return uvec2(row, row + 1u + p - row * (2u * n - row - 1u) / 2u);
 }
 
+#ifdef TIDY_SEARCH_ONLY
 // TIDY_PHASE_SEARCH: item q is (label, move or hiding) below n x TIDY_SWAP, a pair of labels
 // (i < j) above; TIDY_SEARCH_LANES invocations take an item, splitting the other labels.
 shared ivec4 s_counts[64 / TIDY_SEARCH_LANES];
@@ -198,6 +202,13 @@ void main() {
   // (the search's items can pass 65535 workgroups across: its dispatch is two-dimensional)
   const uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
                  gl_LocalInvocationID.x;
+  // A round: nothing to do once the round before applied nothing.
+  if (rounds[params.step] != 0u) search(t, params.label_count);  // (the same for the whole dispatch)
+}
+#else
+void main() {
+  const uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * gl_WorkGroupSize.x +
+                 gl_LocalInvocationID.x;
   const uint n = params.label_count;
   const uint phase = params.phase;
   if (phase == TIDY_PHASE_START) {
@@ -221,10 +232,6 @@ void main() {
   // A round: nothing to do once the round before applied nothing.
   const uint r = params.step;
   if (rounds[r] == 0u) return;  // (the same for the whole dispatch)
-  if (phase == TIDY_PHASE_SEARCH) {
-    search(t, n);
-    return;
-  }
   load_states(n, phase);
   if (phase == TIDY_PHASE_CONFLICTS || phase == TIDY_PHASE_SELECT) {
     // One workgroup per label, its invocations splitting the other labels between them.
@@ -274,3 +281,4 @@ void main() {
   tidy[t].next = tidy_after(t);
   tidy[t].take = 0u;
 }
+#endif

@@ -1,8 +1,14 @@
 // Descriptor layouts come from SPIR-V reflection of the embedded shaders.
 #include <doctest/doctest.h>
 
+#include <array>
+#include <string_view>
+#include <vector>
+
 #include "engine/core/error.h"
+#include "engine/gpu/context.h"
 #include "engine/gpu/shader_library.h"
+#include "gpu_fixture.h"
 #include "shared/summed_area_table.h"
 #include "shared/test_pattern.h"
 
@@ -44,6 +50,25 @@ TEST_SUITE("cpu") {
                          doctest::Contains("no shader named 'missing.comp'"), Error);
     const std::vector<uint32_t> garbage = {1, 2, 3, 4, 5, 6};
     CHECK_THROWS_AS(reflect(garbage, VK_SHADER_STAGE_COMPUTE_BIT, "garbage"), Error);
+  }
+}
+
+TEST_SUITE("gpu") {
+  TEST_CASE_FIXTURE(test::GpuTest,
+                    "pipelines_created_together_come_in_order_or_as_the_first_error") {
+    const std::array<std::string_view, 3> shaders{"test_pattern.comp", "place_label.comp",
+                                                  "summed_area_table_scan.comp"};
+    const std::vector<ComputePipeline> pipelines = create_compute_pipelines(ctx, shaders);
+    REQUIRE(pipelines.size() == shaders.size());
+    for (size_t k = 0; k < shaders.size(); ++k) {
+      CHECK(pipelines[k].name() == shaders[k]);
+      CHECK(pipelines[k].local_size() ==
+            reflect(shader_code(shaders[k]), VK_SHADER_STAGE_COMPUTE_BIT, shaders[k]).local_size);
+    }
+    const std::array<std::string_view, 3> one_missing{"test_pattern.comp", "missing.comp",
+                                                      "place_label.comp"};
+    CHECK_THROWS_WITH_AS(create_compute_pipelines(ctx, one_missing),
+                         doctest::Contains("no shader named 'missing.comp'"), Error);
   }
 }
 

@@ -7,7 +7,9 @@
 // ray-box tests on both sides).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
@@ -132,6 +134,32 @@ void check_against_reference(Context& ctx, const Scene& scene, const Camera& cam
 }
 
 }  // namespace
+
+TEST_SUITE("cpu") {
+  // The resolve's workgroup rows: every row once, and each half of the dispatch order (what each of
+  // lavapipe's two threads takes) reaches over the whole image.
+  TEST_CASE("resolve_rows_are_a_permutation_spread_over_the_image") {
+    for (uint32_t rows = 1; rows <= 130; ++rows) {
+      std::vector<int> seen(rows, 0);
+      for (uint32_t r = 0; r < rows; ++r) {
+        const uint32_t row = gpu::resolve_group_row(r, rows);
+        REQUIRE(row < rows);
+        ++seen[row];
+      }
+      CHECK(std::count(seen.begin(), seen.end(), 1) == int(rows));
+      if (rows < 2 * VR_ROW_INTERLEAVE) continue;
+      for (uint32_t half = 0; half < 2; ++half) {
+        uint32_t lowest = rows, highest = 0;
+        for (uint32_t r = half * (rows / 2); r < (half + 1) * (rows / 2); ++r) {
+          lowest = std::min(lowest, gpu::resolve_group_row(r, rows));
+          highest = std::max(highest, gpu::resolve_group_row(r, rows));
+        }
+        CHECK(lowest < VR_ROW_INTERLEAVE);
+        CHECK(highest >= rows - VR_ROW_INTERLEAVE);
+      }
+    }
+  }
+}
 
 TEST_SUITE("gpu") {
   // The bundled head demo, 256x256, front camera, 4 layers, against tests/golden/head-front-256.png

@@ -1,6 +1,7 @@
 #include "engine/gpu/shader_library.h"
 
 #include <algorithm>
+#include <future>
 #include <memory>
 #include <utility>
 
@@ -162,6 +163,18 @@ Pipeline::Pipeline(Context& ctx, std::string name, ShaderReflection reflection,
       vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
 }
 
+Pipeline::Pipeline(Pipeline&& other) noexcept
+    : ctx_(other.ctx_),
+      device_(other.device_),
+      name_(std::move(other.name_)),
+      reflection_(std::move(other.reflection_)),
+      stages_(other.stages_),
+      bind_point_(other.bind_point_),
+      set_layout_(std::exchange(other.set_layout_, VK_NULL_HANDLE)),
+      layout_(std::exchange(other.layout_, VK_NULL_HANDLE)),
+      pipeline_(std::exchange(other.pipeline_, VK_NULL_HANDLE)),
+      push_descriptor_set_(other.push_descriptor_set_) {}
+
 Pipeline::~Pipeline() {
   if (!ctx_->may_destroy()) return;  // (a wait timed out: the GPU may still run it)
   vkDestroyPipeline(device_, pipeline_, nullptr);
@@ -237,6 +250,21 @@ std::vector<PipelineStatistic> ComputePipeline::statistics() const {
       out.push_back({s.name, value});
     }
   }
+  return out;
+}
+
+std::vector<ComputePipeline> create_compute_pipelines(Context& ctx,
+                                                      std::span<const std::string_view> shaders) {
+  std::vector<std::future<ComputePipeline>> pending;
+  pending.reserve(shaders.size());
+  for (std::string_view shader : shaders) {
+    pending.push_back(
+        std::async(std::launch::async, [&ctx, shader] { return ComputePipeline(ctx, shader); }));
+  }
+  // (a throw leaves the later futures to their destructors, which wait for their threads)
+  std::vector<ComputePipeline> out;
+  out.reserve(shaders.size());
+  for (std::future<ComputePipeline>& p : pending) out.push_back(p.get());
   return out;
 }
 

@@ -48,6 +48,9 @@ class Pipeline {
  public:
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
+  // (the handles move; the moved-from pipeline holds none)
+  Pipeline(Pipeline&& other) noexcept;
+  Pipeline& operator=(Pipeline&&) = delete;
   virtual ~Pipeline();
 
   const std::string& name() const { return name_; }
@@ -103,6 +106,12 @@ class ComputePipeline : public Pipeline {
  private:
   bool captured_ = false;
 };
+
+// The compute pipelines of `shaders`, in that order, created on a thread each: a driver that
+// compiles at creation takes them in parallel (lavapipe spends up to 0.2 s on one of strata's
+// placement pipelines). The first error is thrown once every creation has ended.
+std::vector<ComputePipeline> create_compute_pipelines(Context& ctx,
+                                                      std::span<const std::string_view> shaders);
 
 // Rasterisation state strata's graphics passes choose from; everything else is fixed (triangle
 // lists, no vertex input: vertices are pulled from storage buffers; dynamic viewport/scissor).

@@ -175,12 +175,23 @@ TidyLabel tidy_after(uint i) {
 }
 
 // How much more J changes with both labels a and b changed than the two changes alone counted.
+// (The four terms in a loop, as the pairs in tidy_blocked: one copy of tidy_conflicts, not
+// sixteen, which shader compilers inline: on lavapipe that was most of the pipeline's creation.)
 ivec4 tidy_pair_correction(uint a, uint b) {
   TidyLabel a0 = tidy_state(a), a1 = tidy_next(a), b0 = tidy_state(b), b1 = tidy_next(b);
   ivec4 reach = tidy_union(tidy_extent(a0), tidy_extent(a1));
   if (!tidy_rects_touch(reach, tidy_union(tidy_extent(b0), tidy_extent(b1)))) return ivec4(0);
-  return tidy_conflicts(a1, b1) - tidy_conflicts(a1, b0) - tidy_conflicts(a0, b1) +
-         tidy_conflicts(a0, b0);
+  ivec4 c = ivec4(0);
+  for (uint k = 0u; k < 4u; ++k) {
+    // (a1, b1) and (a0, b0) add, the mixed pairs subtract
+    TidyLabel x = a1, y = b1;
+    if ((k & 1u) != 0u) x = a0;
+    if ((k & 2u) != 0u) y = b0;
+    ivec4 term = tidy_conflicts(x, y);
+    if (k == 1u || k == 2u) c -= term;
+    else c += term;
+  }
+  return c;
 }
 
 // Step 3: is owner i's change held back by a better owner's (of first, first + stride, ...) that
@@ -193,11 +204,11 @@ bool tidy_blocked(uint i, uint first, uint stride) {
     if (l == i || pl == TIDY_NO_PARTNER) continue;
     uint64_t other = tidy_best(l);
     if (other > key || (other == key && l > i)) continue;
-    ivec4 c = tidy_pair_correction(i, l);
-    if (pl != l) c += tidy_pair_correction(i, pl);
-    if (pi != i) {
-      c += tidy_pair_correction(pi, l);
-      if (pl != l) c += tidy_pair_correction(pi, pl);
+    // (i or its partner against l or its partner: the pairs a swap adds)
+    ivec4 c = ivec4(0);
+    for (uint k = 0u; k < 4u; ++k) {
+      if (((k & 1u) != 0u && pl == l) || ((k & 2u) != 0u && pi == i)) continue;
+      c += tidy_pair_correction((k & 2u) != 0u ? pi : i, (k & 1u) != 0u ? pl : l);
     }
     if (tidy_adds_hard(c) || tidy_weight(c) > 0.0f) return true;
   }

@@ -84,6 +84,26 @@ struct FrameGpu {
   float pad4;
 };
 
+// The resolve's workgroup row for position r of `rows` in dispatch order: the rows in
+// VR_ROW_INTERLEAVE interleaved sets (0, 8, 16, ..., then 1, 9, ...), so that every long run of
+// consecutive workgroups spans the whole image. lavapipe hands each of its threads one contiguous
+// run of a dispatch's workgroups; with rows in order, the thread whose half of the image held more
+// of the volume ran on alone (a third of the resolve, for head.json at 512 px, oblique).
+#define VR_ROW_INTERLEAVE 8u
+STRATA_INLINE uint resolve_group_row(uint r, uint rows) {
+  uint q = rows / VR_ROW_INTERLEAVE, m = rows % VR_ROW_INTERLEAVE;
+  // (sets k < m hold q + 1 rows, the others q)
+  uint set, index;
+  if (r < m * (q + 1u)) {
+    set = r / (q + 1u);
+    index = r % (q + 1u);
+  } else {
+    set = m + (r - m * (q + 1u)) / max(q, 1u);
+    index = (r - m * (q + 1u)) % max(q, 1u);
+  }
+  return index * VR_ROW_INTERLEAVE + set;
+}
+
 // Push constants of one mesh's draw in the HA-Buffer build.
 struct DrawGpu {
   mat4 model;        // model to world
