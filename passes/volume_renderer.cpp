@@ -356,6 +356,9 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
         return prepare_render_inputs(scene, ctx.properties().limits.maxImageDimension3D,
                                      limits.max_device_voxels * limits.device_voxel_bytes);
       }()),
+      group_order_(ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU
+                       ? VR_ORDER_ROWS_INTERLEAVED
+                       : VR_ORDER_ROWS),
       counters_readback_(ctx, VR_COUNTER_COUNT * sizeof(uint32_t)),
       build_(ctx, "habuffer_build.vert", "habuffer_build.frag", {}),
       resolve_(ctx, "habuffer_resolve.comp") {
@@ -445,8 +448,9 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {keys, Use::transfer_dst},
                    {counters, Use::transfer_dst}},
                   [this, frame, transfer, keys, counters](graph::PassContext& pc) {
-                    const gpu::FrameGpu data = frame_data(inputs_, camera_, settings_, pc.viewport,
-                                                          slots_for(pc.viewport));
+                    gpu::FrameGpu data = frame_data(inputs_, camera_, settings_, pc.viewport,
+                                                    slots_for(pc.viewport));
+                    data.group_order = group_order_;
                     vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
                     const std::vector<glm::vec4> table = corrected_transfer(inputs_, data.step);
                     vkCmdUpdateBuffer(pc.cmd, pc.buffer(transfer), 0,

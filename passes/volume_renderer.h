@@ -140,6 +140,7 @@ class VolumeRenderer {
   RenderSettings settings_;
   Camera camera_;
   RenderInputs inputs_;
+  uint32_t group_order_;  // VR_ORDER_*: by the device's kind
 
   Image atlas_;
   Buffer volumes_, occupancy_, vertices_, indices_;

@@ -36,7 +36,7 @@ void emit_layer(uint l, vec4 colour) {
 #include "shared/resolve_walk.h"
 
 void main() {
-  const uvec2 group = uvec2(gl_WorkGroupID.x, resolve_group_row(gl_WorkGroupID.y, gl_NumWorkGroups.y));
+  const uvec2 group = resolve_group(gl_WorkGroupID.xy, gl_NumWorkGroups.xy, frame.group_order);
   const uvec2 px = group * gl_WorkGroupSize.xy + gl_LocalInvocationID.xy;
   const bool inside = px.x < frame.width && px.y < frame.height;
   uint count = 0u, dropped = 0u;

@@ -159,6 +159,26 @@ TEST_SUITE("cpu") {
       }
     }
   }
+
+  // Every order takes every workgroup of the grid once.
+  TEST_CASE("resolve_group_orders_take_every_workgroup_once") {
+    for (uint32_t order : {VR_ORDER_ROWS, VR_ORDER_ROWS_INTERLEAVED}) {
+      for (uint32_t gx = 1; gx <= 35; gx += 2) {
+        for (uint32_t gy = 1; gy <= 20; gy += 3) {
+          std::vector<int> seen(size_t(gx) * gy, 0);
+          for (uint32_t y = 0; y < gy; ++y) {
+            for (uint32_t x = 0; x < gx; ++x) {
+              const glm::uvec2 g = gpu::resolve_group({x, y}, {gx, gy}, order);
+              REQUIRE(g.x < gx);
+              REQUIRE(g.y < gy);
+              ++seen[size_t(g.y) * gx + g.x];
+            }
+          }
+          CHECK(std::count(seen.begin(), seen.end(), 1) == int(gx * gy));
+        }
+      }
+    }
+  }
 }
 
 TEST_SUITE("gpu") {

@@ -73,7 +73,7 @@ struct FrameGpu {
   uint table_size;  // HA-Buffer slots
   uint skip_empty;  // 1: empty-space skipping
   uint mesh_count;  // 0: the table is empty and the resolve does not read it
-  uint pad1;
+  uint group_order;  // VR_ORDER_*: which pixels the resolve's workgroups take, in dispatch order
   float near_depth;  // eye depth of the near and far planes
   float far_depth;
   float step;               // sampling distance along rays, world units
@@ -84,12 +84,20 @@ struct FrameGpu {
   float pad4;
 };
 
-// The resolve's workgroup row for position r of `rows` in dispatch order: the rows in
-// VR_ROW_INTERLEAVE interleaved sets (0, 8, 16, ..., then 1, 9, ...), so that every long run of
-// consecutive workgroups spans the whole image. lavapipe hands each of its threads one contiguous
-// run of a dispatch's workgroups; with rows in order, the thread whose half of the image held more
-// of the volume ran on alone (a third of the resolve, for head.json at 512 px, oblique).
+// The order in which the resolve's workgroups (8x8 pixels each) take the image, by the device's
+// kind. GPUs: rows from the top (VR_ORDER_ROWS; vertical strips 4, 8 or 16 workgroups wide, for
+// the texture caches, were 1% slower at 1024² on the H100 and 6% at 1080p in the viewer, 1%
+// faster at 2048²). CPU devices (VR_ORDER_ROWS_INTERLEAVED): rows in VR_ROW_INTERLEAVE
+// interleaved sets (0, 8, 16, ..., then 1, 9, ...), so that every long run of consecutive
+// workgroups spans the whole image: lavapipe hands each of its threads one contiguous run of a
+// dispatch's workgroups, and with rows in order the thread whose half of the image held more of
+// the volume ran on alone (a third of the resolve of head.json at 512 px, oblique). On the H100
+// that order cost 10% (1.51 -> 1.67 ms at 1024²).
+#define VR_ORDER_ROWS 0u
+#define VR_ORDER_ROWS_INTERLEAVED 1u
 #define VR_ROW_INTERLEAVE 8u
+
+// The row for position r of `rows` in VR_ORDER_ROWS_INTERLEAVED.
 STRATA_INLINE uint resolve_group_row(uint r, uint rows) {
   uint q = rows / VR_ROW_INTERLEAVE, m = rows % VR_ROW_INTERLEAVE;
   // (sets k < m hold q + 1 rows, the others q)
@@ -102,6 +110,11 @@ STRATA_INLINE uint resolve_group_row(uint r, uint rows) {
     index = (r - m * (q + 1u)) % max(q, 1u);
   }
   return index * VR_ROW_INTERLEAVE + set;
+}
+
+// The workgroup (column, row) that the one at `id` of the dispatch takes.
+STRATA_INLINE uvec2 resolve_group(uvec2 id, uvec2 groups, uint order) {
+  return order == VR_ORDER_ROWS_INTERLEAVED ? uvec2(id.x, resolve_group_row(id.y, groups.y)) : id;
 }
 
 // Push constants of one mesh's draw in the HA-Buffer build.
