@@ -66,7 +66,14 @@ struct PlacementLayout {
   uint32_t finish_lanes = 0;
   // List entries per classifying workgroup: 4, 8 or 16 (0: placement_classify_tiles()).
   uint32_t classify_tiles = 0;
+  // Direct tidy-up rounds: each block of kTidyBlockRounds past the first is skipped by
+  // conditional rendering where the device has it and the round before the block applied
+  // nothing (then no later round can).
+  bool skip_idle_blocks = true;
 };
+
+// Tidy-up rounds per conditional block (PlacementLayout::skip_idle_blocks).
+inline constexpr uint32_t kTidyBlockRounds = 8;
 
 class Placement {
  public:
@@ -138,6 +145,7 @@ class Placement {
   Context& ctx_;
   uint32_t label_count_;
   bool indirect_;
+  bool skip_idle_blocks_;  // PlacementLayout::skip_idle_blocks on a device that can
   PlacementLayout layout_;
   uint32_t layer_count_ = 1;
   std::vector<gpu::LabelGpu> labels_;

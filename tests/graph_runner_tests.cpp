@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include "engine/gpu/resources.h"
@@ -108,6 +109,113 @@ void check_recording_fails(Context& ctx, graph::Graph g, const char* message) {
 }  // namespace
 
 TEST_SUITE("gpu") {
+  // A conditional block's dispatches run only where the predicate an earlier pass wrote is not 0
+  // (the graph's barrier makes the write visible to the predicate's read: synchronization
+  // validation would say otherwise): a block per dispatch, one across the pass's barriers, and
+  // that one split into several submissions at the barriers. A block must not stay open.
+  TEST_CASE_FIXTURE(test::GpuTest, "conditional_blocks_run_only_where_their_predicate_is_set") {
+    REQUIRE(ctx.conditional_rendering());  // (lavapipe and NVIDIA's driver have it)
+    const graph::Extent size{16, 8};
+    const std::vector<float> ones(size_t{size.width} * size.height, 1.0f);
+    const gpu::SatParams p{size.width, size.height, 1, 1, 1, 0, 0, 0};
+    const ComputePipeline sums(ctx, "summed_area_table_sums.comp");
+    const ComputePipeline carries(ctx, "summed_area_table_carries.comp");
+    const ComputePipeline scan(ctx, "summed_area_table_scan.comp");
+    enum class Blocks { per_dispatch, across_barriers, split };
+    for (const auto& [predicate, blocks] :
+         {std::pair{0u, Blocks::per_dispatch}, std::pair{7u, Blocks::per_dispatch},
+          std::pair{0u, Blocks::across_barriers}, std::pair{7u, Blocks::across_barriers},
+          std::pair{0u, Blocks::split}, std::pair{7u, Blocks::split}}) {
+      CAPTURE(predicate);
+      CAPTURE(int(blocks));
+      const bool per_dispatch = blocks == Blocks::per_dispatch;
+      const VkDeviceSize bytes = ones.size() * sizeof(float);
+      Buffer input(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
+      Buffer output(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
+      upload(ctx, input, as_bytes(ones));
+      upload(ctx, output, as_bytes(std::vector<float>(ones.size(), -1.0f)));
+      graph::Graph g;
+      const auto in = g.import_buffer("input", {.buffer = input.handle(), .has_content = true});
+      const auto out = g.import_buffer(
+          "output",
+          {.buffer = output.handle(), .has_content = true, .final_use = graph::Use::transfer_src});
+      const auto carry = g.add_buffer("carries", small_buffer());
+      const auto flag = g.add_buffer("predicate", small_buffer());
+      g.add_pass({"predicate",
+                  graph::PassKind::transfer,
+                  {{flag, graph::Use::transfer_dst}},
+                  [&](graph::PassContext& pc) {
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(flag), 0, VK_WHOLE_SIZE, predicate);
+                  }});
+      g.add_pass({"table",
+                  graph::PassKind::compute,
+                  {{in, graph::Use::storage_read, SAT_BINDING_INPUT},
+                   {carry, graph::Use::storage_write, SAT_BINDING_CARRIES},
+                   {out, graph::Use::storage_read_write, SAT_BINDING_OUTPUT},
+                   {flag, graph::Use::conditional}},
+                  [&](graph::PassContext& pc) {
+                    pc.begin_conditional(flag, 4);
+                    pc.dispatch_groups(sums, p, {1, 1, 1});
+                    if (per_dispatch) pc.end_conditional();
+                    pc.barrier();
+                    if (per_dispatch) pc.begin_conditional(flag, 0);
+                    pc.dispatch(carries, p, {p.width + p.height, 1, 1});
+                    if (per_dispatch) pc.end_conditional();
+                    pc.barrier();
+                    if (per_dispatch) pc.begin_conditional(flag, 8);
+                    pc.dispatch_groups(scan, p, {1, 1, 1});
+                    pc.end_conditional();
+                  }});
+      graph::GraphRunner runner(ctx, std::move(g));
+      runner.set_viewport(size);
+      std::vector<graph::SplitPoint> points;
+      if (blocks == Blocks::split) {
+        runner.run_split([](const graph::SplitPoint& s) { return s.barrier.has_value(); },
+                         [&](const graph::SplitPoint& s) { points.push_back(s); });
+        CHECK(points.size() == 2);
+      } else {
+        runner.run_now();
+      }
+      const std::vector<float> table = download_as<float>(ctx, output);
+      CHECK(table.front() == (predicate != 0 ? 1.0f : -1.0f));
+      CHECK(table.back() == (predicate != 0 ? float(ones.size()) : -1.0f));
+    }
+
+    // Misuse is a graph error naming the pass.
+    const auto conditional_pass =
+        [&](const char* name, graph::Use use,
+            std::function<void(graph::PassContext&, graph::ResourceId)> record) {
+          graph::Graph g;
+          const auto flag = g.add_buffer("predicate", small_buffer());
+          g.add_pass(fill("zero", flag, flag));
+          g.add_pass({name,
+                      graph::PassKind::compute,
+                      {{flag, use}},
+                      [flag, record](graph::PassContext& pc) { record(pc, flag); }});
+          return g;
+        };
+    check_recording_fails(ctx,
+                          conditional_pass("undeclared", graph::Use::storage_read,
+                                           [](graph::PassContext& pc, graph::ResourceId f) {
+                                             pc.begin_conditional(f, 0);
+                                           }),
+                          "pass 'undeclared' reads a predicate from 'predicate', which it did not "
+                          "declare conditional");
+    check_recording_fails(ctx,
+                          conditional_pass("nested", graph::Use::conditional,
+                                           [](graph::PassContext& pc, graph::ResourceId f) {
+                                             pc.begin_conditional(f, 0);
+                                             pc.begin_conditional(f, 0);
+                                           }),
+                          "pass 'nested' begins a conditional block inside another");
+    check_recording_fails(ctx,
+                          conditional_pass("open", graph::Use::conditional,
+                                           [](graph::PassContext& pc, graph::ResourceId f) {
+                                             pc.begin_conditional(f, 0);
+                                           }),
+                          "pass 'open' leaves a conditional block open");
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "a_pass_that_touches_a_resource_it_did_not_declare_fails") {
     graph::Graph g;
     const auto declared = g.add_buffer("declared", small_buffer());

@@ -79,6 +79,7 @@ struct GpuPlacement {
   std::vector<uint32_t> constraints;
   std::vector<gpu::PlacementGpu> placements;
   std::vector<gpu::PlacementBucketsGpu> buckets;  // per order position (and one more)
+  std::vector<uint32_t> tidy_rounds;  // per tidy-up round: changes the round before applied
 };
 
 template <typename T>
@@ -133,6 +134,7 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
   out.tables = as<float>(runner.download_buffer(r.tables));
   out.constraints = as<uint32_t>(runner.download_buffer(r.constraints));
   out.buckets = as<gpu::PlacementBucketsGpu>(runner.download_buffer(r.buckets));
+  out.tidy_rounds = as<uint32_t>(runner.download_buffer(r.tidy_rounds));
   const auto results = placement.results();
   out.placements.assign(results.begin(), results.end());
   return out;
@@ -503,6 +505,45 @@ TEST_SUITE("gpu") {
         constrained += cpu.placements[i].cost >= settings.weights.connector_shadow;
       }
       CHECK(constrained > 20);
+    }
+  }
+
+  // Direct tidy-up rounds skip each block of kTidyBlockRounds past the first by conditional
+  // rendering once the round before it applied nothing: the same rounds run and the same
+  // positions as the reference's, whether blocks are skipped or run idle, and as the indirect
+  // rounds (which skip each idle round instead).
+  TEST_CASE_FIXTURE(test::GpuTest, "idle_tidy_up_blocks_are_skipped_exactly") {
+    REQUIRE(ctx.conditional_rendering());  // (lavapipe and NVIDIA's driver have it)
+    // (20 labels run 17 rounds: the block from round 16 runs, the next is skipped. More crowded
+    // disc scenes end in cost ties that the GPU and the CPU break apart, summing in other orders.)
+    for (const uint32_t labels : {6u, 20u}) {
+      CAPTURE(labels);
+      const Inputs in = disc_scene(labels, 2.5f);
+      PlacementSettings settings;
+      settings.tidy_rounds = 64;
+      const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                     in.labels, in.order, settings, in.size);
+      const GpuPlacement skipping =
+          place_on_gpu(ctx, in, settings, {.dispatch = LabelDispatch::direct});
+      const GpuPlacement running = place_on_gpu(
+          ctx, in, settings, {.dispatch = LabelDispatch::direct, .skip_idle_blocks = false});
+      const GpuPlacement indirect =
+          place_on_gpu(ctx, in, settings, {.dispatch = LabelDispatch::indirect});
+      const auto rounds = [&](const GpuPlacement& gpu) {
+        return std::vector<uint32_t>(gpu.tidy_rounds.begin(),
+                                     gpu.tidy_rounds.begin() + settings.tidy_rounds + 1);
+      };
+      for (const GpuPlacement* gpu : {&skipping, &running, &indirect}) {
+        CAPTURE(gpu == &skipping ? "skipping" : gpu == &running ? "running" : "indirect");
+        check_placements(*gpu, cpu);
+        CHECK(rounds(*gpu) == rounds(skipping));
+      }
+      const auto run = uint32_t(std::count_if(skipping.tidy_rounds.begin(),
+                                              skipping.tidy_rounds.begin() + settings.tidy_rounds,
+                                              [](uint32_t changes) { return changes > 0; }));
+      MESSAGE(labels << " labels: " << run << " tidy-up rounds run");
+      // (the small scene ends in the first block; the crowded one runs past it)
+      CHECK((labels == 6u ? run < kTidyBlockRounds : run > kTidyBlockRounds));
     }
   }
 

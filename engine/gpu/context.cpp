@@ -98,6 +98,13 @@ DeviceReport describe(VkPhysicalDevice device, uint32_t index) {
     vkGetPhysicalDeviceFeatures2(device, &query);
     caps.pipeline_statistics = executables.pipelineExecutableInfo;
   }
+  if (is13 && has_device_extension(device, VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME)) {
+    VkPhysicalDeviceConditionalRenderingFeaturesEXT conditional{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONDITIONAL_RENDERING_FEATURES_EXT};
+    VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &conditional};
+    vkGetPhysicalDeviceFeatures2(device, &query);
+    caps.conditional_rendering = conditional.conditionalRendering;
+  }
   report.missing = missing_requirements(caps);
   return report;
 }
@@ -355,7 +362,16 @@ Context::Context(const ContextOptions& options)
   if (report_.caps.pipeline_statistics) {
     extensions.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
     executables.pipelineExecutableInfo = VK_TRUE;
+    executables.pNext = f13.pNext;
     f13.pNext = &executables;
+  }
+  VkPhysicalDeviceConditionalRenderingFeaturesEXT conditional{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONDITIONAL_RENDERING_FEATURES_EXT};
+  if (report_.caps.conditional_rendering) {
+    extensions.push_back(VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME);
+    conditional.conditionalRendering = VK_TRUE;
+    conditional.pNext = f13.pNext;
+    f13.pNext = &conditional;
   }
 
   const float priority = 1.0f;

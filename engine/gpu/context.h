@@ -35,6 +35,9 @@ struct DeviceCapabilities {
   bool graphics_compute_queue_with_timestamps = false;
   // Optional: the driver reports per-pipeline statistics (registers, ...; bench output only).
   bool pipeline_statistics = false;
+  // Optional: dispatches skipped by a predicate the GPU wrote (VK_EXT_conditional_rendering; the
+  // tidy-up's idle rounds).
+  bool conditional_rendering = false;
 };
 
 // Names of the requirements `caps` does not meet, in a fixed order; empty when the device is
@@ -119,6 +122,8 @@ class Context {
   const DeviceReport& report() const { return report_; }
   // Pipelines are created with their statistics captured (VK_KHR_pipeline_executable_properties).
   bool pipeline_statistics() const { return report_.caps.pipeline_statistics; }
+  // VK_EXT_conditional_rendering is enabled (graph::Use::conditional).
+  bool conditional_rendering() const { return report_.caps.conditional_rendering; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
   double timestamp_period_ns() const { return properties_.limits.timestampPeriod; }
   ValidationLog& validation_log() { return instance_.validation_log(); }

@@ -1,5 +1,8 @@
 #include "engine/graph/graph_runner.h"
 
+#include <algorithm>
+#include <string>
+
 #include "engine/gpu/context.h"
 #include "engine/gpu/vulkan_check.h"
 
@@ -30,6 +33,37 @@ VkImageView PassContext::view(ResourceId id) const {
   return runner_->bound_[id].view;
 }
 
+void PassContext::begin_conditional(ResourceId predicate, VkDeviceSize offset) {
+  const PassInfo& pass = runner_->graph_.passes()[pass_];
+  declared(predicate);
+  const bool conditional = std::any_of(pass.uses.begin(), pass.uses.end(), [&](const auto& u) {
+    return u.resource == predicate && u.use == Use::conditional;
+  });
+  if (!conditional) {
+    throw GraphError("pass '" + pass.name + "' reads a predicate from '" +
+                     runner_->graph_.resources()[predicate].name +
+                     "', which it did not declare conditional");
+  }
+  if (!runner_->begin_conditional_ || predicate_) {
+    throw GraphError("pass '" + pass.name + "' begins a conditional block " +
+                     (predicate_ ? "inside another" : "on a device without conditional rendering"));
+  }
+  VkConditionalRenderingBeginInfoEXT info{VK_STRUCTURE_TYPE_CONDITIONAL_RENDERING_BEGIN_INFO_EXT};
+  info.buffer = runner_->bound_[predicate].buffer;
+  info.offset = offset;
+  runner_->begin_conditional_(cmd, &info);
+  predicate_ = Predicate{predicate, offset};
+}
+
+void PassContext::end_conditional() {
+  if (!predicate_) {
+    throw GraphError("pass '" + runner_->graph_.passes()[pass_].name +
+                     "' ends a conditional block it did not begin");
+  }
+  runner_->end_conditional_(cmd);
+  predicate_.reset();
+}
+
 VkBuffer PassContext::indirect_buffer(ResourceId id) const {
   const PassInfo& pass = runner_->graph_.passes()[pass_];
   declared(id);
@@ -52,6 +86,14 @@ void PassContext::dispatch_threads(const ComputePipeline& pipeline, glm::uvec3 t
 }
 
 void PassContext::barrier() {
+  record_barrier(false);
+}
+
+void PassContext::barrier_for_predicates() {
+  record_barrier(true);
+}
+
+void PassContext::record_barrier(bool predicates) {
   const PassInfo& pass = runner_->graph_.passes()[pass_];
   if (pass.kind == PassKind::graphics) {
     throw GraphError("pass '" + pass.name +
@@ -68,17 +110,33 @@ void PassContext::barrier() {
     memory.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
     memory.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT;
   }
+  bool declared_predicates = false;
   for (const ResourceUse& u : pass.uses) {
+    declared_predicates = declared_predicates || u.use == Use::conditional;
     if (u.use != Use::indirect) continue;
     memory.dstStageMask |= VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
     memory.dstAccessMask |= VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT;
+  }
+  if (predicates) {
+    if (!declared_predicates) {
+      throw GraphError("pass '" + pass.name +
+                       "' asks for a barrier before predicates, but declared none conditional");
+    }
+    memory.dstStageMask |= VK_PIPELINE_STAGE_2_CONDITIONAL_RENDERING_BIT_EXT;
+    memory.dstAccessMask |= VK_ACCESS_2_CONDITIONAL_RENDERING_READ_BIT_EXT;
   }
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.memoryBarrierCount = 1;
   dep.pMemoryBarriers = &memory;
   vkCmdPipelineBarrier2(cmd, &dep);
-  // (a new command buffer has nothing bound; its handle may be the old one's, reused)
-  if (runner_->split(cmd, {pass_, barriers_++})) bound_ = nullptr;
+  const SplitPoint point{pass_, barriers_++};
+  if (!runner_->splits_at(point)) return;
+  // (a conditional block goes on in the next command buffer)
+  const std::optional<Predicate> open = predicate_;
+  if (open) end_conditional();
+  runner_->split(cmd, point);
+  bound_ = nullptr;  // (a new command buffer has nothing bound; its handle may be the old one's)
+  if (open) begin_conditional(open->resource, open->offset);
 }
 
 void PassContext::bind(const Pipeline& pipeline) {
@@ -113,6 +171,12 @@ GraphRunner::GraphRunner(Context& ctx, Graph graph)
   sampler.addressModeU = sampler.addressModeV = sampler.addressModeW =
       VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
   STRATA_VK(vkCreateSampler(ctx_.device(), &sampler, nullptr, &linear_sampler_));
+  if (ctx_.conditional_rendering()) {
+    begin_conditional_ = reinterpret_cast<PFN_vkCmdBeginConditionalRenderingEXT>(
+        vkGetDeviceProcAddr(ctx_.device(), "vkCmdBeginConditionalRenderingEXT"));
+    end_conditional_ = reinterpret_cast<PFN_vkCmdEndConditionalRenderingEXT>(
+        vkGetDeviceProcAddr(ctx_.device(), "vkCmdEndConditionalRenderingEXT"));
+  }
 }
 
 GraphRunner::~GraphRunner() {
@@ -281,7 +345,16 @@ VkCommandBuffer GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
   pc.viewport = viewport_;
   pc.runner_ = this;
   pc.pass_ = p;
-  graph_.passes()[p].record(pc);
+  try {
+    graph_.passes()[p].record(pc);
+  } catch (...) {
+    if (pc.predicate_) pc.end_conditional();  // (so that the command buffer ends cleanly)
+    throw;
+  }
+  if (pc.predicate_) {
+    pc.end_conditional();  // (the command buffer still ends cleanly)
+    throw GraphError("pass '" + graph_.passes()[p].name + "' leaves a conditional block open");
+  }
   if (stamps_end(p)) {
     vkCmdWriteTimestamp2(pc.cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_[slot_], 2 * p + 1);
   }
@@ -314,12 +387,14 @@ void GraphRunner::record(VkCommandBuffer cmd, uint32_t slot) {
   emit(cmd, compiled_.final_barriers);
 }
 
-bool GraphRunner::split(VkCommandBuffer& cmd, const SplitPoint& point) {
-  if (!split_at_ || !(*split_at_)(point)) return false;
+bool GraphRunner::splits_at(const SplitPoint& point) const {
+  return split_at_ && (*split_at_)(point);
+}
+
+void GraphRunner::split(VkCommandBuffer& cmd, const SplitPoint& point) {
   ctx_.submit_and_wait(cmd);
   (*after_split_)(point);
   cmd = ctx_.begin_commands();
-  return true;
 }
 
 void GraphRunner::run_split(const std::function<bool(const SplitPoint&)>& split_at,
@@ -333,7 +408,7 @@ void GraphRunner::run_split(const std::function<bool(const SplitPoint&)>& split_
   vkCmdResetQueryPool(cmd, queries_[slot_], 0, 2 * passes);
   for (uint32_t p = 0; p < passes; ++p) {
     cmd = record_pass(cmd, p);
-    if (p + 1 < passes) split(cmd, {p});
+    if (p + 1 < passes && splits_at({p})) split(cmd, {p});
   }
   emit(cmd, compiled_.final_barriers);
   split_at_ = nullptr;

@@ -18,7 +18,8 @@ bool image_only(Use use) {
 }
 
 bool buffer_only(Use use) {
-  return use == Use::uniform || use == Use::indirect || use == Use::host_read;
+  return use == Use::uniform || use == Use::indirect || use == Use::conditional ||
+         use == Use::host_read;
 }
 
 VkFlags usage_flag(Use use, bool is_image) {
@@ -34,6 +35,8 @@ VkFlags usage_flag(Use use, bool is_image) {
       return VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT;
     case Use::indirect:
       return VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+    case Use::conditional:
+      return VK_BUFFER_USAGE_CONDITIONAL_RENDERING_BIT_EXT;
     case Use::color_attachment:
     case Use::color_blend:
       return VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
@@ -109,6 +112,10 @@ struct MergedUse {
   ResourceId resource;
   Access access;
   Use first_use;
+  // Reads content from before the pass: every read, but predicates (Use::conditional) of a
+  // resource the pass writes itself, which it reads after writing them.
+  bool needs_content = false;
+  bool predicates = false;
 };
 
 std::vector<MergedUse> merge_uses(const PassInfo& pass, const Graph& graph) {
@@ -136,10 +143,13 @@ std::vector<MergedUse> merge_uses(const PassInfo& pass, const Graph& graph) {
     const Access a = access_of(u.use, pass.kind, r.is_image);
     auto it = std::find_if(merged.begin(), merged.end(),
                            [&](const MergedUse& m) { return m.resource == u.resource; });
+    const bool predicates = u.use == Use::conditional;
     if (it == merged.end()) {
-      merged.push_back({u.resource, a, u.use});
+      merged.push_back({u.resource, a, u.use, a.reads && !predicates, predicates});
       continue;
     }
+    it->needs_content = it->needs_content || (a.reads && !predicates);
+    it->predicates = it->predicates || predicates;
     if (r.is_image && it->access.layout != a.layout) {
       throw GraphError("pass '" + pass.name + "' uses image '" + r.name + "' in two layouts (as " +
                        to_string(it->first_use) + " and as " + to_string(u.use) + ")");
@@ -148,6 +158,9 @@ std::vector<MergedUse> merge_uses(const PassInfo& pass, const Graph& graph) {
     it->access.access |= a.access;
     it->access.reads = it->access.reads || a.reads;
     it->access.writes = it->access.writes || a.writes;
+  }
+  for (MergedUse& m : merged) {
+    if (m.predicates && !m.access.writes) m.needs_content = true;
   }
   return merged;
 }
@@ -168,6 +181,8 @@ const char* to_string(Use use) {
       return "uniform";
     case Use::indirect:
       return "indirect";
+    case Use::conditional:
+      return "conditional";
     case Use::color_attachment:
       return "color_attachment";
     case Use::color_blend:
@@ -205,6 +220,10 @@ Access access_of(Use use, PassKind kind, bool is_image) {
     case Use::indirect:
       return {VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT,
               VK_IMAGE_LAYOUT_UNDEFINED, true, false};
+    case Use::conditional:
+      return {VK_PIPELINE_STAGE_2_CONDITIONAL_RENDERING_BIT_EXT,
+              VK_ACCESS_2_CONDITIONAL_RENDERING_READ_BIT_EXT, VK_IMAGE_LAYOUT_UNDEFINED, true,
+              false};
     case Use::color_attachment:
       return {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
               VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
@@ -294,7 +313,7 @@ CompiledGraph compile(const Graph& graph) {
     }
     for (const MergedUse& m : merge_uses(pass, graph)) {
       const ResourceInfo& r = resources[m.resource];
-      if (m.access.reads && !states[m.resource].has_content) {
+      if (m.needs_content && !states[m.resource].has_content) {
         throw GraphError("pass '" + pass.name + "' reads '" + r.name +
                          "', which no earlier pass writes and which is not imported with content");
       }
@@ -330,6 +349,7 @@ std::string stage_names(VkPipelineStageFlags2 stages) {
       {VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, "compute"},
       {VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, "graphics"},
       {VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, "indirect"},
+      {VK_PIPELINE_STAGE_2_CONDITIONAL_RENDERING_BIT_EXT, "conditional"},
       {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, "transfer"},
       {VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, "color"},
       {VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,

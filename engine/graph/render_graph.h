@@ -44,6 +44,7 @@ enum class Use {
   storage_read_write,  // storage buffer or image, read and written (atomics, accumulation)
   uniform,             // uniform buffer
   indirect,            // indirect dispatch or draw arguments
+  conditional,         // conditional-rendering predicates (PassContext::begin_conditional)
   color_attachment,    // rendered to (cleared or overwritten)
   color_blend,         // rendered onto: loaded, blended over, stored (a UI over the picture)
   depth_attachment,    // depth test and write
