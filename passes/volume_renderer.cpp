@@ -361,7 +361,10 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
                        : VR_ORDER_ROWS),
       counters_readback_(ctx, VR_COUNTER_COUNT * sizeof(uint32_t)),
       build_(ctx, "habuffer_build.vert", "habuffer_build.frag", {}),
-      resolve_(ctx, "habuffer_resolve.comp") {
+      // (one volume and no meshes, the common case: a resolve the compiler specialises)
+      resolve_(ctx, inputs_.volumes.size() == 1 && inputs_.meshes.empty()
+                        ? "habuffer_resolve_one_volume.comp"
+                        : "habuffer_resolve.comp") {
   frame_data(inputs_, camera_, settings_, {1, 1}, 1);  // checks the settings early
   const glm::uvec3 d = inputs_.atlas_dims;
   atlas_ =

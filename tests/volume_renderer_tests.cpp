@@ -216,6 +216,23 @@ TEST_SUITE("gpu") {
     check_against_reference(ctx, scene, camera_at({12.0f, 9.0f, 32.0f}), "one-volume");
   }
 
+  // A scene of one volume and no meshes gets the resolve specialised for it (which the test above
+  // checks against the reference); a mesh or a second volume, the general one.
+  TEST_CASE_FIXTURE(test::GpuTest, "one_volume_without_meshes_takes_the_specialised_resolve") {
+    const auto resolve_of = [&](const Scene& scene) {
+      return VolumeRenderer(ctx, scene, {}).pipeline_statistics().at(0).name;
+    };
+    Scene scene;
+    add_volume(scene, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.6f, 0.3f}));
+    CHECK(resolve_of(scene) == "habuffer_resolve_one_volume.comp");
+    Scene with_mesh = scene;
+    with_mesh.meshes = {quad(0.0f, {0.2f, 0.9f, 0.3f, 0.7f}, 6.0f)};
+    CHECK(resolve_of(with_mesh) == "habuffer_resolve.comp");
+    add_volume(scene, ball({20, 28, 20}, glm::vec3(-4.0f, -14.0f, -8.0f), 9.0f),
+               ramp({0.2f, 0.5f, 1.0f}));
+    CHECK(resolve_of(scene) == "habuffer_resolve.comp");
+  }
+
   // Volume boxes are ray-box tests in the resolve: a scene of volumes only rasterises nothing and
   // needs no HA-Buffer slots; a mesh brings the table back.
   TEST_CASE_FIXTURE(test::GpuTest, "volume_boxes_take_no_habuffer_slots") {

@@ -15,6 +15,14 @@
 // The ray is parametrised by eye depth z: point(z) = origin + direction * z. Samples lie on one
 // grid for the whole ray (near + (k + 0.5) * dz), so segments between fragments join seamlessly.
 
+// The frame's volume count; a constant where the includer resolves one volume only
+// (VR_RESOLVE_ONE_VOLUME), so that the compiler drops the general paths.
+#ifdef VR_RESOLVE_ONE_VOLUME
+#define VR_RESOLVE_VOLUMES 1u
+#else
+#define VR_RESOLVE_VOLUMES frame.volume_count
+#endif
+
 struct PixelResult {
   float depth;                 // eye depth where the total alpha first reaches depth_alpha, or 0
   uint samples;                // ray positions sampled
@@ -77,7 +85,7 @@ vec4 sample_volume(uint v, VolumeGpu vol, vec3 tc, vec3 to_eye) {
 // The sum of every live (entered, not yet left) volume's sample at p (premultiplied).
 vec4 sample_volumes(uint live, vec3 p, vec3 to_eye) {
   vec4 sum = vec4(0.0f);
-  for (uint v = 0u; v < frame.volume_count; ++v) {
+  for (uint v = 0u; v < VR_RESOLVE_VOLUMES; ++v) {
     if ((live & (1u << v)) == 0u) continue;
     VolumeGpu vol = volume_info(v);
     sum += sample_volume(v, vol, vec3(vol.world_to_texture * vec4(p, 1.0f)), to_eye);
@@ -110,7 +118,7 @@ vec2 brick_exit(uint v, VolumeGpu vol, vec3 tc, vec3 d, float z) {
 vec2 brick_state(uint live, vec3 origin, vec3 direction, float z, float dz) {
   float exit_z = 3.4e38f;
   bool empty = true;
-  for (uint v = 0u; v < frame.volume_count; ++v) {
+  for (uint v = 0u; v < VR_RESOLVE_VOLUMES; ++v) {
     if ((live & (1u << v)) == 0u) continue;
     VolumeGpu vol = volume_info(v);
     vec3 tc = vec3(vol.world_to_texture * vec4(origin + direction * z, 1.0f));
@@ -182,7 +190,7 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   // Each box's faces between the near and far planes join the mesh fragments, in depth order
   // (after fragments at the same depth); a box the near plane cuts is live from the start.
   uint live = 0u;
-  for (uint v = 0u; v < frame.volume_count; ++v) {
+  for (uint v = 0u; v < VR_RESOLVE_VOLUMES; ++v) {
     vec3 tc =
         vec3(volume_info(v).world_to_texture * vec4(origin + direction * frame.near_depth, 1.0f));
     if (inside_unit_box(tc)) live |= 1u << v;
@@ -203,7 +211,7 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
 
   // One volume (the common case): its data stay in registers and the ray is stepped in its
   // texture space.
-  const bool one_volume = frame.volume_count == 1u;
+  const bool one_volume = VR_RESOLVE_VOLUMES == 1u;
   VolumeGpu first = volume_info(0u);
   vec3 first_origin = vec3(first.world_to_texture * vec4(origin, 1.0f));
   vec3 first_direction = mat3(first.world_to_texture) * direction;
