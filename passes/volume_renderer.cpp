@@ -371,17 +371,18 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
       Image(ctx, {kAtlasFormat, {d.x, d.y, d.z}, VK_IMAGE_TYPE_3D, VK_IMAGE_USAGE_SAMPLED_BIT});
   upload(ctx, atlas_, as_bytes(inputs_.atlas), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  const auto filled = [&](const auto& data) {
-    Buffer b(ctx, at_least(data.size() * sizeof(data[0])), storage, MemoryKind::device_local);
+  const auto filled = [&](const auto& data, VkBufferUsageFlags usage) {
+    Buffer b(ctx, at_least(data.size() * sizeof(data[0])), usage, MemoryKind::device_local);
     upload(ctx, b, as_bytes(data));
     return b;
   };
-  vertices_ = filled(inputs_.vertices);
-  indices_ = filled(inputs_.indices);
+  vertices_ = filled(inputs_.vertices, storage);
+  indices_ = filled(inputs_.indices, storage);
   // (one entry at least: the resolve loads the first volume's data whatever the count)
   std::vector<gpu::VolumeGpu> volume_data = inputs_.volumes;
   if (volume_data.empty()) volume_data.emplace_back();
-  volumes_ = filled(volume_data);
+  // (a uniform buffer for the one-volume resolve, whose volume data GPUs then read as constants)
+  volumes_ = filled(volume_data, storage | VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   occupancy_ = Buffer(ctx, at_least(inputs_.occupancy.size() * sizeof(uint32_t)), storage,
                       MemoryKind::device_local);
   upload_transfer();
@@ -472,10 +473,16 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {counters, Use::storage_read_write, VR_BINDING_COUNTERS}},
                   [this](graph::PassContext& pc) { record_build(pc); },
                   "render"});
+  // (the one-volume resolve reads the volumes as a uniform buffer, the general one as storage)
+  const auto& bindings = resolve_.reflection().bindings;
+  const bool uniform_volumes = std::any_of(bindings.begin(), bindings.end(), [](const auto& b) {
+    return b.binding == VR_BINDING_VOLUMES && b.descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  });
+  const Use volumes_use = uniform_volumes ? Use::uniform : Use::storage_read;
   graph.add_pass({"render.resolve",
                   graph::PassKind::compute,
                   {{frame, Use::uniform, VR_BINDING_FRAME},
-                   {ids_.volumes, Use::storage_read, VR_BINDING_VOLUMES},
+                   {ids_.volumes, volumes_use, VR_BINDING_VOLUMES},
                    {keys, Use::storage_read, VR_BINDING_KEYS},
                    {payload, Use::storage_read, VR_BINDING_PAYLOAD},
                    {counters, Use::storage_read_write, VR_BINDING_COUNTERS},

@@ -14,7 +14,12 @@
 
 layout(local_size_x = VR_RESOLVE_GROUP, local_size_y = VR_RESOLVE_GROUP) in;
 layout(binding = VR_BINDING_FRAME) uniform Frame { FrameGpu frame; };
+#ifdef VR_RESOLVE_ONE_VOLUME
+// (a uniform block: GPUs read its fields as constants instead of holding them in registers)
+layout(binding = VR_BINDING_VOLUMES) uniform Volumes { VolumeGpu volumes[1]; };
+#else
 layout(binding = VR_BINDING_VOLUMES, std430) readonly buffer Volumes { VolumeGpu volumes[]; };
+#endif
 layout(binding = VR_BINDING_ATLAS) uniform sampler3D atlas;
 layout(binding = VR_BINDING_TRANSFER, std430) readonly buffer Transfer { vec4 transfer_table[]; };
 layout(binding = VR_BINDING_OCCUPANCY, std430) readonly buffer Occupancy { uint occupancy[]; };
