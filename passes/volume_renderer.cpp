@@ -380,9 +380,10 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
   indices_ = filled(inputs_.indices, storage);
   // (one entry at least: the resolve loads the first volume's data whatever the count)
   std::vector<gpu::VolumeGpu> volume_data = inputs_.volumes;
-  if (volume_data.empty()) volume_data.emplace_back();
-  // (a uniform buffer for the one-volume resolve, whose volume data GPUs then read as constants)
-  volumes_ = filled(volume_data, storage | VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  volume_data.resize(VR_MAX_VOLUMES);  // (the uniform block's size)
+  // (a uniform buffer: GPUs read the volumes' records as constants instead of holding them in
+  // registers)
+  volumes_ = filled(volume_data, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   occupancy_ = Buffer(ctx, at_least(inputs_.occupancy.size() * sizeof(uint32_t)), storage,
                       MemoryKind::device_local);
   upload_transfer();
@@ -473,16 +474,10 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {counters, Use::storage_read_write, VR_BINDING_COUNTERS}},
                   [this](graph::PassContext& pc) { record_build(pc); },
                   "render"});
-  // (the one-volume resolve reads the volumes as a uniform buffer, the general one as storage)
-  const auto& bindings = resolve_.reflection().bindings;
-  const bool uniform_volumes = std::any_of(bindings.begin(), bindings.end(), [](const auto& b) {
-    return b.binding == VR_BINDING_VOLUMES && b.descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-  });
-  const Use volumes_use = uniform_volumes ? Use::uniform : Use::storage_read;
   graph.add_pass({"render.resolve",
                   graph::PassKind::compute,
                   {{frame, Use::uniform, VR_BINDING_FRAME},
-                   {ids_.volumes, volumes_use, VR_BINDING_VOLUMES},
+                   {ids_.volumes, Use::uniform, VR_BINDING_VOLUMES},
                    {keys, Use::storage_read, VR_BINDING_KEYS},
                    {payload, Use::storage_read, VR_BINDING_PAYLOAD},
                    {counters, Use::storage_read_write, VR_BINDING_COUNTERS},

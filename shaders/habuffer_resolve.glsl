@@ -3,7 +3,8 @@
 // habuffer_resolve.comp (any scene) and, with VR_RESOLVE_ONE_VOLUME, by
 // habuffer_resolve_one_volume.comp: a scene of one volume and no meshes, whose walk the compiler
 // then specialises (H100, head.json: 72 -> 64 registers, 1.52 -> 1.34 ms at 1024², 5.15 -> 4.52
-// ms at 2048²).
+// ms at 2048²). The volumes' records are a uniform block, read as constants (one volume: 64 -> 51
+// registers, 1.25 ms at 1024²; head-surfaces.json's meshes and volume: 72 -> 56, 1.68 -> 1.57).
 #ifdef VR_RESOLVE_ONE_VOLUME
 #define VR_RESOLVE_MESHES false
 #else
@@ -14,12 +15,8 @@
 
 layout(local_size_x = VR_RESOLVE_GROUP, local_size_y = VR_RESOLVE_GROUP) in;
 layout(binding = VR_BINDING_FRAME) uniform Frame { FrameGpu frame; };
-#ifdef VR_RESOLVE_ONE_VOLUME
 // (a uniform block: GPUs read its fields as constants instead of holding them in registers)
-layout(binding = VR_BINDING_VOLUMES) uniform Volumes { VolumeGpu volumes[1]; };
-#else
-layout(binding = VR_BINDING_VOLUMES, std430) readonly buffer Volumes { VolumeGpu volumes[]; };
-#endif
+layout(binding = VR_BINDING_VOLUMES) uniform Volumes { VolumeGpu volumes[VR_MAX_VOLUMES]; };
 layout(binding = VR_BINDING_ATLAS) uniform sampler3D atlas;
 layout(binding = VR_BINDING_TRANSFER, std430) readonly buffer Transfer { vec4 transfer_table[]; };
 layout(binding = VR_BINDING_OCCUPANCY, std430) readonly buffer Occupancy { uint occupancy[]; };
