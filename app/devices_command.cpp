@@ -29,6 +29,9 @@ void add_devices_command(CLI::App& app, DeviceOptions& device) {
                   VK_API_VERSION_PATCH(d.caps.api_version), d.driver.c_str());
       if (d.missing.empty()) {
         std::printf("     usable: has everything strata needs\n");
+        std::printf("     optional: conditional rendering %s, pipeline statistics %s\n",
+                    d.caps.conditional_rendering ? "yes" : "no",
+                    d.caps.pipeline_statistics ? "yes" : "no");
       } else {
         std::printf("     not usable, lacks:");
         for (const auto& m : d.missing) std::printf(" [%s]", m.c_str());

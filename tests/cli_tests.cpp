@@ -48,6 +48,9 @@ TEST_SUITE("cli") {
     CHECK(r.exit_code == 0);
     CHECK(r.output.find("llvmpipe") != std::string::npos);
     CHECK(r.output.find("usable: has everything strata needs") != std::string::npos);
+    // (lavapipe has conditional rendering and no pipeline statistics)
+    CHECK(r.output.find("optional: conditional rendering yes, pipeline statistics no") !=
+          std::string::npos);
   }
 
   TEST_CASE("render_writes_the_demo_png_with_validation_on_and_silent") {

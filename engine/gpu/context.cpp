@@ -59,6 +59,17 @@ int graphics_compute_family(VkPhysicalDevice device) {
   return -1;
 }
 
+// Whether the device has `extension` and its feature `flag`, asked through `feature` (the
+// extension's feature struct).
+template <typename Feature>
+bool has_feature(VkPhysicalDevice device, const char* extension, Feature feature,
+                 VkBool32 Feature::*flag) {
+  if (!has_device_extension(device, extension)) return false;
+  VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &feature};
+  vkGetPhysicalDeviceFeatures2(device, &query);
+  return feature.*flag == VK_TRUE;
+}
+
 DeviceReport describe(VkPhysicalDevice device, uint32_t index) {
   VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
@@ -91,20 +102,18 @@ DeviceReport describe(VkPhysicalDevice device, uint32_t index) {
       (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
       (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT);
   caps.graphics_compute_queue_with_timestamps = graphics_compute_family(device) >= 0;
-  if (is13 && has_device_extension(device, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME)) {
-    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executables{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
-    VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &executables};
-    vkGetPhysicalDeviceFeatures2(device, &query);
-    caps.pipeline_statistics = executables.pipelineExecutableInfo;
-  }
-  if (is13 && has_device_extension(device, VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME)) {
-    VkPhysicalDeviceConditionalRenderingFeaturesEXT conditional{
-        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONDITIONAL_RENDERING_FEATURES_EXT};
-    VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &conditional};
-    vkGetPhysicalDeviceFeatures2(device, &query);
-    caps.conditional_rendering = conditional.conditionalRendering;
-  }
+  caps.pipeline_statistics =
+      is13 &&
+      has_feature(
+          device, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME,
+          VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR{
+              VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR},
+          &VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR::pipelineExecutableInfo);
+  caps.conditional_rendering =
+      is13 && has_feature(device, VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME,
+                          VkPhysicalDeviceConditionalRenderingFeaturesEXT{
+                              VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONDITIONAL_RENDERING_FEATURES_EXT},
+                          &VkPhysicalDeviceConditionalRenderingFeaturesEXT::conditionalRendering);
   report.missing = missing_requirements(caps);
   return report;
 }
@@ -357,21 +366,23 @@ Context::Context(const ContextOptions& options)
   if (options.presentation) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
   memory_budget_ = has_device_extension(physical_, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
   if (memory_budget_) extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+  // Optional extensions the device has: each with its feature struct chained in.
+  const auto enable = [&](const char* extension, auto& feature) {
+    extensions.push_back(extension);
+    feature.pNext = f13.pNext;
+    f13.pNext = &feature;
+  };
   VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executables{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+  executables.pipelineExecutableInfo = VK_TRUE;
   if (report_.caps.pipeline_statistics) {
-    extensions.push_back(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME);
-    executables.pipelineExecutableInfo = VK_TRUE;
-    executables.pNext = f13.pNext;
-    f13.pNext = &executables;
+    enable(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME, executables);
   }
   VkPhysicalDeviceConditionalRenderingFeaturesEXT conditional{
       VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONDITIONAL_RENDERING_FEATURES_EXT};
+  conditional.conditionalRendering = VK_TRUE;
   if (report_.caps.conditional_rendering) {
-    extensions.push_back(VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME);
-    conditional.conditionalRendering = VK_TRUE;
-    conditional.pNext = f13.pNext;
-    f13.pNext = &conditional;
+    enable(VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME, conditional);
   }
 
   const float priority = 1.0f;
