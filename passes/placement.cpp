@@ -392,14 +392,13 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
            const bool skippable = skip_idle_blocks_ && block_start > 0;
            for (const uint32_t phase :
                 {TIDY_PHASE_CONFLICTS, TIDY_PHASE_SEARCH, TIDY_PHASE_OWNERS, TIDY_PHASE_SELECT}) {
-             if (skippable && round == block_start && phase == TIDY_PHASE_CONFLICTS) {
+             const bool block_begins =
+                 skippable && round == block_start && phase == TIDY_PHASE_CONFLICTS;
+             if (block_begins) {
                pc.barrier_for_predicates();
+               pc.begin_conditional(b.tidy_rounds, block_start * sizeof(uint32_t));
              } else {
                pc.barrier();
-             }
-             const bool block_begins = round == block_start && phase == TIDY_PHASE_CONFLICTS;
-             if (skippable && block_begins) {
-               pc.begin_conditional(b.tidy_rounds, block_start * sizeof(uint32_t));
              }
              p.phase = phase;
              // (tidy_phase_groups; the search's workgroups pass 65535 from about 900 labels: rows
@@ -414,8 +413,9 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
                pc.dispatch_groups(pipeline, p, gpu::tidy_phase_groups(phase, n));
              }
              const bool block_ends =
-                 round + 1 == p.tidy_rounds || (round + 1) % kTidyBlockRounds == 0;
-             if (skippable && block_ends && phase == TIDY_PHASE_SELECT) pc.end_conditional();
+                 skippable && phase == TIDY_PHASE_SELECT &&
+                 (round + 1 == p.tidy_rounds || (round + 1) % kTidyBlockRounds == 0);
+             if (block_ends) pc.end_conditional();
            }
          }
          pc.barrier();
