@@ -378,11 +378,10 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
   };
   vertices_ = filled(inputs_.vertices, storage);
   indices_ = filled(inputs_.indices, storage);
-  // (one entry at least: the resolve loads the first volume's data whatever the count)
+  // (a uniform buffer of the block's VR_MAX_VOLUMES records: GPUs read them as constants instead
+  // of holding them in registers)
   std::vector<gpu::VolumeGpu> volume_data = inputs_.volumes;
-  volume_data.resize(VR_MAX_VOLUMES);  // (the uniform block's size)
-  // (a uniform buffer: GPUs read the volumes' records as constants instead of holding them in
-  // registers)
+  volume_data.resize(VR_MAX_VOLUMES);
   volumes_ = filled(volume_data, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   occupancy_ = Buffer(ctx, at_least(inputs_.occupancy.size() * sizeof(uint32_t)), storage,
                       MemoryKind::device_local);

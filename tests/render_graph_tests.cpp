@@ -121,6 +121,36 @@ TEST_SUITE("cpu") {
                          GraphError);
   }
 
+  // Predicates (Use::conditional) are read by the command processor: a pass that writes them
+  // itself may read them (after its own barrier_for_predicates); otherwise an earlier pass must
+  // have written them, and the graph's barrier waits for the writer before the predicate read.
+  TEST_CASE("predicates_need_a_writer_the_pass_itself_or_one_before_with_a_barrier") {
+    Graph own;
+    const ResourceId rounds = own.add_buffer("rounds", any_size());
+    own.add_pass(pass("tidy", PassKind::compute,
+                      {{rounds, Use::storage_write}, {rounds, Use::conditional}}));
+    const CompiledGraph c_own = compile(own);
+    CHECK(c_own.pass_barriers[0].empty());
+    CHECK(c_own.usage[rounds] ==
+          (VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_CONDITIONAL_RENDERING_BIT_EXT));
+
+    Graph unwritten;
+    const ResourceId flag = unwritten.add_buffer("flag", any_size());
+    unwritten.add_pass(pass("skip", PassKind::compute, {{flag, Use::conditional}}));
+    CHECK_THROWS_WITH_AS(compile(unwritten), doctest::Contains("pass 'skip' reads 'flag'"),
+                         GraphError);
+
+    Graph before;
+    const ResourceId b = before.add_buffer("flag", any_size());
+    before.add_pass(pass("fill", PassKind::transfer, {{b, Use::transfer_dst}}));
+    before.add_pass(pass("skip", PassKind::compute, {{b, Use::conditional}}));
+    const CompiledGraph c = compile(before);
+    REQUIRE(c.pass_barriers[1].size() == 1);
+    CHECK(c.pass_barriers[1][0].src_stage == VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT);
+    CHECK(c.pass_barriers[1][0].dst_stage == VK_PIPELINE_STAGE_2_CONDITIONAL_RENDERING_BIT_EXT);
+    CHECK(c.pass_barriers[1][0].dst_access == VK_ACCESS_2_CONDITIONAL_RENDERING_READ_BIT_EXT);
+  }
+
   TEST_CASE("an_import_with_content_can_be_read_without_a_writer") {
     Graph g;
     const ResourceId volume = g.import_image(
