@@ -635,7 +635,6 @@ TEST_SUITE("loaders") {
   TEST_CASE("dicom_series_skips_files_that_are_not_dicom") {
     const fs::path folder = copy_ct5n("dicom_extra", {"2062", "2392", "2693", "3023", "3353"});
     write_file(folder / "README.txt", "five CT slices\n");
-    write_file(folder / "empty", "");
     write_file(folder / "noise.bin", std::string(4096, '\x08'));
     CHECK(strata::load_volume(folder).dims == glm::uvec3(16, 16, 5));
   }

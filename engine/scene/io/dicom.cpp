@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 
 #include <gdcmImageReader.h>
 #include <gdcmReader.h>
@@ -52,6 +53,7 @@ struct Slice {
   std::string stack, time;     // StackID and TemporalPositionIndex of enhanced files' frames
   double thickness = 0.0;
   double along_normal = 0.0;  // the position projected onto the slice normal
+  bool placed = true;         // false: no ImagePositionPatient (a secondary capture, a 2-D image)
 };
 
 // Element values of one data set (the file's, or a functional group's item) as text: GDCM's
@@ -157,17 +159,68 @@ void read_frame_content(const Elements& e, Slice& s) {
   s.time = e.text(0x0020, 0x9128);
 }
 
+// One sample per pixel is a grey value only in MONOCHROME1/2 (or when the field is missing, as in
+// old files); a PALETTE COLOR pixel is an index into a colour table.
+void check_grey(const Elements& e, const Slice& s) {
+  const std::string photometric = e.text(0x0028, 0x0004);
+  if (photometric.empty() || photometric == "MONOCHROME1" || photometric == "MONOCHROME2") return;
+  if (photometric == "PALETTE COLOR") {
+    const bool table = (e.has(0x0028, 0x1201) && e.has(0x0028, 0x1202) && e.has(0x0028, 0x1203)) ||
+                       (e.has(0x0028, 0x1221) && e.has(0x0028, 0x1222) && e.has(0x0028, 0x1223));
+    if (!table)
+      fail(s.file,
+           "PhotometricInterpretation = PALETTE COLOR without a lookup table (no Red, Green and "
+           "Blue Palette Color Lookup Table Data): the pixel values are indices into a missing "
+           "table");
+    fail(s.file,
+         "PhotometricInterpretation = PALETTE COLOR: the pixel values are indices into a colour "
+         "table, not intensities; strata reads greyscale (MONOCHROME1, MONOCHROME2) images");
+  }
+  fail(s.file, concat("PhotometricInterpretation = ", printable(photometric),
+                      ": strata reads greyscale (MONOCHROME1, MONOCHROME2) images"));
+}
+
 void read_pixel_format(const Elements& e, Slice& s) {
   s.rows = static_cast<uint32_t>(e.integer(0x0028, 0x0010, "Rows"));
   s.columns = static_cast<uint32_t>(e.integer(0x0028, 0x0011, "Columns"));
   if (const int samples = e.integer(0x0028, 0x0002, "SamplesPerPixel", 1.0); samples != 1)
     fail(s.file, concat("SamplesPerPixel = ", samples, ": only grayscale images are supported"));
+  check_grey(e, s);
   s.bits_allocated = e.integer(0x0028, 0x0100, "BitsAllocated");
   if (s.bits_allocated != 8 && s.bits_allocated != 16)
     fail(s.file, concat("BitsAllocated = ", s.bits_allocated, ": only 8 and 16 are supported"));
   s.bits_stored = e.integer(0x0028, 0x0101, "BitsStored", s.bits_allocated);
+  if (s.bits_stored < 1 || s.bits_stored > s.bits_allocated)
+    fail(s.file, concat("BitsStored = ", s.bits_stored, ": must be 1 to BitsAllocated (",
+                        s.bits_allocated, ")"));
   s.high_bit = e.integer(0x0028, 0x0102, "HighBit", s.bits_stored - 1);
+  if (s.high_bit < s.bits_stored - 1 || s.high_bit >= s.bits_allocated)
+    fail(s.file, concat("HighBit = ", s.high_bit, ": must be BitsStored - 1 (", s.bits_stored - 1,
+                        ") to BitsAllocated - 1 (", s.bits_allocated - 1, ")"));
   s.is_signed = e.integer(0x0028, 0x0103, "PixelRepresentation", 0.0) == 1;
+}
+
+// A single image without ImagePositionPatient (a secondary capture, a scanned film): one slice at
+// the origin, rows along x, columns along y unless ImageOrientationPatient says otherwise, in
+// PixelSpacing, else ImagerPixelSpacing, else 1 mm.
+void read_unplaced(const Elements& e, Slice& s) {
+  s.placed = false;
+  if (e.has(0x0020, 0x0037)) {
+    read_orientation(e, s);
+  } else {
+    s.row_cosine = glm::dvec3(1.0, 0.0, 0.0);
+    s.column_cosine = glm::dvec3(0.0, 1.0, 0.0);
+  }
+  if (e.has(0x0028, 0x0030)) {
+    read_pixel_measures(e, s);
+    return;
+  }
+  const auto spacing = e.numbers(0x0018, 0x1164, "ImagerPixelSpacing", 2, 1.0);
+  if (!(spacing[0] > 0.0 && spacing[1] > 0.0 && std::isfinite(spacing[0] + spacing[1])))
+    fail(e.path(), concat("ImagerPixelSpacing = ", spacing[0], " ", spacing[1],
+                          ": spacing must be positive"));
+  s.pixel_spacing = glm::dvec2(spacing[1], spacing[0]);
+  s.thickness = e.numbers(0x0018, 0x0050, "SliceThickness", 1, 0.0)[0];
 }
 
 // ---- enhanced multi-frame files
@@ -262,9 +315,13 @@ std::vector<Slice> read_frames(const gdcm::File& file, const Elements& e, const 
                                " without a Per-frame Functional Groups Sequence: only enhanced "
                                "multi-frame images (CT, MR) are supported"));
     Slice s = common;
-    read_position(e, s);
-    read_orientation(e, s);
-    read_pixel_measures(e, s);
+    if (e.has(0x0020, 0x0032)) {
+      read_position(e, s);
+      read_orientation(e, s);
+      read_pixel_measures(e, s);
+    } else {
+      read_unplaced(e, s);
+    }
     read_rescale(e, s);
     return {s};
   }
@@ -308,16 +365,34 @@ void check_pixel_data_length(const Elements& e, const Slice& s) {
   fail(file, "DICOM file cannot be parsed (truncated or malformed)");
 }
 
+// A file of a series folder that is not DICOM is skipped (a README, a thumbnail database), but one
+// that is a damaged slice must not be: the volume would load a slice short, or with a gap.
+// Empty files, files that cannot be read and files that begin with zero bytes (a preamble
+// without 'DICM' after it) are errors.
+void check_not_a_damaged_slice(const fs::path& file) {
+  std::error_code error;
+  const uintmax_t size = fs::file_size(file, error);
+  if (error) fail(file, concat("cannot read: ", error.message()));
+  if (size == 0) fail(file, "empty file in a DICOM folder (a damaged slice?)");
+  if (file_kind(file) != Kind::other) return;  // DICOM: damage there is found when it is read
+  std::ifstream in(file, std::ios::binary);
+  char head[128] = {};
+  in.read(head, sizeof head);
+  if (!in && !in.eof()) fail(file, "cannot read");
+  const auto got = static_cast<size_t>(in.gcount());
+  if (got == 0) fail(file, "cannot read");
+  if (std::all_of(head, head + got, [](char c) { return c == 0; }))
+    fail(file, got == 128 ? "no 'DICM' after the 128-byte preamble of zeros: a damaged DICOM file"
+                          : "only zero bytes: a damaged DICOM file");
+}
+
 // The file's slices (one, or one per frame), or none for files that are not DICOM images.
 std::vector<Slice> read_file_slices(const fs::path& file) {
   const Kind kind = file_kind(file);
   if (kind == Kind::other) return {};
-  try {
-    check_structure(file, kind);
-  } catch (const Error&) {
-    if (kind == Kind::part10) throw;
-    return {};  // a bare data set that does not hold together: probably not DICOM
-  }
+  // A bare data set (no preamble) that does not hold together is an error too: it begins like
+  // DICOM (a group 0008 tag), so it is most likely a damaged slice.
+  check_structure(file, kind);
   gdcm::Reader reader;
   reader.SetFileName(file.string().c_str());
   bool read = false;
@@ -326,10 +401,7 @@ std::vector<Slice> read_file_slices(const fs::path& file) {
   } catch (const std::exception&) {
     read = false;
   }
-  if (!read) {
-    if (kind == Kind::part10) fail_to_parse(file, reader);
-    return {};
-  }
+  if (!read) fail_to_parse(file, reader);
   const Elements e(reader.GetFile(), reader.GetFile().GetDataSet(), file);
   // DICOMDIRs, reports and other non-image objects may sit beside the slices.
   if (!e.has(0x0028, 0x0010) || !e.has(0x0028, 0x0011)) return {};
@@ -360,7 +432,7 @@ void check_consistent(const fs::path& where, const Slice& first, const Slice& s)
   if (glm::length(s.pixel_spacing - first.pixel_spacing) > 1e-3 * glm::length(first.pixel_spacing))
     fail(where, concat("mixed PixelSpacing: ", name_of(first), " and ", name_of(s), " differ"));
   if (s.bits_allocated != first.bits_allocated || s.is_signed != first.is_signed ||
-      s.bits_stored != first.bits_stored)
+      s.bits_stored != first.bits_stored || s.high_bit != first.high_bit)
     fail(where, concat("mixed pixel formats: ", name_of(first), " and ", name_of(s), " differ"));
   if (!s.series.empty() && !first.series.empty() && s.series != first.series)
     fail(where, concat("holds more than one series: ", name_of(first), " and ", name_of(s),
@@ -371,14 +443,19 @@ void check_consistent(const fs::path& where, const Slice& first, const Slice& s)
 std::vector<Slice> read_folder(const fs::path& folder) {
   std::vector<fs::path> files;
   std::error_code error;
-  for (const auto& entry : fs::directory_iterator(folder, error))
-    if (entry.is_regular_file(error)) files.push_back(entry.path());
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    std::error_code entry_error;
+    if (entry.is_symlink(entry_error) && !fs::exists(entry.path(), entry_error))
+      fail(entry.path(), "cannot read: a link to a file that does not exist (a missing slice?)");
+    if (entry.is_regular_file(entry_error)) files.push_back(entry.path());
+  }
   if (error) fail(folder, concat("cannot list the folder: ", error.message()));
   std::sort(files.begin(), files.end());
   std::vector<Slice> slices;
   size_t images = 0;
   std::string multi_frame;  // the name of a multi-frame file among them
   for (const fs::path& file : files) {
+    if (file.filename().string().front() != '.') check_not_a_damaged_slice(file);
     std::vector<Slice> more = read_file_slices(file);
     if (more.empty()) continue;
     ++images;
@@ -418,13 +495,66 @@ double sort_and_space(const fs::path& where, std::vector<Slice>& slices, glm::dv
   return mean;
 }
 
+// The k axis: the slice normal, or, when the slices also move sideways from one to the next
+// (gantry tilt, a sheared stack), the line through their positions. The voxels are not resampled:
+// the grid is sheared instead, so that every slice stays where its ImagePositionPatient puts it.
+struct StackAxis {
+  glm::dvec3 direction{0.0};
+  double spacing = 0.0;
+};
+
+// Sideways drift below this is rounding in the positions' decimal strings: the grid stays
+// orthogonal.
+constexpr double kRoundingMm = 0.01;
+
+std::string degrees_text(double degrees) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.*f", degrees < 0.1 ? 3 : 1, degrees);
+  return text;
+}
+
+StackAxis stack_axis(const fs::path& where, const std::vector<Slice>& slices, glm::dvec3 normal,
+                     double step, std::vector<std::string>& warnings) {
+  if (slices.size() < 2) return {normal, step};
+  const glm::dvec3 first = slices.front().position;
+  const auto sideways = [&](glm::dvec3 d) { return d - glm::dot(d, normal) * normal; };
+  double drift = 0.0;
+  for (const Slice& s : slices) drift = std::max(drift, glm::length(sideways(s.position - first)));
+  if (drift < kRoundingMm) return {normal, step};
+
+  const glm::dvec3 along = (slices.back().position - first) / double(slices.size() - 1);
+  for (size_t k = 0; k < slices.size(); ++k) {
+    const double off = glm::length(sideways(slices[k].position - (first + double(k) * along)));
+    if (off > std::max(kRoundingMm, 0.01 * glm::length(along)))
+      fail(where, concat("ImagePositionPatient: the slices do not lie on one line: ",
+                         name_of(slices[k]), " is ", off, " mm sideways from the line through ",
+                         name_of(slices.front()), " and ", name_of(slices.back()),
+                         " (strata reads evenly spaced slices, sheared at most uniformly)"));
+  }
+  const glm::dvec3 direction = glm::normalize(along);
+  const double tilt = glm::degrees(std::acos(std::clamp(glm::dot(direction, normal), -1.0, 1.0)));
+  const std::string sheared = concat("ImagePositionPatient: the slices are sheared by ",
+                                     degrees_text(tilt), "° (gantry tilt): each moves ",
+                                     glm::length(sideways(along)), " mm sideways from the last");
+  if (tilt > 45.0)
+    fail(where, sheared + "; more than 45° is not a stack of slices strata can show");
+  warnings.push_back(concat(where.string(), ": ", sheared,
+                            "; shown on a sheared grid, each slice at its own position "
+                            "(not resampled)"));
+  return {direction, glm::length(along)};
+}
+
 // ---- pixels
 
 // Decodes a file's pixel data (all its frames) into `bytes` bytes at destination.
 // Little-endian native pixel data is copied as it is: GDCM's raw codec goes through string
 // streams, up to four copies of a multi-frame file's pixels at once.
+bool is_native_little_endian(const Slice& s) {
+  return s.syntax == "1.2.840.10008.1.2" || s.syntax == "1.2.840.10008.1.2.1";
+}
+
 bool copy_native(const Slice& s, std::byte* destination, size_t bytes) {
-  if (s.syntax != "1.2.840.10008.1.2" && s.syntax != "1.2.840.10008.1.2.1") return false;
+  if (!is_native_little_endian(s)) return false;
   gdcm::Reader reader;
   reader.SetFileName(s.file.string().c_str());
   bool read = false;
@@ -490,15 +620,18 @@ void order_frames(std::vector<std::byte>& voxels, const std::vector<Slice>& slic
   }
 }
 
-// Clears bits above BitsStored (overlays live there in old files) and sign-extends signed data.
+// Moves the BitsStored bits that end at HighBit down to bit 0, clears the bits above them
+// (overlays live there in old files) and sign-extends signed data.
 template <class Unsigned>
-void clean_unused_bits(std::vector<std::byte>& voxels, int bits_stored, bool is_signed) {
+void clean_unused_bits(std::vector<std::byte>& voxels, int bits_stored, int high_bit,
+                       bool is_signed) {
   const auto mask = static_cast<Unsigned>((1u << bits_stored) - 1u);
   const auto sign = static_cast<Unsigned>(1u << (bits_stored - 1));
+  const int shift = high_bit + 1 - bits_stored;
   for (size_t i = 0; i + sizeof(Unsigned) <= voxels.size(); i += sizeof(Unsigned)) {
     Unsigned v;
     std::memcpy(&v, voxels.data() + i, sizeof v);
-    v = static_cast<Unsigned>(v & mask);
+    v = static_cast<Unsigned>((v >> shift) & mask);
     if (is_signed && (v & sign)) v = static_cast<Unsigned>(v | ~mask);
     std::memcpy(voxels.data() + i, &v, sizeof v);
   }
@@ -525,21 +658,50 @@ void decode(Volume& volume, const std::vector<Slice>& slices, size_t bytes) {
       decode_file(slices[k], volume.voxels.data() + k * slice_bytes, slice_bytes);
   }
   const Slice& first = slices.front();
-  if (first.bits_stored < first.bits_allocated && first.bits_stored > 0 &&
-      first.high_bit == first.bits_stored - 1) {
+  if (first.bits_stored < first.bits_allocated) {
     if (first.bits_allocated == 16)
-      clean_unused_bits<uint16_t>(volume.voxels, first.bits_stored, first.is_signed);
+      clean_unused_bits<uint16_t>(volume.voxels, first.bits_stored, first.high_bit,
+                                  first.is_signed);
     else
-      clean_unused_bits<uint8_t>(volume.voxels, first.bits_stored, first.is_signed);
+      clean_unused_bits<uint8_t>(volume.voxels, first.bits_stored, first.high_bit, first.is_signed);
   }
 }
 
+// Pixels whose HighBit is above BitsStored - 1 are moved down after decoding; that is known to be
+// right for uncompressed data only (a codec may have moved them already).
+void check_high_bit(const std::vector<Slice>& slices) {
+  for (const Slice& s : slices)
+    if (s.high_bit != s.bits_stored - 1 && !is_native_little_endian(s))
+      fail(s.file, concat("HighBit = ", s.high_bit, " with BitsStored = ", s.bits_stored,
+                          " in transfer syntax ", s.syntax,
+                          ": strata reads such pixels uncompressed (little endian) only"));
+}
+
+// A slice without a position can only be shown alone, as a 2-D image.
+void check_placed(const fs::path& where, const std::vector<Slice>& slices,
+                  std::vector<std::string>& warnings) {
+  for (const Slice& s : slices)
+    if (!s.placed && slices.size() > 1)
+      fail(s.file, "ImagePositionPatient is missing: a slice of a series needs its position");
+  const Slice& s = slices.front();
+  if (!s.placed)
+    warnings.push_back(concat(where.string(),
+                              ": ImagePositionPatient is missing (a secondary capture or other "
+                              "2-D image): shown as one slice at the origin of patient space, "
+                              "pixels ",
+                              s.pixel_spacing.x, " x ", s.pixel_spacing.y, " mm"));
+}
+
 // The volume of checked slices; `where` (the folder or file) names it in errors.
-Volume assemble(const fs::path& where, std::vector<Slice> slices, const VolumeLimits& limits) {
+Volume assemble(const fs::path& where, std::vector<Slice> slices, const VolumeLimits& limits,
+                std::vector<std::string>& warnings) {
+  check_placed(where, slices, warnings);
   for (const Slice& s : slices) check_consistent(where, slices.front(), s);
+  check_high_bit(slices);
   const Slice& first = slices.front();
   const glm::dvec3 normal = glm::normalize(glm::cross(first.row_cosine, first.column_cosine));
   const double step = sort_and_space(where, slices, normal);
+  const StackAxis axis = stack_axis(where, slices, normal, step, warnings);
 
   const StoredType stored = first.bits_allocated == 8
                                 ? (first.is_signed ? StoredType::int8 : StoredType::uint8)
@@ -553,10 +715,10 @@ Volume assemble(const fs::path& where, std::vector<Slice> slices, const VolumeLi
   volume.name = volume_name(where);
   volume.source = where;
   volume.dims = to_dims(dims);
-  volume.spacing = glm::vec3(first.pixel_spacing.x, first.pixel_spacing.y, step);
+  volume.spacing = glm::vec3(first.pixel_spacing.x, first.pixel_spacing.y, axis.spacing);
   volume.origin = glm::vec3(slices.front().position);
-  volume.direction =
-      glm::mat3(glm::vec3(first.row_cosine), glm::vec3(first.column_cosine), glm::vec3(normal));
+  volume.direction = glm::mat3(glm::vec3(first.row_cosine), glm::vec3(first.column_cosine),
+                               glm::vec3(axis.direction));
   decode(volume, slices, bytes);
   finish_voxels(volume, {.stored = stored,
                          .big_endian = std::endian::native == std::endian::big,
@@ -585,7 +747,7 @@ Volume load_dicom_series(const std::filesystem::path& folder, const VolumeReadOp
   std::vector<Slice> slices = read_folder(folder);
   // A folder holding one multi-frame file: errors about its frames name the file.
   const fs::path where = slices.front().frames_in_file > 1 ? slices.front().file : folder;
-  Volume volume = assemble(where, std::move(slices), options.limits);
+  Volume volume = assemble(where, std::move(slices), options.limits, warnings);
   volume.name = volume_name(folder);
   volume.source = folder;
   return volume;
@@ -601,7 +763,7 @@ Volume load_dicom_file(const std::filesystem::path& path, const VolumeReadOption
   std::vector<Slice> slices = read_file_slices(path);
   if (slices.empty())
     fail(path, "not a DICOM image (no Rows and Columns: a DICOMDIR, report or other object)");
-  return assemble(path, std::move(slices), options.limits);
+  return assemble(path, std::move(slices), options.limits, warnings);
 }
 
 }  // namespace strata
