@@ -146,6 +146,8 @@ TEST_SUITE("window") {
     volume.dims = {12, 10, 8};
     volume.voxels.resize(volume.voxel_count());
     for (size_t i = 0; i < volume.voxels.size(); ++i) volume.voxels[i] = std::byte(i * 37 % 256);
+    fs::create_directories(root / "alone");
+    fs::create_directories(root / "crowded");
     write_metaimage(root / "alone/scan.mha", volume, false);
     write_metaimage(root / "crowded/scan.mha", volume, false);
     fs::copy_file(source / "assets/transfer_functions/head-t1.json", root / "crowded/scan.json");
