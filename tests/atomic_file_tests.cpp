@@ -65,13 +65,16 @@ TEST_SUITE("loaders") {
     CHECK(with_file_size_limit(4096, [&] { write_text_file(file, big); }) == 0);
     CHECK(folder_bytes(folder) == before);
     // A PNG (write_png) and a file that was not there before: nothing is left either.
-    const std::vector<uint8_t> noise = [] {
-      std::vector<uint8_t> pixels(64 * 64 * 4);
-      for (size_t i = 0; i < pixels.size(); ++i) pixels[i] = uint8_t(i * 2654435761u >> 13);
-      return pixels;
-    }();
+    std::vector<uint8_t> noise(128 * 128 * 4);  // (random: no PNG of it is small)
+    uint32_t state = 2463534242u;
+    for (uint8_t& byte : noise) {
+      state ^= state << 13;
+      state ^= state >> 17;
+      state ^= state << 5;
+      byte = uint8_t(state >> 24);
+    }
     CHECK(with_file_size_limit(
-              4096, [&] { write_png((folder / "new.png").string(), 64, 64, noise); }) == 0);
+              4096, [&] { write_png((folder / "new.png").string(), 128, 128, noise); }) == 0);
     CHECK(folder_bytes(folder) == before);
     // Without the limit the same writes succeed (the limit is what failed them).
     write_text_file(file, big);
