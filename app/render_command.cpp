@@ -278,6 +278,12 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
       ->capture_default_str();
   cmd->callback([&device, o] {
+    // An unknown image extension is a usage error, found before any work (and before -o exists).
+    try {
+      check_image_extension(o->output);
+    } catch (const Error& e) {
+      throw UsageError(std::string("-o: ") + e.what());
+    }
     if (o->scene.file.empty()) {
       render_test_pattern(device, *o);
     } else if (o->no_labels) {

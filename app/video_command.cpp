@@ -2,10 +2,10 @@
 // seconds, with the labels moved by the forces between frames (a fixed time step, so the same
 // command gives the same frames). Frames go into an H.264 MP4 (-o NAME.mp4) or a folder as a
 // numbered PNG sequence, and with --layout-dir each frame's layout as JSON (for `strata eval`).
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 
 #include "app/commands.h"
@@ -54,21 +54,40 @@ std::string frame_name(size_t frame, const char* extension) {
   return name;
 }
 
+// -o: NAME.mp4, or a folder for PNG frames (no extension, or one that exists). Anything else
+// (x.avi) is a usage error, not a folder of PNGs nobody asked for.
+bool is_mp4(const std::filesystem::path& output) {
+  std::string extension = output.extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".mp4") return true;
+  std::error_code error;
+  if (extension.empty() || std::filesystem::is_directory(output, error)) return false;
+  throw UsageError("-o: '" + output.string() + "': cannot write a video as '" +
+                   output.extension().string() +
+                   "' (expected NAME.mp4, or a folder without an extension for PNG frames)");
+}
+
+// Folders are made before the video is opened, so one that cannot be made leaves no MP4.
+void create_folder(const std::string& option, const std::filesystem::path& folder) {
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error)
+    throw Error(option + ": " + folder.string() + ": cannot create the folder: " + error.message());
+}
+
 void video(DeviceOptions& device, const VideoOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   if (!(o.fps > 0.0 && o.fps <= 240.0)) throw UsageError("--fps: expected 0 < fps <= 240");
+  const std::filesystem::path output = o.output;
+  const bool mp4 = is_mp4(output);
   Context ctx(device.context());
   const Scene scene = load_scene_reporting(o.scene, ctx);
   const std::vector<Camera> cameras = sample(camera_path(scene, o), o.fps);
-  const std::filesystem::path output = o.output;
-  const bool mp4 = output.extension() == ".mp4";  // anything else names a folder
+  if (!mp4) create_folder("-o", output);
+  if (!o.layout_dir.empty()) create_folder("--layout-dir", o.layout_dir);
+  // Frames go to a temporary file, put in place by finish(): an error on the way leaves no MP4.
   std::unique_ptr<VideoFile> file;
-  if (mp4) {
-    file = std::make_unique<VideoFile>(o.output, size.width, size.height, o.fps);
-  } else {
-    std::filesystem::create_directories(output);
-  }
-  if (!o.layout_dir.empty()) std::filesystem::create_directories(o.layout_dir);
+  if (mp4) file = std::make_unique<VideoFile>(o.output, size.width, size.height, o.fps);
 
   LabellingSettings settings;
   settings.layer_count = o.scene.layer_count(scene);

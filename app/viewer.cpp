@@ -407,19 +407,60 @@ void Viewer::set_label_hidden(int id, bool hidden) {
   throw Error("the scene has no label " + std::to_string(id));
 }
 
+namespace {
+
+// A new scene file beside `opened` (a volume, a DICOM folder, a thesis .xml scene), named after
+// it and clashing with no file there: scan.nii.gz gives scan.scene.json, else scan.scene-2.json...
+// Written with Replace::no, so a file that appears meanwhile is not replaced either.
+std::filesystem::path save_new_scene_file(const std::filesystem::path& opened, const Scene& scene) {
+  std::filesystem::path normal = opened.lexically_normal();
+  if (normal.filename().empty()) normal = normal.parent_path();  // "ct/": the folder ct
+  const std::string file = normal.filename().string();
+  const std::string stem = file.substr(0, file.find('.'));
+  for (int n = 1; n < 1000; ++n) {
+    const std::filesystem::path path =
+        normal.parent_path() /
+        (stem + ".scene" + (n == 1 ? "" : "-" + std::to_string(n)) + ".json");
+    std::error_code error;
+    if (std::filesystem::exists(std::filesystem::symlink_status(path, error))) continue;
+    try {
+      save_scene_json(path, scene, AtomicFile::Replace::no);
+      return path;
+    } catch (const Error&) {
+      if (!std::filesystem::exists(std::filesystem::symlink_status(path, error))) throw;
+    }
+  }
+  throw Error(normal.string() + ": no free name for a new scene file beside it");
+}
+
+}  // namespace
+
+// A strata .json scene is written back to itself; anything else gets a new scene file of its
+// own (never a file that is there already: scan.json may be a transfer function).
 void Viewer::save_position(const std::string& name) {
   const std::string chosen = name.empty() ? new_position_name(scene_) : name;
   for (const CameraPose& p : scene_.camera_positions) {
     if (p.name == chosen) throw Error("the scene already has a position '" + chosen + "'");
   }
   scene_.camera_positions.push_back(control_.pose(chosen));
-  std::filesystem::path path = options_.scene_path;
-  if (path.extension() != ".json") {  // a thesis .xml scene, a volume or a DICOM folder
-    const std::string file = path.lexically_normal().filename().string();
-    path = path.lexically_normal().parent_path() / (file.substr(0, file.find('.')) + ".json");
+  try {
+    if (!saved_scene_path_.empty()) {
+      save_scene_json(saved_scene_path_, scene_);
+      message_ = "saved position '" + chosen + "' in " + saved_scene_path_.string();
+    } else if (!scene_.source_json.empty()) {
+      save_scene_json(options_.scene_path, scene_);
+      saved_scene_path_ = options_.scene_path;
+      message_ = "saved position '" + chosen + "' in " + saved_scene_path_.string();
+    } else {
+      saved_scene_path_ = save_new_scene_file(options_.scene_path, scene_);
+      message_ = "saved position '" + chosen + "' in a new scene file " +
+                 saved_scene_path_.string() + " (" + options_.scene_path.string() +
+                 " is not a strata scene)";
+    }
+  } catch (const Error&) {
+    scene_.camera_positions.pop_back();  // not saved: a later save must not write it unasked
+    throw;
   }
-  save_scene_json(path, scene_);
-  message_ = "saved position '" + chosen + "' in " + path.string();
   std::printf("view: %s\n", message_.c_str());
   ui_event();
 }

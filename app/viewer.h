@@ -105,8 +105,8 @@ struct ViewerSummary {
   std::map<std::string, double> gpu_ms;  // per pass: summed over the frames read back
   uint64_t timed_frames = 0;             // frames whose timings were read
   std::vector<double> gpu_span_ms;  // per frame read (keep_frame_spans): first to last pass's end
-  uint64_t trials = 0;                   // optimisation on idle: orders tried ...
-  uint64_t adopted = 0;                  // ... and kept
+  uint64_t trials = 0;              // optimisation on idle: orders tried ...
+  uint64_t adopted = 0;             // ... and kept
 };
 
 class Viewer {
@@ -263,6 +263,9 @@ class Viewer {
   // Output.
   std::unique_ptr<VideoFile> video_;
   std::filesystem::path video_path_;
+  // Where "save position" wrote the scene: the opened .json, or the new file made for a scene
+  // from elsewhere (a volume, a thesis .xml); later saves go there too.
+  std::filesystem::path saved_scene_path_;
   uint64_t video_frames_ = 0;
   uint32_t screenshots_ = 0;
   ViewerSummary summary_;

@@ -42,7 +42,7 @@ TEST_SUITE("cpu") {
     CHECK_THROWS_WITH_AS(VideoFile(test::output_dir() + "/odd.mp4", 63, 48, 30.0),
                          doctest::Contains("even width and height, not 63x48"), Error);
     CHECK_THROWS_WITH_AS(VideoFile("/nonexistent-dir/x.mp4", 64, 48, 30.0),
-                         doctest::Contains("/nonexistent-dir/x.mp4: opening the file"), Error);
+                         doctest::Contains("/nonexistent-dir/x.mp4: cannot write MP4"), Error);
   }
 }
 #endif

@@ -7,8 +7,8 @@
 
 namespace strata {
 
-// Writes `bytes` to the file, checking every write and the close (a full disk is an error);
-// throws Error "<file>: cannot write <what>: <reason>".
+// Writes `bytes` to the file whole or not at all (atomic_file.h); throws Error "<file>: cannot
+// write <what>: <reason>".
 void write_file_checked(const std::string& path, std::span<const uint8_t> bytes, const char* what);
 // stb's write callback: appends to the std::vector<uint8_t> at `bytes`.
 void append_encoded(void* bytes, void* data, int size);

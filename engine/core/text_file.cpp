@@ -6,6 +6,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "engine/core/atomic_file.h"
 #include "engine/core/error.h"
 
 namespace strata {
@@ -65,9 +66,7 @@ std::string read_text_file(const std::filesystem::path& path, uint64_t max_bytes
 }
 
 void write_text_file(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out.flush()) throw Error(path.string() + ": cannot write the file");
+  write_file_atomically(path, text);
 }
 
 std::string text_position(const std::string& text, std::ptrdiff_t offset) {

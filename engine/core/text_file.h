@@ -26,7 +26,8 @@ std::string read_file_bytes(const std::filesystem::path& path,
 // stop there and silently drop the rest of the file).
 std::string read_text_file(const std::filesystem::path& path,
                            uint64_t max_bytes = kMaxTextFileBytes);
-// Writes `text` to `path` (replacing it); an Error naming the path when it cannot.
+// Writes `text` to `path` whole or not at all (atomic_file.h); an Error naming the path when it
+// cannot.
 void write_text_file(const std::filesystem::path& path, const std::string& text);
 
 // "line L, column C (offset O)" of a byte offset into text (as XML parsers report offsets).

@@ -1,5 +1,6 @@
 #include "engine/core/video_file.h"
 
+#include "engine/core/atomic_file.h"
 #include "engine/core/error.h"
 
 #if STRATA_VIDEO
@@ -24,6 +25,9 @@ struct VideoFile::Codec {
   SwsContext* scaler = nullptr;
   int64_t next_pts = 0;
   bool finished = false;
+  // FFmpeg writes the temporary; finish() renames it into place, anything else removes it.
+  // (Declared last: destroyed after ~Codec has closed FFmpeg's handle on it.)
+  std::unique_ptr<AtomicFile> file;
 
   // Throws Error("<path>: <what>: <FFmpeg's reason>") when an FFmpeg call failed.
   void check(int result, const char* what) const {
@@ -69,7 +73,7 @@ VideoFile::VideoFile(const std::string& path, uint32_t width, uint32_t height, d
     throw Error(path + ": an H.264 video needs an even width and height, not " +
                 std::to_string(width) + "x" + std::to_string(height));
   }
-  c.check(avformat_alloc_output_context2(&c.format, nullptr, "mp4", path.c_str()),
+  c.check(avformat_alloc_output_context2(&c.format, nullptr, "mp4", nullptr),
           "creating an MP4 file");
   const AVCodec* h264 = avcodec_find_encoder_by_name("libx264");
   if (!h264) h264 = avcodec_find_encoder(AV_CODEC_ID_H264);
@@ -104,17 +108,13 @@ VideoFile::VideoFile(const std::string& path, uint32_t width, uint32_t height, d
   c.scaler = sws_getContext(int(width), int(height), AV_PIX_FMT_RGBA, int(width), int(height),
                             AV_PIX_FMT_YUV420P, SWS_BICUBIC, nullptr, nullptr, nullptr);
   if (!c.scaler) throw Error(path + ": no RGBA to YUV conversion");
-  c.check(avio_open(&c.format->pb, path.c_str(), AVIO_FLAG_WRITE), "opening the file");
+  c.file = std::make_unique<AtomicFile>(path, "MP4");
+  c.check(avio_open(&c.format->pb, c.file->temporary().c_str(), AVIO_FLAG_WRITE),
+          "opening the file");
   c.check(avformat_write_header(c.format, nullptr), "writing the header");
 }
 
-VideoFile::~VideoFile() {
-  try {
-    finish();
-  } catch (const Error&) {
-    // (already reported by an explicit finish(); a destructor must not throw)
-  }
-}
+VideoFile::~VideoFile() = default;
 
 void VideoFile::write(std::span<const uint8_t> rgba) {
   Codec& c = *codec_;
@@ -137,6 +137,7 @@ void VideoFile::finish() {
   c.encode(nullptr);
   c.check(av_write_trailer(c.format), "writing the index");
   c.check(avio_closep(&c.format->pb), "closing the file");
+  c.file->commit();
 }
 
 }  // namespace strata

@@ -20,7 +20,9 @@ class VideoFile {
 
   // Appends one frame of width x height RGBA8 pixels, rows top to bottom.
   void write(std::span<const uint8_t> rgba);
-  // Flushes the encoder and writes the file's index; the destructor does it if not called.
+  // Flushes the encoder, writes the file's index and puts the file in place. Until then the frames
+  // go to a temporary file (atomic_file.h): a video destroyed unfinished (an error on the way)
+  // leaves nothing at `path`.
   void finish();
 
  private:

@@ -133,6 +133,10 @@ struct Scene {
   std::vector<CameraPose> camera_positions;  // named poses ("--camera NAME")
   SceneSettings settings;
   std::vector<std::string> warnings;  // e.g. a referenced file that does not exist
+  // The strata scene JSON text `source` held when read (empty for other sources): save_scene_json
+  // writes its entries back as they were, since the model holds what an entry made (an atlas's
+  // surfaces, a label file's labels), not the entry.
+  std::string source_json;
 };
 
 // The scene's camera, or its named position `name` (an Error listing the names if there is none).

@@ -10,6 +10,7 @@
 
 #include <zlib.h>
 
+#include "engine/core/atomic_file.h"
 #include "engine/scene/io/volume_io.h"
 #include "engine/scene/io/volume_loader.h"
 
@@ -211,7 +212,7 @@ std::string header_text(const Volume& v, bool compress, const std::string& data_
 
 // Streams the voxels through deflate (zlib format, as MetaIO writes) in 64 KiB pieces, so writing
 // needs no second copy of the volume.
-void write_deflated(std::ofstream& out, const std::vector<std::byte>& data, const fs::path& path) {
+void write_deflated(AtomicFile& out, const std::vector<std::byte>& data, const fs::path& path) {
   z_stream z{};
   if (deflateInit(&z, Z_DEFAULT_COMPRESSION) != Z_OK) fail(path, "cannot start zlib");
   std::vector<unsigned char> buffer(1 << 16);
@@ -227,25 +228,18 @@ void write_deflated(std::ofstream& out, const std::vector<std::byte>& data, cons
       z.next_out = buffer.data();
       z.avail_out = static_cast<uInt>(buffer.size());
       deflate(&z, flush);
-      out.write(reinterpret_cast<const char*>(buffer.data()),
-                static_cast<std::streamsize>(buffer.size() - z.avail_out));
+      out.write(buffer.data(), buffer.size() - z.avail_out);
     } while (z.avail_out == 0);
   } while (flush != Z_FINISH);
   deflateEnd(&z);
 }
 
-void write_data(const fs::path& file, std::ios::openmode mode, const Volume& volume, bool compress,
-                const fs::path& path) {
-  std::ofstream out(file, std::ios::binary | mode);
-  if (!out) fail(path, concat("cannot open ", file.string(), " for writing"));
+void write_data(AtomicFile& out, const Volume& volume, bool compress, const fs::path& path) {
   if (compress) {
     write_deflated(out, volume.voxels, path);
   } else {
-    out.write(reinterpret_cast<const char*>(volume.voxels.data()),
-              static_cast<std::streamsize>(volume.voxels.size()));
+    out.write(volume.voxels.data(), volume.voxels.size());
   }
-  out.close();
-  if (!out) fail(path, concat("writing ", file.string(), " failed"));
 }
 
 }  // namespace
@@ -303,13 +297,17 @@ void write_metaimage(const std::filesystem::path& path, const Volume& volume, bo
   const bool local = extension == ".mha";
   const fs::path data_file =
       local ? path : path.parent_path() / (path.stem().string() + (compress ? ".zraw" : ".raw"));
-  {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (!out) fail(path, "cannot open for writing");
-    out << header_text(volume, compress, local ? "LOCAL" : data_file.filename().string());
-    if (!out) fail(path, "writing the header failed");
+  // Each file whole or not at all (atomic_file.h); a .mhd's data file first, so its header never
+  // names a data file that is not there.
+  AtomicFile header(path, "MetaImage");
+  if (!local) {
+    AtomicFile data(data_file, "MetaImage data");
+    write_data(data, volume, compress, path);
+    data.commit();
   }
-  write_data(data_file, local ? std::ios::app : std::ios::trunc, volume, compress, path);
+  header.write(header_text(volume, compress, local ? "LOCAL" : data_file.filename().string()));
+  if (local) write_data(header, volume, compress, path);
+  header.commit();
 }
 
 }  // namespace strata

@@ -464,7 +464,18 @@ Scene SceneReader::read(const json& root) {
 }  // namespace
 
 Scene load_scene_json(const std::filesystem::path& path, const VolumeLimits& limits) {
-  return SceneReader(path, limits).read(read_json_file(path));
+  std::string text = read_text_file(path);
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::exception& e) {
+    const std::string what = e.what();
+    const size_t end = what.find("] ");
+    throw Error(path.string() + ": " + (end == std::string::npos ? what : what.substr(end + 2)));
+  }
+  Scene scene = SceneReader(path, limits).read(root);
+  scene.source_json = std::move(text);
+  return scene;
 }
 
 Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& options) {

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "engine/core/atomic_file.h"
 #include "engine/scene/io/volume_loader.h"
 #include "engine/scene/scene.h"
 
@@ -47,9 +48,14 @@ Scene load_scene_json(const std::filesystem::path& path, const VolumeLimits& lim
 // nowhere is skipped with a warning. Implemented in voly_scene_import.cpp.
 Scene import_voly_scene(const std::filesystem::path& path, const VolumeLimits& limits = {});
 
-// Writes strata scene JSON, version 1, with paths relative to the new file's folder and transfer
-// functions inline. Volumes and meshes without a source file (atlas masks and surfaces) cannot
-// be written as files and are left out; meshes are written once per source file.
-void save_scene_json(const std::filesystem::path& path, const Scene& scene);
+// Writes strata scene JSON, version 1, whole or not at all (atomic_file.h), with paths relative
+// to the new file's folder. A scene read from strata JSON is written as it was read (every entry
+// and key kept: atlas entries, transfer functions and labels by file, frames), with the scene's
+// camera positions in place of the file's (those complete_scene fitted left out: it fits them
+// again). Any other scene (a volume, a thesis .xml) is written from the model: volumes and meshes
+// by file, transfer functions by file or inline, labels inline, the camera and its positions.
+// Replace::no: an Error if `path` exists (a new file never replaces another).
+void save_scene_json(const std::filesystem::path& path, const Scene& scene,
+                     AtomicFile::Replace replace = AtomicFile::Replace::yes);
 
 }  // namespace strata

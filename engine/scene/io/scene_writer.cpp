@@ -1,11 +1,12 @@
-// Writing strata scene JSON (docs/scene-format.md): what a loaded or imported scene holds, with
-// paths relative to the written file.
+// Writing strata scene JSON (docs/scene-format.md): a scene read from strata JSON as it was read,
+// any other from the model, with paths relative to the written file.
 #include <algorithm>
-#include <fstream>
 
 #include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
+#include "engine/core/text_file.h"
+#include "engine/scene/fitted_camera.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
 
@@ -28,16 +29,8 @@ ordered_json vector_json(const float* values, int count) {
   return result;
 }
 
-ordered_json camera_json(const Camera& camera, const std::vector<CameraPose>& poses) {
-  ordered_json positions = ordered_json::array();
-  for (const CameraPose& pose : poses) {
-    positions.push_back({{"name", pose.name}, {"view", matrix_json(pose.view)}});
-  }
-  return {{"fov_y", shortest_double(camera.fov_y_degrees)},
-          {"near", shortest_double(camera.near_plane)},
-          {"far", shortest_double(camera.far_plane)},
-          {"view", matrix_json(camera.view)},
-          {"positions", positions}};
+ordered_json position_json(const CameraPose& pose) {
+  return {{"name", pose.name}, {"view", matrix_json(pose.view)}};
 }
 
 ordered_json settings_json(const SceneSettings& settings) {
@@ -77,21 +70,99 @@ ordered_json meshes_json(const std::vector<Mesh>& meshes, const auto& relative) 
   return result;
 }
 
-}  // namespace
+// A path as the file at `from` wrote it, as the file at `to` must write it: unchanged within one
+// folder or when absolute, else relative to the new folder (absolute where there is no relative).
+class Rebase {
+ public:
+  Rebase(const std::filesystem::path& from, const std::filesystem::path& to)
+      : from_(std::filesystem::absolute(from).parent_path()),
+        to_(std::filesystem::absolute(to).parent_path()) {}
 
-void save_scene_json(const std::filesystem::path& path, const Scene& scene) {
-  const std::filesystem::path folder = std::filesystem::absolute(path).parent_path();
-  const auto relative = [&](const std::filesystem::path& file) {
-    const std::filesystem::path r = std::filesystem::absolute(file).lexically_relative(folder);
-    return (r.empty() ? std::filesystem::absolute(file) : r).generic_string();
+  std::string operator()(const std::filesystem::path& file) const {
+    const std::filesystem::path absolute = std::filesystem::absolute(file).lexically_normal();
+    const std::filesystem::path r = absolute.lexically_relative(to_);
+    return (r.empty() ? absolute : r).generic_string();
+  }
+  // A path key of the read file, if there is one and it is a string (else it is not a path).
+  void key(ordered_json& object, const char* name) const {
+    if (!object.is_object() || !object.contains(name) || !object[name].is_string()) return;
+    const std::filesystem::path written(object[name].get<std::string>());
+    if (written.is_absolute() || from_ == to_) return;
+    object[name] = (*this)((from_ / written).lexically_normal());
+  }
+  void each(ordered_json& root, const char* array, std::initializer_list<const char*> names) const {
+    if (!root.contains(array) || !root[array].is_array()) return;
+    for (ordered_json& entry : root[array]) {
+      for (const char* name : names) key(entry, name);
+    }
+  }
+
+ private:
+  std::filesystem::path from_, to_;
+};
+
+// The read file's camera positions: its own entries as written where the scene still has them,
+// then the scene's new ones.
+void write_positions(ordered_json& root, const Scene& scene) {
+  ordered_json* camera = root.contains("camera") ? &root["camera"] : nullptr;
+  ordered_json read =
+      camera && camera->contains("positions") ? (*camera)["positions"] : ordered_json::array();
+  std::vector<bool> used(read.size(), false);
+  // The positions complete_scene appends for a file without a camera: the loader appends them
+  // again, so those at the end of the list are not written (ones before a saved position are,
+  // to keep the order that the keys 1 to 9 follow).
+  const std::vector<CameraPose> fitted =
+      scene.has_camera ? std::vector<CameraPose>{} : fitted_camera(scene).positions;
+  const auto is_fitted = [&](const CameraPose& pose) {
+    return std::any_of(fitted.begin(), fitted.end(), [&](const CameraPose& p) {
+      return p.name == pose.name && p.view == pose.view;
+    });
   };
+  ordered_json positions = ordered_json::array();
+  size_t kept = 0;  // positions up to the last one that is not fitted
+  for (const CameraPose& pose : scene.camera_positions) {
+    bool found = false;
+    for (size_t i = 0; i < read.size() && !found; ++i) {
+      if (used[i] || !read[i].is_object() || read[i].value("name", "") != pose.name) continue;
+      used[i] = found = true;
+      positions.push_back(read[i]);
+    }
+    if (!found) positions.push_back(position_json(pose));
+    if (found || !is_fitted(pose)) kept = positions.size();
+  }
+  positions.erase(positions.begin() + std::ptrdiff_t(kept), positions.end());
+  if (positions.empty() && !(camera && camera->contains("positions"))) return;
+  if (!camera) {
+    root["camera"] = ordered_json::object();
+    camera = &root["camera"];
+  }
+  (*camera)["positions"] = std::move(positions);
+}
+
+// The scene's own file, as read, with its paths rebased to `path` and the scene's positions.
+ordered_json as_read(const std::filesystem::path& path, const Scene& scene) {
+  ordered_json root = ordered_json::parse(scene.source_json);
+  const Rebase rebase(scene.source, path);
+  rebase.each(root, "volumes", {"file", "transfer_function"});
+  rebase.each(root, "meshes", {"file"});
+  rebase.each(root, "atlas", {"labels", "names", "mask_transfer_function"});
+  rebase.key(root, "labels");
+  rebase.each(root, "labels", {"image"});
+  write_positions(root, scene);
+  return root;
+}
+
+// A scene from another source (a volume, a thesis .xml): what the model holds.
+ordered_json from_model(const std::filesystem::path& path, const Scene& scene) {
+  const Rebase relative(path, path);
   ordered_json volumes = ordered_json::array();
   for (const Volume& volume : scene.volumes) {
     if (volume.source.empty()) continue;
     ordered_json entry = {{"name", volume.name}, {"file", relative(volume.source)}};
     if (volume.transfer_function >= 0) {
+      const TransferFunction& tf = scene.transfer_functions.at(size_t(volume.transfer_function));
       entry["transfer_function"] =
-          transfer_function_to_json(scene.transfer_functions.at(size_t(volume.transfer_function)));
+          tf.source.empty() ? transfer_function_to_json(tf) : ordered_json(relative(tf.source));
     }
     if (volume.transform != glm::mat4(1.0f)) entry["transform"] = matrix_json(volume.transform);
     volumes.push_back(std::move(entry));
@@ -102,7 +173,7 @@ void save_scene_json(const std::filesystem::path& path, const Scene& scene) {
                           {"text", label.text},
                           {"anchor", vector_json(&label.anchor[0], 3)},
                           {"size", vector_json(&label.size[0], 2)}};
-    if (label.priority != 0.0f) entry["priority"] = label.priority;
+    if (label.priority != 0.0f) entry["priority"] = shortest_double(label.priority);
     if (const auto& image = label.image) {
       entry["image"] = relative(image->file);
       entry["image_height"] = shortest_double(image->height);
@@ -110,15 +181,29 @@ void save_scene_json(const std::filesystem::path& path, const Scene& scene) {
     }
     labels.push_back(std::move(entry));
   }
-  const ordered_json root = {{"strata_scene", 1},
-                             {"volumes", volumes},
-                             {"meshes", meshes_json(scene.meshes, relative)},
-                             {"labels", labels},
-                             {"camera", camera_json(scene.camera, scene.camera_positions)},
-                             {"settings", settings_json(scene.settings)}};
-  std::ofstream out(path, std::ios::binary);
-  out << root.dump(2) << '\n';
-  if (!out) throw Error(path.string() + ": cannot write the file");
+  ordered_json root = {{"strata_scene", 1},
+                       {"volumes", volumes},
+                       {"meshes", meshes_json(scene.meshes, relative)},
+                       {"labels", labels}};
+  // A fitted camera is not written: the loader fits it again (to the same scene, the same).
+  if (scene.has_camera) {
+    root["camera"] = {{"fov_y", shortest_double(scene.camera.fov_y_degrees)},
+                      {"near", shortest_double(scene.camera.near_plane)},
+                      {"far", shortest_double(scene.camera.far_plane)},
+                      {"view", matrix_json(scene.camera.view)}};
+  }
+  write_positions(root, scene);
+  root["settings"] = settings_json(scene.settings);
+  return root;
+}
+
+}  // namespace
+
+void save_scene_json(const std::filesystem::path& path, const Scene& scene,
+                     AtomicFile::Replace replace) {
+  const ordered_json root =
+      scene.source_json.empty() ? from_model(path, scene) : as_read(path, scene);
+  write_file_atomically(path, root.dump(2) + '\n', "the scene", replace);
 }
 
 }  // namespace strata

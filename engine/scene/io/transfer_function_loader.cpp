@@ -205,9 +205,7 @@ TransferFunction load_transfer_function(const std::filesystem::path& path) {
 }
 
 void write_transfer_function_json(const std::filesystem::path& path, const TransferFunction& tf) {
-  std::ofstream out(path, std::ios::binary);
-  out << transfer_function_to_json(tf).dump(2) << '\n';
-  if (!out) fail(path.string(), "", "cannot write the file");
+  write_text_file(path, transfer_function_to_json(tf).dump(2) + '\n');
 }
 
 bool is_transfer_function_file(const std::filesystem::path& path) {
