@@ -1,6 +1,10 @@
 #include "engine/scene/camera.h"
 
+#include <cmath>
+
 #include <glm/gtc/matrix_transform.hpp>
+
+#include "engine/scene/value_limits.h"
 
 namespace strata {
 
@@ -12,6 +16,24 @@ glm::mat4 Camera::projection(float aspect) const {
 
 glm::vec3 Camera::eye() const {
   return glm::vec3(glm::inverse(view)[3]);
+}
+
+std::optional<LensProblem> lens_problem(const Camera& camera) {
+  using namespace value_limits;
+  const double fov = camera.fov_y_degrees, near = camera.near_plane, far = camera.far_plane;
+  if (!(fov >= kMinFovDegrees && fov <= kMaxFovDegrees))
+    return LensProblem{"fov_y", "expected degrees from " + shown(kMinFovDegrees) + " to " +
+                                    shown(kMaxFovDegrees) + ", got " + shown(fov)};
+  if (!(near > 0.0)) return LensProblem{"near", "expected a number > 0"};
+  if (!(far > near)) return LensProblem{"far", "expected a number > near"};
+  if (!(far <= kMaxFarMm))
+    return LensProblem{"far", "far plane " + shown(far) + " mm is past " + shown(kMaxFarMm)};
+  if (!(far / near <= kMaxFarNearRatio))
+    return LensProblem{"far", "far / near = " + shown(far) + " / " + shown(near) + " = " +
+                                  shown(far / near) + ", more than " + shown(kMaxFarNearRatio) +
+                                  ": the depth range is too deep for a float projection "
+                                  "(raise near or lower far)"};
+  return std::nullopt;
 }
 
 ProjectedPoint project(const Camera& camera, glm::vec3 world, glm::uvec2 size) {

@@ -3,6 +3,7 @@
 // camera paths and the viewer interpolate and orbit its pose.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -21,6 +22,15 @@ struct Camera {
   // The eye's position in world space.
   glm::vec3 eye() const;
 };
+
+// Why a lens makes no meaningful picture, naming its field ("fov_y", "near", "far"): a field of
+// view outside 0.1..179 degrees, near not > 0, far not > near, far past 1e9 mm, or far / near
+// past 1e6, where the float projection loses its far plane (value_limits.h). Nothing when fine.
+struct LensProblem {
+  const char* field;
+  std::string reason;
+};
+std::optional<LensProblem> lens_problem(const Camera& camera);
 
 // A named pose of the scene's camera ("--camera NAME"); the lens stays the scene's.
 struct CameraPose {

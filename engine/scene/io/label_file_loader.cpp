@@ -20,6 +20,7 @@
 #include "engine/core/error.h"
 #include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
+#include "engine/scene/value_limits.h"
 
 namespace strata {
 namespace {
@@ -101,6 +102,22 @@ bool fits_float(double value) {
 glm::vec3 to_world(const glm::dvec3& position, Axes axes) {
   if (axes == Axes::lps) return glm::vec3(position);
   return glm::vec3(glm::dvec3(-position.x, -position.y, position.z));
+}
+
+// The labels read, each with where it is in its file ("line 4", "markups[0].controlPoints[2]")
+// for errors found after reading (an id past int's range).
+struct ReadLabels {
+  std::vector<Label> labels;
+  std::vector<std::string> places;
+
+  void add(Label label, std::string place) {
+    labels.push_back(std::move(label));
+    places.push_back(std::move(place));
+  }
+};
+
+std::optional<std::string> anchor_problem(const Label& label) {
+  return value_limits::position_problem("anchor", glm::dvec3(label.anchor));
 }
 
 // ---- CSV (.fcsv and .csv)
@@ -276,11 +293,11 @@ bool fcsv_defined(std::string_view field, const FileLine& line) {
   line.fail("position status '" + std::string(status) + "' is not 0, 1, 2 or 3");
 }
 
-std::vector<Label> read_fcsv(const fs::path& path, const std::string& text) {
+ReadLabels read_fcsv(const fs::path& path, const std::string& text) {
   const std::string file = path.string();
   std::optional<Axes> axes;
   FcsvLayout layout;
-  std::vector<Label> labels;
+  ReadLabels labels;
   size_t point_index = 0;
   for (const Row& row : csv_rows(text, file, true)) {
     const FileLine line{file, row.line};
@@ -312,9 +329,10 @@ std::vector<Label> read_fcsv(const fs::path& path, const std::string& text) {
                               coordinate(row.fields[layout.z], "z", line));
     Label label;
     label.anchor = to_world(position, *axes);
+    if (const auto problem = anchor_problem(label)) line.fail(*problem);
     if (layout.label) label.text = text_field(row.fields[*layout.label], "label", line);
     if (label.text.empty()) label.text = fallback_text(base_name(path), index);
-    labels.push_back(std::move(label));
+    labels.add(std::move(label), "line " + std::to_string(row.line));
   }
   return labels;
 }
@@ -367,7 +385,7 @@ bool csv_defined(std::string_view field, const FileLine& line) {
   line.fail("column 'defined': '" + std::string(value) + "' is not 0 or 1");
 }
 
-std::vector<Label> read_csv(const fs::path& path, const std::string& text) {
+ReadLabels read_csv(const fs::path& path, const std::string& text) {
   const std::string file = path.string();
   const std::vector<Row> rows = csv_rows(text, file, false);
   if (rows.empty()) {
@@ -375,7 +393,7 @@ std::vector<Label> read_csv(const fs::path& path, const std::string& text) {
   }
   const CsvLayout layout = csv_layout(rows[0], file);
   const std::vector<std::string> names = column_names(rows[0]);
-  std::vector<Label> labels;
+  ReadLabels labels;
   for (size_t i = 1; i < rows.size(); ++i) {
     const Row& row = rows[i];
     const FileLine line{file, row.line};
@@ -391,9 +409,10 @@ std::vector<Label> read_csv(const fs::path& path, const std::string& text) {
     }
     Label label;
     label.anchor = to_world(position, layout.system);
+    if (const auto problem = anchor_problem(label)) line.fail(*problem);
     label.text = text_field(row.fields[layout.text], names[layout.text], line);
     if (label.text.empty()) label.text = fallback_text(base_name(path), i - 1);
-    labels.push_back(std::move(label));
+    labels.add(std::move(label), "line " + std::to_string(row.line));
   }
   return labels;
 }
@@ -471,7 +490,7 @@ bool markup_defined(const json* status, const Field& field) {
 // Angle, Curve, ClosedCurve, Plane, ROI) are skipped: their points shape a figure, and a label on
 // each would name corners, not places.
 void read_markup(const json& markup, const Field& field, const std::string& file_name,
-                 std::vector<Label>& labels) {
+                 ReadLabels& labels) {
   if (!markup.is_object()) field.fail("expected an object");
   if (string(required(markup, field, "type"), field / "type") != "Fiducial") return;
   const json* name = optional(markup, "name");
@@ -499,14 +518,15 @@ void read_markup(const json& markup, const Field& field, const std::string& file
       (point_field / "position").fail("a coordinate is out of range");
     Label label;
     label.anchor = to_world(position, axes);
+    if (const auto problem = anchor_problem(label)) (point_field / "position").fail(*problem);
     const json* text = optional(point, "label");
     if (text) label.text = string(*text, point_field / "label");
     if (label.text.empty()) label.text = fallback_text(list_name, i);
-    labels.push_back(std::move(label));
+    labels.add(std::move(label), point_field.path);
   }
 }
 
-std::vector<Label> read_markups(const fs::path& path) {
+ReadLabels read_markups(const fs::path& path) {
   const std::string file = path.string();
   const json root = read_json_file(path);
   const Field field{file, ""};
@@ -514,7 +534,7 @@ std::vector<Label> read_markups(const fs::path& path) {
   const json& markups = required(root, field, "markups");
   const Field markups_field = field / "markups";
   if (!markups.is_array()) markups_field.fail("expected an array");
-  std::vector<Label> labels;
+  ReadLabels labels;
   for (size_t i = 0; i < markups.size(); ++i)
     read_markup(markups[i], markups_field[i], base_name(path), labels);
   return labels;
@@ -522,9 +542,9 @@ std::vector<Label> read_markups(const fs::path& path) {
 
 }  // namespace
 
-std::vector<Label> load_label_file(const fs::path& path, int first_id) {
+std::vector<Label> load_label_file(const fs::path& path, int64_t first_id) {
   const std::string name = lowercase(path.filename().string());
-  std::vector<Label> labels;
+  ReadLabels labels;
   std::string none = "no points";
   if (name.ends_with(".mrk.json")) {
     labels = read_markups(path);
@@ -539,9 +559,18 @@ std::vector<Label> load_label_file(const fs::path& path, int first_id) {
     throw Error(path.string() + ": unknown label file format '" + path.extension().string() +
                 "' (expected .mrk.json, .fcsv or .csv)");
   }
-  if (labels.empty()) throw Error(path.string() + ": " + none);
-  for (size_t i = 0; i < labels.size(); ++i) labels[i].id = first_id + int(i);
-  return labels;
+  if (labels.labels.empty()) throw Error(path.string() + ": " + none);
+  constexpr int64_t largest = std::numeric_limits<int>::max();
+  for (size_t i = 0; i < labels.labels.size(); ++i) {
+    const int64_t id = first_id + int64_t(i);
+    if (id > largest)
+      throw Error(path.string() + ": " + labels.places[i] + ": label id " + std::to_string(id) +
+                  " is past the largest, " + std::to_string(largest) +
+                  " (this file's ids start at " + std::to_string(first_id) +
+                  ", after the labels before it)");
+    labels.labels[i].id = int(id);
+  }
+  return std::move(labels.labels);
 }
 
 }  // namespace strata

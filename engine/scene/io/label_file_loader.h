@@ -3,6 +3,7 @@
 // describes what each format must hold and what is skipped.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <vector>
 
@@ -15,6 +16,7 @@ namespace strata {
 // LPS (x towards the patient's left, y posterior, z superior): RAS points get x and y negated.
 // Ids are first_id, first_id + 1, ... in file order. Errors: one strata::Error "<file>: <field or
 // line>: <reason>".
-std::vector<Label> load_label_file(const std::filesystem::path& path, int first_id = 0);
+// An id past 2147483647 is an error naming the label's line or entry.
+std::vector<Label> load_label_file(const std::filesystem::path& path, int64_t first_id = 0);
 
 }  // namespace strata

@@ -126,7 +126,8 @@ void set_geometry(Volume& volume, const MetaHeader& header, int ndims) {
   if (const auto text = header.get({"ElementSpacing", "ElementSize"})) {
     const auto s = numbers_of(header, "ElementSpacing", *text, n);
     for (size_t axis = 0; axis < spatial; ++axis) volume.spacing[int(axis)] = s[axis];
-    check_spacing(path, "ElementSpacing", {volume.spacing.x, volume.spacing.y, volume.spacing.z});
+    check_spacing(path, "ElementSpacing", {volume.spacing.x, volume.spacing.y, volume.spacing.z},
+                  "ElementSpacing", 0);
   }
   if (const auto text = header.get({"Offset", "Position", "Origin"})) {
     const auto o = numbers_of(header, "Offset", *text, n);

@@ -194,7 +194,7 @@ using Affine = std::array<std::array<double, 4>, 3>;
 std::array<double, 3> pixdim_spacing(const NiftiHeader& h, const fs::path& path, bool one_slice) {
   std::array<double, 3> spacing{h.pixdim[1], h.pixdim[2], h.pixdim[3]};
   if (one_slice && !(spacing[2] > 0.0 && std::isfinite(spacing[2]))) spacing[2] = 1.0;
-  check_spacing(path, "pixdim[1..3]", spacing);
+  check_spacing(path, "pixdim[1..3]", spacing, "pixdim", 1);
   return spacing;
 }
 

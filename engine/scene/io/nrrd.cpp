@@ -122,9 +122,33 @@ std::vector<std::optional<std::string_view>> vectors(const fs::path& path, std::
   return result;
 }
 
-glm::dvec3 vector3(const fs::path& path, std::string_view field, std::string_view inside) {
+// A vector of the header's space: 3 numbers, or 2 in a 2-D space (its z is 0).
+glm::dvec3 vector_in_space(const fs::path& path, std::string_view field, std::string_view inside,
+                           int space_dimension) {
+  if (space_dimension == 2) {
+    const auto v = parse_exactly<double, 2>(path, field, inside);
+    return glm::dvec3(v[0], v[1], 0.0);
+  }
   const auto v = parse_exactly<double, 3>(path, field, inside);
   return glm::dvec3(v[0], v[1], v[2]);
+}
+
+// How many numbers a vector has: "space dimension", or 3 for a named space (all of NRRD's named
+// spaces are 3-D). A 2-D space (ITK writes one for 2-D images) holds only a 2-D image.
+int space_dimension(const NrrdHeader& header, int rank) {
+  const fs::path& path = header.path;
+  const auto text = header.get("space dimension");
+  if (!text) return 3;
+  if (header.get("space")) fail(path, "both 'space' and 'space dimension': give one");
+  const int64_t n = parse_exactly<int64_t, 1>(path, "space dimension", *text)[0];
+  if (n != 2 && n != 3)
+    fail(path, concat("space dimension = ", n,
+                      ": expected 2 or 3 (strata reads 2-D and 3-D "
+                      "spaces)"));
+  if (n == 2 && rank != 2)
+    fail(path,
+         concat("space dimension = 2: a 2-D space holds a 2-D image, but dimension is ", rank));
+  return int(n);
 }
 
 // Signs that take coordinates of the header's "space" to LPS+.
@@ -191,6 +215,7 @@ Extent image_extent(const NrrdHeader& header) {
 void set_direction(Volume& volume, const NrrdHeader& header, int rank, std::string_view text) {
   const fs::path& path = header.path;
   const glm::dvec3 signs = to_lps(header);
+  const int space = space_dimension(header, rank);
   const auto axes = vectors(path, "space directions", text);
   if (axes.size() != size_t(rank))
     fail(path, concat("space directions: expected ", rank, " entries (dimension ", rank, "), got ",
@@ -200,7 +225,8 @@ void set_direction(Volume& volume, const NrrdHeader& header, int rank, std::stri
       fail(path, concat("space directions: axis ", axis,
                         " is 'none': strata reads 4-D images whose fourth axis is the non-spatial "
                         "one (time)"));
-    const glm::dvec3 v = signs * vector3(path, "space directions", *axes[size_t(axis)]);
+    const glm::dvec3 v =
+        signs * vector_in_space(path, "space directions", *axes[size_t(axis)], space);
     const double length = glm::length(v);
     if (!(length > 0.0) || !std::isfinite(length))
       fail(path,
@@ -224,13 +250,14 @@ void set_geometry(Volume& volume, const NrrdHeader& header, int rank) {
       fail(path, concat("spacings: expected ", rank, " numbers (dimension ", rank, "), got '",
                         printable(trim(*spacings)), "'"));
     const std::array<double, 3> spatial{s[0], s[1], rank > 2 ? s[2] : 1.0};
-    check_spacing(path, "spacings", spatial);
+    check_spacing(path, "spacings", spatial, "spacings", 0);
     volume.spacing = glm::vec3(glm::dvec3(spatial[0], spatial[1], spatial[2]));
   }
   if (const auto text = header.get("space origin")) {
     const auto origin = vectors(path, "space origin", *text);
-    if (origin.size() != 1 || !origin[0]) fail(path, "space origin: expected one (x,y,z) vector");
-    volume.origin = glm::vec3(to_lps(header) * vector3(path, "space origin", *origin[0]));
+    if (origin.size() != 1 || !origin[0]) fail(path, "space origin: expected one vector");
+    volume.origin = glm::vec3(to_lps(header) * vector_in_space(path, "space origin", *origin[0],
+                                                               space_dimension(header, rank)));
   }
   check_geometry(path, "space origin", "space directions", volume);
 }

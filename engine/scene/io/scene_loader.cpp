@@ -21,7 +21,9 @@
 #include "engine/scene/io/mesh_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
 #include "engine/scene/io/volume_loader.h"
+#include "engine/scene/scene_bounds.h"
 #include "engine/scene/transfer_function_presets.h"
+#include "engine/scene/value_limits.h"
 
 namespace strata {
 
@@ -111,12 +113,22 @@ std::optional<glm::mat4> view_matrix(const json& object, const Field& field) {
   if (view && (eye || optional(object, "target") || optional(object, "up"))) {
     field.fail("give either 'view' or 'eye'/'target'/'up', not both");
   }
-  if (view) return matrix(*view, field / "view");
+  if (view) {
+    const glm::mat4 m = matrix(*view, field / "view");
+    const glm::dvec3 from(glm::inverse(glm::dmat4(m))[3]);
+    if (const auto problem =
+            value_limits::position_problem("the eye", from, value_limits::kMaxSceneCoordinateMm))
+      (field / "view").fail(*problem);
+    return m;
+  }
   if (!eye) {
     if (optional(object, "target") || optional(object, "up")) field.fail("missing key 'eye'");
     return std::nullopt;
   }
   const glm::vec3 from = vec3(*eye, field / "eye");
+  if (const auto problem = value_limits::position_problem("the eye", glm::dvec3(from),
+                                                          value_limits::kMaxSceneCoordinateMm))
+    (field / "eye").fail(*problem);
   const glm::vec3 to = vec3(required(object, field, "target"), field / "target");
   const json* up_json = optional(object, "up");
   const glm::vec3 up = up_json ? vec3(*up_json, field / "up") : glm::vec3(0.0f, 1.0f, 0.0f);
@@ -342,6 +354,8 @@ void SceneReader::label(const json& object, const Field& field) {
   label.id = integer(required(object, field, "id"), field / "id");
   label.text = string(required(object, field, "text"), field / "text");
   label.anchor = vec3(required(object, field, "anchor"), field / "anchor");
+  if (const auto problem = value_limits::position_problem("anchor", glm::dvec3(label.anchor)))
+    (field / "anchor").fail(*problem);
   if (const json* size = optional(object, "size")) {
     const auto v = numbers(*size, field / "size", 2);
     if (v[0] < 0.0f || v[1] < 0.0f)
@@ -360,13 +374,9 @@ void SceneReader::camera(const json& object, const Field& field) {
   Camera& camera = scene_.camera;
   if (const json* fov = optional(object, "fov_y"))
     camera.fov_y_degrees = number(*fov, field / "fov_y");
-  if (!(camera.fov_y_degrees > 0.0f && camera.fov_y_degrees < 180.0f)) {
-    (field / "fov_y").fail("expected degrees between 0 and 180");
-  }
   if (const json* n = optional(object, "near")) camera.near_plane = number(*n, field / "near");
   if (const json* f = optional(object, "far")) camera.far_plane = number(*f, field / "far");
-  if (!(camera.near_plane > 0.0f)) (field / "near").fail("expected a number > 0");
-  if (!(camera.far_plane > camera.near_plane)) (field / "far").fail("expected a number > near");
+  if (const auto problem = lens_problem(camera)) (field / problem->field).fail(problem->reason);
   if (const auto view = view_matrix(object, field)) {
     camera.view = *view;
     scene_.has_camera = true;
@@ -505,9 +515,9 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
   return scene;
 }
 
-int next_label_id(const Scene& scene) {
-  int id = 0;
-  for (const Label& l : scene.labels) id = std::max(id, l.id + 1);
+int64_t next_label_id(const Scene& scene) {
+  int64_t id = 0;
+  for (const Label& l : scene.labels) id = std::max(id, int64_t{l.id} + 1);
   return id;
 }
 
@@ -520,6 +530,52 @@ Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOption
   if (volume.name.empty()) volume.name = base_name(path.lexically_normal());
   return scene;
 }
+
+namespace {
+
+// Each volume's box (after its transform) and each mesh (after its) inside the limit: one far
+// corner or vertex would stretch the fitted camera until the rest is a dot, or to infinity.
+void check_content_bounds(const Scene& scene) {
+  using value_limits::kMaxSceneCoordinateMm;
+  const auto check = [&](const std::string& what, const std::filesystem::path& source,
+                         const char* point, const Bounds& box) {
+    for (const glm::vec3 corner : {box.lo, box.hi}) {
+      if (const auto problem =
+              value_limits::position_problem(point, glm::dvec3(corner), kMaxSceneCoordinateMm))
+        throw Error(scene.source.string() + ": " + what + " (" + source.string() +
+                    "), placed by its transform: " + *problem);
+    }
+  };
+  for (const Volume& volume : scene.volumes) {
+    if (volume.voxel_count() == 0) continue;
+    Bounds box;
+    const auto [lo, hi] = volume.world_bounds();
+    box.add(lo);
+    box.add(hi);
+    check("volume '" + volume.name + "'", volume.source, "a corner at", box);
+  }
+  for (const Mesh& mesh : scene.meshes) {
+    Bounds box;
+    for (const glm::vec3& p : mesh.positions)
+      box.add(glm::vec3(mesh.transform * glm::vec4(p, 1.0f)));
+    if (!box.empty()) check("mesh '" + mesh.name + "'", mesh.source, "a vertex at", box);
+  }
+}
+
+// The fitted camera follows from content inside the limits, so a problem here is a bug in
+// fitting, reported rather than rendered as an empty picture.
+void check_fitted_camera(const Scene& scene, const Camera& camera) {
+  std::string problem;
+  if (const auto lens = lens_problem(camera))
+    problem = std::string(lens->field) + ": " + lens->reason;
+  const glm::vec3 eye = camera.eye();
+  if (!(std::isfinite(eye.x) && std::isfinite(eye.y) && std::isfinite(eye.z)))
+    problem = "the eye is not a finite position";
+  if (!problem.empty())
+    throw Error(scene.source.string() + ": the camera fitted to the content: " + problem);
+}
+
+}  // namespace
 
 void complete_scene(Scene& scene, const std::string& preset) {
   for (Volume& volume : scene.volumes) {
@@ -539,8 +595,10 @@ void complete_scene(Scene& scene, const std::string& preset) {
     scene.transfer_functions.push_back(make_transfer_function_preset(name, volume));
     volume.transfer_function = int(scene.transfer_functions.size()) - 1;
   }
+  check_content_bounds(scene);
   if (scene.has_camera) return;
   FittedCamera fitted = fitted_camera(scene);
+  check_fitted_camera(scene, fitted.camera);
   scene.camera = fitted.camera;
   for (CameraPose& pose : fitted.positions) {
     const bool taken = std::any_of(scene.camera_positions.begin(), scene.camera_positions.end(),

@@ -36,7 +36,8 @@ Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOption
 void complete_scene(Scene& scene, const std::string& preset = "");
 
 // One more than the highest label id (0 for none): where added labels' ids start.
-int next_label_id(const Scene& scene);
+// (int64_t: one past a label with id 2147483647 is no int.)
+int64_t next_label_id(const Scene& scene);
 
 // strata scene JSON, version 1. Paths in it are relative to the scene file's folder. Unknown keys
 // are errors (they are almost always typos), and so is a referenced file that does not load.

@@ -67,9 +67,17 @@ inline glm::uvec3 to_dims(const std::array<int64_t, 3>& dims) {
                     static_cast<uint32_t>(dims[2]));
 }
 
-// Spacing must be finite and positive; `field` names where it came from.
+// Spacing must be finite and positive, and within value_limits.h's range; `field` names where
+// it came from, `axis_field` and `first_axis` name one axis's number ("pixdim", 1: "pixdim[1]").
 void check_spacing(const std::filesystem::path& file, std::string_view field,
-                   const std::array<double, 3>& spacing);
+                   const std::array<double, 3>& spacing, std::string_view axis_field = {},
+                   int first_axis = 0);
+
+// The geometry within value_limits.h's limits: each spacing, the origin, the far corner, and
+// voxels still apart in float at their position. check_geometry ends with it; load_volume runs it
+// on every volume (DICOM's reader does not call check_geometry).
+void check_plausible_geometry(const std::filesystem::path& file, std::string_view origin_field,
+                              std::string_view direction_field, const Volume& volume);
 
 // The volume's spacing, origin and direction as a reader set them: spacing positive, every number
 // finite (in float range),

@@ -17,6 +17,7 @@
 #include "engine/core/text_file.h"
 #include "engine/scene/io/dicom_structure.h"
 #include "engine/scene/io/volume_io.h"
+#include "engine/scene/value_limits.h"
 
 namespace strata {
 namespace {
@@ -37,6 +38,45 @@ Format format_of(const std::filesystem::path& path) {
   if (fs::is_regular_file(path, error) && dicom::file_kind(path) == dicom::Kind::part10)
     return Format::dicom_file;
   return Format::none;
+}
+
+// Voxels that are not numbers (NaN, infinity) have no place on a transfer function's value axis.
+// Float images use NaN for "no data" (a masked statistics map, a resampled image's outside), so
+// they are kept as the lowest value, which presets show as transparent, with a warning that
+// counts them; a volume of nothing else is an error. A value range wider than a float holds
+// (-3e38 to 3e38) would normalise every voxel to 0: an error too.
+void check_voxel_values(const std::filesystem::path& path, Volume& volume,
+                        std::vector<std::string>& warnings) {
+  using volume_io::concat;
+  if (volume.type == VoxelType::float32) {
+    const size_t count = volume.voxel_count();
+    size_t not_finite = 0;
+    for (size_t i = 0; i < count; ++i) {
+      float v;
+      std::memcpy(&v, volume.voxels.data() + i * sizeof(float), sizeof v);
+      if (!std::isfinite(v)) ++not_finite;
+    }
+    if (not_finite == count)
+      volume_io::fail(
+          path, concat("voxels: none of the ", count, " is a finite number (all NaN or infinite)"));
+    if (not_finite > 0) {
+      const float lowest = volume.value_range.x;
+      for (size_t i = 0; i < count; ++i) {
+        std::byte* p = volume.voxels.data() + i * sizeof(float);
+        float v;
+        std::memcpy(&v, p, sizeof v);
+        if (!std::isfinite(v)) std::memcpy(p, &lowest, sizeof lowest);
+      }
+      warnings.push_back(concat(path.string(), ": ", not_finite, " of ", count,
+                                " voxels are NaN or infinite; shown as the lowest value, ", lowest,
+                                " (no data)"));
+    }
+  }
+  const double lo = volume.value_range.x, hi = volume.value_range.y;
+  if (!(hi - lo <= double(std::numeric_limits<float>::max())))
+    volume_io::fail(path, concat("voxels: values from ", lo, " to ", hi,
+                                 ": the range is wider than a 32-bit float holds (", hi - lo,
+                                 "), so no transfer function can span it"));
 }
 
 constexpr std::string_view kDicomReader = "the DICOM reader (GDCM)";
@@ -78,6 +118,9 @@ bool is_volume_path(const std::filesystem::path& path) {
 Volume load_volume(const std::filesystem::path& path, const VolumeReadOptions& options,
                    std::vector<std::string>& warnings) {
   Volume volume = read_by_extension(path, options, warnings);
+  // Every format, DICOM too: its reader names the fields it read, this names what they gave.
+  volume_io::check_plausible_geometry(path, "origin", "spacing", volume);
+  check_voxel_values(path, volume, warnings);
   if (volume.dims.z == 1)
     warnings.push_back(volume_io::concat(path.string(), ": 2-D image (one slice of ", volume.dims.x,
                                          "x", volume.dims.y, "); shown as a volume one voxel (",
@@ -184,11 +227,49 @@ size_t checked_voxel_bytes(const std::filesystem::path& file, std::string_view f
 }
 
 void check_spacing(const std::filesystem::path& file, std::string_view field,
-                   const std::array<double, 3>& spacing) {
+                   const std::array<double, 3>& spacing, std::string_view axis_field,
+                   int first_axis) {
   for (double s : spacing)
     if (!std::isfinite(s) || s <= 0.0)
       fail(file, concat(field, " = ", spacing[0], " ", spacing[1], " ", spacing[2],
                         ": spacing must be positive"));
+  for (int axis = 0; axis < 3; ++axis)
+    if (const auto problem = value_limits::spacing_problem(spacing[size_t(axis)]))
+      fail(file, concat(axis_field.empty() ? field : axis_field, "[", first_axis + axis,
+                        "]: ", *problem));
+}
+
+void check_plausible_geometry(const std::filesystem::path& file, std::string_view origin_field,
+                              std::string_view direction_field, const Volume& volume) {
+  using namespace value_limits;
+  for (int axis = 0; axis < 3; ++axis)
+    if (const auto problem = spacing_problem(volume.spacing[axis]))
+      fail(file, concat(direction_field, ": axis ", axis, ": ", *problem));
+  if (const auto problem = position_problem("origin", glm::dvec3(volume.origin)))
+    fail(file, concat(origin_field, ": ", *problem));
+  // The far corner, and whether voxels there are still apart in float.
+  const glm::dvec3 origin(volume.origin);
+  glm::dvec3 far_corner = origin;
+  double largest = glm::length(origin);
+  for (int corner = 1; corner < 8; ++corner) {
+    glm::dvec3 p = origin;
+    for (int axis = 0; axis < 3; ++axis)
+      if (corner & (1 << axis))
+        p += glm::dvec3(volume.direction[axis]) * double(volume.spacing[axis]) *
+             double(volume.dims[axis] - 1);
+    if (glm::length(p) > largest) largest = glm::length(p), far_corner = p;
+  }
+  if (const auto problem =
+          position_problem("the volume's far corner", far_corner, kMaxSceneCoordinateMm))
+    fail(file, concat(direction_field, ": ", *problem));
+  const double float_step = largest * double(std::numeric_limits<float>::epsilon());
+  const float finest = std::min({volume.spacing.x, volume.spacing.y, volume.spacing.z});
+  if (double(finest) < kMinFloatStepsPerVoxel * float_step)
+    fail(file, concat(origin_field, ": ", origin.x, " ", origin.y, " ", origin.z, " mm: ", finest,
+                      " mm voxels ", largest,
+                      " mm from the origin are too fine for the float "
+                      "positions the renderer uses (",
+                      float_step, " mm steps there)"));
 }
 
 void check_geometry(const std::filesystem::path& file, std::string_view origin_field,
@@ -217,6 +298,7 @@ void check_geometry(const std::filesystem::path& file, std::string_view origin_f
     fail(file, concat(direction_field,
                       ": the axes' directions lie in one plane (a singular matrix): the voxels "
                       "have no place in space"));
+  check_plausible_geometry(file, origin_field, direction_field, volume);
 }
 
 // ---- reading

@@ -20,6 +20,7 @@
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
 #include "engine/scene/io/volume_loader.h"
+#include "engine/scene/value_limits.h"
 
 namespace strata {
 
@@ -140,6 +141,8 @@ void VolyImporter::camera(const Node& px) {
   if (!(camera.near_plane > 0.0f && camera.far_plane > camera.near_plane)) {
     projection_node.fail("near and far planes are not 0 < near < far");
   }
+  if (const auto problem = lens_problem(camera))
+    projection_node.fail(std::string(problem->field) + ": " + problem->reason);
   const std::optional<Node> positions = px.optional_child("cameraPositions");
   if (!positions) return;  // scenes saved before version 1 of CameraNode have none
   size_t index = 0;
@@ -160,7 +163,10 @@ void VolyImporter::label(const Node& px) {
     id.fail("expected an integer from -2147483648 to 2147483647");
   label.id = int(id_value);
   label.text = node.child("label.text").text();
-  label.anchor = node.child("label.anchorPosition").vec3();
+  const Node anchor = node.child("label.anchorPosition");
+  label.anchor = anchor.vec3();
+  if (const auto problem = value_limits::position_problem("anchor", glm::dvec3(label.anchor)))
+    anchor.fail(*problem);
   label.size = node.child("label.size").vec2();
   scene_.labels.push_back(std::move(label));
 }
