@@ -23,13 +23,16 @@ strata::Scene box_scene() {
   scene.meshes.push_back(box);
   scene.camera = {glm::lookAt(glm::vec3(-60, -60, 80), glm::vec3(10, 20, 30), glm::vec3(0, 0, 1)),
                   30.0f, 1.0f, 500.0f};
-  const auto pose = [](const char* name, glm::vec3 eye, glm::vec3 up) {
-    return strata::CameraPose{name, glm::lookAt(eye, glm::vec3(10, 20, 30), up)};
+  const auto pose = [](const char* name, glm::vec3 eye, glm::vec3 target, glm::vec3 up) {
+    return strata::CameraPose{name, glm::lookAt(eye, target, up)};
   };
-  scene.camera_positions = {
-      pose("front", {10, -80, 30}, {0, 0, 1}), pose("left", {110, 20, 30}, {0, 0, 1}),
-      pose("top", {10, 20, 130}, {0, -1, 0}), pose("left_side", {110, 21, 30}, {0, 0, 1}),
-      pose("back", {10, 20, 30}, {0, 0, 1})};  // (eye on the centre)
+  const glm::vec3 centre(10, 20, 30);
+  scene.camera_positions = {pose("front", {10, -80, 30}, centre, {0, 0, 1}),
+                            pose("left", {110, 20, 30}, centre, {0, 0, 1}),
+                            pose("top", {10, 20, 130}, centre, {0, -1, 0}),
+                            pose("left_side", {110, 21, 30}, centre, {0, 0, 1}),
+                            // (facing away from the centre: a move to it turns on the spot)
+                            pose("back", {10, 120, 30}, {10, 200, 30}, {0, 0, 1})};
   return scene;
 }
 

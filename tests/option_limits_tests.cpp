@@ -89,9 +89,15 @@ TEST_SUITE("cli") {
   TEST_CASE("video_path_segments_and_frame_counts_have_limits_checked_before_allocation") {
     const std::string video = "video " + kHead + " -o /tmp/never.mp4 ";
     for (const BadOption& bad : std::vector<BadOption>{
-             {video + "--path front,left_1e9", "--path: "},
-             {video + "--path front,left_nan", "--path: "},
-             {video + "--path front,left_2000,front_2000", "more than 3600 s"},
+             {video + "--path front,left_1e9",
+              "--path: " + kHead +
+                  ": camera path 'front,left_1e9': 'left_1e9': '1e9' is not a "
+                  "duration (seconds in (0, 3600])"},
+             {video + "--path front,left_nan", "--path: " + kHead + ": camera path"},
+             {video + "--path front,left_2000,front_2000",
+              "--path: " + kHead +
+                  ": camera path 'front,left_2000,front_2000': 'front_2000': "
+                  "the path lasts more than 3600 s"},
              {video + "--orbit 360 --seconds 3600 --fps 240",
               "--fps: 240 frames a second for 3600 s is 864001 frames, more than 100000"},
          }) {
