@@ -85,6 +85,15 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
   settings.skip_empty = !o.no_skipping;
   settings.step = o.step;
   VolumeRenderer renderer(ctx, scene, settings);
+  // (as the viewer's render.step: far below the voxels, a frame's samples grow without bound)
+  const float finest = renderer.inputs().finest_spacing;
+  if (o.step != 0.0f && o.step < finest / 16.0f) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "--step: %g is below %g, a sixteenth of the finest voxel spacing (0: half of it)",
+                  double(o.step), double(finest / 16.0f));
+    throw UsageError(text);
+  }
   renderer.set_camera(camera_for(scene, o.camera));
   graph::Graph graph;
   renderer.add_to(graph);

@@ -98,6 +98,7 @@ TEST_SUITE("cli") {
               "--path: " + kHead +
                   ": camera path 'front,left_2000,front_2000': 'front_2000': "
                   "the path lasts more than 3600 s"},
+             {"bench render --step 1e-9 --runs 1", "--step: 1e-09 is below 0.0625"},
              {video + "--orbit 360 --seconds 3600 --fps 240",
               "--fps: 240 frames a second for 3600 s is 864001 frames, more than 100000"},
          }) {
