@@ -85,6 +85,15 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
   settings.skip_empty = !o.no_skipping;
   settings.step = o.step;
   VolumeRenderer renderer(ctx, scene, settings);
+  // (as the viewer's render.step: far below the voxels, a frame's samples grow without bound)
+  const float finest = renderer.inputs().finest_spacing;
+  if (o.step != 0.0f && o.step < finest / 16.0f) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "--step: %g is below %g, a sixteenth of the finest voxel spacing (0: half of it)",
+                  double(o.step), double(finest / 16.0f));
+    throw UsageError(text);
+  }
   renderer.set_camera(camera_for(scene, o.camera));
   graph::Graph graph;
   renderer.add_to(graph);
@@ -287,7 +296,7 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   sat->add_option("--size", options->size, "N or WxH")->capture_default_str();
   sat->add_option("--runs", options->runs, "timed runs after 3 warm-up runs")
       ->capture_default_str()
-      ->check(CLI::Range(1u, 100000u));
+      ->check(whole_range(1, 100000));
   sat->callback([&device, options] {
     bench::bench_sat(device, parse_size(options->size, "--size"), options->runs);
   });
@@ -298,14 +307,15 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   render_cmd->add_option("--size", render->size, "N or WxH")->capture_default_str();
   render_cmd->add_option("--camera", render->camera, "named camera position");
   render_cmd->add_option("--layers", render->layers, "depth layers, 1 to 8")
-      ->check(CLI::Range(1u, 8u))
+      ->check(whole_range(1, 8))
       ->capture_default_str();
   render_cmd->add_flag("--no-skipping", render->no_skipping, "turn empty-space skipping off");
-  render_cmd->add_option("--step", render->step,
-                         "sampling distance in world units (0: half a voxel)");
+  render_cmd
+      ->add_option("--step", render->step, "sampling distance in world units (0: half a voxel)")
+      ->check(finite_range(0.0, 1000.0));
   render_cmd->add_option("--runs", options->runs, "timed runs after 3 warm-up runs")
       ->capture_default_str()
-      ->check(CLI::Range(1u, 100000u));
+      ->check(whole_range(1, 100000));
   render_cmd->callback(
       [&device, render, options] { bench::bench_render(device, *render, options->runs); });
 
@@ -318,13 +328,14 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   view_cmd->add_option("--size", view->size, "N or WxH")->capture_default_str();
   view_cmd->add_option("--frames", view->frames, "frames timed along the path")
       ->capture_default_str()
-      ->check(CLI::Range(1u, 100000u));
+      ->check(whole_range(1, 100000));
   view_cmd->add_option("--labels", view->labels, "label count (the scene's cut, or repeated)")
-      ->check(CLI::Range(0u, uint32_t(kMaxLabels)));
+      ->check(whole_range(0, kMaxLabels));
   view_cmd->add_option("--degrees", view->degrees, "how far the turntable turns")
+      ->check(finite_range(-36000.0, 36000.0))
       ->capture_default_str();
   view_cmd->add_option("--tidy-rounds", view->tidy_rounds, "rounds of the layout tidy-up per frame")
-      ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
+      ->check(whole_range(0, TIDY_ROUNDS_MAX))
       ->capture_default_str();
   view_cmd->callback([&device, view] { bench::bench_view(device, *view); });
 

@@ -321,7 +321,7 @@ void add_placement_bench(CLI::App* bench_cmd, DeviceOptions& device) {
                       "skip the baseline with a readback after every label (slow with many)");
   place_cmd->add_option("--runs", place->runs, "timed runs after 3 warm-up runs")
       ->capture_default_str()
-      ->check(CLI::Range(1u, 100000u));
+      ->check(whole_range(1, 100000));
   place_cmd->callback([&device, place] { bench::bench_placement(device, *place); });
 }
 

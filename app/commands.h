@@ -19,6 +19,13 @@ class UsageError : public Error {
   using Error::Error;
 };
 
+// Numeric options: the text must be a finite number in [lo, hi] ((lo, hi] with open_low); NaN,
+// infinities, words and values outside are usage errors (exit 2) that name the option and the
+// range: "--seconds: nan is not a number in (0, 3600]". The text is checked before CLI11 converts
+// it, so the same check serves float and integer options; whole_range also refuses fractions.
+CLI::Validator finite_range(double lo, double hi, bool open_low = false);
+CLI::Validator whole_range(double lo, double hi);
+
 // Options every subcommand that opens a device shares.
 struct DeviceOptions {
   std::string device;     // --device NAME|INDEX

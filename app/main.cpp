@@ -67,11 +67,11 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
                   "labels from a file: 3D Slicer markups (.mrk.json, .fcsv) or CSV "
                   "(docs/scene-format.md)");
   cmd->add_option("--frame", in.frame, "a 4-D volume's frame, from 0 (default: the first)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_range(0, 1e6));
   cmd->add_option("--layers", in.layers,
                   "depth layers, 1 to " + std::to_string(kMaxLayers) +
                       " (default: the scene's settings.layers, else 4)")
-      ->check(CLI::Range(1u, uint32_t(kMaxLayers)));
+      ->check(whole_range(1, kMaxLayers));
 }
 
 std::string find_data_file(const std::string& relative) {
@@ -115,7 +115,7 @@ graph::Extent parse_size(const std::string& text, const char* option) {
 
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {
   cmd->add_option("--label-scale", o.label_scale, "label text and boxes times this (0.25 to 4)")
-      ->check(CLI::Range(0.25f, 4.0f))
+      ->check(finite_range(0.25, 4.0))
       ->capture_default_str();
   cmd->add_flag("--layer-colors", o.layer_colors,
                 "label borders in their depth layer's colour (front to back: orange, blue, green, "

@@ -255,7 +255,7 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
                   "named after it (out-front.png, out-left.png)");
   cmd->add_option("--tidy-rounds", o->tidy_rounds,
                   "rounds of the layout tidy-up after the placement (0: none)")
-      ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
+      ->check(whole_range(0, TIDY_ROUNDS_MAX))
       ->capture_default_str();
   cmd->add_option("--dump-layers", o->dump_layers,
                   "folder to write each (label-free) layer image to, beside the -o image");
@@ -276,6 +276,7 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--dump-graph", o->dump_graph,
                 "print the frame's render graph: passes, their uses and barriers");
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
+      ->check(whole_range(0, 16384))
       ->capture_default_str();
   cmd->callback([&device, o] {
     // An unknown image extension is a usage error, found before any work (and before -o exists).

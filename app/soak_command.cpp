@@ -475,16 +475,17 @@ void add_soak_command(CLI::App* bench, DeviceOptions& device) {
   cmd->add_option("scene", o->scene, "scene file")->capture_default_str();
   cmd->add_option("--frames", o->frames, "frames to run")
       ->capture_default_str()
-      ->check(CLI::Range(1u, 10000000u));
+      ->check(whole_range(1, 10000000));
   cmd->add_option("--size", o->size, "N or WxH")->capture_default_str();
   cmd->add_option("--every", o->every, "frames between measurements after the warm-up")
       ->capture_default_str()
-      ->check(CLI::Range(1u, 1000000u));
+      ->check(whole_range(1, 1000000));
   cmd->add_option("--interval", o->interval, "frames a scheduled change lasts")
       ->capture_default_str()
-      ->check(CLI::Range(1u, 1000000u));
+      ->check(whole_range(1, 1000000));
   cmd->add_option("--habuffer-slots", o->habuffer_slots,
                   "the HA-Buffer's slots at the start (it grows from there; 0: from the size)")
+      ->check(whole_range(0, 1u << 28))
       ->capture_default_str();
   cmd->add_option("--json", o->json, "also write the summary and every measurement as JSON");
   cmd->callback([&device, o] { soak(device, *o); });

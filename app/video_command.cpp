@@ -23,7 +23,7 @@ struct VideoOptions {
   SceneInput scene;
   std::string path;
   double orbit = 0.0;    // degrees; 0: --path
-  double seconds = 0.0;  // of the orbit; 0: 30 degrees a second
+  double seconds = 0.0;  // of the orbit; 0 (not given): 30 degrees a second
   std::string camera;    // where the orbit starts
   double fps = 30.0;
   std::string size = "512";
@@ -41,7 +41,13 @@ struct VideoOptions {
 CameraPath camera_path(const Scene& scene, const VideoOptions& o) {
   if (!o.path.empty() && o.orbit != 0.0)
     throw UsageError("video: give --path or --orbit, not both");
-  if (!o.path.empty()) return parse_camera_path(scene, o.path);
+  if (!o.path.empty()) {
+    try {
+      return parse_camera_path(scene, o.path);
+    } catch (const Error& e) {
+      throw UsageError(std::string("--path: ") + e.what());
+    }
+  }
   if (o.orbit == 0.0)
     throw UsageError("video: give a camera path (--path) or a turntable (--orbit)");
   const double seconds = o.seconds > 0.0 ? o.seconds : std::abs(o.orbit) / 30.0;
@@ -77,12 +83,20 @@ void create_folder(const std::string& option, const std::filesystem::path& folde
 
 void video(DeviceOptions& device, const VideoOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
-  if (!(o.fps > 0.0 && o.fps <= 240.0)) throw UsageError("--fps: expected 0 < fps <= 240");
   const std::filesystem::path output = o.output;
   const bool mp4 = is_mp4(output);
   Context ctx(device.context());
   const Scene scene = load_scene_reporting(o.scene, ctx);
-  const std::vector<Camera> cameras = sample(camera_path(scene, o), o.fps);
+  const CameraPath path = camera_path(scene, o);
+  // (checked before sample() allocates a camera a frame)
+  if (const double frames = sampled_frames(path, o.fps); frames > double(kMaxVideoFrames)) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "--fps: %g frames a second for %g s is %.0f frames, more than %u", o.fps,
+                  path.duration(), frames, kMaxVideoFrames);
+    throw UsageError(text);
+  }
+  const std::vector<Camera> cameras = sample(path, o.fps);
   if (!mp4) create_folder("-o", output);
   if (!o.layout_dir.empty()) create_folder("--layout-dir", o.layout_dir);
   // Frames go to a temporary file, put in place by finish(): an error on the way leaves no MP4.
@@ -139,18 +153,22 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
       ->required();
   add_scene_input_options(cmd, o->scene);
   cmd->add_option("--path", o->path, "camera path: front,left_2,top_3 (docs/scene-format.md)");
-  cmd->add_option("--orbit", o->orbit, "turntable: degrees about the scene's centre");
+  cmd->add_option("--orbit", o->orbit, "turntable: degrees about the scene's centre")
+      ->check(finite_range(-36000.0, 36000.0));
   cmd->add_option("--seconds", o->seconds,
-                  "duration of the turntable (default: 30 degrees a second)");
+                  "duration of the turntable (default: 30 degrees a second)")
+      ->check(finite_range(0.0, kMaxPathSeconds, true));
   cmd->add_option("--camera", o->camera, "named position the turntable starts from");
-  cmd->add_option("--fps", o->fps, "frames per second")->capture_default_str();
+  cmd->add_option("--fps", o->fps, "frames per second")
+      ->check(finite_range(1.0, 240.0))
+      ->capture_default_str();
   cmd->add_option("--size", o->size, "image size, N or WxH")->capture_default_str();
   cmd->add_option("-o,--output", o->output, "NAME.mp4 (H.264), or a folder for PNG frames")
       ->required();
   cmd->add_option("--layout-dir", o->layout_dir, "folder for each frame's layout JSON");
   cmd->add_option("--tidy-rounds", o->tidy_rounds,
                   "rounds of the layout tidy-up after the placement (0: none)")
-      ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
+      ->check(whole_range(0, TIDY_ROUNDS_MAX))
       ->capture_default_str();
   cmd->add_flag("--screen-space", o->screen_space,
                 "labels live on screen (the thesis), not as offsets from their anchors");
@@ -159,28 +177,28 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   add_label_look_options(cmd, o->look);
   cmd->add_option("--speed", o->forces.speed, "forces: pixels per second at full force")
       ->capture_default_str()
-      ->check(CLI::Range(1.0f, 1e6f));
+      ->check(finite_range(1.0, 1e6));
   cmd->add_option("--hold", o->forces.hold_share,
                   "a label keeps its target unless a position costs less by this share of its "
                   "cost (plus --hold-cost)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0f, 100.0f));
+      ->check(finite_range(0.0, 100.0));
   cmd->add_option("--hold-cost", o->forces.hold_cost, "the hold's fixed part (eq. 3.1 units)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0f, 1e9f));
+      ->check(finite_range(0.0, 1e9));
   cmd->add_option("--fade", o->forces.fade_seconds, "seconds a label takes to fade in or out")
       ->capture_default_str()
-      ->check(CLI::Range(0.0f, 60.0f));
+      ->check(finite_range(0.0, 60.0));
   cmd->add_option("--previous-weight", o->forces.previous_weight,
                   "eq. 3.1's eta after the first frame: cost per pixel of distance to a label's "
                   "last target")
       ->capture_default_str()
-      ->check(CLI::Range(0.0f, 1e6f));
+      ->check(finite_range(0.0, 1e6));
   cmd->add_option("--layer-margin", o->layer_margin,
                   "layer hysteresis: how far past its slab an anchor goes before its label "
                   "changes layer, as a share of the distance to the next plane")
       ->capture_default_str()
-      ->check(CLI::Range(0.0f, 100.0f));
+      ->check(finite_range(0.0, 100.0));
   cmd->callback([&device, o] { video(device, *o); });
 }
 

@@ -4,7 +4,6 @@
 #include <fstream>
 #include <map>
 #include <optional>
-#include <sstream>
 
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
@@ -15,6 +14,7 @@
 
 #include "app/commands.h"
 #include "app/viewer.h"
+#include "app/viewer_script.h"
 #include "engine/core/text_file.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/window_target.h"
@@ -53,55 +53,36 @@ struct Window {
 
 // --- input scripts -----------------------------------------------------------------------------
 
-// One line of an input script: a command and its words ('#' starts a comment).
-struct ScriptLine {
-  size_t number = 0;
-  std::vector<std::string> words;
-};
-
-std::vector<ScriptLine> read_script(const std::string& path) {
-  std::istringstream in(read_text_file(path));
-  std::vector<ScriptLine> lines;
-  std::string text;
-  for (size_t n = 1; std::getline(in, text); ++n) {
-    if (const size_t hash = text.find('#'); hash != std::string::npos) text.resize(hash);
-    std::istringstream words(text);
-    ScriptLine line{n, {}};
-    for (std::string w; words >> w;) line.words.push_back(w);
-    if (!line.words.empty()) lines.push_back(std::move(line));
-  }
-  return lines;
-}
-
-int key_code(const std::string& name) {
+int key_code(const std::string& name) {  // (parse_viewer_script checked the name)
   static const std::map<std::string, int> named = {
       {"left", GLFW_KEY_LEFT}, {"right", GLFW_KEY_RIGHT},   {"up", GLFW_KEY_UP},
       {"down", GLFW_KEY_DOWN}, {"escape", GLFW_KEY_ESCAPE}, {"f12", GLFW_KEY_F12},
       {"F12", GLFW_KEY_F12},   {"space", GLFW_KEY_SPACE},
   };
   if (const auto it = named.find(name); it != named.end()) return it->second;
-  if (name.size() == 1 && name[0] >= 'a' && name[0] <= 'z') return GLFW_KEY_A + (name[0] - 'a');
-  if (name.size() == 1 && name[0] >= '0' && name[0] <= '9') return GLFW_KEY_0 + (name[0] - '0');
-  throw Error("no key '" + name + "' (a-z, 0-9, left, right, up, down, escape, f12, space)");
+  if (name[0] >= 'a' && name[0] <= 'z') return GLFW_KEY_A + (name[0] - 'a');
+  return GLFW_KEY_0 + (name[0] - '0');
 }
 
 int mouse_code(const std::string& name) {
   if (name == "left") return GLFW_MOUSE_BUTTON_LEFT;
   if (name == "right") return GLFW_MOUSE_BUTTON_RIGHT;
-  if (name == "middle") return GLFW_MOUSE_BUTTON_MIDDLE;
-  throw Error("no mouse button '" + name + "' (left, right, middle)");
+  return GLFW_MOUSE_BUTTON_MIDDLE;
 }
 
-float script_number(const std::string& word) {
-  size_t used = 0;
-  float v = 0.0f;
-  try {
-    v = std::stof(word, &used);
-  } catch (const std::exception&) {
-    used = 0;
+// The script's commands, checked before the window opens: the parser's checks, and each `set`
+// against its parameter's range.
+std::vector<ScriptCommand> read_script(const std::string& path) {
+  std::vector<ScriptCommand> commands = parse_viewer_script(read_text_file(path), path);
+  for (const ScriptCommand& c : commands) {
+    if (c.op != ScriptOp::set) continue;
+    try {
+      check_viewer_parameter(c.word, c.value);
+    } catch (const Error& e) {
+      throw Error(path + ":" + std::to_string(c.line) + ": " + e.what());
+    }
   }
-  if (used != word.size()) throw Error("'" + word + "' is not a number");
-  return v;
+  return commands;
 }
 
 AnatomicalView view_named(const std::string& name) {
@@ -113,7 +94,7 @@ AnatomicalView view_named(const std::string& name) {
 // a script does the same whatever the device's speed.
 class Script {
  public:
-  Script(std::string path, std::vector<ScriptLine> lines)
+  Script(std::string path, std::vector<ScriptCommand> lines)
       : path_(std::move(path)), lines_(std::move(lines)) {}
 
   bool done() const { return next_ >= lines_.size(); }
@@ -128,106 +109,98 @@ class Script {
   void run_next(Viewer& viewer);
 
  private:
-  void run(Viewer& viewer, const std::vector<std::string>& w);
+  void run(Viewer& viewer, const ScriptCommand& c);
   std::string path_;
-  std::vector<ScriptLine> lines_;
+  std::vector<ScriptCommand> lines_;
   size_t next_ = 0;
   uint32_t frames_ = 0;
   std::chrono::steady_clock::time_point wake_{};
 };
 
 void Script::run_next(Viewer& viewer) {
-  const ScriptLine& line = lines_[next_++];
+  const ScriptCommand& line = lines_[next_++];
   try {
-    run(viewer, line.words);
+    run(viewer, line);
   } catch (const Error& e) {
-    throw Error(path_ + ":" + std::to_string(line.number) + ": " + e.what());
+    throw Error(path_ + ":" + std::to_string(line.line) + ": " + e.what());
   }
 }
 
-void Script::run(Viewer& viewer, const std::vector<std::string>& w) {
-  const std::string& c = w[0];
-  const auto need = [&](size_t n, const char* form) {
-    if (w.size() != n) throw Error("'" + c + "' takes the form: " + form);
-  };
-  if (c == "drag") {
-    // drag BUTTON X0 Y0 X1 Y1 [shift]: press, move in 8 steps, release
-    if (w.size() != 6 && !(w.size() == 7 && w[6] == "shift")) {
-      throw Error("'drag' takes the form: drag left|right|middle X0 Y0 X1 Y1 [shift]");
+void Script::run(Viewer& viewer, const ScriptCommand& c) {
+  const std::vector<double>& n = c.numbers;
+  switch (c.op) {
+    case ScriptOp::drag: {  // press, move in 8 steps, release
+      const int button = mouse_code(c.word);
+      const glm::vec2 from{float(n[0]), float(n[1])};
+      const glm::vec2 to{float(n[2]), float(n[3])};
+      const int mods = c.shift ? GLFW_MOD_SHIFT : 0;
+      viewer.cursor(from);
+      viewer.mouse_button(button, GLFW_PRESS, mods);
+      for (int i = 1; i <= 8; ++i) viewer.cursor(from + (to - from) * (float(i) / 8.0f));
+      viewer.mouse_button(button, GLFW_RELEASE, mods);
+      break;
     }
-    const int button = mouse_code(w[1]);
-    const glm::vec2 from{script_number(w[2]), script_number(w[3])};
-    const glm::vec2 to{script_number(w[4]), script_number(w[5])};
-    const int mods = w.size() == 7 ? GLFW_MOD_SHIFT : 0;
-    viewer.cursor(from);
-    viewer.mouse_button(button, GLFW_PRESS, mods);
-    for (int i = 1; i <= 8; ++i) viewer.cursor(from + (to - from) * (float(i) / 8.0f));
-    viewer.mouse_button(button, GLFW_RELEASE, mods);
-  } else if (c == "scroll") {
-    need(2, "scroll TICKS");
-    viewer.scroll(script_number(w[1]));
-  } else if (c == "key") {
-    need(2, "key NAME");
-    viewer.key(key_code(w[1]), 0);
-  } else if (c == "view") {
-    need(2, "view anterior|posterior|left|right|superior|inferior");
-    viewer.view_from(view_named(w[1]));
-  } else if (c == "preset") {
-    if (w.size() != 2 && w.size() != 3)
-      throw Error("'preset' takes the form: preset NAME [VOLUME]");
-    viewer.set_preset(w.size() == 3 ? uint32_t(script_number(w[2])) : 0u, w[1]);
-  } else if (c == "set") {
-    need(3, "set PARAMETER VALUE");
-    viewer.set_parameter(w[1], w[2]);
-  } else if (c == "hide" || c == "show") {
-    need(2, "hide|show LABEL_ID");
-    viewer.set_label_hidden(int(script_number(w[1])), c == "hide");
-  } else if (c == "screenshot") {
-    need(2, "screenshot FILE.png");
-    viewer.screenshot(w[1]);
-  } else if (c == "capture") {
-    need(2, "capture FILE.png");
-    viewer.capture(w[1]);
-  } else if (c == "layout") {
-    need(2, "layout FILE.json");
-    viewer.write_layout(w[1]);
-  } else if (c == "record") {
-    if (w.size() == 3 && w[1] == "start") {
-      viewer.start_recording(w[2]);
-    } else if (w.size() == 2 && w[1] == "stop") {
+    case ScriptOp::scroll:
+      viewer.scroll(n[0]);
+      break;
+    case ScriptOp::key:
+      viewer.key(key_code(c.word), 0);
+      break;
+    case ScriptOp::view:
+      viewer.view_from(view_named(c.word));
+      break;
+    case ScriptOp::preset:
+      viewer.set_preset(uint32_t(n[0]), c.word);
+      break;
+    case ScriptOp::set:
+      viewer.set_parameter(c.word, c.value);
+      break;
+    case ScriptOp::hide:
+    case ScriptOp::show:
+      viewer.set_label_hidden(int(n[0]), c.op == ScriptOp::hide);
+      break;
+    case ScriptOp::screenshot:
+      viewer.screenshot(c.word);
+      break;
+    case ScriptOp::capture:
+      viewer.capture(c.word);
+      break;
+    case ScriptOp::layout:
+      viewer.write_layout(c.word);
+      break;
+    case ScriptOp::record_start:
+      viewer.start_recording(c.word);
+      break;
+    case ScriptOp::record_stop:
       viewer.stop_recording();
-    } else {
-      throw Error("'record' takes the form: record start FILE.mp4 | record stop");
+      break;
+    case ScriptOp::frames:
+      frames_ = uint32_t(n[0]);
+      break;
+    case ScriptOp::sleep:
+      wake_ = std::chrono::steady_clock::now() +
+              std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                  std::chrono::duration<double>(n[0]));
+      break;
+    case ScriptOp::save_position:
+      viewer.save_position(c.word);
+      break;
+    case ScriptOp::report: {
+      nlohmann::json view = nlohmann::json::array();
+      for (int col = 0; col < 4; ++col) {
+        for (int row = 0; row < 4; ++row) view.push_back(viewer.camera().view[col][row]);
+      }
+      const nlohmann::json report = {{"frames", viewer.summary().frames},
+                                     {"settled", viewer.settled()},
+                                     {"busy", viewer.busy()},
+                                     {"trials", viewer.summary().trials},
+                                     {"view", view}};
+      write_text_file(c.word, report.dump() + "\n");
+      break;
     }
-  } else if (c == "frames") {
-    need(2, "frames N");
-    frames_ = uint32_t(script_number(w[1]));
-  } else if (c == "sleep") {
-    need(2, "sleep SECONDS");
-    wake_ = std::chrono::steady_clock::now() +
-            std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                std::chrono::duration<double>(script_number(w[1])));
-  } else if (c == "save-position") {
-    need(2, "save-position NAME");
-    viewer.save_position(w[1]);
-  } else if (c == "report") {
-    need(2, "report FILE.json");
-    nlohmann::json view = nlohmann::json::array();
-    for (int col = 0; col < 4; ++col) {
-      for (int row = 0; row < 4; ++row) view.push_back(viewer.camera().view[col][row]);
-    }
-    const nlohmann::json report = {{"frames", viewer.summary().frames},
-                                   {"settled", viewer.settled()},
-                                   {"busy", viewer.busy()},
-                                   {"trials", viewer.summary().trials},
-                                   {"view", view}};
-    write_text_file(w[1], report.dump() + "\n");
-  } else if (c == "quit") {
-    viewer.request_quit();
-  } else {
-    throw Error("no command '" + c +
-                "' (drag, scroll, key, view, preset, set, hide, show, screenshot, capture, layout, "
-                "record, frames, sleep, save-position, report, quit)");
+    case ScriptOp::quit:
+      viewer.request_quit();
+      break;
   }
 }
 
@@ -308,6 +281,8 @@ void print_summary(const Viewer& viewer, const std::string& scene) {
 }
 
 void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size) {
+  std::optional<Script> script;  // (a script's mistakes are found before the window opens)
+  if (!o.script.empty()) script.emplace(o.script, read_script(o.script));
   Glfw glfw;
   ContextOptions context = device.context();
   context.instance_extensions = glfw.instance_extensions();
@@ -315,8 +290,6 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   Context ctx(context);
   Scene scene = load_scene_reporting(o.scene, ctx);  // volumes checked against the device
   const Camera camera = camera_for(scene, o.camera);
-  std::optional<Script> script;
-  if (!o.script.empty()) script.emplace(o.script, read_script(o.script));
   const std::string title = "strata - " + std::filesystem::path(o.scene.file).filename().string();
   Window window(size, o.size, title);
   float scale_x = 1.0f, scale_y = 1.0f;
@@ -430,10 +403,10 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--camera", o->camera, "named camera position of the scene to start at");
   cmd->add_option("--size", o->size, "window size in screen units, N or WxH")
       ->capture_default_str();
-  cmd->add_option("--frames", o->frames,
-                  "close after this many frames (0: when the window closes)");
+  cmd->add_option("--frames", o->frames, "close after this many frames (0: when the window closes)")
+      ->check(whole_range(0, 1e9));
   cmd->add_option("--tidy-rounds", o->tidy_rounds, "rounds of the layout tidy-up per frame")
-      ->check(CLI::Range(0u, TIDY_ROUNDS_MAX))
+      ->check(whole_range(0, TIDY_ROUNDS_MAX))
       ->capture_default_str();
   cmd->add_option("--script", o->script,
                   "input script: events and actions run one by one, each once the view has "
@@ -443,16 +416,17 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
       ->capture_default_str();
   cmd->add_option("--frames-in-flight", o->frames_in_flight,
                   "frames recorded before the earlier ones finished, 1 to 3")
-      ->check(CLI::Range(1, 3))
+      ->check(whole_range(1, 3))
       ->capture_default_str();
   cmd->add_flag("--no-optimize", o->no_optimize,
                 "do not try random insertion orders when the camera rests");
   cmd->add_flag("--no-panel", o->no_panel, "start with the panel hidden (h shows it)");
   cmd->add_option("--label-scale", o->label_scale,
                   "label text and boxes times this and the display's content scale (0.25 to 4)")
-      ->check(CLI::Range(0.25f, 4.0f))
+      ->check(finite_range(0.25, 4.0))
       ->capture_default_str();
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
+      ->check(whole_range(0, 16384))
       ->capture_default_str();
   cmd->callback([&device, o] {
     const graph::Extent size = parse_size(o->size, "--size");

@@ -71,9 +71,13 @@ struct SettingsRef {
   ViewerOptions& viewer;
 };
 
+// A parameter: a number in [lo, hi] or (with `flag`) on or off. The ranges keep a frame's work
+// bounded (render.step has a lower bound from the volumes too: Viewer::set_number) and hold the
+// panel's slider ranges (app/viewer_panel.cpp).
 struct Parameter {
   const char* name;
   const char* what;
+  float lo = 0.0f, hi = 0.0f;
   float* (*number)(const SettingsRef&) = nullptr;
   bool* (*flag)(const SettingsRef&) = nullptr;
   bool reproject = false;  // the anchors are projected and layered again
@@ -81,61 +85,67 @@ struct Parameter {
 
 const std::vector<Parameter>& parameters() {
   using S = const SettingsRef&;
+  constexpr float kMaxWeight = 1e9f;
   static const std::vector<Parameter> all = {
-      {"weights.label_shadow", "eq. 3.1: a box over an earlier box or its leader",
+      {"weights.label_shadow", "eq. 3.1: a box over an earlier box or its leader", 0.0f, kMaxWeight,
        [](S s) { return &s.labels.placement.weights.label_shadow; }},
-      {"weights.anchor_constraint", "eq. 3.1: a box or leader over an anchor",
+      {"weights.anchor_constraint", "eq. 3.1: a box or leader over an anchor", 0.0f, kMaxWeight,
        [](S s) { return &s.labels.placement.weights.anchor_constraint; }},
-      {"weights.connector_shadow", "eq. 3.1: a leader over an earlier box or leader",
-       [](S s) { return &s.labels.placement.weights.connector_shadow; }},
-      {"weights.leader_crossing", "tidy-up: a leader crossing a leader or through a box",
-       [](S s) { return &s.labels.placement.weights.leader_crossing; }},
-      {"weights.illegible", "a box the layers in front hide (hard mode: never)",
+      {"weights.connector_shadow", "eq. 3.1: a leader over an earlier box or leader", 0.0f,
+       kMaxWeight, [](S s) { return &s.labels.placement.weights.connector_shadow; }},
+      {"weights.leader_crossing", "tidy-up: a leader crossing a leader or through a box", 0.0f,
+       kMaxWeight, [](S s) { return &s.labels.placement.weights.leader_crossing; }},
+      {"weights.illegible", "a box the layers in front hide (hard mode: never)", 0.0f, kMaxWeight,
        [](S s) { return &s.labels.placement.weights.illegible; }},
-      {"weights.integral_costs", "eq. 3.1: the occlusion and saliency under the box",
-       [](S s) { return &s.labels.placement.weights.integral_costs; }},
-      {"weights.distance_to_anchor", "eq. 3.1: leader length",
+      {"weights.integral_costs", "eq. 3.1: the occlusion and saliency under the box", 0.0f,
+       kMaxWeight, [](S s) { return &s.labels.placement.weights.integral_costs; }},
+      {"weights.distance_to_anchor", "eq. 3.1: leader length", 0.0f, kMaxWeight,
        [](S s) { return &s.labels.placement.weights.distance_to_anchor; }},
-      {"weights.connector_direction", "eq. 3.1: connector direction",
+      {"weights.connector_direction", "eq. 3.1: connector direction", 0.0f, kMaxWeight,
        [](S s) { return &s.labels.placement.weights.connector_direction; }},
-      {"weights.previous_position", "eq. 3.1 eta: per pixel of distance to the last target",
-       [](S s) { return &s.labels.forces.previous_weight; }},
-      {"integral.saliency", "eq. 3.3: how much saliency modulates occlusion",
+      {"weights.previous_position", "eq. 3.1 eta: per pixel of distance to the last target", 0.0f,
+       1e6f, [](S s) { return &s.labels.forces.previous_weight; }},
+      {"integral.saliency", "eq. 3.3: how much saliency modulates occlusion", 0.0f, 1.0f,
        [](S s) { return &s.labels.placement.saliency_weight; }},
-      {"integral.occlusion", "eq. 3.4: occlusion weight with one layer",
+      {"integral.occlusion", "eq. 3.4: occlusion weight with one layer", 0.0f, 1.0f,
        [](S s) { return &s.labels.placement.occlusion_weight; }},
-      {"integral.single_saliency", "eq. 3.4: saliency weight with one layer",
+      {"integral.single_saliency", "eq. 3.4: saliency weight with one layer", 0.0f, 1.0f,
        [](S s) { return &s.labels.placement.single_saliency_weight; }},
-      {"margin", "pixels around boxes in the constraints",
+      {"margin", "pixels around boxes in the constraints", 0.0f, 256.0f,
        [](S s) { return &s.labels.placement.margin; }},
-      {"layers", "depth layers asked for, 1 to 8"},
-      {"tidy_rounds", "rounds of the layout tidy-up per frame, 0 to 256"},
-      {"hard", "on: no constraint violations (labels may be hidden)", nullptr,
+      {"layers", "depth layers asked for, 1 to 8", 1.0f, 8.0f},
+      {"tidy_rounds", "rounds of the layout tidy-up per frame, 0 to 256", 0.0f,
+       float(TIDY_ROUNDS_MAX)},
+      {"hard", "on: no constraint violations (labels may be hidden)", 0.0f, 0.0f, nullptr,
        [](S s) { return &s.labels.placement.hard; }},
-      {"internal", "on: each label on its anchor", nullptr, [](S s) { return &s.labels.internal; },
-       true},
-      {"font", "label font size in pixels"},
-      {"label_scale", "label text and boxes times this (0.25 to 4)"},
-      {"layer_colors", "on: label borders in their layer's colour", nullptr,
+      {"internal", "on: each label on its anchor", 0.0f, 0.0f, nullptr,
+       [](S s) { return &s.labels.internal; }, true},
+      {"font", "label font size in pixels, 4 to 128", 4.0f, 128.0f},
+      {"label_scale", "label text and boxes times this (0.25 to 4)", 0.25f, 4.0f},
+      {"layer_colors", "on: label borders in their layer's colour", 0.0f, 0.0f, nullptr,
        [](S s) { return &s.labels.layer_colors; }},
-      {"forces.speed", "pixels per second at full force",
+      // (speed / epsilon bounds the force steps of a frame: at most 2,000 in a 0.1 s frame)
+      {"forces.speed", "pixels per second at full force", 1.0f, 1e4f,
        [](S s) { return &s.labels.forces.speed; }},
-      {"forces.epsilon", "pixels: nearer than this the force shrinks",
+      {"forces.epsilon", "pixels: nearer than this the force shrinks", 0.5f, 1000.0f,
        [](S s) { return &s.labels.forces.epsilon; }},
-      {"forces.snap", "pixels: nearer than this a label lands on its target",
+      {"forces.snap", "pixels: nearer than this a label lands on its target", 0.0f, 100.0f,
        [](S s) { return &s.labels.forces.snap; }},
-      {"forces.hold_share", "hold: this share of the target's cost ...",
+      {"forces.hold_share", "hold: this share of the target's cost ...", 0.0f, 100.0f,
        [](S s) { return &s.labels.forces.hold_share; }},
-      {"forces.hold_cost", "... plus this", [](S s) { return &s.labels.forces.hold_cost; }},
-      {"forces.fade", "seconds a label takes to fade in or out",
+      {"forces.hold_cost", "... plus this", 0.0f, kMaxWeight,
+       [](S s) { return &s.labels.forces.hold_cost; }},
+      {"forces.fade", "seconds a label takes to fade in or out", 0.0f, 60.0f,
        [](S s) { return &s.labels.forces.fade_seconds; }},
-      {"forces.anchor_relative", "on: labels held as offsets from their anchors", nullptr,
-       [](S s) { return &s.labels.forces.anchor_relative; }},
-      {"optimize", "on: try random insertion orders when the camera rests", nullptr,
+      {"forces.anchor_relative", "on: labels held as offsets from their anchors", 0.0f, 0.0f,
+       nullptr, [](S s) { return &s.labels.forces.anchor_relative; }},
+      {"optimize", "on: try random insertion orders when the camera rests", 0.0f, 0.0f, nullptr,
        [](S s) { return &s.viewer.optimize_on_idle; }},
-      {"render.step", "world units between ray samples (0: half the finest voxel)",
-       [](S s) { return &s.render.step; }},
-      {"render.skip_empty", "on: empty-space skipping", nullptr,
+      {"render.step",
+       "world units between ray samples (0: half the finest voxel; else at least a sixteenth of "
+       "it)",
+       0.0f, 1000.0f, [](S s) { return &s.render.step; }},
+      {"render.skip_empty", "on: empty-space skipping", 0.0f, 0.0f, nullptr,
        [](S s) { return &s.render.skip_empty; }},
   };
   return all;
@@ -149,6 +159,26 @@ const Parameter& parameter(const std::string& name) {
   for (const Parameter& p : parameters())
     names += (names.empty() ? "" : ", ") + std::string(p.name);
   throw Error("no parameter '" + name + "' (parameters: " + names + ")");
+}
+
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// The value in the parameter's range (a whole number for layers and tidy_rounds), else an Error
+// naming the parameter and its range.
+void check_range(const Parameter& p, float value) {
+  const bool whole =
+      std::string_view(p.name) == "layers" || std::string_view(p.name) == "tidy_rounds";
+  if (std::isfinite(value) && value >= p.lo && value <= p.hi &&
+      (!whole || value == std::floor(value))) {
+    return;
+  }
+  throw Error("parameter " + std::string(p.name) + ": " + number_text(value) + " is not " +
+              (whole ? "a whole number" : "a number") + " in [" + number_text(p.lo) + ", " +
+              number_text(p.hi) + "]");
 }
 
 }  // namespace
@@ -167,6 +197,15 @@ graph::Extent WindowOutput::extent() const {
   int w = 0, h = 0;
   glfwGetFramebufferSize(window_, &w, &h);
   return {uint32_t(std::max(w, 0)), uint32_t(std::max(h, 0))};
+}
+
+void check_viewer_parameter(const std::string& name, const std::string& value) {
+  const Parameter& p = parameter(name);
+  if (p.flag) {
+    parse_bool(name, value);
+  } else {
+    check_range(p, parse_float(name, value));
+  }
 }
 
 std::vector<std::pair<std::string, std::string>> viewer_parameters() {
@@ -476,6 +515,7 @@ void Viewer::set_parameter(const std::string& name, const std::string& value) {
 void Viewer::set_number(const std::string& name, float value) {
   const Parameter& p = parameter(name);
   if (p.flag) throw Error("parameter " + name + " is on or off, not a number");
+  check_range(p, value);
   if (name == "font" || name == "label_scale") {  // (the renderer checks the value)
     if (name == "font") {
       labelled_->set_font_pixels(value);
@@ -490,14 +530,17 @@ void Viewer::set_number(const std::string& name, float value) {
   RenderSettings render = labelled_->renderer().settings();
   ViewerOptions viewer = options_;
   if (name == "layers") {
-    if (!(value >= 1.0f && value <= 8.0f)) throw Error("parameter layers: 1 to 8");
     labels.layer_count = uint32_t(value);
   } else if (name == "tidy_rounds") {
-    if (!(value >= 0.0f && value <= float(TIDY_ROUNDS_MAX))) {
-      throw Error("parameter tidy_rounds: 0 to " + std::to_string(TIDY_ROUNDS_MAX));
-    }
     labels.placement.tidy_rounds = uint32_t(value);
   } else {
+    // A step far below the voxels multiplies a frame's samples without showing more.
+    const float finest = labelled_->renderer().inputs().finest_spacing;
+    if (name == "render.step" && value != 0.0f && value < finest / 16.0f) {
+      throw Error("parameter render.step: " + number_text(value) + " is below " +
+                  number_text(finest / 16.0f) +
+                  ", a sixteenth of the finest voxel spacing (0: half of it)");
+    }
     *p.number({labels, render, viewer}) = value;
   }
   commit_settings(labels, render, viewer, p.reproject || name == "layers");

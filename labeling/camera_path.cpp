@@ -113,11 +113,12 @@ std::string position_names(const Scene& scene) {
   throw Error(file + "camera path '" + text + "': " + reason);
 }
 
-// "2", "0.5", "1e1": a finite number > 0 and nothing else.
+// "2", "0.5", "1e1": a number in (0, kMaxPathSeconds] and nothing else.
 bool parse_seconds(const std::string& text, double& seconds) {
   const char* end = text.data() + text.size();
   const auto [ptr, ec] = std::from_chars(text.data(), end, seconds);
-  return ec == std::errc() && ptr == end && std::isfinite(seconds) && seconds > 0.0;
+  return ec == std::errc() && ptr == end && std::isfinite(seconds) && seconds > 0.0 &&
+         seconds <= kMaxPathSeconds;
 }
 
 // One part of a path's text: the pose it names and the seconds the move to it takes.
@@ -146,7 +147,8 @@ PathPart parse_part(const Scene& scene, const std::string& text, const std::stri
   PathPart out{camera_position(scene, name)};
   if (!parse_seconds(duration, out.seconds)) {
     fail(scene, text,
-         "'" + part + "': '" + duration + "' is not a duration (a positive number of seconds)");
+         "'" + part + "': '" + duration + "' is not a duration (seconds in (0, " +
+             std::to_string(int(kMaxPathSeconds)) + "])");
   }
   return out;
 }
@@ -202,6 +204,11 @@ CameraPath parse_camera_path(const Scene& scene, const std::string& text) {
   for (size_t i = 0; i < parts.size(); ++i) {
     const PathPart part = parse_part(scene, text, parts[i], i);
     time += part.seconds;
+    if (time > kMaxPathSeconds) {
+      fail(scene, text,
+           "'" + parts[i] + "': the path lasts more than " + std::to_string(int(kMaxPathSeconds)) +
+               " s by here");
+    }
     path.keys.push_back({part.camera, time});
   }
   return path;
@@ -209,8 +216,9 @@ CameraPath parse_camera_path(const Scene& scene, const std::string& text) {
 
 CameraPath orbit_path(const Scene& scene, const Camera& start, double degrees, double seconds) {
   if (!std::isfinite(degrees)) throw Error("orbit: the angle must be a number of degrees");
-  if (!(std::isfinite(seconds) && seconds > 0.0)) {
-    throw Error("orbit: the duration must be a positive number of seconds");
+  if (!(std::isfinite(seconds) && seconds > 0.0 && seconds <= kMaxPathSeconds)) {
+    throw Error("orbit: the duration must be a number of seconds in (0, " +
+                std::to_string(int(kMaxPathSeconds)) + "]");
   }
   CameraPath path;
   path.centre = scene_bounds(scene).centre();
@@ -220,8 +228,16 @@ CameraPath orbit_path(const Scene& scene, const Camera& start, double degrees, d
   return path;
 }
 
+double sampled_frames(const CameraPath& path, double fps) {
+  return std::round(path.duration() * fps) + 1.0;
+}
+
 std::vector<Camera> sample(const CameraPath& path, double fps) {
   if (!(std::isfinite(fps) && fps > 0.0)) throw Error("camera path: fps must be positive");
+  if (!(sampled_frames(path, fps) <= double(kMaxVideoFrames))) {
+    throw Error("camera path: " + std::to_string(path.duration()) + " s at " + std::to_string(fps) +
+                " fps is more than " + std::to_string(kMaxVideoFrames) + " frames");
+  }
   const long long intervals = std::llround(path.duration() * fps);
   std::vector<Camera> frames;
   frames.push_back(path.at(0.0));

@@ -4,6 +4,7 @@
 // paths"). A turntable (3D Slicer's screen capture) turns the camera about the scene's centre.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,12 @@
 #include "engine/scene/scene.h"
 
 namespace strata {
+
+// Limits that keep a video's work and memory bounded, checked before anything is allocated: a
+// path (each move and their sum) or a turntable lasts at most an hour, and sample() gives at most
+// 100,000 frames (an hour at about 28 fps; 55 minutes at 30).
+inline constexpr double kMaxPathSeconds = 3600.0;
+inline constexpr uint32_t kMaxVideoFrames = 100000;
 
 // The pose reached at `time`, and how the camera gets there from the key before.
 struct CameraKey {
@@ -46,8 +53,9 @@ std::vector<std::string> split_camera_list(const std::string& text);
 // `front,left_2,top_3`: each part is a position name with `_SECONDS` for the time the move to it
 // takes (default 1 s); a part that is itself a position's name is that position (`left_side`).
 // The first part is where the path starts and takes no duration. One Error per problem (an empty
-// path or part, an unknown name listing the scene's names, a duration that is not a positive
-// number), naming the part. The lens (field of view, near, far) is the scene camera's throughout.
+// path or part, an unknown name listing the scene's names, a duration that is not a number of
+// seconds in (0, kMaxPathSeconds], a path longer than kMaxPathSeconds), naming the part. The lens
+// (field of view, near, far) is the scene camera's throughout.
 CameraPath parse_camera_path(const Scene& scene, const std::string& text);
 
 // A turntable: the scene turns `degrees` counter-clockwise about its up axis through its centre,
@@ -58,6 +66,9 @@ CameraPath orbit_path(const Scene& scene, const Camera& start, double degrees, d
 // The frames of a video at `fps`: round(duration * fps) + 1 cameras, evenly spaced from t = 0 to
 // t = duration (so exactly 1 / fps apart when duration * fps is whole). A looping video (a full
 // turn) drops the last frame, which repeats the first. One frame for a path of one position.
+// An Error, before any allocation, past kMaxVideoFrames or for an fps that is not positive.
 std::vector<Camera> sample(const CameraPath& path, double fps);
+// The frames sample() would give (before a looping video drops its last): duration * fps + 1.
+double sampled_frames(const CameraPath& path, double fps);
 
 }  // namespace strata

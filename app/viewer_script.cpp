@@ -1,0 +1,175 @@
+#include "app/viewer_script.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "engine/core/error.h"
+#include "engine/scene/fitted_camera.h"
+#include "engine/scene/transfer_function_presets.h"
+
+namespace strata::app {
+namespace {
+
+std::string number_text(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+// A finite number in [lo, hi] (a whole one with `whole`), written as nothing else.
+double number(const std::string& word, double lo, double hi, bool whole = false) {
+  const char* begin = word.c_str();
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  const bool inside = end == begin + word.size() && std::isfinite(v) && v >= lo && v <= hi &&
+                      (!whole || v == std::floor(v));
+  if (!inside) {
+    throw Error("'" + word + "' is not " + (whole ? "a whole number" : "a number") + " in [" +
+                number_text(lo) + ", " + number_text(hi) + "]");
+  }
+  return v;
+}
+
+void check_key(const std::string& name) {
+  static const char* const named[] = {"left",   "right", "up",  "down",
+                                      "escape", "f12",   "F12", "space"};
+  for (const char* n : named) {
+    if (name == n) return;
+  }
+  if (name.size() == 1 &&
+      ((name[0] >= 'a' && name[0] <= 'z') || (name[0] >= '0' && name[0] <= '9')))
+    return;
+  throw Error("no key '" + name + "' (a-z, 0-9, left, right, up, down, escape, f12, space)");
+}
+
+void check_button(const std::string& name) {
+  if (name != "left" && name != "right" && name != "middle")
+    throw Error("no mouse button '" + name + "' (left, right, middle)");
+}
+
+void check_view(const std::string& name) {
+  if (!anatomical_view_named(name))
+    throw Error("no view '" + name + "' (anterior, posterior, left, right, superior, inferior)");
+}
+
+void check_preset(const std::string& name) {
+  std::string names;
+  for (const TransferFunctionPreset& p : transfer_function_presets()) {
+    if (name == p.name) return;
+    names += std::string(names.empty() ? "" : ", ") + p.name;
+  }
+  throw Error("no transfer-function preset '" + name + "' (" + names + ")");
+}
+
+ScriptCommand command(const std::vector<std::string>& w) {
+  const std::string& c = w[0];
+  const auto need = [&](size_t n, const char* form) {
+    if (w.size() != n) throw Error("'" + c + "' takes the form: " + form);
+  };
+  ScriptCommand out;
+  if (c == "drag") {
+    if (w.size() != 6 && !(w.size() == 7 && w[6] == "shift")) {
+      throw Error("'drag' takes the form: drag left|right|middle X0 Y0 X1 Y1 [shift]");
+    }
+    out.op = ScriptOp::drag;
+    check_button(w[1]);
+    out.word = w[1];
+    for (size_t i = 2; i < 6; ++i) {
+      out.numbers.push_back(number(w[i], -kScriptMaxCoordinate, kScriptMaxCoordinate));
+    }
+    out.shift = w.size() == 7;
+  } else if (c == "scroll") {
+    need(2, "scroll TICKS");
+    out.op = ScriptOp::scroll;
+    out.numbers = {number(w[1], -kScriptMaxScroll, kScriptMaxScroll)};
+  } else if (c == "key") {
+    need(2, "key NAME");
+    out.op = ScriptOp::key;
+    check_key(w[1]);
+    out.word = w[1];
+  } else if (c == "view") {
+    need(2, "view anterior|posterior|left|right|superior|inferior");
+    out.op = ScriptOp::view;
+    check_view(w[1]);
+    out.word = w[1];
+  } else if (c == "preset") {
+    if (w.size() != 2 && w.size() != 3)
+      throw Error("'preset' takes the form: preset NAME [VOLUME]");
+    out.op = ScriptOp::preset;
+    check_preset(w[1]);
+    out.word = w[1];
+    out.numbers = {w.size() == 3 ? number(w[2], 0.0, kScriptMaxVolume, true) : 0.0};
+  } else if (c == "set") {
+    need(3, "set PARAMETER VALUE");
+    out.op = ScriptOp::set;
+    out.word = w[1];
+    out.value = w[2];
+  } else if (c == "hide" || c == "show") {
+    need(2, "hide|show LABEL_ID");
+    out.op = c == "hide" ? ScriptOp::hide : ScriptOp::show;
+    out.numbers = {number(w[1], 0.0, kScriptMaxLabelId, true)};
+  } else if (c == "screenshot" || c == "capture") {
+    need(2, c == "screenshot" ? "screenshot FILE.png" : "capture FILE.png");
+    out.op = c == "screenshot" ? ScriptOp::screenshot : ScriptOp::capture;
+    out.word = w[1];
+  } else if (c == "layout" || c == "report") {
+    need(2, c == "layout" ? "layout FILE.json" : "report FILE.json");
+    out.op = c == "layout" ? ScriptOp::layout : ScriptOp::report;
+    out.word = w[1];
+  } else if (c == "record") {
+    if (w.size() == 3 && w[1] == "start") {
+      out.op = ScriptOp::record_start;
+      out.word = w[2];
+    } else if (w.size() == 2 && w[1] == "stop") {
+      out.op = ScriptOp::record_stop;
+    } else {
+      throw Error("'record' takes the form: record start FILE.mp4 | record stop");
+    }
+  } else if (c == "frames") {
+    need(2, "frames N");
+    out.op = ScriptOp::frames;
+    out.numbers = {number(w[1], 0.0, kScriptMaxFrames, true)};
+  } else if (c == "sleep") {
+    need(2, "sleep SECONDS");
+    out.op = ScriptOp::sleep;
+    out.numbers = {number(w[1], 0.0, kScriptMaxSleep)};
+  } else if (c == "save-position") {
+    need(2, "save-position NAME");
+    out.op = ScriptOp::save_position;
+    out.word = w[1];
+  } else if (c == "quit") {
+    need(1, "quit");
+    out.op = ScriptOp::quit;
+  } else {
+    throw Error("no command '" + c +
+                "' (drag, scroll, key, view, preset, set, hide, show, screenshot, capture, layout, "
+                "record, frames, sleep, save-position, report, quit)");
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<ScriptCommand> parse_viewer_script(const std::string& text, const std::string& file) {
+  std::istringstream in(text);
+  std::vector<ScriptCommand> commands;
+  std::string line;
+  for (size_t n = 1; std::getline(in, line); ++n) {
+    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    std::istringstream words(line);
+    std::vector<std::string> w;
+    for (std::string word; words >> word;) w.push_back(word);
+    if (w.empty()) continue;
+    try {
+      commands.push_back(command(w));
+    } catch (const Error& e) {
+      throw Error(file + ":" + std::to_string(n) + ": " + e.what());
+    }
+    commands.back().line = n;
+  }
+  return commands;
+}
+
+}  // namespace strata::app

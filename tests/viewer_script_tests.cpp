@@ -1,0 +1,123 @@
+// The viewer's input scripts are checked: the parser (app/viewer_script.h) refuses NaN,
+// infinities and numbers outside each command's range with FILE:LINE, and `strata view` stops on
+// such a line with that error in bounded time instead of hanging.
+#include <doctest/doctest.h>
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "app/viewer_script.h"
+#include "engine/core/error.h"
+#include "gpu_fixture.h"
+#include "test_files.h"
+
+namespace strata {
+namespace {
+
+using app::parse_viewer_script;
+
+// The Error a one-line script gives after a valid first line (so the line number is 2).
+std::string parse_error(const std::string& line) {
+  try {
+    parse_viewer_script("key r\n" + line + "\n", "demo.txt");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The tester's lines that hung or were accepted, and others of the same kind.
+const std::vector<std::string> kBadNumbers = {
+    "drag left nan nan 10 10",
+    "drag left 0 0 inf 10",
+    "drag left 0 0 1e30 10",
+    "frames -1",
+    "frames nan",
+    "frames 1.5",
+    "frames 1e9",
+    "sleep nan",
+    "sleep -1",
+    "sleep inf",
+    "scroll nan",
+    "scroll 1e30",
+    "hide -1",
+    "show nan",
+    "preset ct-bone -1",
+};
+
+}  // namespace
+
+TEST_SUITE("cpu") {
+  TEST_CASE("viewer_script_parser_refuses_nan_infinite_and_out_of_range_numbers_with_file_line") {
+    for (const std::string& line : kBadNumbers) {
+      CAPTURE(line);
+      const std::string error = parse_error(line);
+      CHECK(error.rfind("demo.txt:2: '", 0) == 0);
+      CHECK(error.find("is not a") != std::string::npos);
+    }
+    CHECK(parse_error("frames -1") == "demo.txt:2: '-1' is not a whole number in [0, 100000]");
+    CHECK(parse_error("sleep nan") == "demo.txt:2: 'nan' is not a number in [0, 600]");
+  }
+
+  TEST_CASE("viewer_script_parser_reads_commands_with_their_lines_and_numbers") {
+    const auto commands = parse_viewer_script(
+        "# a comment\ndrag middle 1 2 3.5 4 shift\n\nframes 12  # twelve\nsleep 0.25\n"
+        "set weights.label_shadow 50\nkey f12\nquit\n",
+        "s.txt");
+    REQUIRE(commands.size() == 6);
+    CHECK(commands[0].line == 2);
+    CHECK(commands[0].op == app::ScriptOp::drag);
+    CHECK(commands[0].word == "middle");
+    CHECK(commands[0].numbers == std::vector<double>{1, 2, 3.5, 4});
+    CHECK(commands[0].shift);
+    CHECK(commands[1].line == 4);
+    CHECK(commands[1].numbers == std::vector<double>{12});
+    CHECK(commands[2].numbers == std::vector<double>{0.25});
+    CHECK(commands[3].word == "weights.label_shadow");
+    CHECK(commands[3].value == "50");
+    CHECK(commands[5].op == app::ScriptOp::quit);
+  }
+
+  TEST_CASE("viewer_script_parser_refuses_unknown_names_before_anything_runs") {
+    CHECK(parse_error("key ctrl").find("demo.txt:2: no key 'ctrl'") == 0);
+    CHECK(parse_error("drag wheel 0 0 1 1").find("demo.txt:2: no mouse button 'wheel'") == 0);
+    CHECK(parse_error("view behind").find("demo.txt:2: no view 'behind'") == 0);
+    CHECK(parse_error("preset glass").find("demo.txt:2: no transfer-function preset") == 0);
+    CHECK(parse_error("quit now").find("demo.txt:2: 'quit' takes the form") == 0);
+  }
+}
+
+TEST_SUITE("window") {
+  // Each line that hung or was accepted before: the viewer stops with FILE:LINE well within the
+  // time limit (a tiny window; all but render.step are found before the window opens).
+  TEST_CASE("viewer_stops_on_bad_script_numbers_with_file_line_in_bounded_time") {
+    const auto dir = test::fresh_folder("viewer", "bad-numbers");
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"drag left nan nan 10 10", "'nan' is not a number"},
+        {"frames -1", "'-1' is not a whole number in [0, 100000]"},
+        {"frames nan", "'nan' is not a whole number"},
+        {"sleep nan", "'nan' is not a number in [0, 600]"},
+        {"set weights.label_shadow -5",
+         "parameter weights.label_shadow: -5 is not a number in [0, 1e+09]"},
+        {"set forces.fade nan", "parameter forces.fade: 'nan' is not a number"},
+        {"set render.step 1e-9", "parameter render.step: 1e-09 is below"},
+    };
+    for (const auto& [line, message] : cases) {
+      CAPTURE(line);
+      const auto script = test::write_file(dir / "script.txt", "frames 1\n" + line + "\nquit\n");
+      const auto start = std::chrono::steady_clock::now();
+      const auto r = test::run_strata("view " STRATA_SOURCE_DIR
+                                      "/assets/scenes/head.json --size 48x32 --no-optimize "
+                                      "--no-panel --script " +
+                                      script.string());
+      CAPTURE(r.output);
+      CHECK(r.exit_code == 1);
+      CHECK(r.output.find("strata: error: " + script.string() + ":2: " + message) !=
+            std::string::npos);
+      CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(60));
+    }
+  }
+}
+
+}  // namespace strata
