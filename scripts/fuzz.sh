@@ -20,7 +20,8 @@ elif [[ ${1:-} =~ ^[0-9]+$ ]]; then
   shift
 fi
 all=(fuzz_nifti fuzz_metaimage fuzz_nrrd fuzz_dicom_structure fuzz_scene_json fuzz_thesis_xml
-     fuzz_gra fuzz_transfer_function_json fuzz_markups_json fuzz_fcsv fuzz_label_csv)
+     fuzz_gra fuzz_transfer_function_json fuzz_markups_json fuzz_fcsv fuzz_label_csv
+     fuzz_text_layout)
 targets=("$@")
 ((${#targets[@]})) || targets=("${all[@]}")
 
@@ -54,6 +55,7 @@ copy fuzz_transfer_function_json assets/transfer_functions/*.json
 copy fuzz_markups_json tests/data/labels/*.mrk.json
 copy fuzz_fcsv tests/data/labels/*.fcsv
 copy fuzz_label_csv tests/data/labels/*.csv
+copy fuzz_text_layout fuzz/corpus/fuzz_text_layout/*
 
 dictionary() {
   case $1 in
