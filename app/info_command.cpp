@@ -1,11 +1,13 @@
 // `strata info FILE`: what a scene, volume, mesh or transfer-function file holds, as plain text.
 // Needs no device, so it also checks scene files on machines without Vulkan.
+#include <algorithm>
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 
 #include "app/commands.h"
+#include "engine/core/font.h"
 #include "engine/scene/io/mesh_loader.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
@@ -19,11 +21,16 @@ namespace fs = std::filesystem;
 
 std::string format(const char* pattern, ...) __attribute__((format(printf, 1, 2)));
 std::string format(const char* pattern, ...) {
-  char text[1024];
   va_list args;
   va_start(args, pattern);
-  std::vsnprintf(text, sizeof text, pattern, args);
+  va_list again;
+  va_copy(again, args);
+  const int length = std::vsnprintf(nullptr, 0, pattern, args);
   va_end(args);
+  std::string text(size_t(std::max(length, 0)) + 1, '\0');  // (a long label text is kept whole)
+  std::vsnprintf(text.data(), text.size(), pattern, again);
+  va_end(again);
+  text.pop_back();
   return text;
 }
 
@@ -43,8 +50,8 @@ void describe_volumes(const Scene& scene, std::string& out) {
   out += format("volumes: %zu\n", scene.volumes.size());
   for (const Volume& v : scene.volumes) {
     const auto [lo, hi] = v.world_bounds();
-    out += format("  %s: %ux%ux%u %s\n", v.name.c_str(), v.dims.x, v.dims.y, v.dims.z,
-                  to_string(v.type));
+    out += format("  %s: %ux%ux%u %s\n", printable_text(v.name).c_str(), v.dims.x, v.dims.y,
+                  v.dims.z, to_string(v.type));
     if (!v.source.empty()) out += "    file: " + v.source.string() + "\n";
     out += format("    spacing: %g x %g x %g mm\n", v.spacing.x, v.spacing.y, v.spacing.z);
     out += "    world bounds: " + vec(lo) + " .. " + vec(hi) + "\n";
@@ -63,7 +70,7 @@ void describe_volumes(const Scene& scene, std::string& out) {
 void describe_transfer_functions(const Scene& scene, std::string& out) {
   out += format("transfer functions: %zu\n", scene.transfer_functions.size());
   for (const TransferFunction& tf : scene.transfer_functions) {
-    out += format("  %s: %zu stops", tf.name.c_str(), tf.stops.size());
+    out += format("  %s: %zu stops", printable_text(tf.name).c_str(), tf.stops.size());
     out += tf.source.empty() ? "\n" : " (" + tf.source.string() + ")\n";
     for (const TransferFunction::Stop& stop : tf.stops) {
       out += format("    %-9.6g rgba ", stop.position) + rgba(stop.color) + "\n";
@@ -74,8 +81,8 @@ void describe_transfer_functions(const Scene& scene, std::string& out) {
 void describe_meshes(const Scene& scene, std::string& out) {
   out += format("meshes: %zu\n", scene.meshes.size());
   for (const Mesh& m : scene.meshes) {
-    out += format("  %s: %zu triangles, %zu vertices, colour ", m.name.c_str(), m.triangle_count(),
-                  m.positions.size());
+    out += format("  %s: %zu triangles, %zu vertices, colour ", printable_text(m.name).c_str(),
+                  m.triangle_count(), m.positions.size());
     out += rgba(m.color) + (m.transform != glm::mat4(1.0f) ? ", transformed" : "") + "\n";
     if (!m.source.empty()) out += "    file: " + m.source.string() + "\n";
   }
@@ -92,8 +99,10 @@ void describe_labels(const Scene& scene, std::string& out) {
                      l.image->pixels.width, l.image->pixels.height, l.image->height,
                      l.image->side == LabelImage::Side::left ? "left" : "above");
     }
-    out += format("  %4d  %-24s anchor ", l.id, ("\"" + l.text + "\"").c_str()) + vec(l.anchor) +
-           "  size " + size + image + "\n";
+    // (control characters written \u0007, so that a text can neither drive the terminal nor end
+    // at a U+0000)
+    out += format("  %4d  %-24s anchor ", l.id, ("\"" + printable_text(l.text) + "\"").c_str()) +
+           vec(l.anchor) + "  size " + size + image + "\n";
   }
 }
 
@@ -105,7 +114,8 @@ void describe_camera_and_settings(const Scene& scene, std::string& out) {
          vec(eye) + "\n";
   out += format("  positions: %zu\n", scene.camera_positions.size());
   for (const CameraPose& p : scene.camera_positions) {
-    out += "    " + p.name + ": eye " + vec(glm::vec3(glm::inverse(p.view)[3])) + "\n";
+    out +=
+        "    " + printable_text(p.name) + ": eye " + vec(glm::vec3(glm::inverse(p.view)[3])) + "\n";
   }
   const CostWeights& w = scene.settings.weights;
   out += format("settings: %d layers\n", scene.settings.layer_count);
@@ -128,7 +138,7 @@ std::string describe(const Scene& scene, bool whole_scene) {
   describe_labels(scene, out);
   describe_camera_and_settings(scene, out);
   out += format("warnings: %zu\n", scene.warnings.size());
-  for (const std::string& w : scene.warnings) out += "  " + w + "\n";
+  for (const std::string& w : scene.warnings) out += "  " + printable_text(w) + "\n";
   return out;
 }
 

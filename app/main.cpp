@@ -8,6 +8,7 @@
 #include "engine/core/error.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/transfer_function_presets.h"
+#include "labeling/text_layout.h"
 #include "passes/volume_renderer.h"
 
 namespace strata::app {
@@ -33,6 +34,10 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
   options.labels = in.labels;
   if (in.frame >= 0) options.frame = in.frame;
   Scene scene = load_scene(in.file, options);
+  if (!scene.labels.empty()) {  // (characters no font draws: the size does not matter)
+    for (std::string& w : missing_glyph_warnings(Font(16.0f), scene.labels))
+      scene.warnings.push_back(std::move(w));
+  }
   for (const std::string& warning : scene.warnings)
     std::fprintf(stderr, "strata: warning: %s\n", warning.c_str());
   return scene;

@@ -19,8 +19,10 @@ std::vector<ShapedLine> shape_label_text(const Font& font, std::string_view text
   while (true) {
     const size_t end = std::min(text.find('\n', start), text.size());
     const std::string_view paragraph = text.substr(start, end - start);
+    // (every line of a wrapped paragraph has the paragraph's direction)
+    const TextDirection direction = paragraph_direction(paragraph);
     if (style.max_width <= 0.0f) {
-      lines.push_back(font.shape(paragraph));
+      lines.push_back(font.shape(paragraph, direction));
     } else {
       // Greedy: as many words as fit, each line shaped as a whole.
       std::string line;
@@ -30,15 +32,15 @@ std::vector<ShapedLine> shape_label_text(const Font& font, std::string_view text
         const std::string_view word = paragraph.substr(word_start, word_end - word_start);
         const std::string longer =
             line.empty() ? std::string(word) : line + " " + std::string(word);
-        if (!line.empty() && font.shape(longer).advance > style.max_width) {
-          lines.push_back(font.shape(line));
+        if (!line.empty() && font.shape(longer, direction).advance > style.max_width) {
+          lines.push_back(font.shape(line, direction));
           line = word;
         } else {
           line = longer;
         }
         word_start = word_end + 1;
       }
-      lines.push_back(font.shape(line));
+      lines.push_back(font.shape(line, direction));
     }
     if (end == text.size()) break;
     start = end + 1;
@@ -55,6 +57,39 @@ FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,
     }
   }
   return font.bake(keys);
+}
+
+std::vector<std::string> missing_glyph_warnings(const Font& font, std::span<const Label> labels) {
+  std::vector<std::string> warnings;
+  for (const Label& label : labels) {
+    std::vector<char32_t> missing;
+    for (const ShapedLine& line : shape_label_text(font, label.text)) {
+      for (const char32_t c : line.missing) {
+        if (std::find(missing.begin(), missing.end(), c) == missing.end()) missing.push_back(c);
+      }
+    }
+    if (missing.empty()) continue;
+    std::string characters;
+    for (const char32_t c : missing) {
+      std::string utf8;  // (the character itself, unless it is a control character)
+      if (c < 0x80) {
+        utf8 = std::string(1, char(c));
+      } else if (c < 0x800) {
+        utf8 = {char(0xC0 | (c >> 6)), char(0x80 | (c & 0x3F))};
+      } else if (c < 0x10000) {
+        utf8 = {char(0xE0 | (c >> 12)), char(0x80 | ((c >> 6) & 0x3F)), char(0x80 | (c & 0x3F))};
+      } else {
+        utf8 = {char(0xF0 | (c >> 18)), char(0x80 | ((c >> 12) & 0x3F)),
+                char(0x80 | ((c >> 6) & 0x3F)), char(0x80 | (c & 0x3F))};
+      }
+      const std::string shown = printable_text(utf8);
+      characters += (characters.empty() ? "" : ", ") + codepoint_name(c) +
+                    (shown == utf8 ? " (" + utf8 + ")" : "");
+    }
+    warnings.push_back("label " + std::to_string(label.id) + " \"" + printable_text(label.text) +
+                       "\": no font has " + characters + "; drawn as an empty box");
+  }
+  return warnings;
 }
 
 LabelImages bake_label_images(std::span<const Label> labels, float scale) {

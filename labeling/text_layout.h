@@ -53,10 +53,16 @@ struct LabelImages {
 };
 LabelImages bake_label_images(std::span<const Label> labels, float scale);
 
-// The lines of `text` (UTF-8), shaped: split at "\n", each wrapped at style.max_width at spaces
-// (a word wider than that keeps a line of its own).
+// The lines of `text` (UTF-8), shaped: split at "\n" into paragraphs, each wrapped at
+// style.max_width at spaces (a word wider than that keeps a line of its own), every line in its
+// paragraph's direction (paragraph_direction) and in visual order.
 std::vector<ShapedLine> shape_label_text(const Font& font, std::string_view text,
                                          const TextStyle& style = {});
+
+// One warning per label whose text has characters no face of `font` has (an emoji without an
+// emoji font, say): the label's id and text, and each such character as U+XXXX with the
+// character itself.
+std::vector<std::string> missing_glyph_warnings(const Font& font, std::span<const Label> labels);
 
 // The atlas with every glyph of `texts`.
 FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,

@@ -22,7 +22,8 @@ fi
 all=(fuzz_nifti fuzz_metaimage fuzz_nrrd fuzz_dicom_structure fuzz_scene_json fuzz_thesis_xml
      fuzz_gra fuzz_transfer_function_json fuzz_markups_json fuzz_fcsv fuzz_label_csv
      fuzz_viewer_script
-     fuzz_camera_path)
+     fuzz_camera_path
+     fuzz_text_layout)
 targets=("$@")
 ((${#targets[@]})) || targets=("${all[@]}")
 
@@ -58,6 +59,7 @@ copy fuzz_fcsv tests/data/labels/*.fcsv
 copy fuzz_label_csv tests/data/labels/*.csv
 copy fuzz_viewer_script fuzz/corpus/fuzz_viewer_script/*
 copy fuzz_camera_path fuzz/corpus/fuzz_camera_path/*
+copy fuzz_text_layout fuzz/corpus/fuzz_text_layout/*
 
 dictionary() {
   case $1 in

@@ -12,9 +12,11 @@ packages=(
   libspirv-cross-c-shared-dev
   # libraries
   libglm-dev libglfw3-dev libimgui-dev doctest-dev libcli11-dev libstb-dev
-  # label text (engine/core/font.cpp): faces read and rasterised by FreeType, shaped by HarfBuzz;
-  # DejaVu Sans, FreeSans and FreeSerif for characters it lacks
-  libfreetype-dev libharfbuzz-dev fonts-dejavu-core fonts-freefont-ttf
+  # label text (engine/core/font.cpp): faces read and rasterised by FreeType, shaped by HarfBuzz,
+  # right-to-left text ordered by FriBiDi; DejaVu Sans, FreeSans and FreeSerif for characters it
+  # lacks, WenQuanYi Micro Hei for Chinese, Japanese and Korean
+  libfreetype-dev libharfbuzz-dev libfribidi-dev fonts-dejavu-core fonts-freefont-ttf
+  fonts-wqy-microhei
   # file formats: gzip, DICOM, meshes, JSON, XML, JPEG (label pictures)
   zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev libjpeg62-turbo-dev
   # videos: H.264 in MP4 through FFmpeg's libraries; ffprobe checks them in the tests

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <numeric>
 
+#include <fribidi.h>
 #include <ft2build.h>
 #include FT_FREETYPE_H
 #include <hb-ft.h>
@@ -20,6 +23,8 @@ constexpr uint32_t kAtlasWidth = 512;
 // filtering at the quad's edge fades to zero and never reaches a neighbour's ink.
 constexpr int kPad = 1;
 constexpr char32_t kReplacement = 0xFFFD;
+// FriBiDi indexes with int; a label line is far shorter.
+constexpr size_t kMaxLineCharacters = size_t(1) << 24;
 
 // Light hinting (vertical only) keeps small text crisp without moving glyphs sideways, so the
 // shaped advances (unhinted) and the ink agree.
@@ -44,39 +49,101 @@ std::string font_file(const std::string& path) {
   return path == kDefaultFontPath && env && *env ? std::string(env) : path;
 }
 
+namespace {
+
+// The code point at text[i] and its length in bytes; 0 for a malformed or truncated sequence
+// (overlong forms, surrogates and values past U+10FFFF are malformed too).
+size_t decode_one(std::string_view text, size_t i, char32_t& cp) {
+  const auto b = static_cast<unsigned char>(text[i]);
+  const size_t length = b < 0x80u              ? 1
+                        : (b & 0xE0u) == 0xC0u ? 2
+                        : (b & 0xF0u) == 0xE0u ? 3
+                        : (b & 0xF8u) == 0xF0u ? 4
+                                               : 0;
+  if (length == 0 || i + length > text.size()) return 0;
+  cp = length == 1 ? b : length == 2 ? (b & 0x1Fu) : length == 3 ? (b & 0x0Fu) : (b & 0x07u);
+  for (size_t k = 1; k < length; ++k) {
+    const auto c = static_cast<unsigned char>(text[i + k]);
+    if ((c & 0xC0u) != 0x80u) return 0;
+    cp = (cp << 6) | (c & 0x3Fu);
+  }
+  const char32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
+  const bool ok = cp >= least[length] && cp <= 0x10FFFF && !(cp >= 0xD800 && cp <= 0xDFFF);
+  return ok ? length : 0;
+}
+
+}  // namespace
+
 std::u32string decode_utf8(std::string_view text) {
   std::u32string out;
   size_t i = 0;
   while (i < text.size()) {
-    const auto b = static_cast<unsigned char>(text[i]);
-    const int length = b < 0x80u              ? 1
-                       : (b & 0xE0u) == 0xC0u ? 2
-                       : (b & 0xF0u) == 0xE0u ? 3
-                       : (b & 0xF8u) == 0xF0u ? 4
-                                              : 0;
-    char32_t cp = length == 1   ? b
-                  : length == 2 ? (b & 0x1Fu)
-                  : length == 3 ? (b & 0x0Fu)
-                                : (b & 0x07u);
-    bool ok = length > 0 && i + size_t(length) <= text.size();
-    for (int k = 1; ok && k < length; ++k) {
-      const auto c = static_cast<unsigned char>(text[i + size_t(k)]);
-      ok = (c & 0xC0u) == 0x80u;
-      cp = (cp << 6) | (c & 0x3Fu);
-    }
-    // (overlong forms, surrogates and values past U+10FFFF are malformed too)
-    const char32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
-    ok = ok && cp >= least[length] && cp <= 0x10FFFF && !(cp >= 0xD800 && cp <= 0xDFFF);
-    if (!ok) {
+    char32_t cp = 0;
+    const size_t length = decode_one(text, i, cp);
+    if (length == 0) {
       out.push_back(kReplacement);
       ++i;
       while (i < text.size() && (static_cast<unsigned char>(text[i]) & 0xC0u) == 0x80u) ++i;
       continue;
     }
     out.push_back(cp);
-    i += size_t(length);
+    i += length;
   }
   return out;
+}
+
+std::string codepoint_name(char32_t c) {
+  char name[16];
+  std::snprintf(name, sizeof name, "U+%04X", unsigned(c));
+  return name;
+}
+
+std::string printable_text(std::string_view text) {
+  std::string out;
+  char escape[16];
+  for (size_t i = 0; i < text.size();) {
+    char32_t cp = 0;
+    const size_t length = decode_one(text, i, cp);
+    if (length == 0) {
+      std::snprintf(escape, sizeof escape, "\\x%02X",
+                    unsigned(static_cast<unsigned char>(text[i])));
+      out += escape;
+      ++i;
+      continue;
+    }
+    // (C0 and C1 controls, DEL, and the bidirectional controls that would reorder what follows)
+    const bool control = cp < 0x20 || (cp >= 0x7F && cp <= 0x9F) || cp == 0x200E || cp == 0x200F ||
+                         (cp >= 0x202A && cp <= 0x202E) || (cp >= 0x2066 && cp <= 0x2069);
+    if (control) {
+      std::snprintf(escape, sizeof escape, "\\u%04X", unsigned(cp));
+      out += escape;
+    } else {
+      out += text.substr(i, length);
+    }
+    i += length;
+  }
+  return out;
+}
+
+TextDirection paragraph_direction(std::string_view paragraph) {
+  // (rules P2 and P3 of the bidirectional algorithm: FriBiDi's own resolution of FRIBIDI_PAR_ON,
+  // which skips the characters inside isolates)
+  const std::u32string text = decode_utf8(paragraph);
+  if (text.empty() || text.size() > kMaxLineCharacters) return TextDirection::left_to_right;
+  const auto length = static_cast<FriBidiStrIndex>(text.size());
+  const auto* chars = reinterpret_cast<const FriBidiChar*>(text.data());
+  std::vector<FriBidiCharType> types(text.size());
+  std::vector<FriBidiBracketType> brackets(text.size());
+  std::vector<FriBidiLevel> levels(text.size());
+  fribidi_get_bidi_types(chars, length, types.data());
+  fribidi_get_bracket_types(chars, length, types.data(), brackets.data());
+  FriBidiParType base = FRIBIDI_PAR_ON;
+  if (fribidi_get_par_embedding_levels_ex(types.data(), brackets.data(), length, &base,
+                                          levels.data()) == 0) {
+    throw Error("font: FriBiDi could not resolve a label paragraph of " +
+                std::to_string(text.size()) + " characters");
+  }
+  return FRIBIDI_IS_RTL(base) ? TextDirection::right_to_left : TextDirection::left_to_right;
 }
 
 Font::Font(float pixel_height, const std::string& path) : faces_(std::make_unique<Faces>()) {
@@ -92,6 +159,12 @@ Font::Font(float pixel_height, const std::string& path) : faces_(std::make_uniqu
   std::vector<std::string> files{file};
   for (const char* fallback : kFallbackFontPaths) {
     if (std::filesystem::is_regular_file(fallback)) files.emplace_back(fallback);
+  }
+  for (const char* cjk : kCjkFontPaths) {
+    if (std::filesystem::is_regular_file(cjk)) {
+      files.emplace_back(cjk);
+      break;
+    }
   }
   float em_pixels = 0.0f;
   for (size_t i = 0; i < files.size(); ++i) {
@@ -138,13 +211,27 @@ bool Font::covers(char32_t codepoint) const {
   return false;
 }
 
-ShapedLine Font::shape(std::string_view line) const {
+namespace {
+
+bool real_script(hb_script_t s) {
+  return s != HB_SCRIPT_COMMON && s != HB_SCRIPT_INHERITED && s != HB_SCRIPT_UNKNOWN &&
+         s != HB_SCRIPT_INVALID;
+}
+
+}  // namespace
+
+ShapedLine Font::shape(std::string_view line, TextDirection direction) const {
   const std::u32string text = decode_utf8(line);
+  const size_t n = text.size();
+  if (n > kMaxLineCharacters) {
+    throw Error("font: a label line of " + std::to_string(n) + " characters (at most " +
+                std::to_string(kMaxLineCharacters) + ")");
+  }
   // The face of each character: the first that has it; a combining mark stays with its base's
   // face when that face has the mark too; none has it: the main face (its missing-glyph box).
   hb_unicode_funcs_t* unicode = hb_unicode_funcs_get_default();
-  std::vector<uint32_t> face_of(text.size(), 0);
-  for (size_t i = 0; i < text.size(); ++i) {
+  std::vector<uint32_t> face_of(n, 0);
+  for (size_t i = 0; i < n; ++i) {
     const bool mark = hb_unicode_general_category(unicode, text[i]) ==
                       HB_UNICODE_GENERAL_CATEGORY_NON_SPACING_MARK;
     if (mark && i > 0 && FT_Get_Char_Index(faces_->faces[face_of[i - 1]], text[i]) != 0) {
@@ -158,30 +245,95 @@ ShapedLine Font::shape(std::string_view line) const {
       }
     }
   }
+  // The script of each character: spaces, digits, punctuation and marks (common, inherited) take
+  // the script before them, else the one after.
+  std::vector<hb_script_t> script(n, HB_SCRIPT_INVALID);
+  for (size_t i = 0; i < n; ++i) {
+    const hb_script_t s = hb_unicode_script(unicode, text[i]);
+    script[i] = real_script(s) ? s : i > 0 ? script[i - 1] : HB_SCRIPT_INVALID;
+  }
+  for (size_t i = n; i-- > 0;) {
+    if (script[i] == HB_SCRIPT_INVALID) script[i] = i + 1 < n ? script[i + 1] : HB_SCRIPT_COMMON;
+  }
+
+  // The bidirectional algorithm: embedding levels for the line as a paragraph of its own in
+  // `direction`, then the visual order (map[visual] = logical, trailing spaces at the
+  // paragraph's level). Marks are not moved after their bases (no FRIBIDI_FLAG_REORDER_NSM):
+  // HarfBuzz places them, shaping each right-to-left run in its own direction.
+  const auto length = static_cast<FriBidiStrIndex>(n);
+  const auto* chars = reinterpret_cast<const FriBidiChar*>(text.data());
+  std::vector<FriBidiCharType> types(n);
+  std::vector<FriBidiBracketType> brackets(n);
+  std::vector<FriBidiLevel> levels(n, 0);
+  std::vector<FriBidiStrIndex> map(n);
+  std::iota(map.begin(), map.end(), FriBidiStrIndex{0});
+  FriBidiParType base = direction == TextDirection::left_to_right   ? FRIBIDI_PAR_LTR
+                        : direction == TextDirection::right_to_left ? FRIBIDI_PAR_RTL
+                                                                    : FRIBIDI_PAR_ON;
+  if (n > 0) {
+    fribidi_get_bidi_types(chars, length, types.data());
+    fribidi_get_bracket_types(chars, length, types.data(), brackets.data());
+    if (fribidi_get_par_embedding_levels_ex(types.data(), brackets.data(), length, &base,
+                                            levels.data()) == 0 ||
+        fribidi_reorder_line(0, types.data(), length, 0, base, levels.data(), nullptr,
+                             map.data()) == 0) {
+      throw Error("font: FriBiDi could not order a label line of " + std::to_string(n) +
+                  " characters");
+    }
+  } else if (base == FRIBIDI_PAR_ON) {
+    base = FRIBIDI_PAR_LTR;
+  }
+
   ShapedLine out;
+  out.right_to_left = FRIBIDI_IS_RTL(base);
   glm::vec2 pen(0.0f);
   hb_buffer_t* buffer = hb_buffer_create();
-  for (size_t start = 0; start < text.size();) {
-    size_t end = start + 1;
-    while (end < text.size() && face_of[end] == face_of[start]) ++end;
+  // Runs in visual order: characters next to each other in both orders, of one level, face and
+  // script.
+  for (size_t v = 0; v < n;) {
+    const auto first = size_t(map[v]);
+    const FriBidiLevel level = levels[first];
+    const bool rtl = (level & 1) != 0;
+    size_t w = v + 1;
+    for (; w < n; ++w) {
+      const auto logical = size_t(map[w]);
+      const size_t expected = rtl ? size_t(map[w - 1]) - 1 : size_t(map[w - 1]) + 1;
+      if (logical != expected || levels[logical] != level || face_of[logical] != face_of[first] ||
+          script[logical] != script[first]) {
+        break;
+      }
+    }
+    const size_t start = rtl ? size_t(map[w - 1]) : first;
+    const size_t count = w - v;
+    v = w;
+    const uint32_t face = face_of[first];
     hb_buffer_clear_contents(buffer);
     // (the whole line is the context: shaping at a run's edge sees its neighbours)
-    hb_buffer_add_utf32(buffer, reinterpret_cast<const uint32_t*>(text.data()), int(text.size()),
-                        unsigned(start), int(end - start));
-    hb_buffer_guess_segment_properties(buffer);
-    hb_shape(faces_->fonts[face_of[start]], buffer, nullptr, 0);
-    unsigned count = 0;
-    const hb_glyph_info_t* info = hb_buffer_get_glyph_infos(buffer, &count);
-    const hb_glyph_position_t* position = hb_buffer_get_glyph_positions(buffer, &count);
-    for (unsigned g = 0; g < count; ++g) {
+    hb_buffer_add_utf32(buffer, reinterpret_cast<const uint32_t*>(text.data()), int(n),
+                        unsigned(start), int(count));
+    hb_buffer_set_direction(buffer, rtl ? HB_DIRECTION_RTL : HB_DIRECTION_LTR);
+    hb_buffer_set_script(buffer, script[first]);
+    hb_buffer_guess_segment_properties(buffer);  // (the language)
+    hb_shape(faces_->fonts[face], buffer, nullptr, 0);
+    unsigned glyphs = 0;
+    const hb_glyph_info_t* info = hb_buffer_get_glyph_infos(buffer, &glyphs);
+    const hb_glyph_position_t* position = hb_buffer_get_glyph_positions(buffer, &glyphs);
+    for (unsigned g = 0; g < glyphs; ++g) {
       const glm::vec2 offset(float(position[g].x_offset) / 64.0f,
                              -float(position[g].y_offset) / 64.0f);
-      out.glyphs.push_back({{face_of[start], info[g].codepoint}, pen + offset});
+      out.glyphs.push_back({{face, info[g].codepoint}, pen + offset, info[g].cluster});
       pen += glm::vec2(float(position[g].x_advance), -float(position[g].y_advance)) / 64.0f;
+      const char32_t c = info[g].cluster < n ? text[info[g].cluster] : kReplacement;
+      if (info[g].codepoint == 0 &&
+          std::find(out.missing.begin(), out.missing.end(), c) == out.missing.end()) {
+        out.missing.push_back(c);
+      }
     }
-    start = end;
   }
   hb_buffer_destroy(buffer);
+  // (the runs were visited in visual order; the missing characters are listed in logical order)
+  std::sort(out.missing.begin(), out.missing.end(),
+            [&](char32_t a, char32_t b) { return text.find(a) < text.find(b); });
   out.advance = pen.x;
   return out;
 }

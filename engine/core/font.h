@@ -1,6 +1,8 @@
 // Label text: OpenType/TrueType faces read by FreeType and shaped by HarfBuzz (kerning, ligatures,
-// combining marks), a character the main face lacks taken from the first fallback face that has
-// it, and the glyphs a set of texts uses rasterised into an R8 coverage atlas. Labels sample the
+// combining marks, Arabic joining), a character the main face lacks taken from the first fallback
+// face that has it, right-to-left and mixed text put in visual order by GNU FriBiDi (the Unicode
+// bidirectional algorithm), and the glyphs a set of texts uses rasterised into an R8 coverage
+// atlas. Labels sample the
 // atlas with bilinear filtering, so every glyph keeps one texel of zero coverage around it.
 #pragma once
 
@@ -19,11 +21,22 @@ namespace strata {
 
 // From Debian's fonts-dejavu-core.
 inline constexpr const char* kDefaultFontPath = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-// Tried in order for characters the main face lacks (Debian's fonts-freefont-ttf); those not
-// installed are skipped.
+// Tried in order for characters the main face lacks (Debian's fonts-freefont-ttf, then a CJK
+// face: fonts-wqy-microhei, which scripts/setup.sh installs, else fonts-noto-cjk, fonts-wqy-zenhei
+// or fonts-droid-fallback); those not installed are skipped. Of the CJK faces only the first
+// installed one is read.
 inline constexpr const char* kFallbackFontPaths[] = {
     "/usr/share/fonts/truetype/freefont/FreeSans.ttf",
     "/usr/share/fonts/truetype/freefont/FreeSerif.ttf"};
+inline constexpr const char* kCjkFontPaths[] = {
+    "/usr/share/fonts/truetype/wqy/wqy-microhei.ttc",
+    "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc",
+    "/usr/share/fonts/truetype/wqy/wqy-zenhei.ttc",
+    "/usr/share/fonts/truetype/droid/DroidSansFallbackFull.ttf"};
+
+// A paragraph's base direction: automatic takes its first strong character's (left-to-right when
+// it has none), as HTML's dir=auto does.
+enum class TextDirection { automatic, left_to_right, right_to_left };
 
 // A glyph of one of the font's faces (0: the main face, then the fallbacks in order).
 struct GlyphKey {
@@ -36,11 +49,15 @@ struct GlyphKey {
 struct ShapedGlyph {
   GlyphKey key;
   glm::vec2 pen{0.0f};
+  uint32_t cluster = 0;  // the (first) character it draws: an index into the line's code points
 };
 
 struct ShapedLine {
-  std::vector<ShapedGlyph> glyphs;  // in visual order
+  std::vector<ShapedGlyph> glyphs;  // in visual order, left to right
   float advance = 0.0f;             // the line's width, pixels
+  bool right_to_left = false;       // the paragraph's resolved direction
+  std::vector<char32_t> missing;    // characters no face has (drawn as the missing-glyph box),
+                                    // each once, in logical order
 };
 
 struct GlyphMetrics {
@@ -77,9 +94,11 @@ class Font {
   float line_spacing() const { return line_spacing_; }
   size_t face_count() const;
 
-  // One line of UTF-8 text (malformed bytes become U+FFFD), shaped. A character no face has is
-  // drawn with the main face's missing-glyph box.
-  ShapedLine shape(std::string_view line) const;
+  // One line of UTF-8 text (malformed bytes become U+FFFD), shaped: its embedding levels resolved
+  // in `direction` (the paragraph's: see paragraph_direction), cut into runs of one level, face
+  // and script, each shaped in its direction, the runs in visual order. A character no face has
+  // is drawn with the main face's missing-glyph box and listed in `missing`.
+  ShapedLine shape(std::string_view line, TextDirection direction = TextDirection::automatic) const;
   // Whether some face has a glyph for `codepoint`.
   bool covers(char32_t codepoint) const;
 
@@ -101,5 +120,16 @@ std::string font_file(const std::string& path = kDefaultFontPath);
 
 // UTF-8 to code points; a malformed or truncated sequence becomes one U+FFFD.
 std::u32string decode_utf8(std::string_view text);
+
+// The direction of the first strong character of `paragraph` (UTF-8): right_to_left or
+// left_to_right (also when it has none).
+TextDirection paragraph_direction(std::string_view paragraph);
+
+// `text` (UTF-8) safe to print on a terminal: control characters (C0, DEL, C1, U+0000 too) and
+// bidirectional controls written \u0007, \u001B, ...; a malformed byte \xFF; the rest as is.
+std::string printable_text(std::string_view text);
+
+// "U+1F600".
+std::string codepoint_name(char32_t c);
 
 }  // namespace strata
