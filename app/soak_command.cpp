@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -485,7 +486,7 @@ void add_soak_command(CLI::App* bench, DeviceOptions& device) {
       ->check(whole_range(1, 1000000));
   cmd->add_option("--habuffer-slots", o->habuffer_slots,
                   "the HA-Buffer's slots at the start (it grows from there; 0: from the size)")
-      ->check(whole_range(0, 1u << 28))
+      ->check(whole_range(0, double(UINT32_MAX)))  // (the device's limit is checked with the sizes)
       ->capture_default_str();
   cmd->add_option("--json", o->json, "also write the summary and every measurement as JSON");
   cmd->callback([&device, o] { soak(device, *o); });

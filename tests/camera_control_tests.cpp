@@ -333,6 +333,7 @@ TEST_SUITE("cpu") {
         std::filesystem::path(STRATA_TEST_OUTPUT) / "camera_control_tests";
     std::filesystem::create_directories(folder);
     Scene scene = box_scene();
+    scene.has_camera = true;  // its own camera, written back (a fitted one is not)
     CameraControl control(scene);
     control.rotate({123.0f, -45.0f}, viewport);
     control.zoom_wheel(-2.0);
