@@ -3,18 +3,14 @@
 #include <cstdlib>
 
 #include "app/commands.h"
+#include "engine/scene/value_limits.h"
 
 namespace strata::app {
 namespace {
 
-std::string number_text(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
-
 CLI::Validator range_check(double lo, double hi, bool open_low, bool whole) {
-  const std::string range = (open_low ? "(" : "[") + number_text(lo) + ", " + number_text(hi) + "]";
+  const std::string range =
+      (open_low ? "(" : "[") + value_limits::shown(lo) + ", " + value_limits::shown(hi) + "]";
   const std::string kind = whole ? "a whole number" : "a number";
   auto check = [=](std::string& input) -> std::string {
     const char* begin = input.c_str();

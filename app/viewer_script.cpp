@@ -8,15 +8,10 @@
 #include "engine/core/error.h"
 #include "engine/scene/fitted_camera.h"
 #include "engine/scene/transfer_function_presets.h"
+#include "engine/scene/value_limits.h"
 
 namespace strata::app {
 namespace {
-
-std::string number_text(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
 
 // A finite number in [lo, hi] (a whole one with `whole`), written as nothing else.
 double number(const std::string& word, double lo, double hi, bool whole = false) {
@@ -27,7 +22,7 @@ double number(const std::string& word, double lo, double hi, bool whole = false)
                       (!whole || v == std::floor(v));
   if (!inside) {
     throw Error("'" + word + "' is not " + (whole ? "a whole number" : "a number") + " in [" +
-                number_text(lo) + ", " + number_text(hi) + "]");
+                value_limits::shown(lo) + ", " + value_limits::shown(hi) + "]");
   }
   return v;
 }

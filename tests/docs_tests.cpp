@@ -19,33 +19,8 @@ namespace {
 
 const fs::path source = STRATA_SOURCE_DIR;
 
-struct CodeBlock {
-  std::string language;
-  std::string text;
-  size_t line = 0;
-};
-
-std::vector<CodeBlock> code_blocks(const std::string& markdown) {
-  std::vector<CodeBlock> blocks;
-  std::istringstream in(markdown);
-  std::string line;
-  size_t number = 0;
-  std::optional<CodeBlock> open;
-  while (std::getline(in, line)) {
-    ++number;
-    if (line.starts_with("```")) {
-      if (open) {
-        blocks.push_back(*open);
-        open.reset();
-      } else {
-        open = CodeBlock{line.substr(3), "", number};
-      }
-    } else if (open) {
-      open->text += line + "\n";
-    }
-  }
-  return blocks;
-}
+using strata::test::code_blocks;
+using strata::test::CodeBlock;
 
 // The example scene's paths are as seen from assets/scenes/: a copy of that layout with the
 // repository's data linked in, and a small mesh for the example's skull.ply.

@@ -119,29 +119,12 @@ void check_round_trip(const fs::path& file, const fs::path& out) {
   CHECK(test::read_file(again) == test::read_file(out));
 }
 
-struct CodeBlock {
-  std::string text;
-  size_t line = 0;
-};
-
 // The ```-fenced blocks of a page that are strata scenes.
-std::vector<CodeBlock> scene_blocks(const std::string& markdown) {
-  std::vector<CodeBlock> blocks;
-  std::istringstream in(markdown);
-  std::string line;
-  size_t number = 0;
-  std::optional<CodeBlock> open;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.starts_with("```")) {
-      if (open) open->text += line + "\n";
-    } else if (open) {
-      if (open->text.find("\"strata_scene\"") != std::string::npos) blocks.push_back(*open);
-      open.reset();
-    } else {
-      open = CodeBlock{"", number};
-    }
-  }
+std::vector<test::CodeBlock> scene_blocks(const std::string& markdown) {
+  std::vector<test::CodeBlock> blocks = test::code_blocks(markdown);
+  std::erase_if(blocks, [](const test::CodeBlock& block) {
+    return block.text.find("\"strata_scene\"") == std::string::npos;
+  });
   return blocks;
 }
 
@@ -185,7 +168,8 @@ TEST_SUITE("loaders") {
     const fs::path out = root / "written";
     fs::create_directories(out);
     size_t scenes = 0;
-    for (const CodeBlock& block : scene_blocks(test::read_file(source / "docs/scene-format.md"))) {
+    for (const test::CodeBlock& block :
+         scene_blocks(test::read_file(source / "docs/scene-format.md"))) {
       INFO("docs/scene-format.md line " << block.line);
       const std::string name = "example-" + std::to_string(block.line) + ".json";
       check_round_trip(test::write_file(root / "scenes" / name, block.text), out / name);

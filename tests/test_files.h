@@ -4,8 +4,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "engine/core/error.h"
 
@@ -41,6 +44,35 @@ std::string error_of(F&& f) {
     return e.what();
   }
   return "(no error)";
+}
+
+// A ```-fenced block of a Markdown page: its language, its text and the line of its fence.
+struct CodeBlock {
+  std::string language;
+  std::string text;
+  size_t line = 0;
+};
+
+inline std::vector<CodeBlock> code_blocks(const std::string& markdown) {
+  std::vector<CodeBlock> blocks;
+  std::istringstream in(markdown);
+  std::string line;
+  size_t number = 0;
+  std::optional<CodeBlock> open;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.starts_with("```")) {
+      if (open) {
+        blocks.push_back(*open);
+        open.reset();
+      } else {
+        open = CodeBlock{line.substr(3), "", number};
+      }
+    } else if (open) {
+      open->text += line + "\n";
+    }
+  }
+  return blocks;
 }
 
 }  // namespace strata::test
