@@ -302,8 +302,7 @@ TEST_SUITE("window") {
     const auto script = test::write_file(
         dir / "script.txt", "screenshot " + d("head.png") + "\npreset mr-brain\nscreenshot " +
                                 d("brain.png") + "\nview superior\nscreenshot " + d("top.png") +
-                                "\npreset ct-bone\nscreenshot " + d("bone.png") +
-                                "\npreset lung\nquit\n");
+                                "\npreset ct-bone\nscreenshot " + d("bone.png") + "\nquit\n");
     const auto r = run_strata("--validate view " STRATA_SOURCE_DIR
                               "/assets/cache/mricron/ch2.nii.gz --size 96 --no-optimize "
                               "--no-panel --script " +
@@ -311,9 +310,7 @@ TEST_SUITE("window") {
     INFO(r.output);
     CHECK(r.output.find("validation") == std::string::npos);
     CHECK(r.output.find("preset mr-head") != std::string::npos);  // chosen and said
-    // The script stops at the unknown preset, with the names.
-    CHECK(r.exit_code != 0);
-    CHECK(r.output.find("no transfer-function preset 'lung' (ct-skin,") != std::string::npos);
+    CHECK(r.exit_code == 0);
     const Rgba8Image head = read_png(d("head.png")), brain = read_png(d("brain.png"));
     const Rgba8Image bone = read_png(d("bone.png")), top = read_png(d("top.png"));
     CHECK(changed_pixels(head, brain) > 500);
