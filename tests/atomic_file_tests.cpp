@@ -89,7 +89,7 @@ TEST_SUITE("loaders") {
       AtomicFile atomic(file);
       atomic.write(std::string_view("new, but cut short"));
       CHECK(fs::exists(atomic.temporary()));
-      CHECK(atomic.temporary().parent_path() == file.parent_path());
+      CHECK(folder_bytes(folder) == before);  // the temporary has no name in the folder
       CHECK(test::read_file(file) == "old");
     }  // (as when an exception leaves the writer)
     CHECK(folder_bytes(folder) == before);
@@ -100,6 +100,23 @@ TEST_SUITE("loaders") {
     }
     CHECK(test::read_file(file) == "new");
     CHECK(folder_bytes(folder).size() == 1);
+  }
+
+  TEST_CASE("an_atomic_file_killed_before_it_is_done_leaves_the_old_file_and_nothing_else") {
+    const fs::path folder = test::fresh_folder("atomic_file", "killed");
+    const fs::path file = test::write_file(folder / "out.png", "the old picture");
+    const auto before = folder_bytes(folder);
+    const pid_t pid = fork();
+    if (pid == 0) {
+      AtomicFile atomic(file, "PNG");
+      atomic.write(std::string(1 << 20, 'x'));
+      ::kill(::getpid(), SIGKILL);  // (as a user's kill -9 or the OOM killer)
+      _exit(1);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    CHECK(WIFSIGNALED(status));
+    CHECK(folder_bytes(folder) == before);
   }
 
   TEST_CASE("an_atomic_file_that_must_not_replace_fails_on_an_existing_file") {

@@ -1,7 +1,8 @@
-// Files written whole or not at all. The bytes go to a temporary file beside the target
-// ("<path>.tmp-XXXXXX", so the rename stays on one file system), are flushed to the disk and
-// renamed over the target only when every one was written. A failure, an exception included,
-// removes the temporary: the old file stays as it was, or there is none, never a cut one.
+// Files written whole or not at all. The bytes go to an unnamed file in the target's folder
+// (O_TMPFILE; where the file system lacks it, "<path>.tmp-XXXXXX"), are flushed to the disk and
+// given the target's name only when every one was written (a link, then a rename over the old
+// file, on one file system). A failure, an exception or a kill before that leaves the old file
+// as it was, or none, never a cut one.
 #pragma once
 
 #include <cstddef>
@@ -25,7 +26,8 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   const std::filesystem::path& path() const { return path_; }
-  // Where the bytes go until commit(): for writers that open files by name (FFmpeg).
+  // Where the bytes go until commit(), for writers that open files by name (FFmpeg): the unnamed
+  // file as /proc/self/fd/N, or the named temporary.
   const std::filesystem::path& temporary() const { return temporary_; }
 
   // Appends bytes; an Error naming the target and the reason (a full disk: "No space left").
@@ -37,12 +39,14 @@ class AtomicFile {
 
  private:
   [[noreturn]] void fail(const std::string& reason) const;
+  void close_or_fail();
 
   std::filesystem::path path_, temporary_;
   std::string what_;
   Replace replace_;
   int fd_ = -1;
-  bool direct_ = false;  // a device or pipe: no temporary
+  bool direct_ = false;   // a device or pipe: no temporary
+  bool unnamed_ = false;  // O_TMPFILE: the temporary has no name yet
   bool committed_ = false;
 };
 
