@@ -10,7 +10,6 @@
 #include <csignal>
 #include <filesystem>
 #include <functional>
-#include <map>
 #include <string>
 
 #include "engine/core/atomic_file.h"
@@ -22,14 +21,6 @@ namespace fs = std::filesystem;
 
 namespace strata {
 namespace {
-
-// Every file in the folder with its bytes.
-std::map<std::string, std::string> folder_bytes(const fs::path& folder) {
-  std::map<std::string, std::string> files;
-  for (const auto& entry : fs::directory_iterator(folder))
-    files[entry.path().filename().string()] = test::read_file(entry.path());
-  return files;
-}
 
 // Runs `write` in a child whose files may grow to `limit` bytes (write() then fails with EFBIG,
 // as on a full disk); the child's exit status: 0 when write threw strata::Error, 1 when it did
@@ -60,10 +51,10 @@ TEST_SUITE("loaders") {
   TEST_CASE("a_write_past_the_file_size_limit_fails_and_leaves_the_old_file_and_no_temporary") {
     const fs::path folder = test::fresh_folder("atomic_file", "limit");
     const fs::path file = test::write_file(folder / "out.json", "the old file\n");
-    const auto before = folder_bytes(folder);
+    const auto before = test::folder_bytes(folder);
     const std::string big(64 * 1024, 'x');
     CHECK(with_file_size_limit(4096, [&] { write_text_file(file, big); }) == 0);
-    CHECK(folder_bytes(folder) == before);
+    CHECK(test::folder_bytes(folder) == before);
     // A PNG (write_png) and a file that was not there before: nothing is left either.
     std::vector<uint8_t> noise(128 * 128 * 4);  // (random: no PNG of it is small)
     uint32_t state = 2463534242u;
@@ -75,7 +66,7 @@ TEST_SUITE("loaders") {
     }
     CHECK(with_file_size_limit(
               4096, [&] { write_png((folder / "new.png").string(), 128, 128, noise); }) == 0);
-    CHECK(folder_bytes(folder) == before);
+    CHECK(test::folder_bytes(folder) == before);
     // Without the limit the same writes succeed (the limit is what failed them).
     write_text_file(file, big);
     CHECK(test::read_file(file) == big);
@@ -84,28 +75,28 @@ TEST_SUITE("loaders") {
   TEST_CASE("an_atomic_file_left_uncommitted_removes_its_temporary_and_keeps_the_old_file") {
     const fs::path folder = test::fresh_folder("atomic_file", "uncommitted");
     const fs::path file = test::write_file(folder / "out.txt", "old");
-    const auto before = folder_bytes(folder);
+    const auto before = test::folder_bytes(folder);
     {
       AtomicFile atomic(file);
       atomic.write(std::string_view("new, but cut short"));
       CHECK(fs::exists(atomic.temporary()));
-      CHECK(folder_bytes(folder) == before);  // the temporary has no name in the folder
+      CHECK(test::folder_bytes(folder) == before);  // the temporary has no name in the folder
       CHECK(test::read_file(file) == "old");
     }  // (as when an exception leaves the writer)
-    CHECK(folder_bytes(folder) == before);
+    CHECK(test::folder_bytes(folder) == before);
     {
       AtomicFile atomic(file);
       atomic.write(std::string_view("new"));
       atomic.commit();
     }
     CHECK(test::read_file(file) == "new");
-    CHECK(folder_bytes(folder).size() == 1);
+    CHECK(test::folder_bytes(folder).size() == 1);
   }
 
   TEST_CASE("an_atomic_file_killed_before_it_is_done_leaves_the_old_file_and_nothing_else") {
     const fs::path folder = test::fresh_folder("atomic_file", "killed");
     const fs::path file = test::write_file(folder / "out.png", "the old picture");
-    const auto before = folder_bytes(folder);
+    const auto before = test::folder_bytes(folder);
     const pid_t pid = fork();
     if (pid == 0) {
       AtomicFile atomic(file, "PNG");
@@ -116,7 +107,7 @@ TEST_SUITE("loaders") {
     int status = 0;
     waitpid(pid, &status, 0);
     CHECK(WIFSIGNALED(status));
-    CHECK(folder_bytes(folder) == before);
+    CHECK(test::folder_bytes(folder) == before);
   }
 
   TEST_CASE("an_atomic_file_that_must_not_replace_fails_on_an_existing_file") {
@@ -126,7 +117,7 @@ TEST_SUITE("loaders") {
             write_file_atomically(file, "a scene", "the scene", AtomicFile::Replace::no);
           }).find("scan.json: cannot write the scene: it exists") != std::string::npos);
     CHECK(test::read_file(file) == "a transfer function");
-    CHECK(folder_bytes(folder).size() == 1);
+    CHECK(test::folder_bytes(folder).size() == 1);
     write_file_atomically(folder / "new.json", "a scene", "the scene", AtomicFile::Replace::no);
     CHECK(test::read_file(folder / "new.json") == "a scene");
   }

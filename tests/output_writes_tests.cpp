@@ -20,16 +20,6 @@ namespace {
 
 using test::run_strata;
 
-// Every regular file under `folder` (symbolic links to folders not followed) with its bytes.
-std::map<std::string, std::string> folder_bytes(const fs::path& folder) {
-  std::map<std::string, std::string> files;
-  for (const auto& entry : fs::recursive_directory_iterator(folder)) {
-    if (entry.is_regular_file() && !entry.is_symlink())
-      files[fs::relative(entry.path(), folder).string()] = test::read_file(entry.path());
-  }
-  return files;
-}
-
 // The shell runs strata with its files limited to 1 block (512 or 1024 bytes) and SIGXFSZ
 // ignored, so a write past it fails with EFBIG as on a full disk.
 const std::string kSmallFiles = "trap '' XFSZ; ulimit -f 1;";
@@ -40,12 +30,12 @@ TEST_SUITE("cli") {
   TEST_CASE("render_that_cannot_write_its_png_leaves_the_old_file_and_no_other") {
     const fs::path dir = test::fresh_folder("output_writes", "render_limit");
     const fs::path png = test::write_file(dir / "out.png", "the old picture");
-    const auto before = folder_bytes(dir);
+    const auto before = test::folder_bytes(dir);
     const auto r = run_strata("render --size 128 -o " + png.string(), kSmallFiles);
     INFO(r.output);
     CHECK(r.exit_code == 1);
     CHECK(r.output.find(png.string() + ": cannot write PNG: File too large") != std::string::npos);
-    CHECK(folder_bytes(dir) == before);
+    CHECK(test::folder_bytes(dir) == before);
     // (without the limit the same command writes it)
     CHECK(run_strata("render --size 128 -o " + png.string()).exit_code == 0);
     CHECK(test::read_file(png).starts_with("\x89PNG"));
@@ -72,12 +62,12 @@ TEST_SUITE("cli") {
     const std::string video = "video " STRATA_SOURCE_DIR
                               "/assets/scenes/head.json --orbit 12 --seconds 0.1 --size 64 -o ";
     const fs::path old_mp4 = test::write_file(dir / "old.mp4", "the old video");
-    const auto before = folder_bytes(dir);
+    const auto before = test::folder_bytes(dir);
     const auto limited = run_strata(video + old_mp4.string(), kSmallFiles);
     INFO(limited.output);
     CHECK(limited.exit_code == 1);
     CHECK(limited.output.find("File too large") != std::string::npos);
-    CHECK(folder_bytes(dir) == before);
+    CHECK(test::folder_bytes(dir) == before);
     // A layout folder inside a file cannot be made: found before the video is opened.
     const fs::path mp4 = dir / "new.mp4";
     const auto no_folder =
@@ -86,7 +76,7 @@ TEST_SUITE("cli") {
     CHECK(no_folder.exit_code == 1);
     CHECK(no_folder.output.find("--layout-dir: " + (old_mp4 / "layouts").string() +
                                 ": cannot create the folder") != std::string::npos);
-    CHECK(folder_bytes(dir) == before);
+    CHECK(test::folder_bytes(dir) == before);
   }
 #endif
 }
@@ -108,7 +98,7 @@ std::string save_positions(const fs::path& scene, const fs::path& script_folder)
 // loads and holds both new positions.
 void check_only_saved(const fs::path& folder, const std::map<std::string, std::string>& before,
                       const fs::path& saved) {
-  auto after = folder_bytes(folder);
+  auto after = test::folder_bytes(folder);
   const std::string name = fs::relative(saved, folder).string();
   REQUIRE(after.count(name) == 1);
   CHECK(after[name] != (before.count(name) ? before.at(name) : std::string()));
@@ -155,13 +145,13 @@ TEST_SUITE("window") {
 
     for (const fs::path& scene : scenes) {
       INFO(scene.string());
-      const auto before = folder_bytes(root);
+      const auto before = test::folder_bytes(root);
       const std::string output = save_positions(scene, scripts);
       CHECK(output.find("saved position 'mine2' in " + scene.string()) != std::string::npos);
       check_only_saved(root, before, scene);
     }
     {
-      const auto before = folder_bytes(root);
+      const auto before = test::folder_bytes(root);
       const std::string output = save_positions(root / "alone/scan.mha", scripts);
       const fs::path saved = root / "alone/scan.scene.json";
       CHECK(output.find("in a new scene file " + saved.string()) != std::string::npos);
@@ -169,7 +159,7 @@ TEST_SUITE("window") {
       check_only_saved(root, before, saved);
     }
     {
-      const auto before = folder_bytes(root);
+      const auto before = test::folder_bytes(root);
       const std::string output = save_positions(root / "crowded/scan.mha", scripts);
       const fs::path saved = root / "crowded/scan.scene-2.json";
       CHECK(output.find("in a new scene file " + saved.string()) != std::string::npos);

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -44,6 +45,17 @@ std::string error_of(F&& f) {
     return e.what();
   }
   return "(no error)";
+}
+
+// Every regular file below `folder` (links not followed) with its bytes, by relative path: a
+// folder's state before and after a command, to show what it changed.
+inline std::map<std::string, std::string> folder_bytes(const std::filesystem::path& folder) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder)) {
+    if (entry.is_regular_file() && !entry.is_symlink())
+      files[std::filesystem::relative(entry.path(), folder).string()] = read_file(entry.path());
+  }
+  return files;
 }
 
 // A ```-fenced block of a Markdown page: its language, its text and the line of its fence.
