@@ -76,32 +76,47 @@ trap 'rm -rf "$TMPDIR"' EXIT
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
-failed=()
-for target in "${targets[@]}"; do
-  corpus=$build/corpus/$target
+# One target: its run, then its line (and the finding's excerpt) in $build/findings/<target>.line.
+run_target() {
+  local target=$1 corpus=$build/corpus/$1 log=$build/findings/$1.log status=ok
   mkdir -p "$corpus"
-  log=$build/findings/$target.log
   # The inputs stay small (-max_len), so a lying header is the only way to a large allocation:
   # every legitimate one stays far below -malloc_limit_mb (a 64 KiB input inflates to 66 MB at
   # most, and its conversion to float needs four times that).
-  args=(-max_len=65536 -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=512
-        -dict="$(dictionary "$target")" -artifact_prefix="$build/findings/$target-"
-        -print_final_stats=1 "${limit[@]}")
-  start=$SECONDS
-  if "$build/fuzz/$target" "${args[@]}" "$corpus" "$seeds/$target" >"$log" 2>&1; then
-    status=ok
-  else
-    status=FINDING
-    failed+=("$target")
-  fi
+  local args=(-max_len=65536 -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=512
+              -dict="$(dictionary "$target")" -artifact_prefix="$build/findings/$target-"
+              -print_final_stats=1 "${limit[@]}")
+  local start=$SECONDS
+  rm -f "$build/findings/$target.line"
+  "$build/fuzz/$target" "${args[@]}" "$corpus" "$seeds/$target" >"$log" 2>&1 || status=FINDING
+  local runs speed
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
-  printf '%-30s %10s executions %5d s %7s exec/s  %s\n' "$target" "${runs:-?}" \
-    $((SECONDS - start)) "${speed:-?}" "$status"
-  if [[ $status != ok ]]; then
-    grep -E 'ERROR|SUMMARY|fuzz:|Test unit written|==[0-9]+==' "$log" | head -20 | sed 's/^/    /'
-    echo "    log: $log; replay: $build/fuzz/$target <the input written above>"
+  {
+    printf '%-30s %10s executions %5d s %7s exec/s  %s\n' "$target" "${runs:-?}" \
+      $((SECONDS - start)) "${speed:-?}" "$status"
+    if [[ $status != ok ]]; then
+      grep -E 'ERROR|SUMMARY|fuzz:|Test unit written|==[0-9]+==' "$log" | head -20 | sed 's/^/    /'
+      echo "    log: $log; replay: $build/fuzz/$target <the input written above>"
+    fi
+  } >"$build/findings/$target.line"
+}
+
+# As many targets at a time as there are cores (each is one process), reported in list order.
+running=0
+for target in "${targets[@]}"; do
+  if ((running >= $(nproc))); then
+    wait -n || true
+    ((running--))
   fi
+  run_target "$target" &
+  ((++running))
+done
+wait || true
+failed=()
+for target in "${targets[@]}"; do
+  cat "$build/findings/$target.line"
+  grep -q ' FINDING$' "$build/findings/$target.line" && failed+=("$target")
 done
 if ((${#failed[@]})); then
   echo "fuzz: findings in ${failed[*]}" >&2
