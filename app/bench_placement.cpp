@@ -167,8 +167,8 @@ PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& c
   frame.run();  // warm up, and grow the HA-Buffer if it must
   graph::GraphRunner& runner = frame.runner();
   PlacementRun r;
-  // (three warm-up runs: with one, an H100 sweep read 100 labels' loop as 5.1 ms and a run of
-  // that count alone as 1.95 ms; the GPU idles while the CPU builds each count's frame)
+  // (three warm-up runs: with one, a sweep read a count's loop much slower than a run of that
+  // count alone; the GPU idles while the CPU builds each count's frame)
   r.timings = measure(runner, 3, runs);
   // The whole placement again with timestamps only where groups begin and end (a stamp waits for
   // the GPU to drain and costs time the real frame does not spend).

@@ -32,10 +32,9 @@ struct Timings {
 // end) GPU times.
 Timings measure(graph::GraphRunner& runner, uint32_t warmup, uint32_t runs,
                 const std::function<void()>& after_run = {});
-// A GPU that idled while the host set a benchmark up runs its first frames slowly: on an H100,
-// with three warm-up frames the first count measured in a process (10 labels' placement) read
-// its loop 1.5 to 4 times too slow in four processes of six; warming up for this long left one
-// of nine at 1.5 times. (The labels' state carries over from frame to frame, so how many frames
+// A GPU that idled while the host set a benchmark up runs its first frames slowly: with three
+// warm-up frames the first count measured in a process read its loop several times too slow
+// (docs/performance.md); warming up for this long made that rare. (The labels' state carries over from frame to frame, so how many frames
 // ran changes how many tidy-up rounds the measured frames run.)
 inline constexpr double kWarmupSeconds = 0.5;
 

@@ -23,8 +23,8 @@ using graph::Use;
 
 // The tidy-up's rounds for `labels` labels: as asked up to TIDY_SHARED_MAX (256); past that a
 // round's work grows with the square of the count or faster (each conflicted label's moves and
-// each crossing pair weighed against every label: 64 rounds of 1000 labels took 324 ms on an
-// H100, of 4096 past the 10 s GPU timeout), so at most 64 (256 / labels)^2 rounds, at least one:
+// each crossing pair weighed against every label; 4096 labels' 64 rounds ran past the GPU
+// timeout: docs/performance.md), so at most 64 (256 / labels)^2 rounds, at least one:
 // 500 labels take 16, 1000 take 4, from 2048 on one.
 namespace {
 uint32_t tidy_rounds_for(uint32_t asked, uint32_t labels) {
@@ -358,9 +358,8 @@ glm::uvec3 Placement::direct_groups(graph::Extent viewport) const {
 // The layout tidy-up (its rounds: four dispatches each; a round after one that changed nothing
 // has nothing to do) and each label's position and whether it is shown, copied to the host after
 // the frame. On CPU devices the rounds are indirect dispatches sized by the round before, none
-// once nothing changes (lavapipe, head.json at 128²: 266 -> 43 ms); on an H100 that made them
-// slower (100 labels' tidy-up 4.59 -> 5.19 ms), so there the rounds are direct and their
-// workgroups leave at once (13 us a round).
+// once nothing changes; on a discrete GPU that made them slower (docs/performance.md), so there
+// the rounds are direct and their workgroups leave at once.
 void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
   std::vector<graph::ResourceUse> uses = {
       {b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
@@ -371,8 +370,8 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
       {b.tidy_rounds, Use::storage_write, PLACEMENT_BINDING_TIDY_ROUNDS},
       {b.tidy_args, Use::storage_read_write, PLACEMENT_BINDING_TIDY_ARGS},
       {b.placements, Use::storage_write, PLACEMENT_BINDING_PLACEMENTS}};
-  // (an indirect use makes every barrier of the pass wait for indirect reads too: on an H100 the
-  // 320 barriers of 64 rounds then cost 10 labels' tidy-up 0.89 -> 1.69 ms)
+  // (an indirect use makes every barrier of the pass wait for indirect reads too, which costs a
+  // GPU's 320 barriers of 64 rounds dearly)
   if (indirect_) uses.push_back({b.tidy_args, Use::indirect});
   if (skip_idle_blocks_) uses.push_back({b.tidy_rounds, Use::conditional});
   graph.add_pass(
@@ -386,8 +385,8 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
            p.step = round;
            // (a block past the first runs when the round before it applied a change: its first
            // round's count in the rounds buffer, which a round of the block before wrote. One
-           // conditional block per block of rounds: one around each dispatch cost the H100 more
-           // than the idle dispatches, 10 labels 1.07 -> 1.52 ms; this way 0.65 ms.)
+           // conditional block per block of rounds: one around each dispatch cost a GPU more than
+           // the idle dispatches it skipped.)
            const uint32_t block_start = round - round % kTidyBlockRounds;
            const bool skippable = skip_idle_blocks_ && block_start > 0;
            for (const uint32_t phase :

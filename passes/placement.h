@@ -47,9 +47,9 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
 // How the label loop's dispatches are sized. Their sizes are only known on the GPU: an indirect
 // dispatch reads them there; a direct one has enough workgroups for any sizes (with at most
 // PlacementLayout::direct_groups for the passes' tiles, each taking several past that), those past
-// the sizes leaving at once. On an H100 direct is faster (a chain of dependent dispatches costs
-// 2.2 us per step direct, 4.6 us indirect, and the idle workgroups about 0.5 us); on lavapipe,
-// where every workgroup runs on the CPU, idle ones cost more than the whole placement.
+// the sizes leaving at once. On a GPU direct is faster (a chain of dependent dispatches costs
+// less per step direct than indirect, and idle workgroups little; docs/performance.md); on
+// lavapipe, where every workgroup runs on the CPU, idle ones cost more than the whole placement.
 enum class LabelDispatch {
   automatic,  // direct, except on CPU devices
   direct,
@@ -103,7 +103,7 @@ class Placement {
   // `label_count` sizes the per-label buffers; a frame may enable fewer labels.
   Placement(Context& ctx, uint32_t label_count, PlacementLayout layout = {});
   // The same with its compute pipelines made beforehand by create_pipelines: they take a while on
-  // drivers that compile at creation (lavapipe: 0.3 s), so a caller may create them meanwhile.
+  // drivers that compile at creation (lavapipe), so a caller may create them meanwhile.
   Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
             std::vector<ComputePipeline> pipelines);
   static std::vector<ComputePipeline> create_pipelines(Context& ctx, uint32_t label_count);

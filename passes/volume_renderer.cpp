@@ -37,8 +37,8 @@ glm::mat4 texture_to_world(const Volume& v) {
   return v.index_to_world() * voxel_from_texture;
 }
 
-// Runs slices(first, last) over [0, count) split between the machine's cores. (The atlas of the
-// demo's head took 0.1 s on one core, while lavapipe's pipelines compiled on the other.)
+// Runs slices(first, last) over [0, count) split between the machine's cores. (On one core the
+// demo's atlas waited while lavapipe's pipelines compiled on the other.)
 template <typename F>
 void over_slices(uint32_t count, const F& slices) {
   const uint32_t parts = std::clamp(std::thread::hardware_concurrency(), 1u, 16u);

@@ -2,9 +2,8 @@
 // the volumes' boxes added, the walk, the layers and the final image. Included by
 // habuffer_resolve.comp (any scene) and, with VR_RESOLVE_ONE_VOLUME, by
 // habuffer_resolve_one_volume.comp: a scene of one volume and no meshes, whose walk the compiler
-// then specialises (H100, head.json: 72 -> 64 registers, 1.52 -> 1.34 ms at 1024², 5.15 -> 4.52
-// ms at 2048²). The volumes' records are a uniform block, read as constants (one volume: 64 -> 51
-// registers, 1.25 ms at 1024²; head-surfaces.json's meshes and volume: 72 -> 56, 1.68 -> 1.57).
+// then specialises (fewer registers, a faster resolve: docs/performance.md). The volumes' records
+// are a uniform block, read as constants.
 #ifdef VR_RESOLVE_ONE_VOLUME
 #define VR_RESOLVE_MESHES false
 #else

@@ -3,13 +3,13 @@
 // four dispatches per round, and each label's placement (box centre, cost, shown). A round whose
 // round before applied nothing leaves at once. The changes a round applies are taken up by the
 // next round's conflicts step (each label's workgroup stores its own; every workgroup reads the
-// others' as `take` says), or by the output: a fifth dispatch per round for that alone cost an
-// H100 about 3 us a round, even a round with nothing to do (10 labels: 0.90 -> 0.73 ms without).
+// others' as `take` says), or by the output: a fifth dispatch per round for that alone cost time
+// on every round, even a round with nothing to do.
 // Included by placement_finalize.comp (up to TIDY_SHARED_MAX labels) and
 // placement_finalize_large.comp (more: TIDY_STATES_IN_BUFFER), and with TIDY_SEARCH_ONLY by
 // placement_tidy_search.comp and placement_tidy_search_large.comp: the search step in a pipeline
-// of its own, the other steps without it. (One pipeline for all of them took lavapipe 420 ms to
-// create, the two together 190; on a GPU, registers are allocated for a pipeline's largest step.)
+// of its own, the other steps without it. (One pipeline for all of them took lavapipe twice as
+// long to create; on a GPU, registers are allocated for a pipeline's largest step.)
 layout(local_size_x = 64) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
 layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
@@ -159,7 +159,7 @@ void search(uint t, uint n) {
   uint i = 0u, change = 0u;
   bool live = false;
   // (A workgroup whose items could change nothing leaving before it copied the states, deciding
-  // that from the buffer, made 100 labels' tidy-up slower on an H100: 4.59 -> 5.42 ms.)
+  // that from the buffer, made the tidy-up slower on a GPU.)
   load_states(n, TIDY_PHASE_SEARCH);
   if (q < singles) {
     i = q / TIDY_SWAP;

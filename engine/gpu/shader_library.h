@@ -108,8 +108,8 @@ class ComputePipeline : public Pipeline {
 };
 
 // The compute pipelines of `shaders`, in that order, created on a thread each: a driver that
-// compiles at creation takes them in parallel (lavapipe spends up to 0.2 s on one of strata's
-// placement pipelines). The first error is thrown once every creation has ended.
+// compiles at creation takes them in parallel (lavapipe compiles at creation; docs/performance.md).
+// The first error is thrown once every creation has ended.
 std::vector<ComputePipeline> create_compute_pipelines(Context& ctx,
                                                       std::span<const std::string_view> shaders);
 

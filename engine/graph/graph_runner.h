@@ -77,15 +77,15 @@ class PassContext {
   // passes; this orders the steps inside one.
   void barrier();
   // barrier(), after which the conditional-rendering predicates read (begin_conditional) see
-  // what the pass wrote before it too. (Kept apart: on an H100 a barrier that waits for the
-  // command processor's reads costs several microseconds more than one between shaders.)
+  // what the pass wrote before it too. (Kept apart: on a GPU a barrier that waits for the
+  // command processor's reads costs more than one between shaders; docs/performance.md.)
   void barrier_for_predicates();
 
   // The dispatches recorded up to end_conditional() run only where the uint32 at `offset` of
   // `predicate` (declared conditional) is not 0 (VK_EXT_conditional_rendering:
-  // Context::conditional_rendering()). Barriers in between are not conditional. (On an H100 each
-  // block costs about 2 us: a block around each of the tidy-up's idle dispatches cost more than
-  // the dispatches did.)
+  // Context::conditional_rendering()). Barriers in between are not conditional. (Each block has a
+  // cost of its own: a block around each of the tidy-up's idle dispatches cost more than the
+  // dispatches did; docs/performance.md.)
   void begin_conditional(ResourceId predicate, VkDeviceSize offset);
   void end_conditional();
 

@@ -8,8 +8,8 @@
 
 #define PLACEMENT_GROUP 16  // per-pixel passes: 16 x 16 threads per workgroup
 #define PLACEMENT_TILE 32   // place_label: 32 x 32 candidates per workgroup ...
-#define PLACE_GROUP_X 16    // ... of 16 x 16 threads, 2 x 2 candidates each (on an
-#define PLACE_GROUP_Y 16    // H200, 16 x 8 and 8 x 8 ran slower, 32 x 16 no faster)
+#define PLACE_GROUP_X 16    // ... of 16 x 16 threads, 2 x 2 candidates each (16 x 8
+#define PLACE_GROUP_Y 16    // and 8 x 8 ran slower, 32 x 16 no faster: docs/performance.md)
 #define PLACE_SPAN_X (PLACEMENT_TILE / PLACE_GROUP_X)  // candidates per invocation across ...
 #define PLACE_SPAN_Y (PLACEMENT_TILE / PLACE_GROUP_Y)  // ... and down
 #define PLACEMENT_CELL 4               // placement_bounds: 4 x 4 candidates per cell, ...
@@ -242,7 +242,7 @@ STRATA_INLINE uint placement_classify_groups(uint beyond, uint per_group) {
 
 // List entries per classifying workgroup for `tiles` tiles: 4, or 8 or 16 where that keeps the
 // classification within 256 workgroups (fewer resident at once make a label's dispatch longer;
-// smaller groups finish sooner: on an H100 4 was fastest at 1024 tiles, 16 at 2040).
+// smaller groups finish sooner; docs/performance.md has the sizes measured).
 STRATA_INLINE uint placement_classify_tiles(uint tiles) {
   return tiles <= 1024u ? 4u : tiles <= 2048u ? 8u : 16u;
 }

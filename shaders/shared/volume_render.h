@@ -91,8 +91,7 @@ struct FrameGpu {
 // interleaved sets (0, 8, 16, ..., then 1, 9, ...), so that every long run of consecutive
 // workgroups spans the whole image: lavapipe hands each of its threads one contiguous run of a
 // dispatch's workgroups, and with rows in order the thread whose half of the image held more of
-// the volume ran on alone (a third of the resolve of head.json at 512 px, oblique). On the H100
-// that order cost 10% (1.51 -> 1.67 ms at 1024²).
+// the volume ran on alone. On a GPU that order is slower (docs/performance.md).
 #define VR_ORDER_ROWS 0u
 #define VR_ORDER_ROWS_INTERLEAVED 1u
 #define VR_ROW_INTERLEAVE 8u
