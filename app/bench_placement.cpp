@@ -72,7 +72,7 @@ struct PlacementRun {
   uint32_t labels = 0, labels_shown = 0, layers = 0;
   double whole_ms = 0.0;    // the placement group with stamps only at its two ends
   double stamped_ms = 0.0;  // the same group with a stamp around every pass
-  double loop_ms = 0.0, finalize_ms = 0.0, forces_ms = 0.0;
+  double loop_ms = 0.0, tidy_ms = 0.0, forces_ms = 0.0;
   std::optional<double> baseline_loop_ms;  // the label loop with a readback after every label
   double first_tiles = 0.0, rest_tiles = 0.0;
   uint32_t tidy_rounds = 0, tidy_rounds_run = 0;  // asked (after the cap), and that ran
@@ -181,7 +181,7 @@ PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& c
     if (name == "placement") r.stamped_ms = stat.median;
   }
   r.loop_ms = r.ms_per_pass(runner.graph().passes()[frame.placement().label_loop].name);
-  r.finalize_ms = r.ms_per_pass("placement.finalize");  // the layout's tidy-up
+  r.tidy_ms = r.ms_per_pass("placement.tidy");  // the tidy-up
   r.forces_ms = r.ms_per_pass("labels.forces");         // thesis 3.4: one invocation per label
   if (baseline) r.baseline_loop_ms = label_loop_with_readback_per_label(frame, runs);
   std::tie(r.first_tiles, r.rest_tiles) = tiles_per_label(frame);  // (runs a frame)
@@ -227,8 +227,8 @@ ordered_json sweep_entry(const PlacementRun& r) {
       {"labels", r.labels}, {"labels_shown", r.labels_shown}, {"layers", r.layers}};
   entry.update(placement_results(r));
   entry["label_loop_us_per_label"] = std::round(loop_us_per_label(r) * 1e3) / 1e3;
-  entry["finalize_ms"] = ms_json(r.finalize_ms);
-  entry["placement_rest_ms"] = ms_json(r.stamped_ms - r.loop_ms - r.finalize_ms);
+  entry["tidy_ms"] = ms_json(r.tidy_ms);
+  entry["placement_rest_ms"] = ms_json(r.stamped_ms - r.loop_ms - r.tidy_ms);
   for (const auto& [key, list] :
        {std::pair{"groups", &r.timings.groups}, std::pair{"passes", &r.timings.passes}}) {
     ordered_json& medians = entry[key] = ordered_json::object();
@@ -242,17 +242,17 @@ ordered_json sweep_entry(const PlacementRun& r) {
 void print_placement_row(const PlacementRun* r) {
   if (!r) {
     std::fprintf(stderr, "%6s %6s %12s %10s %9s %12s %9s %9s %9s %12s\n", "labels", "shown",
-                 "placement", "loop", "us/label", "finalize", "tidy", "rest", "forces", "baseline");
+                 "placement", "loop", "us/label", "tidy-up", "rounds", "rest", "forces", "baseline");
     return;
   }
   const std::optional<double> baseline = r->baseline_ms();
   char base[32] = "-";
   if (baseline) std::snprintf(base, sizeof base, "%.3f", *baseline);
-  char tidy[32];  // (rounds that ran of those asked)
-  std::snprintf(tidy, sizeof tidy, "%u/%u", r->tidy_rounds_run, r->tidy_rounds);
+  char rounds[32];  // (tidy-up rounds that ran of those asked)
+  std::snprintf(rounds, sizeof rounds, "%u/%u", r->tidy_rounds_run, r->tidy_rounds);
   std::fprintf(stderr, "%6u %6u %12.3f %10.3f %9.2f %12.3f %9s %9.3f %9.4f %12s   (ms)\n",
                r->labels, r->labels_shown, r->whole_ms, r->loop_ms, loop_us_per_label(*r),
-               r->finalize_ms, tidy, r->stamped_ms - r->loop_ms - r->finalize_ms, r->forces_ms,
+               r->tidy_ms, rounds, r->stamped_ms - r->loop_ms - r->tidy_ms, r->forces_ms,
                base);
 }
 

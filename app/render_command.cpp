@@ -254,7 +254,7 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
                   "named camera position of the scene, or several (front,left): one image each, "
                   "named after it (out-front.png, out-left.png)");
   cmd->add_option("--tidy-rounds", o->tidy_rounds,
-                  "rounds of the layout tidy-up after the placement (0: none)")
+                  "rounds of the tidy-up after the placement (0: none)")
       ->check(whole_range(0, TIDY_ROUNDS_MAX))
       ->capture_default_str();
   cmd->add_option("--dump-layers", o->dump_layers,

@@ -167,7 +167,7 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
       ->required();
   cmd->add_option("--layout-dir", o->layout_dir, "folder for each frame's layout JSON");
   cmd->add_option("--tidy-rounds", o->tidy_rounds,
-                  "rounds of the layout tidy-up after the placement (0: none)")
+                  "rounds of the tidy-up after the placement (0: none)")
       ->check(whole_range(0, TIDY_ROUNDS_MAX))
       ->capture_default_str();
   cmd->add_flag("--screen-space", o->screen_space,

@@ -114,7 +114,7 @@ const std::vector<Parameter>& parameters() {
       {"margin", "pixels around boxes in the constraints", 0.0f, 256.0f,
        [](S s) { return &s.labels.placement.margin; }},
       {"layers", "depth layers asked for, 1 to 8", 1.0f, 8.0f},
-      {"tidy_rounds", "rounds of the layout tidy-up per frame, 0 to 256", 0.0f,
+      {"tidy_rounds", "rounds of the tidy-up per frame, 0 to 256", 0.0f,
        float(TIDY_ROUNDS_MAX)},
       {"hard", "on: no constraint violations (labels may be hidden)", 0.0f, 0.0f, nullptr,
        [](S s) { return &s.labels.placement.hard; }},

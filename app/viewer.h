@@ -79,7 +79,7 @@ class WindowOutput : public ViewerOutput {
   GLFWwindow* window_;
 };
 
-// Rounds of the layout tidy-up a viewer frame runs at most (stills: PlacementSettings'
+// Rounds of the tidy-up a viewer frame runs at most (stills: PlacementSettings'
 // default): a frame's labels are held where the last frame's tidy-up put them, so the work
 // spreads over frames.
 inline constexpr uint32_t kViewerTidyRounds = 4;

@@ -230,7 +230,9 @@ void LabelledRenderer::build_graph() {
       graph, {.final_image = rendered.final,
               .layers = rendered.layers,
               .layer_count = render.layer_count,
-              .previous = Placement::Previous{.state = state, .params = &p.forces.params()}});
+              .adjust_labels = [&p, state](graph::Graph& g, graph::ResourceId labels) {
+                p.forces.add_previous(g, labels, state);
+              }});
   const LabelForces::Outputs moved = p.forces.add_to(
       graph, {.labels = placed_.labels, .targets = placed_.placements, .state = state});
   layers_id_ = rendered.layers;

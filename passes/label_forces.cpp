@@ -45,6 +45,7 @@ LabelForces::LabelForces(Context& ctx, uint32_t label_count)
       label_count_(label_count),
       params_(forces_params({}, label_count, 0.0)),
       forces_(ctx, "label_forces.comp"),
+      previous_(ctx, "label_previous.comp"),
       state_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::LabelStateGpu),
              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                  VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -74,6 +75,18 @@ std::span<const gpu::PlacementGpu> LabelForces::drawn() const {
 
 graph::ResourceId LabelForces::import_state(graph::Graph& graph) const {
   return graph.import_buffer("forces.state", {.buffer = state_.handle(), .has_content = true});
+}
+
+void LabelForces::add_previous(graph::Graph& graph, graph::ResourceId labels,
+                               graph::ResourceId state) const {
+  graph.add_pass({"forces.previous",
+                  graph::PassKind::compute,
+                  {{labels, Use::storage_read_write, FORCES_BINDING_LABELS},
+                   {state, Use::storage_read, FORCES_BINDING_STATE}},
+                  [this](graph::PassContext& pc) {
+                    pc.dispatch(previous_, params_, {label_count_, 1, 1});
+                  },
+                  "placement"});  // (timed with the placement it feeds)
 }
 
 LabelForces::Outputs LabelForces::add_to(graph::Graph& graph, const Inputs& in) {

@@ -60,6 +60,10 @@ class LabelForces {
   // The state kept across frames (LabelStateGpu[]), imported into `graph`: before the placement,
   // which reads last frame's drawn positions from it.
   graph::ResourceId import_state(graph::Graph& graph) const;
+  // What each label of this frame takes from the last (forces_previous: eq. 3.1's previous
+  // position, the held position and its hold, hard mode's padding), written into `labels`
+  // (LabelGpu[]) in place: the placement's Inputs::adjust_labels.
+  void add_previous(graph::Graph& graph, graph::ResourceId labels, graph::ResourceId state) const;
   // The forces pass, and a copy of the drawn placements for the host.
   Outputs add_to(graph::Graph& graph, const Inputs& in);
 
@@ -68,7 +72,7 @@ class LabelForces {
   // Marks the frame set last as a trial (ForcesParams::trial): labels are drawn where they were
   // and the state is not written, so several trial placements start from the same state.
   void set_trial(bool trial) { params_.trial = trial ? 1u : 0u; }
-  // The frame's push constants (the placement's previous pass reads them too).
+  // The frame's push constants.
   const gpu::ForcesParams& params() const { return params_; }
   // Forgets every drawn position: the next frame puts each label on its target.
   void reset();
@@ -82,12 +86,12 @@ class LabelForces {
   Context& ctx_;
   uint32_t label_count_;
   gpu::ForcesParams params_{};
-  ComputePipeline forces_;
+  ComputePipeline forces_, previous_;
   Buffer state_;
   graph::Readback readback_;
 };
 
-// The CPU reference of the placement's previous pass: what each label takes from the state.
+// The CPU reference of add_previous's pass: what each label takes from the state.
 std::vector<gpu::LabelGpu> previous_reference(std::vector<gpu::LabelGpu> labels,
                                               const std::vector<gpu::LabelStateGpu>& state,
                                               const gpu::ForcesParams& params);

@@ -59,17 +59,23 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   return p;
 }
 
+PlacementPlan PlacementPlan::choose(const Context& ctx, uint32_t label_count,
+                                    const PlacementLayout& layout) {
+  PlacementPlan plan;
+  plan.indirect = layout.dispatch == LabelDispatch::indirect ||
+                  (layout.dispatch == LabelDispatch::automatic &&
+                   ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
+  plan.skip_idle_blocks = !plan.indirect && layout.skip_idle_blocks && ctx.conditional_rendering();
+  plan.large = label_count > TIDY_SHARED_MAX;
+  return plan;
+}
+
 std::vector<ComputePipeline> Placement::create_pipelines(Context& ctx, uint32_t label_count) {
-  // (more labels than a workgroup's shared memory holds: the tidy-up's states are read from the
-  // buffer)
-  const bool large = label_count > TIDY_SHARED_MAX;
-  const std::array<std::string_view, 6> shaders{
-      "integral_costs.comp",
-      "placement_bounds.comp",
-      "place_label.comp",
-      large ? "placement_finalize_large.comp" : "placement_finalize.comp",
-      large ? "placement_tidy_search_large.comp" : "placement_tidy_search.comp",
-      "label_previous.comp"};
+  const bool large = PlacementPlan::choose(ctx, label_count, {}).large;
+  const std::array<std::string_view, 5> shaders{
+      "integral_costs.comp", "placement_bounds.comp", "place_label.comp",
+      large ? "placement_tidy_large.comp" : "placement_tidy.comp",
+      large ? "placement_tidy_search_large.comp" : "placement_tidy_search.comp"};
   return create_compute_pipelines(ctx, shaders);
 }
 
@@ -80,17 +86,13 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
                      std::vector<ComputePipeline> pipelines)
     : ctx_(ctx),
       label_count_(label_count),
-      indirect_(layout.dispatch == LabelDispatch::indirect ||
-                (layout.dispatch == LabelDispatch::automatic &&
-                 ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)),
-      skip_idle_blocks_(!indirect_ && layout.skip_idle_blocks && ctx.conditional_rendering()),
       layout_(layout),
+      plan_(PlacementPlan::choose(ctx, label_count, layout)),
       integral_costs_(std::move(pipelines[0])),
       bounds_(std::move(pipelines[1])),
       place_(std::move(pipelines[2])),
-      finalize_(std::move(pipelines[3])),
+      tidy_(std::move(pipelines[3])),
       search_(std::move(pipelines[4])),
-      previous_(std::move(pipelines[5])),
       tables_(ctx),
       readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu)) {
   static_assert(LABEL_MAX == kMaxLabels, "the scene side's label limit is the placement's");
@@ -112,6 +114,7 @@ gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) co
   p.spec_label = step < order_.size() ? order_[step] : 0;
   p.finish_lanes = layout_.finish_lanes;
   p.classify_tiles = classify_tiles(viewport);
+  p.indirect = plan_.indirect ? 1u : 0u;
   return p;
 }
 
@@ -156,11 +159,11 @@ Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
   layer_count_ = in.layer_count;
   const Buffers b = add_buffers(graph);
   add_upload(graph, b);
-  if (in.previous) add_previous(graph, b, *in.previous);
+  if (in.adjust_labels) in.adjust_labels(graph, b.labels);
   add_costs(graph, b, in);
   add_bounds(graph, b);
   const graph::PassId loop = add_label_loop(graph, b);
-  add_finalize(graph, b);
+  add_tidy(graph, b);
   return {b.labels,  b.placements, b.saliency,    b.costs, b.tables, b.constraints,
           b.results, b.buckets,    b.tidy_rounds, b.order, loop};
 }
@@ -231,23 +234,10 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                     // (each speculative workgroup writes its tile's entry before anything reads it)
                     fill(b.speculative, 0xFFFFFFFFu);
                     fill(b.samples, 0xFFFFFFFFu);
-                    fill(b.tidy_args, 0);  // (no round runs until the one before sizes it)
+                    fill(b.tidy_args, 0);  // (indirect: no round runs until the one before sizes it)
                     // (placement.regions needs none: the loop writes each pair, from the placed
                     // label's result, before a later label reads it; a label never placed
                     // writes regions that constrain nobody)
-                  },
-                  "placement"});
-}
-
-// What each label takes from last frame's forces state (forces_previous): its previous position
-// (eq. 3.1's eta), its held position and hold, its padding.
-void Placement::add_previous(graph::Graph& graph, const Buffers& b, const Previous& previous) {
-  graph.add_pass({"placement.previous",
-                  graph::PassKind::compute,
-                  {{b.labels, Use::storage_read_write, FORCES_BINDING_LABELS},
-                   {previous.state, Use::storage_read, FORCES_BINDING_STATE}},
-                  [this, params = previous.params](graph::PassContext& pc) {
-                    pc.dispatch(previous_, *params, {label_count_, 1, 1});
                   },
                   "placement"});
 }
@@ -326,23 +316,35 @@ graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
       // (written: the loop writes every pair before it reads it, ARCHITECTURE.md)
       {b.regions, Use::storage_write, PLACEMENT_BINDING_REGIONS},
       {b.samples, Use::storage_read_write, PLACEMENT_BINDING_SAMPLES}};
-  // (direct: the sizes are still written, but nothing waits for them)
-  if (indirect_) uses.push_back({b.args, Use::indirect});
+  declare_sizes(uses, b.args);
   const ResourceId args = b.args;
   return graph.add_pass(
       {"placement.labels", graph::PassKind::compute, std::move(uses),
        [this, args](graph::PassContext& pc) {
+         const glm::uvec3 groups = direct_groups(pc.viewport);
          for (uint32_t step = 0; !order_.empty() && step <= order_.size(); ++step) {
            if (step > 0) pc.barrier();
-           const gpu::PlacementParams p = params(pc.viewport, step);
-           if (indirect_) {
-             pc.dispatch_indirect(place_, p, args, VkDeviceSize{step} * 3 * sizeof(uint32_t));
-           } else {
-             pc.dispatch_groups(place_, p, direct_groups(pc.viewport));
-           }
+           dispatch(pc, place_, params(pc.viewport, step), args,
+                    VkDeviceSize{step} * 3 * sizeof(uint32_t), groups);
          }
        },
        "placement"});
+}
+
+void Placement::declare_sizes(std::vector<graph::ResourceUse>& uses, ResourceId args) const {
+  // (a direct plan declares none: an indirect use makes every barrier of the pass wait for
+  // indirect reads too, which costs a GPU's hundreds of barriers dearly)
+  if (plan_.indirect) uses.push_back({args, Use::indirect});
+}
+
+void Placement::dispatch(graph::PassContext& pc, const ComputePipeline& pipeline,
+                         const gpu::PlacementParams& p, ResourceId args, VkDeviceSize offset,
+                         glm::uvec3 groups) const {
+  if (plan_.indirect) {
+    pc.dispatch_indirect(pipeline, p, args, offset);
+  } else {
+    pc.dispatch_groups(pipeline, p, groups);
+  }
 }
 
 // A direct place_label dispatch: room for any classification, the passes' tiles and the region
@@ -355,12 +357,10 @@ glm::uvec3 Placement::direct_groups(graph::Extent viewport) const {
       gpu::placement_classify_groups(tile_count, classify_tiles(viewport)) + tiles + 1);
 }
 
-// The layout tidy-up (its rounds: four dispatches each; a round after one that changed nothing
-// has nothing to do) and each label's position and whether it is shown, copied to the host after
-// the frame. On CPU devices the rounds are indirect dispatches sized by the round before, none
-// once nothing changes; on a discrete GPU that made them slower (docs/performance.md), so there
-// the rounds are direct and their workgroups leave at once.
-void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
+// The tidy-up: its start, its rounds (four dispatches each; a round after one that changed nothing
+// has nothing to do), and each label's position and whether it is shown, copied to the host after
+// the frame.
+void Placement::add_tidy(graph::Graph& graph, const Buffers& b) {
   std::vector<graph::ResourceUse> uses = {
       {b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
       {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
@@ -370,58 +370,19 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
       {b.tidy_rounds, Use::storage_write, PLACEMENT_BINDING_TIDY_ROUNDS},
       {b.tidy_args, Use::storage_read_write, PLACEMENT_BINDING_TIDY_ARGS},
       {b.placements, Use::storage_write, PLACEMENT_BINDING_PLACEMENTS}};
-  // (an indirect use makes every barrier of the pass wait for indirect reads too, which costs a
-  // GPU's 320 barriers of 64 rounds dearly)
-  if (indirect_) uses.push_back({b.tidy_args, Use::indirect});
-  if (skip_idle_blocks_) uses.push_back({b.tidy_rounds, Use::conditional});
-  graph.add_pass(
-      {"placement.finalize", graph::PassKind::compute, std::move(uses),
-       [this, b](graph::PassContext& pc) {
-         gpu::PlacementParams p = params(pc.viewport, 0);
-         const uint32_t n = label_count_;
-         p.phase = TIDY_PHASE_START;
-         pc.dispatch(finalize_, p, {std::max(n, p.tidy_rounds + 1), 1, 1});
-         for (uint32_t round = 0; round < p.tidy_rounds; ++round) {
-           p.step = round;
-           // (a block past the first runs when the round before it applied a change: its first
-           // round's count in the rounds buffer, which a round of the block before wrote. One
-           // conditional block per block of rounds: one around each dispatch cost a GPU more than
-           // the idle dispatches it skipped.)
-           const uint32_t block_start = round - round % kTidyBlockRounds;
-           const bool skippable = skip_idle_blocks_ && block_start > 0;
-           for (const uint32_t phase :
-                {TIDY_PHASE_CONFLICTS, TIDY_PHASE_SEARCH, TIDY_PHASE_OWNERS, TIDY_PHASE_SELECT}) {
-             const bool block_begins =
-                 skippable && round == block_start && phase == TIDY_PHASE_CONFLICTS;
-             if (block_begins) {
-               pc.barrier_for_predicates();
-               pc.begin_conditional(b.tidy_rounds, block_start * sizeof(uint32_t));
-             } else {
-               pc.barrier();
-             }
-             p.phase = phase;
-             // (tidy_phase_groups; the search's workgroups pass 65535 from about 900 labels: rows
-             // of them)
-             const ComputePipeline& pipeline = phase == TIDY_PHASE_SEARCH ? search_ : finalize_;
-             if (indirect_) {
-               const VkDeviceSize offset =
-                   (VkDeviceSize{round} * TIDY_ROUND_STEPS + (phase - TIDY_PHASE_CONFLICTS)) * 3 *
-                   sizeof(uint32_t);
-               pc.dispatch_indirect(pipeline, p, b.tidy_args, offset);
-             } else {
-               pc.dispatch_groups(pipeline, p, gpu::tidy_phase_groups(phase, n));
-             }
-             const bool block_ends =
-                 skippable && phase == TIDY_PHASE_SELECT &&
-                 (round + 1 == p.tidy_rounds || (round + 1) % kTidyBlockRounds == 0);
-             if (block_ends) pc.end_conditional();
-           }
-         }
-         pc.barrier();
-         p.phase = TIDY_PHASE_OUTPUT;
-         pc.dispatch(finalize_, p, {n, 1, 1});
-       },
-       "placement"});
+  declare_sizes(uses, b.tidy_args);
+  if (plan_.skip_idle_blocks) uses.push_back({b.tidy_rounds, Use::conditional});
+  graph.add_pass({"placement.tidy", graph::PassKind::compute, std::move(uses),
+                  [this, b](graph::PassContext& pc) {
+                    gpu::PlacementParams p = params(pc.viewport, 0);
+                    p.phase = TIDY_PHASE_START;
+                    pc.dispatch(tidy_, p, {std::max(label_count_, p.tidy_rounds + 1), 1, 1});
+                    record_tidy_rounds(pc, p, b);
+                    pc.barrier();
+                    p.phase = TIDY_PHASE_OUTPUT;
+                    pc.dispatch(tidy_, p, {label_count_, 1, 1});
+                  },
+                  "placement"});
   graph.add_pass({"placement.readback",
                   graph::PassKind::transfer,
                   {{b.placements, Use::transfer_src}, {b.readback, Use::transfer_dst}},
@@ -432,9 +393,38 @@ void Placement::add_finalize(graph::Graph& graph, const Buffers& b) {
                   }});
 }
 
+// The tidy-up's rounds. Where the plan skips idle blocks, a block of kTidyBlockRounds past the first
+// runs only when the round before it applied a change: its first round's count in the rounds
+// buffer, which a round of the block before wrote. (One conditional block per block of rounds:
+// one around each dispatch cost a GPU more than the idle dispatches it skipped.)
+void Placement::record_tidy_rounds(graph::PassContext& pc, gpu::PlacementParams p,
+                                   const Buffers& b) const {
+  for (uint32_t round = 0; round < p.tidy_rounds; ++round) {
+    p.step = round;
+    const uint32_t block_start = round - round % kTidyBlockRounds;
+    const bool conditional = plan_.skip_idle_blocks && block_start > 0;
+    if (conditional && round == block_start) {
+      pc.barrier_for_predicates();
+      pc.begin_conditional(b.tidy_rounds, block_start * sizeof(uint32_t));
+    } else {
+      pc.barrier();
+    }
+    for (uint32_t k = 0; k < TIDY_ROUND_STEPS; ++k) {
+      if (k > 0) pc.barrier();
+      p.phase = TIDY_PHASE_CONFLICTS + k;
+      // (the search's workgroups pass 65535 from about 900 labels: rows of them)
+      const ComputePipeline& pipeline = p.phase == TIDY_PHASE_SEARCH ? search_ : tidy_;
+      const VkDeviceSize offset = (VkDeviceSize{round} * TIDY_ROUND_STEPS + k) * 3 * sizeof(uint32_t);
+      dispatch(pc, pipeline, p, b.tidy_args, offset, gpu::tidy_phase_groups(p.phase, label_count_));
+    }
+    const bool block_ends = (round + 1) % kTidyBlockRounds == 0 || round + 1 == p.tidy_rounds;
+    if (conditional && block_ends) pc.end_conditional();
+  }
+}
+
 std::vector<PipelineReport> Placement::pipeline_statistics() const {
   std::vector<PipelineReport> out;
-  for (const ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &finalize_, &search_}) {
+  for (const ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &tidy_, &search_}) {
     out.push_back({p->name(), p->statistics()});
   }
   return out;

@@ -7,7 +7,7 @@
 // placements are copied to the host after the frame; nothing waits for them inside it.
 #pragma once
 
-#include <optional>
+#include <functional>
 #include <span>
 #include <string>
 #include <utility>
@@ -19,7 +19,6 @@
 #include "engine/graph/readback.h"
 #include "engine/scene/scene.h"
 #include "passes/summed_area_table.h"
-#include "shared/forces.h"
 #include "shared/placement.h"
 
 namespace strata {
@@ -35,8 +34,8 @@ struct PlacementSettings {
   // Cost above a label's lowest tile bound that its speculative pass covers (speed only:
   // the positions do not depend on it).
   float bucket_width = 0.0625f;
-  // Rounds of the layout tidy-up after the greedy placement at most (shaders/shared/
-  // layout_tidy.h: swaps, moves and hiding that lower the finished layout's cost with crossings
+  // Rounds of the tidy-up after the greedy placement at most (shaders/shared/
+  // tidy.h: swaps, moves and hiding that lower the finished layout's cost with crossings
   // and overlaps counted); 0: none. Hard mode has none: its layouts have no conflicts.
   uint32_t tidy_rounds = 64;
 };
@@ -44,20 +43,21 @@ struct PlacementSettings {
 gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent viewport,
                                       uint32_t layer_count, uint32_t label_count, uint32_t step);
 
-// How the label loop's dispatches are sized. Their sizes are only known on the GPU: an indirect
-// dispatch reads them there; a direct one has enough workgroups for any sizes (with at most
-// PlacementLayout::direct_groups for the passes' tiles, each taking several past that), those past
-// the sizes leaving at once. On a GPU direct is faster (a chain of dependent dispatches costs
-// less per step direct than indirect, and idle workgroups little; docs/performance.md); on
-// lavapipe, where every workgroup runs on the CPU, idle ones cost more than the whole placement.
+// How the placement's dispatches are sized. The label loop's and the tidy-up rounds' sizes are only
+// known on the GPU: an indirect dispatch reads them there; a direct one has enough workgroups for
+// any sizes (with at most PlacementLayout::direct_groups for the passes' tiles, each taking several
+// past that), those past the sizes leaving at once. On a GPU direct is faster (a chain of dependent
+// dispatches costs less per step direct than indirect, and idle workgroups little:
+// docs/performance.md); on lavapipe, where every workgroup runs on the CPU, idle ones cost more
+// than the whole placement.
 enum class LabelDispatch {
   automatic,  // direct, except on CPU devices
   direct,
   indirect,
 };
 
-// How the label loop is laid out on the device (speed and tests only: the positions do not
-// depend on it).
+// How the placement is laid out on the device (speed and tests only: the positions do not depend
+// on it).
 struct PlacementLayout {
   LabelDispatch dispatch = LabelDispatch::automatic;
   // A direct dispatch's workgroups for the passes' tiles (at most), and the invocations of a
@@ -75,20 +75,29 @@ struct PlacementLayout {
 // Tidy-up rounds per conditional block (PlacementLayout::skip_idle_blocks).
 inline constexpr uint32_t kTidyBlockRounds = 8;
 
+// The dispatch plan, decided once from the device, the layout and the label count.
+struct PlacementPlan {
+  bool indirect = false;          // LabelDispatch, resolved for the device
+  bool skip_idle_blocks = false;  // conditional blocks of tidy-up rounds (direct only)
+  // More labels than a tidy-up workgroup keeps in shared memory (TIDY_SHARED_MAX): the tidy-up
+  // shaders that read the states from the buffer.
+  bool large = false;
+  static PlacementPlan choose(const Context& ctx, uint32_t label_count,
+                              const PlacementLayout& layout);
+};
+
 class Placement {
  public:
-  struct Previous {
-    graph::ResourceId state;          // LabelStateGpu[]
-    const gpu::ForcesParams* params;  // read when the frame is recorded
-  };
+  // Adds passes that adjust the uploaded labels (LabelGpu[]) before they are placed.
+  using AdjustLabels = std::function<void(graph::Graph&, graph::ResourceId labels)>;
   struct Inputs {
     graph::ResourceId final_image;  // the label-free final image (rgba8)
     graph::ResourceId layers;       // the depth layers (rgba16f array), premultiplied
     uint32_t layer_count = 1;
-    // Last frame's forces state (passes/label_forces.h): the labels' previous positions (eq.
-    // 3.1's eta term), held positions with their hold, and hard-mode padding (forces_previous in
-    // shaders/shared/forces.h); none: the anchors set_frame() gave, nothing held.
-    std::optional<Previous> previous;
+    // What the labels take from last frame (LabelForces::add_previous: previous positions for
+    // eq. 3.1's eta term, held positions with their hold, hard-mode padding); none: the anchors
+    // set_frame() gave, nothing held.
+    AdjustLabels adjust_labels;
   };
   struct Outputs {
     graph::ResourceId labels, placements, saliency, costs, tables, constraints, results;
@@ -107,8 +116,10 @@ class Placement {
   Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
             std::vector<ComputePipeline> pipelines);
   static std::vector<ComputePipeline> create_pipelines(Context& ctx, uint32_t label_count);
+  const PlacementPlan& plan() const { return plan_; }
 
-  // Adds the placement's passes: upload, costs, bounds, the label loop, finalize and readback.
+  // Adds the placement's passes: upload (then in.adjust_labels), costs, bounds, the label loop,
+  // the tidy-up and the readback.
   Outputs add_to(graph::Graph& graph, const Inputs& in);
 
   // This frame's labels (label_count of them; disabled ones are skipped) and insertion order
@@ -132,11 +143,18 @@ class Placement {
   };
   Buffers add_buffers(graph::Graph& graph);
   void add_upload(graph::Graph& graph, const Buffers& b);
-  void add_previous(graph::Graph& graph, const Buffers& b, const Previous& previous);
   void add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in);
   void add_bounds(graph::Graph& graph, const Buffers& b);
   graph::PassId add_label_loop(graph::Graph& graph, const Buffers& b);
-  void add_finalize(graph::Graph& graph, const Buffers& b);
+  void add_tidy(graph::Graph& graph, const Buffers& b);
+  void record_tidy_rounds(graph::PassContext& pc, gpu::PlacementParams p, const Buffers& b) const;
+  // The one place that tells direct and indirect dispatches apart: the use a pass declares for
+  // sizes it reads from `args` (none when direct), and a dispatch, sized by `args` at `offset` on
+  // the GPU or by `groups`.
+  void declare_sizes(std::vector<graph::ResourceUse>& uses, graph::ResourceId args) const;
+  void dispatch(graph::PassContext& pc, const ComputePipeline& pipeline,
+                const gpu::PlacementParams& p, graph::ResourceId args, VkDeviceSize offset,
+                glm::uvec3 groups) const;
   glm::uvec3 direct_groups(graph::Extent viewport) const;
   // List entries per classifying workgroup at this viewport (the layout's, or by tile count).
   uint32_t classify_tiles(graph::Extent viewport) const;
@@ -144,14 +162,13 @@ class Placement {
 
   Context& ctx_;
   uint32_t label_count_;
-  bool indirect_;
-  bool skip_idle_blocks_;  // PlacementLayout::skip_idle_blocks on a device that can
   PlacementLayout layout_;
+  PlacementPlan plan_;
   uint32_t layer_count_ = 1;
   std::vector<gpu::LabelGpu> labels_;
   std::vector<uint32_t> order_;
   PlacementSettings settings_;
-  ComputePipeline integral_costs_, bounds_, place_, finalize_, search_, previous_;
+  ComputePipeline integral_costs_, bounds_, place_, tidy_, search_;
   SummedAreaTable tables_;
   graph::Readback readback_;
 };

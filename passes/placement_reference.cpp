@@ -49,7 +49,7 @@ struct Placer {
 #include "shared/placement_cost.h"
 };
 
-// The layout tidy-up's rounds (shared/layout_tidy_search.h) one step at a time: each step over
+// The tidy-up's rounds (shared/tidy_search.h) one step at a time: each step over
 // every label before the next, as the GPU's barriers separate them.
 struct Tidier {
   PlacementParams params;
@@ -75,8 +75,8 @@ struct Tidier {
   uint tidy_partner(uint k) const { return partners[k]; }
   ivec4 tidy_conflicts_now(uint k) const { return currents[k]; }
 
-#include "shared/layout_tidy.h"
-#include "shared/layout_tidy_search.h"
+#include "shared/tidy.h"
+#include "shared/tidy_search.h"
 
   bool movable(uint k) const {
     return (states[k].flags & (TIDY_PLACED | TIDY_MOVABLE)) == (TIDY_PLACED | TIDY_MOVABLE);

@@ -19,8 +19,8 @@ struct ReferencePlacement {
   std::vector<gpu::PlacementGpu> placements;  // per label
 };
 
-// The placement finalize pass: the greedy loop's results (cost bits << 32 | pixel per label)
-// after the layout tidy-up (shaders/shared/layout_tidy.h) over the placement's `tables`.
+// The placement tidy-up pass: the greedy loop's results (cost bits << 32 | pixel per label)
+// after the tidy-up (shaders/shared/tidy.h) over the placement's `tables`.
 std::vector<gpu::PlacementGpu> tidy_reference(std::span<const gpu::LabelGpu> labels,
                                               std::span<const uint32_t> order,
                                               std::span<const uint64_t> results,

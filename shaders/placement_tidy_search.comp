@@ -4,7 +4,9 @@
 #extension GL_EXT_shader_atomic_int64 : require
 #include "shared/tidy_gpu.h"
 
-// The tidy-up's search phase for up to 256 labels, with the shared memory only it needs
-// (placement_finalize.glsl).
-#define TIDY_SEARCH_ONLY
-#include "placement_finalize.glsl"
+// The tidy-up's search step for up to TIDY_SHARED_MAX (256) labels, with the shared memory only
+// it needs.
+#include "placement_tidy.glsl"
+#include "placement_tidy_search_states_shared.glsl"
+#include "placement_tidy_round.glsl"
+#include "placement_tidy_search.glsl"

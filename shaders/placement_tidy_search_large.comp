@@ -4,8 +4,9 @@
 #extension GL_EXT_shader_atomic_int64 : require
 #include "shared/tidy_gpu.h"
 
-// The tidy-up's search phase for more than 256 labels: the labels' states are read from the
-// buffer (placement_finalize.glsl).
-#define TIDY_STATES_IN_BUFFER
-#define TIDY_SEARCH_ONLY
-#include "placement_finalize.glsl"
+// The tidy-up's search step for more than TIDY_SHARED_MAX (256) labels: the labels' states are
+// read from the buffer.
+#include "placement_tidy.glsl"
+#include "placement_tidy_states_buffer.glsl"
+#include "placement_tidy_round.glsl"
+#include "placement_tidy_search.glsl"

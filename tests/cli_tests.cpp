@@ -112,7 +112,7 @@ TEST_SUITE("cli") {
       CHECK(entry["placement_ms"].get<double>() > 0.0);
       CHECK(entry["label_loop_ms"].get<double>() > 0.0);
       CHECK(entry["label_loop_us_per_label"].get<double>() > 0.0);
-      CHECK(entry["finalize_ms"].get<double>() > 0.0);
+      CHECK(entry["tidy_ms"].get<double>() > 0.0);
       CHECK(entry["passes"]["placement.labels"].get<double>() > 0.0);
       CHECK(entry["groups"]["placement"].get<double>() > 0.0);
       CHECK(entry["label_loop_with_readback_per_label_ms"].is_null());

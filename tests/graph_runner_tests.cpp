@@ -226,14 +226,14 @@ TEST_SUITE("gpu") {
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "an_indirect_dispatch_needs_an_indirect_declaration") {
-    const ComputePipeline finalize(ctx, "placement_finalize.comp");
+    const ComputePipeline tidy(ctx, "placement_tidy.comp");
     graph::Graph g;
     const auto args = g.add_buffer("args", small_buffer());
     g.add_pass(fill("zero", args, args));
     g.add_pass({"dispatch",
                 graph::PassKind::compute,
                 {{args, graph::Use::storage_read}},
-                [&](graph::PassContext& pc) { pc.dispatch_indirect(finalize, 0u, args, 0); }});
+                [&](graph::PassContext& pc) { pc.dispatch_indirect(tidy, 0u, args, 0); }});
     check_recording_fails(
         ctx, std::move(g),
         "pass 'dispatch' dispatches from 'args', which it did not declare indirect");

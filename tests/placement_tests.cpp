@@ -25,6 +25,8 @@
 namespace strata {
 namespace {
 
+constexpr double kFrameSeconds = 1.0 / 30.0;  // a frame of a 30 fps animation
+
 struct Inputs {
   graph::Extent size{96, 72};
   uint32_t layer_count = 2;
@@ -89,12 +91,12 @@ std::vector<T> as(const std::vector<std::byte>& bytes) {
   return out;
 }
 
-// `previous`: the forces' state that the labels take their previous and held positions and
-// their padding from, with the forces' `params`.
+// A frame of 1/30 s after one that left `previous`: the forces' state that the labels take their
+// previous and held positions and their padding from (LabelForces::add_previous, with `forces`).
 GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSettings& settings,
                           const PlacementLayout& layout = {},
                           const std::vector<gpu::LabelStateGpu>& previous = {},
-                          const gpu::ForcesParams& params = {}) {
+                          const ForceSettings& forces = {}) {
   Image final_image(ctx, {VK_FORMAT_R8G8B8A8_UNORM,
                           {in.size.width, in.size.height, 1},
                           VK_IMAGE_TYPE_2D,
@@ -114,16 +116,20 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
   Buffer state(ctx, std::max<size_t>(1, previous.size()) * sizeof(gpu::LabelStateGpu),
                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
   if (!previous.empty()) upload(ctx, state, as_bytes(previous));
-  std::optional<Placement::Previous> state_id;
+  LabelForces last_frame(ctx, uint32_t(in.labels.size()));
+  last_frame.set_frame(forces, kFrameSeconds, settings.hard);
+  Placement::AdjustLabels adjust;
   if (!previous.empty()) {
-    state_id = Placement::Previous{
-        .state = g.import_buffer("state", {.buffer = state.handle(), .has_content = true}),
-        .params = &params};
+    const graph::ResourceId state_id =
+        g.import_buffer("state", {.buffer = state.handle(), .has_content = true});
+    adjust = [&last_frame, state_id](graph::Graph& graph, graph::ResourceId labels) {
+      last_frame.add_previous(graph, labels, state_id);
+    };
   }
   const Placement::Outputs r = placement.add_to(g, {.final_image = general("final", final_image),
                                                     .layers = general("layers", layers),
                                                     .layer_count = in.layer_count,
-                                                    .previous = state_id});
+                                                    .adjust_labels = adjust});
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(in.size);
   placement.set_frame(in.labels, in.order, settings);
@@ -224,6 +230,31 @@ TEST_SUITE("gpu") {
   // anchors, with no cost for crossing an earlier leader: the greedy placement leaves two pairs of
   // crossing leaders; the tidy-up swaps them (on the GPU as in the reference), with no overlap,
   // and without hiding a label.
+  // Past TIDY_SHARED_MAX labels the tidy-up's shaders read the labels' states from the buffer
+  // (placement_tidy_large.comp, placement_tidy_search_large.comp): the same layout as the
+  // reference, with rounds that change it.
+  TEST_CASE_FIXTURE(test::GpuTest, "past_256_labels_the_tidy_up_reads_the_states_from_the_buffer") {
+    Inputs in = disc_scene(0);
+    in.size = {64, 48};
+    const size_t pixels = size_t{in.size.width} * in.size.height;
+    in.final_rgba8.assign(pixels * 4, 40);
+    in.layers.assign(pixels * in.layer_count, glm::vec4(0.0f));
+    const uint32_t count = TIDY_SHARED_MAX + 4;
+    for (uint32_t i = 0; i < count; ++i) {
+      const glm::vec2 anchor(4.0f + float(i * 7 % 56), 4.0f + float(i * 5 % 40));
+      in.labels.push_back(label(anchor, {6.0f, 4.0f}, i % 2));
+      in.order.push_back(i);
+    }
+    PlacementSettings settings;
+    settings.tidy_rounds = 2;
+    const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
+    const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                   in.labels, in.order, settings, in.size);
+    check_placements(gpu, cpu);
+    REQUIRE(gpu.tidy_rounds.size() > 1);
+    CHECK(gpu.tidy_rounds[1] > 0);  // (round 0 applied changes)
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "the_layout_tidy_up_removes_leader_crossings") {
     Inputs in;
     in.size = {160, 120};
@@ -373,9 +404,10 @@ TEST_SUITE("gpu") {
       CAPTURE(relative);
       PlacementSettings settings;
       settings.weights.previous_position = 0.2f;
+      const ForceSettings forces{.anchor_relative = relative};
       const gpu::ForcesParams params =
-          forces_params({.anchor_relative = relative}, uint32_t(in.labels.size()), 1.0 / 30.0);
-      const GpuPlacement gpu = place_on_gpu(ctx, in, settings, {}, state, params);
+          forces_params(forces, uint32_t(in.labels.size()), kFrameSeconds);
+      const GpuPlacement gpu = place_on_gpu(ctx, in, settings, {}, state, forces);
       const std::vector<gpu::LabelGpu> expected = previous_reference(in.labels, state, params);
       for (size_t i = 0; i < 3; ++i) {
         CHECK(expected[i].previous ==
@@ -416,12 +448,13 @@ TEST_SUITE("gpu") {
     }
     for (const float hold : {0.0f, 1e3f}) {
       CAPTURE(hold);
-      const gpu::ForcesParams params = forces_params({.hold_share = 0.0f, .hold_cost = hold},
-                                                     uint32_t(in.labels.size()), 1.0 / 30.0);
+      const ForceSettings forces{.hold_share = 0.0f, .hold_cost = hold};
+      const gpu::ForcesParams params =
+          forces_params(forces, uint32_t(in.labels.size()), kFrameSeconds);
       const std::vector<gpu::LabelGpu> labels = previous_reference(in.labels, state, params);
       const ReferencePlacement cpu =
           place_reference(in.final_rgba8, in.layers, in.layer_count, labels, in.order, {}, in.size);
-      check_placements(place_on_gpu(ctx, in, {}, {}, state, params), cpu);
+      check_placements(place_on_gpu(ctx, in, {}, {}, state, forces), cpu);
       for (size_t i = 0; i < in.labels.size(); ++i) {
         CAPTURE(i);
         CHECK(labels[i].hold == hold);
@@ -450,13 +483,14 @@ TEST_SUITE("gpu") {
     for (const uint32_t flags : {LABEL_STATE_SEEN | LABEL_STATE_SHOWN, LABEL_STATE_SEEN}) {
       CAPTURE(flags);
       const std::vector<gpu::LabelStateGpu> state(in.labels.size(), {.flags = flags});
+      const ForceSettings forces{.appear_padding = 12.0f};
       const gpu::ForcesParams params =
-          forces_params({.appear_padding = 12.0f}, uint32_t(in.labels.size()), 1.0 / 30.0, true);
+          forces_params(forces, uint32_t(in.labels.size()), kFrameSeconds, true);
       const std::vector<gpu::LabelGpu> labels = previous_reference(in.labels, state, params);
       CHECK(labels[0].padding == (flags & LABEL_STATE_SHOWN ? 0.0f : 12.0f));
       const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                      labels, in.order, settings, in.size);
-      check_placements(place_on_gpu(ctx, in, settings, {}, state, params), cpu);
+      check_placements(place_on_gpu(ctx, in, settings, {}, state, forces), cpu);
       shown[flags & LABEL_STATE_SHOWN ? 0 : 1] = shown_count(cpu.placements);
     }
     MESSAGE("labels shown: staying " << shown[0] << ", appearing " << shown[1]);

@@ -101,7 +101,7 @@ struct CostWeights {
   float distance_to_anchor = 0.015f;
   float connector_direction = 1.0f;
   float previous_position = 0.0f;
-  // Not the thesis's: the layout tidy-up after the placement (shaders/shared/layout_tidy.h)
+  // Not the thesis's: the tidy-up after the placement (shaders/shared/tidy.h)
   // counts this per pair of crossing leaders and per leader through another label's box.
   float leader_crossing = 1000.0f;
   // Not the thesis's: a box the layers in front of the label's would hide (less than

@@ -55,11 +55,11 @@
 #define PLACEMENT_BINDING_SPECULATIVE 15  // uint64_t per bucket-0 tile, two labels' worth
 #define PLACEMENT_BINDING_REGIONS 16      // PairRegionsGpu per (order position, placed one's)
 #define PLACEMENT_BINDING_SAMPLES 17      // uint64_t per tile-list position: a sampled candidate
-#define PLACEMENT_BINDING_TIDY 18         // TidyGpu per label: the layout tidy-up's state
+#define PLACEMENT_BINDING_TIDY 18         // TidyGpu per label: the tidy-up's state
 #define PLACEMENT_BINDING_TIDY_ROUNDS 19  // uint per tidy-up round + 1: changes applied before it
 #define PLACEMENT_BINDING_TIDY_ARGS 20    // uint[3] per tidy-up round and step: its workgroups
 
-// PlacementParams.phase of placement_finalize.comp: the tidy-up's start, the four steps of each
+// PlacementParams.phase of placement_tidy.comp: the tidy-up's start, the four steps of each
 // round (params.step), and the placements' output. The changes a round applies are taken up by
 // the next round's conflicts step, or by the output (TidyGpu::take).
 #define TIDY_PHASE_START 0u
@@ -100,7 +100,7 @@
 #define PLACEMENT_PHASE_COUNT 1u   // ... tiles per bucket
 #define PLACEMENT_PHASE_SORT 2u    // ... tiles sorted by bucket, the first dispatch's size
 
-// The layout tidy-up after the greedy placement (shared/layout_tidy.h).
+// The tidy-up after the greedy placement (shared/tidy.h).
 #define TIDY_SUBPIXEL 64.0f
 #define TIDY_DIRECTIONS 24u  // move candidates: 24 directions from the anchor ...
 #define TIDY_RADII 5u        // ... at 5 distances (tidy_radius)
@@ -111,7 +111,7 @@
 #define TIDY_NO_PARTNER 0xFFFFFFFFu
 #define TIDY_ROUNDS_MAX 256u  // PlacementParams::tidy_rounds at most
 #define TIDY_SHARED_MAX 256u  // labels whose states a tidy-up workgroup keeps in shared memory
-#define TIDY_SEARCH_LANES 8u  // invocations weighing one change (placement_finalize.comp)
+#define TIDY_SEARCH_LANES 8u  // invocations weighing one change (placement_tidy.comp)
 
 // TidyLabel.flags
 #define TIDY_PLACED 1u   // the label has a box (placed, and not hidden by the tidy-up)
@@ -129,7 +129,7 @@ struct CostWeightsGpu {
   float anchor_constraint;    // epsilon
   float integral_costs;       // zeta, times the integral over the label box
   float previous_position;    // eta, per pixel
-  float leader_crossing;      // the layout tidy-up: per leader crossing or through a box
+  float leader_crossing;      // the tidy-up: per leader crossing or through a box
   float illegible;            // a box the front layers hide (less than LEGIBLE_SHARE visible)
 };
 
@@ -156,7 +156,8 @@ struct PlacementParams {
   uint finish_lanes;    // place_label: invocations of the last workgroup taking list entries
                         // (0: all; fewer make more chunks, for tests)
   uint classify_tiles;  // place_label: list entries per classifying workgroup (4, 8 or 16)
-  uint tidy_rounds;     // placement_finalize: rounds of the layout tidy-up at most (0: none)
+  uint tidy_rounds;     // placement_tidy: rounds of the tidy-up at most (0: none)
+  uint indirect;        // 1: the tidy-up rounds are indirect dispatches (PlacementPlan)
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,

@@ -1,6 +1,6 @@
 // Eq. 3.1 without its constraint terms, and where a label may go at all: written once for the
-// label loop (place_label.comp, through placement_cost.h), the layout tidy-up
-// (placement_finalize.comp, through layout_tidy.h) and their CPU references. The includer
+// label loop (place_label.comp, through placement_cost.h), the tidy-up
+// (placement_tidy.comp, through tidy.h) and their CPU references. The includer
 // provides params (PlacementParams) and
 //   float table_at(uint layer, int x, int y)   summed-area table of the layer's integral costs
 //                                  (layer < layer_count) or hidden pixels (layer_count + layer)

@@ -1,4 +1,4 @@
-// The layout tidy-up's state per label on the GPU (placement.tidy), for C++ and GLSL; apart
+// The tidy-up's state per label on the GPU (placement.tidy), for C++ and GLSL; apart
 // from shared/placement.h since it needs 64-bit integers in GLSL.
 #ifndef STRATA_SHARED_TIDY_GPU_H
 #define STRATA_SHARED_TIDY_GPU_H

@@ -1,4 +1,4 @@
-// The layout tidy-up after the greedy placement: a local search that swaps two labels' boxes,
+// The tidy-up after the greedy placement: a local search that swaps two labels' boxes,
 // moves one label's box to a nearby position, or hides a label whose box overlaps an earlier
 // one's, each only when it lowers the layout's cost
 //   J = sum over the placed labels of eq. 3.1 without its constraint terms (free_cost)
@@ -8,7 +8,7 @@
 // The greedy placement only sees the labels placed before each one, as shadows, and in soft
 // mode takes a violation when it is cheaper than the free positions, so crossings that come from
 // the insertion order stay; J sees the finished layout. Written once for the GPU
-// (placement_finalize.comp, one workgroup) and the CPU reference (passes/placement_reference.cpp),
+// (placement_tidy.comp, one workgroup) and the CPU reference (passes/placement_reference.cpp),
 // which apply the same rounds in the same order.
 //
 // Geometry is exact: positions in fixed point (1/TIDY_SUBPIXEL pixel, anchors rounded to it;

@@ -1,4 +1,4 @@
-// One round of the layout tidy-up (layout_tidy.h), written once for the GPU and the CPU:
+// One round of the tidy-up (tidy.h), written once for the GPU and the CPU:
 //   1. every label's best change (tidy_key of its J change and the change id; none when no change
 //      lowers J): moves and hiding for labels in some conflict, swaps for pairs whose leaders
 //      cross or run through the other's box;
@@ -8,7 +8,7 @@
 //      interacts with it: applying both would change J by more than the sum of their changes
 //      (some pair of their labels conflicts differently). So every applied pair of changes adds
 //      at most its own changes and J falls every round; the best owner is always applied.
-// The includer provides, besides layout_tidy.h's needs:
+// The includer provides, besides tidy.h's needs:
 //   uint tidy_count()               labels
 //   LabelGpu tidy_input(uint k)     the label as placed
 //   TidyLabel tidy_state(uint k)    its state this round
