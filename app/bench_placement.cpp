@@ -181,8 +181,8 @@ PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& c
     if (name == "placement") r.stamped_ms = stat.median;
   }
   r.loop_ms = r.ms_per_pass(runner.graph().passes()[frame.placement().label_loop].name);
-  r.tidy_ms = r.ms_per_pass("placement.tidy");  // the tidy-up
-  r.forces_ms = r.ms_per_pass("labels.forces");         // thesis 3.4: one invocation per label
+  r.tidy_ms = r.ms_per_pass("placement.tidy");   // the tidy-up
+  r.forces_ms = r.ms_per_pass("labels.forces");  // thesis 3.4: one invocation per label
   if (baseline) r.baseline_loop_ms = label_loop_with_readback_per_label(frame, runs);
   std::tie(r.first_tiles, r.rest_tiles) = tiles_per_label(frame);  // (runs a frame)
   r.tidy_rounds =
@@ -242,7 +242,8 @@ ordered_json sweep_entry(const PlacementRun& r) {
 void print_placement_row(const PlacementRun* r) {
   if (!r) {
     std::fprintf(stderr, "%6s %6s %12s %10s %9s %12s %9s %9s %9s %12s\n", "labels", "shown",
-                 "placement", "loop", "us/label", "tidy-up", "rounds", "rest", "forces", "baseline");
+                 "placement", "loop", "us/label", "tidy-up", "rounds", "rest", "forces",
+                 "baseline");
     return;
   }
   const std::optional<double> baseline = r->baseline_ms();
@@ -252,8 +253,7 @@ void print_placement_row(const PlacementRun* r) {
   std::snprintf(rounds, sizeof rounds, "%u/%u", r->tidy_rounds_run, r->tidy_rounds);
   std::fprintf(stderr, "%6u %6u %12.3f %10.3f %9.2f %12.3f %9s %9.3f %9.4f %12s   (ms)\n",
                r->labels, r->labels_shown, r->whole_ms, r->loop_ms, loop_us_per_label(*r),
-               r->tidy_ms, rounds, r->stamped_ms - r->loop_ms - r->tidy_ms, r->forces_ms,
-               base);
+               r->tidy_ms, rounds, r->stamped_ms - r->loop_ms - r->tidy_ms, r->forces_ms, base);
 }
 
 void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {

@@ -4,7 +4,7 @@
 // the viewer feeds it events and renders camera(). Animated moves (to a named position or an
 // anatomical view) follow the camera paths' interpolation (camera_path.h).
 //
-// World space is DICOM's LPS+ patient space (docs/ARCHITECTURE.md, "Scenes and data"): +x is the
+// World space is DICOM's LPS+ patient space (docs/ARCHITECTURE.md, "Code map"): +x is the
 // patient's left, +y posterior, +z superior. The loaders convert to it (NIfTI and RAS NRRD negate
 // x and y; DICOM and MetaImage are LPS already), so "anterior" is -y, not Slicer's RAS +y.
 #pragma once

@@ -234,7 +234,8 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                     // (each speculative workgroup writes its tile's entry before anything reads it)
                     fill(b.speculative, 0xFFFFFFFFu);
                     fill(b.samples, 0xFFFFFFFFu);
-                    fill(b.tidy_args, 0);  // (indirect: no round runs until the one before sizes it)
+                    fill(b.tidy_args,
+                         0);  // (indirect: no round runs until the one before sizes it)
                     // (placement.regions needs none: the loop writes each pair, from the placed
                     // label's result, before a later label reads it; a label never placed
                     // writes regions that constrain nobody)
@@ -313,22 +314,22 @@ graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
       {b.tiles, Use::storage_read_write, PLACEMENT_BINDING_TILES},
       {b.args, Use::storage_read_write, PLACEMENT_BINDING_ARGS},
       {b.speculative, Use::storage_read_write, PLACEMENT_BINDING_SPECULATIVE},
-      // (written: the loop writes every pair before it reads it, ARCHITECTURE.md)
+      // (written: the loop writes every pair before it reads it)
       {b.regions, Use::storage_write, PLACEMENT_BINDING_REGIONS},
       {b.samples, Use::storage_read_write, PLACEMENT_BINDING_SAMPLES}};
   declare_sizes(uses, b.args);
   const ResourceId args = b.args;
-  return graph.add_pass(
-      {"placement.labels", graph::PassKind::compute, std::move(uses),
-       [this, args](graph::PassContext& pc) {
-         const glm::uvec3 groups = direct_groups(pc.viewport);
-         for (uint32_t step = 0; !order_.empty() && step <= order_.size(); ++step) {
-           if (step > 0) pc.barrier();
-           dispatch(pc, place_, params(pc.viewport, step), args,
-                    VkDeviceSize{step} * 3 * sizeof(uint32_t), groups);
-         }
-       },
-       "placement"});
+  return graph.add_pass({"placement.labels", graph::PassKind::compute, std::move(uses),
+                         [this, args](graph::PassContext& pc) {
+                           const glm::uvec3 groups = direct_groups(pc.viewport);
+                           for (uint32_t step = 0; !order_.empty() && step <= order_.size();
+                                ++step) {
+                             if (step > 0) pc.barrier();
+                             dispatch(pc, place_, params(pc.viewport, step), args,
+                                      VkDeviceSize{step} * 3 * sizeof(uint32_t), groups);
+                           }
+                         },
+                         "placement"});
 }
 
 void Placement::declare_sizes(std::vector<graph::ResourceUse>& uses, ResourceId args) const {
@@ -393,8 +394,8 @@ void Placement::add_tidy(graph::Graph& graph, const Buffers& b) {
                   }});
 }
 
-// The tidy-up's rounds. Where the plan skips idle blocks, a block of kTidyBlockRounds past the first
-// runs only when the round before it applied a change: its first round's count in the rounds
+// The tidy-up's rounds. Where the plan skips idle blocks, a block of kTidyBlockRounds past the
+// first runs only when the round before it applied a change: its first round's count in the rounds
 // buffer, which a round of the block before wrote. (One conditional block per block of rounds:
 // one around each dispatch cost a GPU more than the idle dispatches it skipped.)
 void Placement::record_tidy_rounds(graph::PassContext& pc, gpu::PlacementParams p,
@@ -414,7 +415,8 @@ void Placement::record_tidy_rounds(graph::PassContext& pc, gpu::PlacementParams 
       p.phase = TIDY_PHASE_CONFLICTS + k;
       // (the search's workgroups pass 65535 from about 900 labels: rows of them)
       const ComputePipeline& pipeline = p.phase == TIDY_PHASE_SEARCH ? search_ : tidy_;
-      const VkDeviceSize offset = (VkDeviceSize{round} * TIDY_ROUND_STEPS + k) * 3 * sizeof(uint32_t);
+      const VkDeviceSize offset =
+          (VkDeviceSize{round} * TIDY_ROUND_STEPS + k) * 3 * sizeof(uint32_t);
       dispatch(pc, pipeline, p, b.tidy_args, offset, gpu::tidy_phase_groups(p.phase, label_count_));
     }
     const bool block_ends = (round + 1) % kTidyBlockRounds == 0 || round + 1 == p.tidy_rounds;

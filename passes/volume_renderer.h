@@ -1,8 +1,8 @@
 // The renderer: transparent meshes hashed into the HA-Buffer by one thin graphics pass, then one
 // compute pass that sorts each pixel's mesh fragments, adds the volumes' boxes by a ray-box test,
 // ray-casts the volumes live between them from the volume atlas, and writes one premultiplied image
-// per depth layer, the label-free final image and a depth image. docs/ARCHITECTURE.md, "Rendering",
-// says why.
+// per depth layer, the label-free final image and a depth image. docs/ARCHITECTURE.md ("Design
+// reasons") says why.
 #pragma once
 
 #include <cstdint>

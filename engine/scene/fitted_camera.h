@@ -1,6 +1,6 @@
 // Cameras made from the content when a scene has none: the six anatomical views, each at the
 // distance where the content's box just fits the view. strata's world is the patient's LPS
-// (docs/ARCHITECTURE.md), so each view is a world axis.
+// (docs/ARCHITECTURE.md, "Code map"), so each view is a world axis.
 #pragma once
 
 #include <array>

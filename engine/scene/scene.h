@@ -92,7 +92,8 @@ struct Label {
   float priority = 0.0f;
 };
 
-// The thesis program's final paper settings (see docs/ARCHITECTURE.md, "Cost weights").
+// The thesis program's final paper settings (eq. 3.1; docs/ARCHITECTURE.md, "Thesis equations
+// in the code").
 struct CostWeights {
   float label_shadow = 1e5f;
   float anchor_constraint = 1e6f;

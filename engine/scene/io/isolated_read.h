@@ -1,6 +1,6 @@
 // Third-party parsers (Assimp for meshes, GDCM for DICOM) run in a child process, so that a crash,
 // an assertion, an endless loop or a runaway allocation inside them becomes one strata::Error
-// naming the file instead of taking strata down (docs/ARCHITECTURE.md, "Third-party parsers").
+// naming the file instead of taking strata down (docs/ARCHITECTURE.md, "Invariants").
 #pragma once
 
 #include <cstdint>
