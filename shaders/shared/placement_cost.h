@@ -162,8 +162,8 @@ float constraint_weight(uint bits) {
 // are not tested again (a GPU tile may know them for all its candidates). The search stops once
 // the bits found weigh more than `budget` (the GPU's candidates that cannot win any more; the
 // CPU reference passes infinity and always gets every bit). The label loop runs it for an
-// invocation's four candidates at once (candidate_bits in place_label.comp), the debug view and
-// the reference one candidate at a time.
+// invocation's four candidates at once (candidate_bits in place_label_evaluate.glsl), the debug
+// view and the reference one candidate at a time.
 uint constraint_bits(LabelGpu me, vec2 c, uint known, float budget) {
   vec2 h = constraint_half_size(me, params.margin);
   const uint shadows = CONSTRAINT_LABEL | CONSTRAINT_CONNECTOR;
