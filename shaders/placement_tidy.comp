@@ -8,5 +8,6 @@
 // copies the labels' states into shared memory first.
 #include "placement_tidy.glsl"
 #include "placement_tidy_states_shared.glsl"
+#include "placement_tidy_states_shared_steps.glsl"
 #include "placement_tidy_round.glsl"
 #include "placement_tidy_steps.glsl"

@@ -7,6 +7,7 @@
 // The tidy-up's search step for up to TIDY_SHARED_MAX (256) labels, with the shared memory only
 // it needs.
 #include "placement_tidy.glsl"
-#include "placement_tidy_search_states_shared.glsl"
+#include "placement_tidy_states_shared.glsl"
+#include "placement_tidy_states_shared_search.glsl"
 #include "placement_tidy_round.glsl"
 #include "placement_tidy_search.glsl"

@@ -9,7 +9,7 @@
 
 #include "labels.h"
 
-#define LABEL_DRAW_GROUP 16  // (8 x 8 culled the labels four times as often: slower on an H100)
+#define LABEL_DRAW_GROUP 16  // (8 x 8 culled the labels four times as often: docs/performance.md)
 #define LABEL_DRAW_BINDING_LAYERS 0  // rgba16f 2D array, one premultiplied layer per depth layer
 #define LABEL_DRAW_BINDING_LABELS 1  // LabelGpu[]
 #define LABEL_DRAW_BINDING_PLACEMENTS 2  // PlacementGpu[], one per label

@@ -37,8 +37,7 @@ ivec4 tidy_conflicts_of(uint i, uint first, uint stride) {
 // How label i's conflicts with the others (but `skip`) change when it goes from its state
 // (`from`) to `to`. The part whose first is 0 takes all of `from`'s at once (tidy_conflicts_now,
 // less skip's); the others of first, first + stride, ... are weighed against `to` only. (Weighing
-// each against both, as the search once did, took most of a round: 77 of 101 us for 100 labels on
-// an H100.)
+// each against both, as the search once did, took most of a round: docs/performance.md.)
 ivec4 tidy_conflict_change(uint i, TidyLabel from, TidyLabel to, uint skip, uint first,
                            uint stride) {
   ivec4 change = ivec4(0);

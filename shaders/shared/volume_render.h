@@ -86,8 +86,7 @@ struct FrameGpu {
 
 // The order in which the resolve's workgroups (8x8 pixels each) take the image, by the device's
 // kind. GPUs: rows from the top (VR_ORDER_ROWS; vertical strips 4, 8 or 16 workgroups wide, for
-// the texture caches, were 1% slower at 1024² on the H100 and 6% at 1080p in the viewer, 1%
-// faster at 2048²). CPU devices (VR_ORDER_ROWS_INTERLEAVED): rows in VR_ROW_INTERLEAVE
+// the texture caches, were slower: docs/performance.md). CPU devices (VR_ORDER_ROWS_INTERLEAVED): rows in VR_ROW_INTERLEAVE
 // interleaved sets (0, 8, 16, ..., then 1, 9, ...), so that every long run of consecutive
 // workgroups spans the whole image: lavapipe hands each of its threads one contiguous run of a
 // dispatch's workgroups, and with rows in order the thread whose half of the image held more of

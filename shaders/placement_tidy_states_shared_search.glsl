@@ -1,11 +1,4 @@
-// The tidy-up search's label states in shared memory (placement_tidy_search.comp, up to
-// TIDY_SHARED_MAX labels; placement_tidy_states_shared.glsl says why a copy).
-shared TidyLabel s_label[TIDY_SHARED_MAX];
-shared float s_free[TIDY_SHARED_MAX];
-shared uint s_rank[TIDY_SHARED_MAX];
-TidyLabel tidy_state(uint k) { return s_label[k]; }
-float tidy_free(uint k) { return s_free[k]; }
-uint tidy_rank(uint k) { return s_rank[k]; }
+// The tidy-up search's copy of the labels' states.
 // (the search reads only the states, free costs and ranks, so its workgroups keep 10 KB of shared
 // memory instead of 21.5 and more of them fit an SM)
 uint64_t tidy_best(uint k) { return tidy[k].best; }
