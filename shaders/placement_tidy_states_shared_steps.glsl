@@ -1,9 +1,9 @@
 // The tidy-up steps' copy of the labels' states, the bests, next states and partners included.
 shared TidyLabel s_next[TIDY_SHARED_MAX];
-shared uint64_t s_best[TIDY_SHARED_MAX];
-shared uint s_partner[TIDY_SHARED_MAX];
-uint64_t tidy_best(uint k) { return s_best[k]; }
 TidyLabel tidy_next(uint k) { return s_next[k]; }
+shared uint64_t s_best[TIDY_SHARED_MAX];
+uint64_t tidy_best(uint k) { return s_best[k]; }
+shared uint s_partner[TIDY_SHARED_MAX];
 uint tidy_partner(uint k) { return s_partner[k]; }
 
 // The workgroup's copy of the labels' states (the bests only after the search has them).
