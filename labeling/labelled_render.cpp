@@ -11,10 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
+#include "engine/core/json_field.h"
 #include "engine/gpu/context.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
-#include "engine/scene/io/transfer_function_loader.h"
 #include "labeling/insertion_order.h"
 #include "labeling/text_layout.h"
 #include "passes/label_drawing.h"
