@@ -172,20 +172,6 @@ void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
   for (const Still& still : all) render_labelled_still(ctx, scene, o, size, still);
 }
 
-// An overflowing HA-Buffer grows for the next frame; an offline image waits for a clean one.
-RenderStats render_until_clean(VolumeRenderer& renderer, graph::GraphRunner& runner,
-                               graph::Extent size) {
-  RenderStats stats;
-  for (int attempt = 0; attempt < 4; ++attempt) {
-    runner.run_now();
-    stats = renderer.collect(runner);
-    if (stats.overflow == 0) break;
-    std::fprintf(stderr, "strata: HA-Buffer overflow (%u fragments), table grows to %u slots\n",
-                 stats.overflow, renderer.table_slots(size));
-  }
-  return stats;
-}
-
 // The label-free image; the renderer and its graph are built once and run for each position.
 void render_scene(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
@@ -206,7 +192,10 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   print_graph(o, runner);
   for (const Still& still : all) {
     renderer.set_camera(still.camera);
-    const RenderStats stats = render_until_clean(renderer, runner, size);
+    const RenderStats stats = renderer.run_until_no_overflow(runner, [&](const RenderStats& s) {
+      std::fprintf(stderr, "strata: HA-Buffer overflow (%u fragments), table grows to %u slots\n",
+                   s.overflow, renderer.table_slots(size));
+    });
     write_image(still.image, size.width, size.height, target.pixels());
     std::printf(
         "wrote %s (%ux%u, %u layers): %u fragments, load factor %.2f, %.1f samples per ray\n",

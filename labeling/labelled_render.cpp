@@ -290,11 +290,7 @@ std::vector<PipelineReport> LabelledRenderer::placement_pipelines() const {
 }
 
 void LabelledRenderer::run_frame() {
-  for (int attempt = 0; attempt < 4; ++attempt) {
-    runner_->run_now();
-    stats_ = parts_->renderer.collect(*runner_);
-    if (stats_.overflow == 0) break;
-  }
+  stats_ = parts_->renderer.run_until_no_overflow(*runner_);
 }
 
 // Stein & Decoret's order inside each layer, from the first frame's image: occupancy is the
