@@ -161,27 +161,38 @@ void check_outputs(const std::vector<Still>& all) {
   for (const Still& still : all) check_image_extension(still.image);
 }
 
+// What a render of a scene opens before anything renders: the device, the scene, and its stills
+// with every output file checked.
+struct SceneRender {
+  graph::Extent size;
+  Context ctx;
+  Scene scene;
+  std::vector<Still> stills;
+
+  SceneRender(DeviceOptions& device, const RenderOptions& o)
+      : size(parse_size(o.size, "--size")), ctx(device.context()) {
+    check_image_size(ctx, size, "--size");
+    scene = load_scene_reporting(o.scene, ctx);
+    stills = app::stills(scene, o);
+    check_outputs(stills);
+  }
+};
+
 // strata's main job: the labelled image (labeling/labelled_render.h), once per position.
 void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
-  const graph::Extent size = parse_size(o.size, "--size");
-  Context ctx(device.context());
-  check_image_size(ctx, size, "--size");
-  const Scene scene = load_scene_reporting(o.scene, ctx);
-  const std::vector<Still> all = stills(scene, o);
-  check_outputs(all);
-  for (const Still& still : all) render_labelled_still(ctx, scene, o, size, still);
+  SceneRender job(device, o);
+  for (const Still& still : job.stills) {
+    render_labelled_still(job.ctx, job.scene, o, job.size, still);
+  }
 }
 
 // The label-free image; the renderer and its graph are built once and run for each position.
 void render_scene(DeviceOptions& device, const RenderOptions& o) {
-  const graph::Extent size = parse_size(o.size, "--size");
-  Context ctx(device.context());
-  check_image_size(ctx, size, "--size");
-  const Scene scene = load_scene_reporting(o.scene, ctx);
-  const std::vector<Still> all = stills(scene, o);
-  check_outputs(all);
-  const RenderSettings settings = render_settings(o, scene);
-  VolumeRenderer renderer(ctx, scene, settings);
+  SceneRender job(device, o);
+  Context& ctx = job.ctx;
+  const graph::Extent size = job.size;
+  const RenderSettings settings = render_settings(o, job.scene);
+  VolumeRenderer renderer(ctx, job.scene, settings);
   HeadlessTarget target(ctx);
   graph::Graph graph;
   const VolumeRenderer::Outputs out = renderer.add_to(graph);
@@ -190,7 +201,7 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   runner.set_viewport(size);
   target.bind(runner);
   print_graph(o, runner);
-  for (const Still& still : all) {
+  for (const Still& still : job.stills) {
     renderer.set_camera(still.camera);
     const RenderStats stats = renderer.run_until_no_overflow(runner, [&](const RenderStats& s) {
       std::fprintf(stderr, "strata: HA-Buffer overflow (%u fragments), table grows to %u slots\n",
