@@ -161,41 +161,38 @@ void check_outputs(const std::vector<Still>& all) {
   for (const Still& still : all) check_image_extension(still.image);
 }
 
+// What a render of a scene opens before anything renders: the device, the scene, and its stills
+// with every output file checked.
+struct SceneRender {
+  graph::Extent size;
+  Context ctx;
+  Scene scene;
+  std::vector<Still> stills;
+
+  SceneRender(DeviceOptions& device, const RenderOptions& o)
+      : size(parse_size(o.size, "--size")), ctx(device.context()) {
+    check_image_size(ctx, size, "--size");
+    scene = load_scene_reporting(o.scene, ctx);
+    stills = app::stills(scene, o);
+    check_outputs(stills);
+  }
+};
+
 // strata's main job: the labelled image (labeling/labelled_render.h), once per position.
 void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
-  const graph::Extent size = parse_size(o.size, "--size");
-  Context ctx(device.context());
-  check_image_size(ctx, size, "--size");
-  const Scene scene = load_scene_reporting(o.scene, ctx);
-  const std::vector<Still> all = stills(scene, o);
-  check_outputs(all);
-  for (const Still& still : all) render_labelled_still(ctx, scene, o, size, still);
-}
-
-// An overflowing HA-Buffer grows for the next frame; an offline image waits for a clean one.
-RenderStats render_until_clean(VolumeRenderer& renderer, graph::GraphRunner& runner,
-                               graph::Extent size) {
-  RenderStats stats;
-  for (int attempt = 0; attempt < 4; ++attempt) {
-    runner.run_now();
-    stats = renderer.collect(runner);
-    if (stats.overflow == 0) break;
-    std::fprintf(stderr, "strata: HA-Buffer overflow (%u fragments), table grows to %u slots\n",
-                 stats.overflow, renderer.table_slots(size));
+  SceneRender job(device, o);
+  for (const Still& still : job.stills) {
+    render_labelled_still(job.ctx, job.scene, o, job.size, still);
   }
-  return stats;
 }
 
 // The label-free image; the renderer and its graph are built once and run for each position.
 void render_scene(DeviceOptions& device, const RenderOptions& o) {
-  const graph::Extent size = parse_size(o.size, "--size");
-  Context ctx(device.context());
-  check_image_size(ctx, size, "--size");
-  const Scene scene = load_scene_reporting(o.scene, ctx);
-  const std::vector<Still> all = stills(scene, o);
-  check_outputs(all);
-  const RenderSettings settings = render_settings(o, scene);
-  VolumeRenderer renderer(ctx, scene, settings);
+  SceneRender job(device, o);
+  Context& ctx = job.ctx;
+  const graph::Extent size = job.size;
+  const RenderSettings settings = render_settings(o, job.scene);
+  VolumeRenderer renderer(ctx, job.scene, settings);
   HeadlessTarget target(ctx);
   graph::Graph graph;
   const VolumeRenderer::Outputs out = renderer.add_to(graph);
@@ -204,9 +201,12 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   runner.set_viewport(size);
   target.bind(runner);
   print_graph(o, runner);
-  for (const Still& still : all) {
+  for (const Still& still : job.stills) {
     renderer.set_camera(still.camera);
-    const RenderStats stats = render_until_clean(renderer, runner, size);
+    const RenderStats stats = renderer.run_until_no_overflow(runner, [&](const RenderStats& s) {
+      std::fprintf(stderr, "strata: HA-Buffer overflow (%u fragments), table grows to %u slots\n",
+                   s.overflow, renderer.table_slots(size));
+    });
     write_image(still.image, size.width, size.height, target.pixels());
     std::printf(
         "wrote %s (%ux%u, %u layers): %u fragments, load factor %.2f, %.1f samples per ray\n",

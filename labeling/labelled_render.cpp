@@ -11,10 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
+#include "engine/core/json_field.h"
 #include "engine/gpu/context.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
-#include "engine/scene/io/transfer_function_loader.h"
 #include "labeling/insertion_order.h"
 #include "labeling/text_layout.h"
 #include "passes/label_drawing.h"
@@ -290,11 +290,7 @@ std::vector<PipelineReport> LabelledRenderer::placement_pipelines() const {
 }
 
 void LabelledRenderer::run_frame() {
-  for (int attempt = 0; attempt < 4; ++attempt) {
-    runner_->run_now();
-    stats_ = parts_->renderer.collect(*runner_);
-    if (stats_.overflow == 0) break;
-  }
+  stats_ = parts_->renderer.run_until_no_overflow(*runner_);
 }
 
 // Stein & Decoret's order inside each layer, from the first frame's image: occupancy is the

@@ -548,4 +548,16 @@ RenderStats VolumeRenderer::collect(graph::GraphRunner& runner) {
   return stats;
 }
 
+RenderStats VolumeRenderer::run_until_no_overflow(
+    graph::GraphRunner& runner, const std::function<void(const RenderStats&)>& on_overflow) {
+  RenderStats stats;
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    runner.run_now();
+    stats = collect(runner);
+    if (stats.overflow == 0) break;
+    if (on_overflow) on_overflow(stats);
+  }
+  return stats;
+}
+
 }  // namespace strata

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "engine/gpu/resources.h"
@@ -125,6 +126,11 @@ class VolumeRenderer {
   // Reads the counters of the last completed frame; grows the table (and reallocates the
   // runner's transients) when fragments overflowed or it is fuller than 0.75. Returns the stats.
   RenderStats collect(graph::GraphRunner& runner);
+  // An offline image waits for a clean frame: runs `runner` and collect()s until no fragment
+  // overflowed the HA-Buffer (it grows after each overflow), four runs at most. `on_overflow`
+  // hears of each overflow, after the table grew. Returns the last run's stats.
+  RenderStats run_until_no_overflow(
+      graph::GraphRunner& runner, const std::function<void(const RenderStats&)>& on_overflow = {});
 
   const RenderInputs& inputs() const { return inputs_; }
   // The counters' readback, one per frame in flight (collect() reads its current slot).

@@ -1,7 +1,9 @@
 // Where a value sits in a JSON file, for errors that name it ("scene.json: volumes[0].transform:
-// expected 16 numbers"), and the key lookups every JSON reader of strata makes.
+// expected 16 numbers"), the key lookups every JSON reader of strata makes, and the numbers its
+// JSON writers write.
 #pragma once
 
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -86,6 +88,16 @@ inline nlohmann::json read_json_file(const std::filesystem::path& path) {
     const size_t end = what.find("] ");
     throw Error(path.string() + ": " + (end == std::string::npos ? what : what.substr(end + 2)));
   }
+}
+
+// The JSON value of a float written with the fewest digits that read back as the same float
+// (0.1f is written 0.1, not 0.10000000149011612).
+inline double shortest_double(float value) {
+  char text[32];
+  const auto result = std::to_chars(text, text + sizeof text, value);
+  double shortest = value;
+  std::from_chars(text, result.ptr, shortest);
+  return shortest;
 }
 
 }  // namespace strata

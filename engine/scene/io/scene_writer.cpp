@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
+#include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
 #include "engine/scene/fitted_camera.h"
 #include "engine/scene/io/scene_loader.h"

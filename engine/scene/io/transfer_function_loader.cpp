@@ -106,14 +106,6 @@ TransferFunction::Stop gra_stop(const pugi::xml_node& node, const std::string& f
 
 }  // namespace
 
-double shortest_double(float value) {
-  char text[32];
-  const auto result = std::to_chars(text, text + sizeof text, value);
-  double shortest = value;
-  std::from_chars(text, result.ptr, shortest);
-  return shortest;
-}
-
 TransferFunction transfer_function_from_json(const json& object, const std::string& file,
                                              const std::string& field) {
   if (!object.is_object()) fail(file, field, "expected a transfer-function object");

@@ -29,8 +29,4 @@ TransferFunction transfer_function_from_json(const nlohmann::json& object, const
 // Keys in the documented order (ordered_json), for files people read.
 nlohmann::ordered_json transfer_function_to_json(const TransferFunction& tf);
 
-// The JSON value of a float written with the fewest digits that read back as the same float
-// (0.1f is written 0.1, not 0.10000000149011612).
-double shortest_double(float value);
-
 }  // namespace strata
