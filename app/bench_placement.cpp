@@ -1,6 +1,6 @@
 // `strata bench placement` (app/bench_placement.h): one Context, a LabelledRenderer per label
 // count, each measured with a stamp around every pass, again with stamps only where groups begin
-// and end, and (unless --no-baseline) split into a submission per label.
+// and end, and (unless --no-baseline) against a frame of its own submitted a label at a time.
 #include "app/bench_placement.h"
 
 #include <algorithm>
@@ -95,34 +95,31 @@ ordered_json optional_ms(std::optional<double> ms) {
   return ms ? ordered_json(ms_json(*ms)) : ordered_json(nullptr);
 }
 
-// The thesis program's structure: back to the CPU after every label, reading its result. The
-// loop's barrier b follows dispatch b, and dispatches 1 .. N each finish a label. Returns the
-// median time of the loop so split, on the host's clock.
-double label_loop_with_readback_per_label(LabelledRenderer& frame, uint32_t runs) {
+// The thesis program's structure: back to the CPU after every label, reading its result. A
+// frame of its own with the label loop as a pass per step (step s finishes position s - 1): the
+// passes before the loop first, then a submission per label (the first with step 0, the
+// speculative start) and a readback of the results after each. Returns the median time of the
+// loop so split, on the host's clock.
+double label_loop_with_readback_per_label(Context& ctx, const Scene& scene, const Camera& camera,
+                                          graph::Extent size, LabellingSettings settings,
+                                          uint32_t runs) {
+  settings.placement_layout.pass_per_label = true;
+  LabelledRenderer frame(ctx, scene, camera, size, settings);
+  frame.run();  // warm up, grow the HA-Buffer if it must, and set the frame's order
   graph::GraphRunner& runner = frame.runner();
   const graph::PassId loop = frame.placement().label_loop;
+  const auto labels = static_cast<graph::PassId>(frame.placement_order_count());
   std::vector<double> readback_ms;
-  for (uint32_t run = 0; run < std::max(1u, runs / 4); ++run) {
-    std::chrono::steady_clock::time_point start;
-    const auto before_loop = [&](const graph::SplitPoint& s) {
-      return s.pass + 1 == loop && !s.barrier;
-    };
-    const auto ends_label = [&](const graph::SplitPoint& s) {
-      return s.pass == loop && (!s.barrier || *s.barrier >= 1);
-    };
-    runner.run_split([&](const graph::SplitPoint& s) { return before_loop(s) || ends_label(s); },
-                     [&](const graph::SplitPoint& s) {
-                       if (before_loop(s)) {
-                         start = std::chrono::steady_clock::now();
-                         return;
-                       }
-                       runner.download_buffer(frame.placement().results);
-                       if (!s.barrier) {
-                         readback_ms.push_back(std::chrono::duration<double, std::milli>(
-                                                   std::chrono::steady_clock::now() - start)
-                                                   .count());
-                       }
-                     });
+  for (uint32_t run = 0; run < std::max(1u, runs / 4) && labels > 0; ++run) {
+    runner.run_passes(0, loop);
+    const auto start = std::chrono::steady_clock::now();
+    for (graph::PassId label = 1; label <= labels; ++label) {
+      runner.run_passes(label == 1 ? loop : loop + label, loop + label + 1);
+      runner.download_buffer(frame.placement().results);
+    }
+    readback_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
   }
   return stat_of(readback_ms.empty() ? std::vector<double>{0.0} : readback_ms).median;
 }
@@ -159,10 +156,15 @@ uint32_t tidy_rounds_run(LabelledRenderer& frame, uint32_t rounds) {
   return run;
 }
 
-PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& camera,
-                               graph::Extent size, uint32_t runs, bool baseline) {
+LabellingSettings labelling_settings(const Scene& scene) {
   LabellingSettings settings;
   settings.placement.weights = scene.settings.weights;
+  return settings;
+}
+
+PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& camera,
+                               graph::Extent size, uint32_t runs) {
+  const LabellingSettings settings = labelling_settings(scene);
   LabelledRenderer frame(ctx, scene, camera, size, settings);
   frame.run();  // warm up, and grow the HA-Buffer if it must
   graph::GraphRunner& runner = frame.runner();
@@ -183,7 +185,6 @@ PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& c
   r.loop_ms = r.ms_per_pass(runner.graph().passes()[frame.placement().label_loop].name);
   r.tidy_ms = r.ms_per_pass("placement.tidy");   // the tidy-up
   r.forces_ms = r.ms_per_pass("labels.forces");  // thesis 3.4: one invocation per label
-  if (baseline) r.baseline_loop_ms = label_loop_with_readback_per_label(frame, runs);
   std::tie(r.first_tiles, r.rest_tiles) = tiles_per_label(frame);  // (runs a frame)
   r.tidy_rounds =
       placement_params(settings.placement, size, 1, uint32_t(scene.labels.size()), 0).tidy_rounds;
@@ -273,7 +274,11 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
   print_placement_row(nullptr);
   for (std::vector<Label>& these : labels) {
     scene.labels = std::move(these);
-    measured.push_back(measure_placement(ctx, scene, camera, size, o.runs, !o.no_baseline));
+    measured.push_back(measure_placement(ctx, scene, camera, size, o.runs));
+    if (!o.no_baseline) {
+      measured.back().baseline_loop_ms = label_loop_with_readback_per_label(
+          ctx, scene, camera, size, labelling_settings(scene), o.runs);
+    }
     print_placement_row(&measured.back());
   }
   if (counts.size() == 1) {

@@ -48,15 +48,16 @@ std::vector<ProjectedPoint> project_anchors(const Scene& scene, const Camera& ca
 }
 
 struct LabelledRenderer::Parts {
-  Parts(Context& ctx, const Scene& scene, const RenderSettings& render, uint32_t label_count)
-      : Parts(ctx, scene, render, label_count, std::async(std::launch::async, [&ctx, label_count] {
+  Parts(Context& ctx, const Scene& scene, const LabellingSettings& settings, uint32_t label_count)
+      : Parts(ctx, scene, settings, label_count,
+              std::async(std::launch::async, [&ctx, label_count] {
                 return Placement::create_pipelines(ctx, label_count);
               })) {}
   // (the placement's pipelines compile while the renderer prepares the volumes)
-  Parts(Context& ctx, const Scene& scene, const RenderSettings& render, uint32_t label_count,
+  Parts(Context& ctx, const Scene& scene, const LabellingSettings& settings, uint32_t label_count,
         std::future<std::vector<ComputePipeline>> placement_pipelines)
-      : renderer(ctx, scene, render),
-        placement(ctx, label_count, {}, placement_pipelines.get()),
+      : renderer(ctx, scene, settings.render),
+        placement(ctx, label_count, settings.placement_layout, placement_pipelines.get()),
         forces(ctx, label_count),
         target(ctx) {}
   VolumeRenderer renderer;
@@ -76,7 +77,7 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
   hidden_.assign(scene.labels.size(), false);
   for (size_t i = 0; i < scene.labels.size(); ++i) labels_[i].size = scene.labels[i].size;
   project_and_layer(camera);
-  parts_ = std::make_unique<Parts>(ctx, scene, settings.render, uint32_t(labels_.size()));
+  parts_ = std::make_unique<Parts>(ctx, scene, settings, uint32_t(labels_.size()));
   parts_->renderer.set_camera(camera);
   build_labels();
   set_order(scene_order(uint32_t(labels_.size())));

@@ -32,6 +32,8 @@ struct LabellingSettings {
   InsertionOrder order = InsertionOrder::scene;
   uint32_t optimize_tries = 8;  // InsertionOrder::optimized: random orders tried
   PlacementSettings placement;
+  // How the placement is dispatched (speed and benchmarks only).
+  PlacementLayout placement_layout;
   ForceSettings forces;        // how drawn positions follow the placement from frame to frame
   LayerHysteresis hysteresis;  // how labels keep their layers while the camera moves
   bool internal = false;       // internal labelling: every label drawn on its anchor

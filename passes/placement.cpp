@@ -163,9 +163,10 @@ Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
   add_costs(graph, b, in);
   add_bounds(graph, b);
   const graph::PassId loop = add_label_loop(graph, b);
+  const auto loop_end = static_cast<graph::PassId>(graph.passes().size());
   add_tidy(graph, b);
   return {b.labels,  b.placements, b.saliency,    b.costs, b.tables, b.constraints,
-          b.results, b.buckets,    b.tidy_rounds, b.order, loop};
+          b.results, b.buckets,    b.tidy_rounds, b.order, loop,     loop_end};
 }
 
 Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
@@ -302,7 +303,8 @@ void Placement::add_bounds(graph::Graph& graph, const Buffers& b) {
 // The greedy loop as one graph pass: a place_label dispatch per label and one more (dispatch j:
 // the main pass of order position j - 1 and the speculative pass of j), each reading what the one
 // before wrote, so the graph's barrier helper separates them. Each dispatch sizes the next one's
-// main pass, and the next dispatch.
+// main pass, and the next dispatch. With pass_per_label, a pass per dispatch, with the same uses:
+// the graph derives the barrier between them.
 graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
   std::vector<graph::ResourceUse> uses{
       {b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
@@ -318,18 +320,27 @@ graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
       {b.regions, Use::storage_write, PLACEMENT_BINDING_REGIONS},
       {b.samples, Use::storage_read_write, PLACEMENT_BINDING_SAMPLES}};
   declare_sizes(uses, b.args);
-  const ResourceId args = b.args;
-  return graph.add_pass({"placement.labels", graph::PassKind::compute, std::move(uses),
-                         [this, args](graph::PassContext& pc) {
-                           const glm::uvec3 groups = direct_groups(pc.viewport);
-                           for (uint32_t step = 0; !order_.empty() && step <= order_.size();
-                                ++step) {
-                             if (step > 0) pc.barrier();
-                             dispatch(pc, place_, params(pc.viewport, step), args,
-                                      VkDeviceSize{step} * 3 * sizeof(uint32_t), groups);
-                           }
-                         },
-                         "placement"});
+  // Steps [first, end) of the loop, those the frame's order has.
+  const auto steps = [this, args = b.args](uint32_t first, uint32_t end) {
+    return [this, args, first, end](graph::PassContext& pc) {
+      const glm::uvec3 groups = direct_groups(pc.viewport);
+      for (uint32_t step = first; step < end && step <= order_.size() && !order_.empty(); ++step) {
+        if (step > first) pc.barrier();
+        dispatch(pc, place_, params(pc.viewport, step), args,
+                 VkDeviceSize{step} * 3 * sizeof(uint32_t), groups);
+      }
+    };
+  };
+  if (!layout_.pass_per_label) {
+    return graph.add_pass({"placement.labels", graph::PassKind::compute, std::move(uses),
+                           steps(0, label_count_ + 1), "placement"});
+  }
+  const auto first = static_cast<graph::PassId>(graph.passes().size());
+  for (uint32_t step = 0; step <= label_count_; ++step) {
+    graph.add_pass({"placement.labels." + std::to_string(step), graph::PassKind::compute, uses,
+                    steps(step, step + 1), "placement"});
+  }
+  return first;
 }
 
 void Placement::declare_sizes(std::vector<graph::ResourceUse>& uses, ResourceId args) const {

@@ -70,6 +70,9 @@ struct PlacementLayout {
   // conditional rendering where the device has it and the round before the block applied
   // nothing (then no later round can).
   bool skip_idle_blocks = true;
+  // The label loop as a graph pass per step instead of one pass (benchmark baselines that return
+  // to the host between labels: GraphRunner::run_passes).
+  bool pass_per_label = false;
 };
 
 // Tidy-up rounds per conditional block (PlacementLayout::skip_idle_blocks).
@@ -105,8 +108,11 @@ class Placement {
     // uint per tidy-up round r: 1 for round 0, then the changes round r - 1 applied (round r runs
     // only when that is not 0; benchmark statistics)
     graph::ResourceId tidy_rounds;
-    graph::ResourceId order;   // uint[]: the frame's insertion order (label indices)
-    graph::PassId label_loop;  // the pass that places the labels one by one
+    graph::ResourceId order;  // uint[]: the frame's insertion order (label indices)
+    // The passes that place the labels one by one, [label_loop, label_loop_end): one, or with
+    // PlacementLayout::pass_per_label pass label_loop + s records step s (place_label dispatch s:
+    // the main pass of order position s - 1 and the speculative one of s).
+    graph::PassId label_loop, label_loop_end;
   };
 
   // `label_count` sizes the per-label buffers; a frame may enable fewer labels.
@@ -145,6 +151,7 @@ class Placement {
   void add_upload(graph::Graph& graph, const Buffers& b);
   void add_costs(graph::Graph& graph, const Buffers& b, const Inputs& in);
   void add_bounds(graph::Graph& graph, const Buffers& b);
+  // The loop's first pass; its last is the graph's last.
   graph::PassId add_label_loop(graph::Graph& graph, const Buffers& b);
   void add_tidy(graph::Graph& graph, const Buffers& b);
   void record_tidy_rounds(graph::PassContext& pc, gpu::PlacementParams p, const Buffers& b) const;

@@ -7,6 +7,7 @@
 #include <functional>
 #include <random>
 
+#include "engine/core/error.h"
 #include "engine/gpu/resources.h"
 #include "engine/graph/graph_runner.h"
 #include "gpu_fixture.h"
@@ -23,18 +24,10 @@ bool has_hazard(const std::vector<std::string>& messages) {
   return false;
 }
 
-enum class Run {
-  with_barriers,
-  without_barriers,
-  split_at_barriers,  // run_split, back to the host at each barrier
-};
-
 // The summed-area table's three dispatches in one pass, with or without the barrier helper
-// between them; returns the table (and, split, the points where the run came back to the host).
+// between them; returns the table.
 std::vector<float> table_in_one_pass(Context& ctx, const std::vector<float>& values,
-                                     graph::Extent size, Run run,
-                                     std::vector<graph::SplitPoint>* points = nullptr) {
-  const bool barriers = run != Run::without_barriers;
+                                     graph::Extent size, bool barriers) {
   const VkDeviceSize bytes = values.size() * sizeof(float);
   Buffer input(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
   Buffer output(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
@@ -76,13 +69,17 @@ std::vector<float> table_in_one_pass(Context& ctx, const std::vector<float>& val
               }});
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(size);
-  if (run == Run::split_at_barriers) {
-    runner.run_split([](const graph::SplitPoint& s) { return s.barrier.has_value(); },
-                     [&](const graph::SplitPoint& s) { points->push_back(s); });
-  } else {
-    runner.run_now();
-  }
+  runner.run_now();
   return download_as<float>(ctx, output);
+}
+
+// A viewport's worth of values in [0, 1).
+std::vector<float> random_values(graph::Extent size, uint32_t seed) {
+  std::vector<float> values(size_t{size.width} * size.height);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> dist(0.0f, 1.0f);
+  for (float& v : values) v = dist(rng);
+  return values;
 }
 
 graph::BufferInfo small_buffer() {
@@ -111,8 +108,8 @@ void check_recording_fails(Context& ctx, graph::Graph g, const char* message) {
 TEST_SUITE("gpu") {
   // A conditional block's dispatches run only where the predicate an earlier pass wrote is not 0
   // (the graph's barrier makes the write visible to the predicate's read: synchronization
-  // validation would say otherwise): a block per dispatch, one across the pass's barriers, and
-  // that one split into several submissions at the barriers. A block must not stay open.
+  // validation would say otherwise): a block per dispatch, or one across the pass's barriers.
+  // A block must not stay open.
   TEST_CASE_FIXTURE(test::GpuTest, "conditional_blocks_run_only_where_their_predicate_is_set") {
     REQUIRE(ctx.conditional_rendering());  // (lavapipe and NVIDIA's driver have it)
     const graph::Extent size{16, 8};
@@ -121,14 +118,10 @@ TEST_SUITE("gpu") {
     const ComputePipeline sums(ctx, "summed_area_table_sums.comp");
     const ComputePipeline carries(ctx, "summed_area_table_carries.comp");
     const ComputePipeline scan(ctx, "summed_area_table_scan.comp");
-    enum class Blocks { per_dispatch, across_barriers, split };
-    for (const auto& [predicate, blocks] :
-         {std::pair{0u, Blocks::per_dispatch}, std::pair{7u, Blocks::per_dispatch},
-          std::pair{0u, Blocks::across_barriers}, std::pair{7u, Blocks::across_barriers},
-          std::pair{0u, Blocks::split}, std::pair{7u, Blocks::split}}) {
+    for (const auto& [predicate, per_dispatch] :
+         {std::pair{0u, true}, std::pair{7u, true}, std::pair{0u, false}, std::pair{7u, false}}) {
       CAPTURE(predicate);
-      CAPTURE(int(blocks));
-      const bool per_dispatch = blocks == Blocks::per_dispatch;
+      CAPTURE(per_dispatch);
       const VkDeviceSize bytes = ones.size() * sizeof(float);
       Buffer input(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
       Buffer output(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
@@ -168,14 +161,7 @@ TEST_SUITE("gpu") {
                   }});
       graph::GraphRunner runner(ctx, std::move(g));
       runner.set_viewport(size);
-      std::vector<graph::SplitPoint> points;
-      if (blocks == Blocks::split) {
-        runner.run_split([](const graph::SplitPoint& s) { return s.barrier.has_value(); },
-                         [&](const graph::SplitPoint& s) { points.push_back(s); });
-        CHECK(points.size() == 2);
-      } else {
-        runner.run_now();
-      }
+      runner.run_now();
       const std::vector<float> table = download_as<float>(ctx, output);
       CHECK(table.front() == (predicate != 0 ? 1.0f : -1.0f));
       CHECK(table.back() == (predicate != 0 ? float(ones.size()) : -1.0f));
@@ -241,10 +227,7 @@ TEST_SUITE("gpu") {
 
   TEST_CASE_FIXTURE(test::GpuTest, "dependent_dispatches_in_one_pass_are_ordered_by_its_barriers") {
     const graph::Extent size{70, 45};
-    std::vector<float> values(size_t{size.width} * size.height);
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<float> dist(0.0f, 1.0f);
-    for (float& v : values) v = dist(rng);
+    const std::vector<float> values = random_values(size, 5);
     const std::vector<double> cpu = summed_area_table_reference(values, size.width, size.height);
 
     const auto worst_error = [&](const std::vector<float>& gpu) {
@@ -254,24 +237,50 @@ TEST_SUITE("gpu") {
       }
       return worst;
     };
-    CHECK(worst_error(table_in_one_pass(ctx, values, size, Run::with_barriers)) < 1e-5);
+    CHECK(worst_error(table_in_one_pass(ctx, values, size, true)) < 1e-5);
     CHECK(ctx.validation_log().count() == 0);
-
-    // Back to the host at each barrier (the benchmarks' baseline): the same table, and the
-    // dispatches after a split find their pipeline bound again in the new command buffer.
-    std::vector<graph::SplitPoint> points;
-    CHECK(worst_error(table_in_one_pass(ctx, values, size, Run::split_at_barriers, &points)) <
-          1e-5);
-    CHECK(ctx.validation_log().count() == 0);
-    REQUIRE(points.size() == 3);
-    for (uint32_t i = 0; i < 3; ++i) {
-      CHECK(points[i].pass == 0);
-      CHECK(points[i].barrier == i);
-    }
 
     // The same dispatches without the helper's barriers: a read-after-write hazard.
-    table_in_one_pass(ctx, values, size, Run::without_barriers);
+    table_in_one_pass(ctx, values, size, false);
     CHECK(has_hazard(ctx.validation_log().take()));
+  }
+
+  // A frame run a range of passes at a time, a submission each (work that returns to the host
+  // between passes), does what one run does: the barriers before each range's first pass come
+  // with it, and every pass has its timings.
+  TEST_CASE_FIXTURE(test::GpuTest, "a_graph_run_in_ranges_of_passes_matches_one_run") {
+    const graph::Extent size{70, 45};
+    const std::vector<float> values = random_values(size, 7);
+    const VkDeviceSize bytes = values.size() * sizeof(float);
+    Buffer input(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
+    upload(ctx, input, as_bytes(values));
+    const SummedAreaTable tables(ctx);
+    const auto table = [&](bool in_ranges) {
+      Buffer output(ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
+      graph::Graph g;
+      const auto in = g.import_buffer("input", {.buffer = input.handle(), .has_content = true});
+      const auto out = g.import_buffer(
+          "output", {.buffer = output.handle(), .final_use = graph::Use::transfer_src});
+      tables.add_to(g, in, out);  // (three passes, each reading what the one before wrote)
+      graph::GraphRunner runner(ctx, std::move(g));
+      REQUIRE(runner.graph().passes().size() == 3);
+      runner.set_viewport(size);
+      if (in_ranges) {
+        runner.run_passes(0, 1);
+        runner.run_passes(1, 1);  // (nothing)
+        runner.run_passes(1, 3);
+      } else {
+        runner.run_now();
+      }
+      CHECK(runner.timings().size() == 3);
+      CHECK_THROWS_AS(runner.run_passes(2, 4), Error);
+      return download_as<float>(ctx, output);
+    };
+    const std::vector<float> whole = table(false);
+    CHECK(table(true) == whole);
+    const std::vector<double> cpu = summed_area_table_reference(values, size.width, size.height);
+    CHECK(whole.back() == doctest::Approx(cpu.back()).epsilon(1e-5));
+    CHECK(ctx.validation_log().count() == 0);
   }
 }
 

@@ -133,10 +133,6 @@ class Context {
   // Records `record` into a fresh command buffer, submits it and waits: for uploads, readbacks and
   // tests, never inside a frame.
   void run_now(const std::function<void(VkCommandBuffer)>& record);
-  // The two halves of run_now, for work that returns to the host part-way (GraphRunner::run_split):
-  // a fresh command buffer in the recording state; and its submission, a wait, and its release.
-  VkCommandBuffer begin_commands();
-  void submit_and_wait(VkCommandBuffer cmd);
 
   // Every wait for the GPU ends within this, or it is a GpuTimeout naming what was waited for:
   // a hung device ends with a message, not a hang. 10 s on GPUs (their drivers reset a hung
@@ -172,6 +168,11 @@ class Context {
   VkDeviceSize max_buffer() const { return max_buffer_; }
 
  private:
+  // run_now's halves: a fresh command buffer in the recording state; its submission, a wait and
+  // its release.
+  VkCommandBuffer begin_commands();
+  void submit_and_wait(VkCommandBuffer cmd);
+
   Instance instance_;
   DeviceReport report_;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;

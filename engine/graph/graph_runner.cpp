@@ -129,14 +129,6 @@ void PassContext::record_barrier(bool predicates) {
   dep.memoryBarrierCount = 1;
   dep.pMemoryBarriers = &memory;
   vkCmdPipelineBarrier2(cmd, &dep);
-  const SplitPoint point{pass_, barriers_++};
-  if (!runner_->splits_at(point)) return;
-  // (a conditional block goes on in the next command buffer)
-  const std::optional<Predicate> open = predicate_;
-  if (open) end_conditional();
-  runner_->split(cmd, point);
-  bound_ = nullptr;  // (a new command buffer has nothing bound; its handle may be the old one's)
-  if (open) begin_conditional(open->resource, open->offset);
 }
 
 void PassContext::bind(const Pipeline& pipeline) {
@@ -335,7 +327,7 @@ bool GraphRunner::stamps_end(uint32_t p) const {
   return per_pass_stamps_ || p + 1 == passes.size() || passes[p + 1].group != passes[p].group;
 }
 
-VkCommandBuffer GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
+void GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
   emit(cmd, compiled_.pass_barriers[p]);
   if (stamps_begin(p)) {
     vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_[slot_], 2 * p);
@@ -356,20 +348,27 @@ VkCommandBuffer GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
     throw GraphError("pass '" + graph_.passes()[p].name + "' leaves a conditional block open");
   }
   if (stamps_end(p)) {
-    vkCmdWriteTimestamp2(pc.cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_[slot_], 2 * p + 1);
+    vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_[slot_], 2 * p + 1);
   }
-  return pc.cmd;
 }
 
 void GraphRunner::record(VkCommandBuffer cmd, uint32_t slot) {
+  record_passes(cmd, 0, static_cast<PassId>(graph_.passes().size()), slot);
+}
+
+void GraphRunner::record_passes(VkCommandBuffer cmd, PassId first, PassId end, uint32_t slot) {
   check_bound();
   if (slot >= queries_.size()) {
     throw Error("render graph: frame slot " + std::to_string(slot) + " of " +
                 std::to_string(queries_.size()) + " frames in flight");
   }
+  const auto passes = static_cast<PassId>(graph_.passes().size());
+  if (first > end || end > passes) {
+    throw Error("render graph: passes " + std::to_string(first) + " to " + std::to_string(end) +
+                " of " + std::to_string(passes));
+  }
   slot_ = slot;
-  const auto passes = static_cast<uint32_t>(graph_.passes().size());
-  if (frames_in_flight() > 1) {
+  if (first == 0 && frames_in_flight() > 1) {
     // Frames share the transient resources and follow each other on the queue: everything the
     // earlier frames did is done and visible before this one starts (compile() orders the passes
     // inside one frame only).
@@ -382,43 +381,17 @@ void GraphRunner::record(VkCommandBuffer cmd, uint32_t slot) {
     dep.pMemoryBarriers = &all;
     vkCmdPipelineBarrier2(cmd, &dep);
   }
-  vkCmdResetQueryPool(cmd, queries_[slot_], 0, 2 * passes);
-  for (uint32_t p = 0; p < passes; ++p) record_pass(cmd, p);
-  emit(cmd, compiled_.final_barriers);
-}
-
-bool GraphRunner::splits_at(const SplitPoint& point) const {
-  return split_at_ && (*split_at_)(point);
-}
-
-void GraphRunner::split(VkCommandBuffer& cmd, const SplitPoint& point) {
-  ctx_.submit_and_wait(cmd);
-  (*after_split_)(point);
-  cmd = ctx_.begin_commands();
-}
-
-void GraphRunner::run_split(const std::function<bool(const SplitPoint&)>& split_at,
-                            const std::function<void(const SplitPoint&)>& after) {
-  check_bound();
-  split_at_ = &split_at;
-  after_split_ = &after;
-  const auto passes = static_cast<uint32_t>(graph_.passes().size());
-  VkCommandBuffer cmd = ctx_.begin_commands();
-  slot_ = 0;
-  vkCmdResetQueryPool(cmd, queries_[slot_], 0, 2 * passes);
-  for (uint32_t p = 0; p < passes; ++p) {
-    cmd = record_pass(cmd, p);
-    if (p + 1 < passes && splits_at({p})) split(cmd, {p});
-  }
-  emit(cmd, compiled_.final_barriers);
-  split_at_ = nullptr;
-  after_split_ = nullptr;
-  ctx_.submit_and_wait(cmd);
-  if (passes > 0 && split_at({passes - 1})) after({passes - 1});
+  if (first < end) vkCmdResetQueryPool(cmd, queries_[slot_], 2 * first, 2 * (end - first));
+  for (PassId p = first; p < end; ++p) record_pass(cmd, p);
+  if (end == passes) emit(cmd, compiled_.final_barriers);
 }
 
 void GraphRunner::run_now() {
-  ctx_.run_now([&](VkCommandBuffer cmd) { record(cmd); });
+  run_passes(0, static_cast<PassId>(graph_.passes().size()));
+}
+
+void GraphRunner::run_passes(PassId first, PassId end) {
+  ctx_.run_now([&](VkCommandBuffer cmd) { record_passes(cmd, first, end); });
 }
 
 std::vector<PassTiming> GraphRunner::timings(uint32_t slot) const {

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <array>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -25,18 +24,11 @@ namespace strata::graph {
 
 class GraphRunner;
 
-// A place where GraphRunner::run_split may return to the host: after a pass, or at one of the
-// barriers a pass records between its dependent dispatches.
-struct SplitPoint {
-  PassId pass = 0;
-  std::optional<uint32_t> barrier;  // which of the pass's barriers; none: after the whole pass
-};
-
 // What a pass's record function sees: its command buffer, the viewport, and the resources it
 // declared. Asking for one it did not declare is a GraphError naming the pass and the resource.
 class PassContext {
  public:
-  VkCommandBuffer cmd = VK_NULL_HANDLE;  // may change at barrier() (GraphRunner::run_split)
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
   Extent viewport;
 
   VkBuffer buffer(ResourceId id) const;
@@ -100,7 +92,6 @@ class PassContext {
   GraphRunner* runner_ = nullptr;
   PassId pass_ = 0;
   const Pipeline* bound_ = nullptr;  // the pipeline this pass bound last in `cmd`
-  uint32_t barriers_ = 0;
   struct Predicate {
     ResourceId resource;
     VkDeviceSize offset;
@@ -138,13 +129,14 @@ class GraphRunner {
 
   // Records one frame into `cmd`, its timestamps into frame slot `slot`.
   void record(VkCommandBuffer cmd, uint32_t slot = 0);
-  // Records into a fresh command buffer, submits and waits (headless runs, benchmarks, tests).
+  // Records passes [first, end) into `cmd` with their barriers and timestamps: a frame recorded
+  // range after range, in order, does what record() does (work that returns to the host between
+  // passes); timings() is the frame's once every range of it has run.
+  void record_passes(VkCommandBuffer cmd, PassId first, PassId end, uint32_t slot = 0);
+  // Records into a fresh command buffer, submits and waits (headless runs, benchmarks, tests):
+  // the whole frame, or passes [first, end) of it.
   void run_now();
-  // The same work split into several submissions: at every point (after a pass, or at a pass's
-  // barrier) for which `split_at` is true it submits, waits on the host and calls `after`, the
-  // structure of a program that returns to the CPU there (benchmark baselines).
-  void run_split(const std::function<bool(const SplitPoint&)>& split_at,
-                 const std::function<void(const SplitPoint&)>& after);
+  void run_passes(PassId first, PassId end);
 
   // Re-creates the transient resources (after a size function's answer changed, e.g. a grown
   // hash table), keeping the viewport.
@@ -184,13 +176,7 @@ class GraphRunner {
   };
   void emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) const;
   void check_bound() const;
-  // Records pass p; returns the command buffer that is current after it (run_split may submit
-  // inside a pass and go on in a new one).
-  VkCommandBuffer record_pass(VkCommandBuffer cmd, uint32_t pass);
-  // Inside run_split: whether `split_at` wants it at `point`; split() then submits `cmd`, waits,
-  // calls `after` and replaces `cmd` with a fresh command buffer.
-  bool splits_at(const SplitPoint& point) const;
-  void split(VkCommandBuffer& cmd, const SplitPoint& point);
+  void record_pass(VkCommandBuffer cmd, uint32_t pass);
   // Whether pass p stamps its begin / its end (every pass, or a group's first / last).
   bool stamps_begin(uint32_t pass) const;
   bool stamps_end(uint32_t pass) const;
@@ -208,8 +194,6 @@ class GraphRunner {
   VkSampler linear_sampler_ = VK_NULL_HANDLE;
   PFN_vkCmdBeginConditionalRenderingEXT begin_conditional_ = nullptr;  // with the extension only
   PFN_vkCmdEndConditionalRenderingEXT end_conditional_ = nullptr;
-  const std::function<bool(const SplitPoint&)>* split_at_ = nullptr;  // inside run_split only
-  const std::function<void(const SplitPoint&)>* after_split_ = nullptr;
 };
 
 }  // namespace strata::graph
