@@ -1,7 +1,9 @@
 // `strata video`: the labelled scene along a camera path or a turntable, one frame every 1 / fps
 // seconds, with the labels moved by the forces between frames (a fixed time step, so the same
 // command gives the same frames). Frames go into an H.264 MP4 (-o NAME.mp4) or a folder as a
-// numbered PNG sequence, and with --layout-dir each frame's layout as JSON (for `strata eval`).
+// numbered PNG sequence, and with --layout-dir each frame's layout as JSON (for `strata eval`),
+// with --still-layouts a still placement's of the same camera, and with --report the
+// layout-quality summary of `strata eval` over the frames at the end.
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +17,7 @@
 #include "engine/core/video_file.h"
 #include "labeling/camera_path.h"
 #include "labeling/labelled_render.h"
+#include "labeling/layout_metrics.h"
 
 namespace strata::app {
 namespace {
@@ -29,6 +32,8 @@ struct VideoOptions {
   std::string size = "512";
   std::string output;
   std::string layout_dir;
+  std::string still_layouts;
+  bool report = false;
   bool screen_space = false;
   bool no_forces = false;
   bool hard = false;
@@ -81,6 +86,30 @@ void create_folder(const std::string& option, const std::filesystem::path& folde
     throw Error(option + ": " + folder.string() + ": cannot create the folder: " + error.message());
 }
 
+// A frame's layout: written into `folder` (empty: not written), and kept for the report (read
+// back from the JSON, so that it measures exactly what `strata eval` would read).
+void record_layout(const std::string& folder, size_t f, const LabelledFrame& frame,
+                   std::vector<Layout>* kept) {
+  const std::string text = layout_json(frame);
+  const std::filesystem::path path = std::filesystem::path(folder) / frame_name(f, "json");
+  if (!folder.empty()) write_text_file(path, text);
+  if (kept) kept->push_back(parse_layout(nlohmann::json::parse(text), path));
+}
+
+LabellingSettings labelling_settings(const Scene& scene, const VideoOptions& o) {
+  LabellingSettings settings;
+  settings.layer_count = o.scene.layer_count(scene);
+  settings.placement.weights = scene.settings.weights;
+  settings.placement.hard = o.hard;
+  settings.placement.tidy_rounds = o.tidy_rounds;
+  settings.label_scale = o.look.label_scale;
+  settings.layer_colors = o.look.layer_colors;
+  settings.forces = o.forces;
+  settings.forces.anchor_relative = !o.screen_space;
+  settings.hysteresis.margin = o.layer_margin;
+  return settings;
+}
+
 void video(DeviceOptions& device, const VideoOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const std::filesystem::path output = o.output;
@@ -99,22 +128,22 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   const std::vector<Camera> cameras = sample(path, o.fps);
   if (!mp4) create_folder("-o", output);
   if (!o.layout_dir.empty()) create_folder("--layout-dir", o.layout_dir);
+  if (!o.still_layouts.empty()) create_folder("--still-layouts", o.still_layouts);
   // Frames go to a temporary file, put in place by finish(): an error on the way leaves no MP4.
   std::unique_ptr<VideoFile> file;
   if (mp4) file = std::make_unique<VideoFile>(o.output, size.width, size.height, o.fps);
 
-  LabellingSettings settings;
-  settings.layer_count = o.scene.layer_count(scene);
-  settings.placement.weights = scene.settings.weights;
-  settings.placement.hard = o.hard;
-  settings.placement.tidy_rounds = o.tidy_rounds;
-  settings.label_scale = o.look.label_scale;
-  settings.layer_colors = o.look.layer_colors;
-  settings.forces = o.forces;
-  settings.forces.anchor_relative = !o.screen_space;
-  settings.hysteresis.margin = o.layer_margin;
+  const LabellingSettings settings = labelling_settings(scene, o);
   LabelledRenderer renderer(ctx, scene, cameras.front(), size, settings);
   renderer.run();  // the first frame: the labels settled on their placement
+  // --still-layouts: a second renderer places every frame's camera afresh, as a still.
+  std::unique_ptr<LabelledRenderer> still;
+  if (!o.still_layouts.empty()) {
+    still = std::make_unique<LabelledRenderer>(ctx, scene, cameras.front(), size, settings);
+  }
+  // (legibility only where a layout is used: it reads the layers back)
+  const bool measured = !o.layout_dir.empty() || o.report;
+  std::vector<Layout> frame_layouts, still_layouts;  // for the report
   Progress progress("frame", cameras.size());
   for (size_t f = 0; f < cameras.size(); ++f) {
     if (f > 0) {
@@ -125,22 +154,29 @@ void video(DeviceOptions& device, const VideoOptions& o) {
         renderer.advance(1.0 / o.fps);
       }
     }
-    // (legibility only where a layout is written: it reads the layers back)
-    const LabelledFrame frame = renderer.result(!o.layout_dir.empty());
+    LabelledFrame frame = renderer.result(measured);
+    if (f > 0) frame.seconds = 1.0 / o.fps;  // (with --no-forces too: a frame of the sequence)
     if (file) {
       file->write(frame.image);
     } else {
       write_png((output / frame_name(f, "png")).string(), size.width, size.height, frame.image);
     }
-    if (!o.layout_dir.empty()) {
-      write_text_file(std::filesystem::path(o.layout_dir) / frame_name(f, "json"),
-                      layout_json(frame));
+    if (measured) record_layout(o.layout_dir, f, frame, o.report ? &frame_layouts : nullptr);
+    if (still) {
+      still->set_camera(cameras[f]);
+      still->run();
+      record_layout(o.still_layouts, f, still->result(), o.report ? &still_layouts : nullptr);
     }
     progress.step_done(f + 1);
   }
   if (file) file->finish();
   std::printf("wrote %zu frames (%ux%u, %g fps) to %s\n", cameras.size(), size.width, size.height,
               o.fps, o.output.c_str());
+  if (o.report) {
+    const std::string report =
+        to_json(sequence_metrics(frame_layouts, still_layouts), false).dump(2);
+    std::printf("%s\n", report.c_str());
+  }
 }
 
 }  // namespace
@@ -166,6 +202,12 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("-o,--output", o->output, "NAME.mp4 (H.264), or a folder for PNG frames")
       ->required();
   cmd->add_option("--layout-dir", o->layout_dir, "folder for each frame's layout JSON");
+  cmd->add_option("--still-layouts", o->still_layouts,
+                  "folder for the layout of a still placement of each frame's camera (one more "
+                  "frame rendered per frame; `strata eval --stills`)");
+  cmd->add_flag("--report", o->report,
+                "print the layout-quality summary of `strata eval` over the frames (stdout, "
+                "JSON) at the end");
   cmd->add_option("--tidy-rounds", o->tidy_rounds,
                   "rounds of the tidy-up after the placement (0: none)")
       ->check(whole_range(0, TIDY_ROUNDS_MAX))

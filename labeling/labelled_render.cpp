@@ -192,6 +192,7 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
   parts_->forces.set_frame(forces, seconds, settings_.placement.hard);
   parts_->forces.set_trial(trial);
   afresh_ = false;
+  frame_seconds_ = seconds > 0.0 ? std::optional(seconds) : std::nullopt;  // (0 s: a still)
 }
 
 // Layering on the CPU, from the camera alone: k-means++ on the visible anchors' depths, after the
@@ -328,6 +329,7 @@ void LabelledRenderer::run(const std::function<void(uint32_t done, uint32_t tota
     set_placement_frame(false, within_);
     parts_->forces.reset();
     parts_->forces.set_frame(settings_.forces, 0.0, settings_.placement.hard);
+    frame_seconds_.reset();
     run_frame();
   };
   set_order(scene_order(uint32_t(labels_.size())));
@@ -374,6 +376,7 @@ std::vector<glm::vec4> LabelledRenderer::download_layers() const {
 LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
   LabelledFrame frame;
   frame.size = size_;
+  frame.seconds = frame_seconds_;
   frame.layering = layering_;
   frame.render_stats = stats_;
   frame.timings = runner_->timings();
@@ -393,6 +396,10 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
     l.box_size = labels_[i].size;
     l.box_origin = drawn[i].position - labels_[i].size * 0.5f;
     l.placed = drawn[i].shown == PLACEMENT_SHOWN;
+    l.opacity = drawn[i].opacity;
+    if ((labels_[i].flags & LABEL_ENABLED) != 0u && results[i].shown == PLACEMENT_SHOWN) {
+      l.target_origin = results[i].position - labels_[i].size * 0.5f;
+    }
     l.cost = results[i].cost;
     frame.labels.push_back(l);
   }
@@ -462,12 +469,22 @@ std::string layout_json(const LabelledFrame& frame) {
                           {"shown", l.shown},
                           {"placed", l.placed},
                           {"visible", shortest_double(l.visible)},
-                          {"cost", shortest_double(l.cost)}};
+                          {"cost", shortest_double(l.cost)},
+                          {"opacity", shortest_double(l.opacity)},
+                          {"target", ordered_json()}};
+    if (const auto& t = l.target_origin) {
+      entry["target"] = {shortest_double(t->x), shortest_double(t->y),
+                         shortest_double(l.box_size.x), shortest_double(l.box_size.y)};
+    }
     if (!l.image.empty()) entry["image"] = l.image;
     labels.push_back(std::move(entry));
   }
-  const ordered_json layout = {
-      {"width", frame.size.width}, {"height", frame.size.height}, {"labels", labels}};
+  ordered_json seconds;  // (null: a still)
+  if (frame.seconds) seconds = *frame.seconds;
+  const ordered_json layout = {{"width", frame.size.width},
+                               {"height", frame.size.height},
+                               {"seconds", seconds},
+                               {"labels", labels}};
   // Label texts come from scene files: bytes that are not UTF-8 are replaced, never thrown on.
   return layout.dump(2, ' ', false, ordered_json::error_handler_t::replace) + "\n";
 }

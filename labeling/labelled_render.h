@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -64,6 +65,10 @@ struct LabelLayout {
   float visible = std::numeric_limits<float>::quiet_NaN();
   bool shown = false;  // placed and legible: visible >= kLegibleShare (placed, when not measured)
   float cost = 0.0f;
+  float opacity = 0.0f;  // as drawn: the forces fade it from 0 (hidden) to 1 (fully drawn)
+  // The top-left corner of the placement's box this frame, where the label is heading (its size
+  // is box_size); none where the placement did not place it.
+  std::optional<glm::vec2> target_origin;
 };
 
 // A label counts as shown when at least this share of its box is visible (label_visibility).
@@ -80,6 +85,9 @@ std::vector<float> label_visibility(std::span<const glm::vec4> layers, graph::Ex
 
 struct LabelledFrame {
   graph::Extent size;
+  // The time step since the last frame of an animation (LabelledRenderer::advance,
+  // prepare_frame); none for a still (run).
+  std::optional<double> seconds;
   std::vector<uint8_t> image;  // rgba8, the labelled picture
   std::vector<LabelLayout> labels;
   Layering layering;
@@ -212,6 +220,7 @@ class LabelledRenderer {
   std::vector<uint32_t> within_;  // the order inside each layer set_order() was last given
   std::vector<uint32_t> trial_within_;
   bool afresh_ = false;
+  std::optional<double> frame_seconds_;  // of the last frame set up; none: a still
   void build_labels();  // glyphs and box sizes from the texts at settings_.font_pixels
   void set_label_text(float pixels, float scale);
   Extension extension_;
@@ -235,7 +244,8 @@ void check_label_text(float font_pixels, float label_scale);
 LabelledFrame render_labelled(Context& ctx, const Scene& scene, const Camera& camera,
                               graph::Extent size, const LabellingSettings& settings);
 
-// The layout as JSON: per label id, text, layer, anchor, box (x, y, width, height), shown, cost.
+// The layout as JSON (docs/layout-metrics.md): the frame's size and seconds, and per label id,
+// text, layer, anchor, box (x, y, width, height), shown, placed, visible, cost, opacity, target.
 std::string layout_json(const LabelledFrame& frame);
 
 }  // namespace strata

@@ -2,118 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <unordered_map>
 
 #include <glm/geometric.hpp>
 
 #include "engine/core/error.h"
-#include "engine/core/json_field.h"
-#include "engine/core/text_file.h"
 
 namespace strata {
 
-namespace {
-
-using nlohmann::json;
 using nlohmann::ordered_json;
-
-using Field = JsonField;
-
-uint32_t image_extent(const json& value, const Field& field) {
-  if (!value.is_number_unsigned() || value.get<uint64_t>() == 0 ||
-      value.get<uint64_t>() > std::numeric_limits<uint32_t>::max()) {
-    field.fail("expected a positive integer");
-  }
-  return value.get<uint32_t>();
-}
-
-std::vector<double> numbers(const json& value, const Field& field, size_t count) {
-  return json_numbers(value, field, count);
-}
-
-int label_id(const json& value, const Field& field) {
-  if (!value.is_number_integer() || value.get<int64_t>() < std::numeric_limits<int>::min() ||
-      value.get<int64_t>() > std::numeric_limits<int>::max()) {
-    field.fail("expected an integer");
-  }
-  return value.get<int>();
-}
-
-uint32_t layer(const json& value, const Field& field) {
-  if (!value.is_number_unsigned() || value.get<uint64_t>() > std::numeric_limits<uint32_t>::max()) {
-    field.fail("expected an integer >= 0");
-  }
-  return value.get<uint32_t>();
-}
-
-// render writes null for a cost that is not finite.
-double cost(const json& value, const Field& field) {
-  if (value.is_null()) return std::numeric_limits<double>::quiet_NaN();
-  if (!value.is_number()) field.fail("expected a number or null");
-  return value.get<double>();
-}
-
-LayoutLabel read_label(const json& object, const Field& field) {
-  if (!object.is_object()) field.fail("expected an object");
-  LayoutLabel label;
-  label.id = label_id(required(object, field, "id"), field / "id");
-  const auto anchor = numbers(required(object, field, "anchor"), field / "anchor", 2);
-  label.anchor = {anchor[0], anchor[1]};
-  const auto box = numbers(required(object, field, "box"), field / "box", 4);
-  if (box[2] < 0.0 || box[3] < 0.0) (field / "box").fail("width and height must be >= 0");
-  label.box_origin = {box[0], box[1]};
-  label.box_size = {box[2], box[3]};
-  const json& shown = required(object, field, "shown");
-  if (!shown.is_boolean()) (field / "shown").fail("expected true or false");
-  label.shown = shown.get<bool>();
-  label.placed = label.shown;
-  if (const json* placed = optional(object, "placed")) {
-    if (!placed->is_boolean()) (field / "placed").fail("expected true or false");
-    label.placed = placed->get<bool>();
-  }
-  if (const json* text = optional(object, "text")) {
-    if (!text->is_string()) (field / "text").fail("expected a string");
-    label.text = text->get<std::string>();
-  }
-  if (const json* l = optional(object, "layer")) label.layer = layer(*l, field / "layer");
-  if (const json* c = optional(object, "cost")) label.cost = cost(*c, field / "cost");
-  return label;
-}
-
-// Ids match labels across frames, so one id twice in a frame would make matching ambiguous.
-void check_unique_ids(const std::vector<LayoutLabel>& labels, const Field& field) {
-  std::unordered_map<int, size_t> first;
-  for (size_t i = 0; i < labels.size(); ++i) {
-    const auto [it, fresh] = first.emplace(labels[i].id, i);
-    if (!fresh) {
-      (field[i] / "id")
-          .fail("duplicate id " + std::to_string(labels[i].id) + " (also labels[" +
-                std::to_string(it->second) + "])");
-    }
-  }
-}
-
-}  // namespace
-
-Layout read_layout(const std::filesystem::path& path) {
-  const json root = read_json_file(path);
-  const std::string file = path.string();
-  const Field top{file, ""};
-  if (!root.is_object()) top.fail("expected an object");
-  Layout layout;
-  layout.source = path;
-  layout.width = image_extent(required(root, top, "width"), top / "width");
-  layout.height = image_extent(required(root, top, "height"), top / "height");
-  const json& labels = required(root, top, "labels");
-  const Field labels_field = top / "labels";
-  if (!labels.is_array()) labels_field.fail("expected an array");
-  for (size_t i = 0; i < labels.size(); ++i) {
-    layout.labels.push_back(read_label(labels[i], labels_field[i]));
-  }
-  check_unique_ids(layout.labels, labels_field);
-  return layout;
-}
 
 // --- Geometry ---
 
@@ -235,6 +132,28 @@ bool outside_image(const LayoutLabel& label, const Layout& layout) {
          box.max.y > double(layout.height);
 }
 
+bool opaque(const LayoutLabel& label) {
+  return label.opacity >= opaque_opacity;
+}
+
+bool apparent(const LayoutLabel& label) {
+  return label.opacity > apparent_opacity;
+}
+
+// Overlaps and cut boxes of the labels drawn with more than apparent_opacity.
+void count_apparent(const Layout& layout, FrameMetrics& m) {
+  std::vector<const LayoutLabel*> seen;
+  for (const LayoutLabel& l : layout.labels) {
+    if (apparent(l)) seen.push_back(&l);
+  }
+  for (size_t i = 0; i < seen.size(); ++i) {
+    if (outside_image(*seen[i], layout)) ++m.cut;
+    for (size_t j = i + 1; j < seen.size(); ++j) {
+      if (intersection_area(box_of(*seen[i]), box_of(*seen[j])) > 0.0) ++m.apparent_overlaps;
+    }
+  }
+}
+
 void measure_leaders(const Layout& layout, const std::vector<const LayoutLabel*>& shown,
                      FrameMetrics& m) {
   const double diagonal = std::hypot(double(layout.width), double(layout.height));
@@ -261,6 +180,8 @@ FrameMetrics frame_metrics(const Layout& layout) {
     m.illegible += l.placed && !l.shown ? 1 : 0;
   }
   m.hidden = m.labels - m.shown;
+  m.opaque = size_t(std::count_if(layout.labels.begin(), layout.labels.end(), opaque));
+  count_apparent(layout, m);
   count_overlaps(shown, m);
   count_leader_crossings(shown, m);
   for (const LayoutLabel* label : shown) {
@@ -290,10 +211,14 @@ FrameMetrics sum_frame_metrics(const std::vector<FrameMetrics>& frames) {
     total.anchors_covered += f.anchors_covered;
     total.outside_image += f.outside_image;
     total.leaders += f.leaders;
-    leader_length_sum += f.leader_length_mean * double(f.shown);
+    total.opaque += f.opaque;
+    total.apparent_overlaps += f.apparent_overlaps;
+    total.cut += f.cut;
+    leader_length_sum += f.leader_length_mean * double(f.shown + f.illegible);  // (drawn)
     total.leader_length_max = std::max(total.leader_length_max, f.leader_length_max);
   }
-  total.leader_length_mean = total.shown == 0 ? 0.0 : leader_length_sum / double(total.shown);
+  const size_t drawn = total.shown + total.illegible;
+  total.leader_length_mean = drawn == 0 ? 0.0 : leader_length_sum / double(drawn);
   return total;
 }
 
@@ -309,10 +234,31 @@ double share(size_t count, size_t of) {
   return of == 0 ? 0.0 : double(count) / double(of);
 }
 
+// What the comparisons of consecutive frames collect besides the counts.
+struct Movements {
+  std::vector<double> px;                // shown pairs: the offset's change
+  std::vector<double> width_per_second;  // opaque pairs: of the width, per second
+  double label_seconds = 0.0;            // label-frame pairs: frame k + 1's seconds summed
+};
+
+// The opaque-state measures of one label-frame pair: flips, and for a label opaque in both
+// frames its motion relative to the image.
+void compare_opaque(const LayoutLabel& before, const LayoutLabel& after, const Layout& to,
+                    SequenceMetrics& m, Movements& movements) {
+  if (to.seconds) movements.label_seconds += *to.seconds;
+  if (opaque(before) != opaque(after)) ++m.opaque_flips;
+  if (!opaque(before) || !opaque(after)) return;
+  ++m.opaque_pairs;
+  const double of_width =
+      glm::distance(offset_from_anchor(after), offset_from_anchor(before)) / double(to.width);
+  if (of_width > jump_threshold_of_width) ++m.opaque_jumps;
+  if (to.seconds) movements.width_per_second.push_back(of_width / *to.seconds);
+}
+
 // Compares each label of frame `from` with the same id in frame `to`; adds to the counts and
-// appends the movements of labels shown in both.
+// the movements.
 void compare_frames(const Layout& from, const Layout& to, SequenceMetrics& m,
-                    std::vector<double>& movements) {
+                    Movements& movements) {
   std::unordered_map<int, const LayoutLabel*> next;
   for (const LayoutLabel& l : to.labels) next.emplace(l.id, &l);
   for (const LayoutLabel& before : from.labels) {
@@ -321,13 +267,55 @@ void compare_frames(const Layout& from, const Layout& to, SequenceMetrics& m,
     const LayoutLabel& after = *it->second;
     ++m.label_frame_pairs;
     if (before.shown != after.shown) ++m.show_hide_flips;
+    compare_opaque(before, after, to, m, movements);
     if (!(before.placed || before.shown) || !(after.placed || after.shown)) continue;
     ++m.shown_pairs;
     const double movement = glm::distance(offset_from_anchor(after), offset_from_anchor(before));
-    movements.push_back(movement);
+    movements.px.push_back(movement);
     if (movement > jump_threshold_px) ++m.jumps;
     if (before.layer != after.layer) ++m.layer_switches;
   }
+}
+
+double mean(const std::vector<double>& values) {
+  double sum = 0.0;
+  for (double value : values) sum += value;
+  return values.empty() ? 0.0 : sum / double(values.size());
+}
+
+// The sequence's duration: frame 1 .. N - 1's time steps; none for a single frame or when one
+// of them has none.
+std::optional<double> duration(const std::vector<Layout>& frames) {
+  if (frames.size() < 2) return std::nullopt;
+  double sum = 0.0;
+  for (size_t k = 1; k < frames.size(); ++k) {
+    if (!frames[k].seconds) return std::nullopt;
+    sum += *frames[k].seconds;
+  }
+  return sum;
+}
+
+std::string extent_text(const Layout& layout) {
+  return std::to_string(layout.width) + "x" + std::to_string(layout.height);
+}
+
+std::vector<FrameMetrics> still_metrics(const std::vector<Layout>& frames,
+                                        const std::vector<Layout>& stills) {
+  if (stills.empty()) return {};
+  if (stills.size() != frames.size()) {
+    throw Error("stills: " + std::to_string(stills.size()) + " layouts for " +
+                std::to_string(frames.size()) + " frames");
+  }
+  std::vector<FrameMetrics> out;
+  for (size_t k = 0; k < frames.size(); ++k) {
+    if (stills[k].width != frames[k].width || stills[k].height != frames[k].height) {
+      throw Error(stills[k].source.string() + ": a still of " + extent_text(stills[k]) +
+                  " for a frame of " + extent_text(frames[k]) + " (" + frames[k].source.string() +
+                  ")");
+    }
+    out.push_back(frame_metrics(stills[k]));
+  }
+  return out;
 }
 
 }  // namespace
@@ -339,69 +327,113 @@ double nearest_rank_percentile(std::vector<double> values, double q) {
   return values[std::clamp<size_t>(rank, 1, values.size()) - 1];
 }
 
-SequenceMetrics sequence_metrics(const std::vector<Layout>& frames) {
+SequenceMetrics sequence_metrics(const std::vector<Layout>& frames,
+                                 const std::vector<Layout>& stills) {
   SequenceMetrics m;
   m.frames = frames.size();
+  m.stills = still_metrics(frames, stills);
+  m.stills_total = sum_frame_metrics(m.stills);
   for (const Layout& frame : frames) m.per_frame.push_back(frame_metrics(frame));
   m.total = sum_frame_metrics(m.per_frame);
-  std::vector<double> movements;
+  Movements movements;
   for (size_t k = 0; k + 1 < frames.size(); ++k) {
     compare_frames(frames[k], frames[k + 1], m, movements);
   }
-  double sum = 0.0;
-  for (double movement : movements) sum += movement;
-  m.movement_mean = movements.empty() ? 0.0 : sum / double(movements.size());
-  m.movement_p95 = nearest_rank_percentile(movements, 0.95);
+  m.movement_mean = mean(movements.px);
+  m.movement_p95 = nearest_rank_percentile(movements.px, 0.95);
   m.jump_share = share(m.jumps, m.shown_pairs);
   m.layer_switch_share = share(m.layer_switches, m.shown_pairs);
   m.show_hide_flip_share = share(m.show_hide_flips, m.label_frame_pairs);
+  m.seconds = duration(frames);
+  if (m.seconds) {
+    m.motion_mean = mean(movements.width_per_second);
+    m.motion_p95 = nearest_rank_percentile(movements.width_per_second, 0.95);
+    m.opaque_flips_per_label_per_second =
+        movements.label_seconds > 0.0 ? double(m.opaque_flips) / movements.label_seconds : 0.0;
+  }
   return m;
 }
 
 // --- JSON ---
 
-ordered_json to_json(const FrameMetrics& m) {
-  return {{"labels", m.labels},
-          {"shown", m.shown},
-          {"hidden", m.hidden},
-          {"illegible", m.illegible},
-          {"overlaps", m.overlaps},
-          {"overlap_area_px2", m.overlap_area},
-          {"leader_crossings", m.leader_crossings},
-          {"leader_crossings_same_layer", m.leader_crossings_same_layer},
-          {"leaders_through_boxes", m.leaders_through_boxes},
-          {"anchors_covered", m.anchors_covered},
-          {"outside_image", m.outside_image},
-          {"leaders", m.leaders},
-          {"leader_length_mean_of_diagonal", m.leader_length_mean},
-          {"leader_length_max_of_diagonal", m.leader_length_max}};
+namespace {
+
+ordered_json optional_number(std::optional<double> value) {
+  return value ? ordered_json(*value) : ordered_json();
+}
+
+std::optional<double> ratio(size_t count, size_t of) {
+  return of == 0 ? std::nullopt : std::optional(double(count) / double(of));
+}
+
+}  // namespace
+
+ordered_json to_json(const FrameMetrics& m, const FrameMetrics* still) {
+  ordered_json out = {{"labels", m.labels},
+                      {"shown", m.shown},
+                      {"hidden", m.hidden},
+                      {"illegible", m.illegible},
+                      {"overlaps", m.overlaps},
+                      {"overlap_area_px2", m.overlap_area},
+                      {"leader_crossings", m.leader_crossings},
+                      {"leader_crossings_same_layer", m.leader_crossings_same_layer},
+                      {"leaders_through_boxes", m.leaders_through_boxes},
+                      {"anchors_covered", m.anchors_covered},
+                      {"outside_image", m.outside_image},
+                      {"leaders", m.leaders},
+                      {"leader_length_mean_of_diagonal", m.leader_length_mean},
+                      {"leader_length_max_of_diagonal", m.leader_length_max},
+                      {"opaque", m.opaque},
+                      {"apparent_overlaps", m.apparent_overlaps},
+                      {"cut", m.cut}};
+  if (still) {
+    out["still_opaque"] = still->opaque;
+    out["opaque_of_still"] = optional_number(ratio(m.opaque, still->opaque));
+    out["still_leader_crossings"] = still->leader_crossings;
+  }
+  return out;
 }
 
 namespace {
 
 ordered_json temporal_json(const SequenceMetrics& m) {
-  return {{"label_frame_pairs", m.label_frame_pairs},
-          {"shown_pairs", m.shown_pairs},
-          {"movement_mean_px", m.movement_mean},
-          {"movement_p95_px", m.movement_p95},
-          {"jump_threshold_px", jump_threshold_px},
-          {"jumps", m.jumps},
-          {"jump_share", m.jump_share},
-          {"layer_switches", m.layer_switches},
-          {"layer_switch_share", m.layer_switch_share},
-          {"show_hide_flips", m.show_hide_flips},
-          {"show_hide_flip_share", m.show_hide_flip_share}};
+  return {
+      {"label_frame_pairs", m.label_frame_pairs},
+      {"shown_pairs", m.shown_pairs},
+      {"movement_mean_px", m.movement_mean},
+      {"movement_p95_px", m.movement_p95},
+      {"jump_threshold_px", jump_threshold_px},
+      {"jumps", m.jumps},
+      {"jump_share", m.jump_share},
+      {"layer_switches", m.layer_switches},
+      {"layer_switch_share", m.layer_switch_share},
+      {"show_hide_flips", m.show_hide_flips},
+      {"show_hide_flip_share", m.show_hide_flip_share},
+      {"seconds", optional_number(m.seconds)},
+      {"opaque_pairs", m.opaque_pairs},
+      {"motion_mean_of_width_per_second", optional_number(m.motion_mean)},
+      {"motion_p95_of_width_per_second", optional_number(m.motion_p95)},
+      {"jump_threshold_of_width", jump_threshold_of_width},
+      {"opaque_jumps", m.opaque_jumps},
+      {"opaque_flips", m.opaque_flips},
+      {"opaque_flips_per_label_per_second", optional_number(m.opaque_flips_per_label_per_second)}};
 }
 
 }  // namespace
 
-ordered_json to_json(const SequenceMetrics& m) {
-  ordered_json per_frame = ordered_json::array();
-  for (const FrameMetrics& f : m.per_frame) per_frame.push_back(to_json(f));
-  return {{"frames", m.frames},
-          {"per_frame", per_frame},
-          {"total", to_json(m.total)},
-          {"sequence", temporal_json(m)}};
+ordered_json to_json(const SequenceMetrics& m, bool with_per_frame) {
+  const bool stills = !m.stills.empty();
+  ordered_json out = {{"frames", m.frames}};
+  if (with_per_frame) {
+    ordered_json per_frame = ordered_json::array();
+    for (size_t k = 0; k < m.per_frame.size(); ++k) {
+      per_frame.push_back(to_json(m.per_frame[k], stills ? &m.stills[k] : nullptr));
+    }
+    out["per_frame"] = per_frame;
+  }
+  out["total"] = to_json(m.total, stills ? &m.stills_total : nullptr);
+  out["sequence"] = temporal_json(m);
+  return out;
 }
 
 }  // namespace strata

@@ -1,6 +1,7 @@
-// Layout quality, measured from the layout files `strata render --layout` writes: overlaps,
-// leader crossings, occluded anchors, leader lengths per frame, and movement, jumps, layer
-// switches and show/hide flips over a sequence. `strata eval`, the tests, the docs
+// Layout quality, measured from the layout files `strata render --layout` and `strata video
+// --layout-dir` write: overlaps, cut boxes, leader crossings, occluded anchors, leader lengths
+// per frame, and movement, jumps, layer switches and flips over a sequence, optionally against
+// stills of the same views. `strata eval`, `strata video --report`, the tests, the docs
 // (docs/layout-metrics.md) and the benchmarks share these definitions. No GPU.
 //
 // Pixels, y down. A box is its top-left corner and its size. A label's leader is the segment
@@ -40,20 +41,31 @@ struct LayoutLabel {
   bool shown = false;   // placed and legible
   bool placed = false;  // drawn (the file's "placed"; without it, "shown")
   double cost = 0.0;    // NaN when the file has null (a non-finite cost)
+  // The drawn opacity, 0..1 (the file's "opacity"; without it, 1 when placed, else 0).
+  double opacity = 0.0;
+  // The placement's box this frame, where the label is heading (the file's "target"; without
+  // it, the box); none where the file has null (the placement did not place the label).
+  std::optional<Rect> target;
 };
 
 struct Layout {
   std::filesystem::path source;  // for messages
   uint32_t width = 0;
   uint32_t height = 0;
+  // The frame's time step (the file's "seconds"); none for a still or an older file.
+  std::optional<double> seconds;
   std::vector<LayoutLabel> labels;
 };
 
 // A layout file. Every error is "<file>: <field>: <reason>", e.g.
 // "a.json: labels[3].box: expected 4 numbers". Required: width, height, labels, and per label
-// id (unique), anchor, box (size >= 0) and shown; text, layer and cost are optional (empty, 0,
-// 0). Unknown keys are ignored, so files from later versions still read.
+// id (unique), anchor, box (size >= 0) and shown; text, layer, cost, placed, opacity, target
+// and the top level's seconds are optional (defaults above). Unknown keys are ignored, so files
+// from later versions still read.
 Layout read_layout(const std::filesystem::path& path);
+// The same from JSON already parsed (`strata video --report` reads the layouts it writes);
+// `source` names it in errors.
+Layout parse_layout(const nlohmann::json& root, const std::filesystem::path& source);
 
 // --- Geometry (exact predicates, double precision) ---
 
@@ -106,6 +118,10 @@ struct FrameMetrics {
   // Leader length / image diagonal, over the shown labels (no leader = length 0).
   double leader_length_mean = 0.0;
   double leader_length_max = 0.0;
+  // By the drawn opacity (a fading label is drawn, but not read): issue 33's measures.
+  size_t opaque = 0;             // labels with opacity >= opaque_opacity ("shown" in motion)
+  size_t apparent_overlaps = 0;  // pairs, both opacity > apparent_opacity, interiors intersecting
+  size_t cut = 0;                // opacity > apparent_opacity, box not wholly inside the image
 };
 
 FrameMetrics frame_metrics(const Layout& layout);
@@ -117,6 +133,12 @@ FrameMetrics sum_frame_metrics(const std::vector<FrameMetrics>& frames);
 // --- Over a sequence ---
 
 inline constexpr double jump_threshold_px = 40.0;
+// A label is opaque (shown, for the viewer) from this opacity, apparent above this one.
+inline constexpr double opaque_opacity = 0.5;
+inline constexpr double apparent_opacity = 0.1;
+// An opaque label jumps when its offset changes by more than this share of the image width in
+// one frame.
+inline constexpr double jump_threshold_of_width = 0.04;
 
 // Labels are matched by id between consecutive frames k and k + 1; a label-frame pair is a label
 // present in both. A label's offset is its box centre minus its anchor; its movement from k to
@@ -136,15 +158,37 @@ struct SequenceMetrics {
   double layer_switch_share = 0.0;    // layer_switches / shown_pairs
   size_t show_hide_flips = 0;         // label-frame pairs whose shown flag differs
   double show_hide_flip_share = 0.0;  // show_hide_flips / label_frame_pairs
+
+  // By the drawn opacity, over opaque pairs (opaque in both frames); per second with the frames'
+  // time steps (frame k + 1's seconds for the pair k, k + 1): none when a frame lacks one.
+  std::optional<double> seconds;  // the sum of the time steps of frames 1 .. N - 1
+  size_t opaque_pairs = 0;
+  // The offset's change / frame k + 1's width / its seconds, over the opaque pairs (0 when none).
+  std::optional<double> motion_mean;
+  std::optional<double> motion_p95;  // nearest rank
+  size_t opaque_jumps = 0;           // opaque pairs moving more than jump_threshold_of_width
+  size_t opaque_flips = 0;           // label-frame pairs whose opaque state differs
+  // opaque_flips / the label-seconds: each label-frame pair counts frame k + 1's seconds.
+  std::optional<double> opaque_flips_per_label_per_second;
+
+  // Stills of the same views, frame by frame (empty: none given).
+  std::vector<FrameMetrics> stills;
+  FrameMetrics stills_total;  // sum_frame_metrics(stills)
 };
 
-SequenceMetrics sequence_metrics(const std::vector<Layout>& frames);
+// `stills`: empty, or the layouts of still placements of the same cameras, one per frame, each
+// the size of its frame (an Error otherwise).
+SequenceMetrics sequence_metrics(const std::vector<Layout>& frames,
+                                 const std::vector<Layout>& stills = {});
 
 // The nearest-rank percentile (0 < q <= 1) of values: the ceil(q n)-th smallest; 0 when empty.
 double nearest_rank_percentile(std::vector<double> values, double q);
 
-nlohmann::ordered_json to_json(const FrameMetrics& metrics);
-// {"frames", "per_frame", "total", "sequence"}: the report of `strata eval` for several files.
-nlohmann::ordered_json to_json(const SequenceMetrics& metrics);
+// `still`: the metrics of a still of the same view, or none: adds the still's opaque labels and
+// leader crossings and opaque / the still's opaque.
+nlohmann::ordered_json to_json(const FrameMetrics& metrics, const FrameMetrics* still = nullptr);
+// {"frames", "per_frame", "total", "sequence"}: the report of `strata eval` for several files;
+// without per_frame, the summary `strata video --report` prints.
+nlohmann::ordered_json to_json(const SequenceMetrics& metrics, bool with_per_frame = true);
 
 }  // namespace strata

@@ -206,6 +206,59 @@ TEST_SUITE("cli") {
 
 #endif
 
+  // Layouts with opacity, target and seconds, stills of the same cameras, and the report at the
+  // end, which is what `strata eval --stills` says of the files written.
+  TEST_CASE("video_report_measures_the_frames_as_eval_does_with_stills") {
+    const std::string dir = empty_folder("video-report");
+    const auto r = run_strata("video " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --orbit 20 --seconds 0.25 --fps 12 "
+                              "--size 128 -o " +
+                              dir + "/frames --layout-dir " + dir + "/layouts --still-layouts " +
+                              dir + "/stills --report");
+    REQUIRE(r.exit_code == 0);
+    const nlohmann::json report = bench_report(r.output);
+    const size_t frames = report["frames"].get<size_t>();
+    CHECK(frames >= 3);
+    CHECK_FALSE(report.contains("per_frame"));
+    const nlohmann::json& total = report["total"];
+    CHECK(total["labels"] == 11 * frames);
+    CHECK(total["opaque"].get<size_t>() > 0);
+    CHECK(total["opaque"].get<size_t>() <=
+          total["shown"].get<size_t>() + total["illegible"].get<size_t>());
+    CHECK(total["still_opaque"].get<size_t>() > 0);
+    CHECK(total["opaque_of_still"].get<double>() > 0.0);
+    const nlohmann::json& sequence = report["sequence"];
+    CHECK(sequence["seconds"].get<double>() == doctest::Approx(double(frames - 1) / 12.0));
+    CHECK(sequence["motion_mean_of_width_per_second"].get<double>() >= 0.0);
+    CHECK(sequence["motion_p95_of_width_per_second"].get<double>() >=
+          sequence["motion_mean_of_width_per_second"].get<double>());
+    CHECK(sequence["opaque_flips_per_label_per_second"].get<double>() >= 0.0);
+    CHECK(sequence["label_frame_pairs"] == 11 * (frames - 1));
+
+    const auto layout = [&](const std::string& folder, int frame) {
+      char name[32];
+      std::snprintf(name, sizeof name, "/frame-%05d.json", frame);
+      return nlohmann::json::parse(test::read_file(dir + "/" + folder + name));
+    };
+    CHECK(layout("layouts", 0)["seconds"].is_null());  // the first frame is a still
+    const nlohmann::json second = layout("layouts", 1);
+    CHECK(second["seconds"].get<double>() == doctest::Approx(1.0 / 12.0));
+    for (const auto& label : second["labels"]) {
+      CHECK(label["opacity"].get<double>() >= 0.0);
+      CHECK(label["opacity"].get<double>() <= 1.0);
+      CHECK((label["target"].is_null() || label["target"].size() == 4));
+    }
+    CHECK(layout("stills", 1)["seconds"].is_null());
+
+    const auto eval =
+        run_strata("eval " + dir + "/layouts/frame-*.json --stills " + dir + "/stills");
+    REQUIRE(eval.exit_code == 0);
+    const nlohmann::json evaluated = bench_report(eval.output);
+    CHECK(evaluated["total"] == total);
+    CHECK(evaluated["sequence"] == sequence);
+    CHECK(evaluated["per_frame"].size() == frames);
+  }
+
   TEST_CASE("video_with_two_paths_or_none_is_one_clear_error") {
     const auto both = run_strata("video " STRATA_SOURCE_DIR
                                  "/assets/scenes/head.json --orbit 10 --path front -o x.mp4");

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "labeling/labelled_render.h"
+#include "labeling/layout_metrics.h"
 
 namespace strata {
 namespace {
@@ -57,6 +58,39 @@ TEST_SUITE("cpu") {
     CHECK(as_float(l["cost"]) == label.cost);
     CHECK(layout["labels"][1]["text"] == "");
     CHECK(layout["labels"][1]["shown"] == false);
+  }
+
+  TEST_CASE("layout_json_writes_opacity_target_and_seconds_that_eval_reads_back") {
+    LabelledFrame frame;
+    frame.size = {64, 48};
+    frame.seconds = 1.0 / 12.0;
+    LabelLayout heading;
+    heading.id = 1;
+    heading.box_origin = {10.5f, 4.0f};
+    heading.box_size = {20.0f, 8.0f};
+    heading.placed = heading.shown = true;
+    heading.opacity = 0.625f;
+    heading.target_origin = glm::vec2(30.25f, 6.0f);
+    LabelLayout hidden;
+    hidden.id = 2;
+    frame.labels = {heading, hidden};
+    const std::string text = layout_json(frame);
+    const nlohmann::json layout = nlohmann::json::parse(text);
+    CHECK(layout["seconds"].get<double>() == 1.0 / 12.0);
+    CHECK(layout["labels"][0]["opacity"] == 0.625);
+    CHECK(layout["labels"][0]["target"] == nlohmann::json({30.25, 6.0, 20.0, 8.0}));
+    CHECK(layout["labels"][1]["opacity"] == 0.0);
+    CHECK(layout["labels"][1]["target"].is_null());
+    const Layout read = parse_layout(layout, "frame.json");
+    REQUIRE(read.seconds);
+    CHECK(*read.seconds == 1.0 / 12.0);
+    CHECK(read.labels[0].opacity == 0.625);
+    REQUIRE(read.labels[0].target);
+    CHECK(read.labels[0].target->min == glm::dvec2(30.25, 6.0));
+    CHECK_FALSE(read.labels[1].target);
+    // A still has no time step.
+    frame.seconds.reset();
+    CHECK(nlohmann::json::parse(layout_json(frame))["seconds"].is_null());
   }
 
   TEST_CASE("layout_json_writes_non_finite_numbers_as_null") {

@@ -3,13 +3,16 @@
 
 #include <cmath>
 
+#include <nlohmann/json.hpp>
+
 #include "labeling/layout_metrics.h"
 #include "test_files.h"
 
 namespace strata {
 namespace {
 
-// A label with its box's top-left corner and size; shown on layer 0 unless said otherwise.
+// A label with its box's top-left corner and size; shown (opacity 1) on layer 0 unless said
+// otherwise.
 LayoutLabel label(int id, glm::dvec2 anchor, glm::dvec2 origin, glm::dvec2 size, bool shown = true,
                   uint32_t layer = 0) {
   return {.id = id,
@@ -17,7 +20,16 @@ LayoutLabel label(int id, glm::dvec2 anchor, glm::dvec2 origin, glm::dvec2 size,
           .anchor = anchor,
           .box_origin = origin,
           .box_size = size,
-          .shown = shown};
+          .shown = shown,
+          .opacity = shown ? 1.0 : 0.0};
+}
+
+// A label drawn (placed) with this opacity, as the forces fade it.
+LayoutLabel fading(LayoutLabel l, double opacity) {
+  l.placed = opacity > 0.0;
+  l.shown = l.placed;
+  l.opacity = opacity;
+  return l;
 }
 
 // A label drawn over its anchor (no leader): the box centred on the anchor.
@@ -30,6 +42,11 @@ Layout layout(uint32_t width, uint32_t height, std::vector<LayoutLabel> labels) 
   l.width = width;
   l.height = height;
   l.labels = std::move(labels);
+  return l;
+}
+
+Layout timed(Layout l, double seconds) {
+  l.seconds = seconds;
   return l;
 }
 
@@ -226,24 +243,195 @@ TEST_SUITE("cpu") {
     CHECK(m.total.hidden == 2);
   }
 
-  TEST_CASE("summed_frame_metrics_pool_leader_lengths_over_every_shown_label") {
+  TEST_CASE("summed_frame_metrics_pool_leader_lengths_over_every_drawn_label") {
     FrameMetrics a, b;
     a.shown = 1;
     a.leader_length_mean = 0.4;
     a.leader_length_max = 0.4;
     a.overlaps = 2;
     a.overlap_area = 10.0;
-    b.shown = 3;
+    b.shown = 2;
+    b.illegible = 1;  // drawn: its leader counts
     b.leader_length_mean = 0.2;
     b.leader_length_max = 0.5;
     b.overlaps = 1;
     b.overlap_area = 2.5;
+    a.opaque = 1;
+    b.opaque = 2;
+    b.apparent_overlaps = 1;
+    a.cut = 1;
     const FrameMetrics total = sum_frame_metrics({a, b});
-    CHECK(total.shown == 4);
+    CHECK(total.shown == 3);
+    CHECK(total.opaque == 3);
+    CHECK(total.apparent_overlaps == 1);
+    CHECK(total.cut == 1);
     CHECK(total.overlaps == 3);
     CHECK(total.overlap_area == 12.5);
     CHECK(total.leader_length_mean == doctest::Approx(0.25));
     CHECK(total.leader_length_max == 0.5);
+  }
+
+  TEST_CASE("labels_are_opaque_from_half_opacity") {
+    const FrameMetrics m = frame_metrics(layout(100, 100,
+                                                {fading(internal_label(1, {0, 0}, {10, 10}), 0.5),
+                                                 fading(internal_label(2, {20, 0}, {10, 10}), 0.49),
+                                                 fading(internal_label(3, {40, 0}, {10, 10}), 1.0),
+                                                 internal_label(4, {60, 0}, {10, 10}, false)}));
+    CHECK(m.opaque == 2);
+    CHECK(m.shown == 3);  // (placed, whatever the opacity)
+  }
+
+  TEST_CASE("a_box_cut_by_the_image_edge_counts_above_a_tenth_of_opacity") {
+    const FrameMetrics m =
+        frame_metrics(layout(100, 80,
+                             {internal_label(1, {-5, 10}, {20, 10}),                // cut, opaque
+                              fading(internal_label(2, {95, 30}, {10, 10}), 0.11),  // cut, faint
+                              fading(internal_label(3, {50, 75}, {10, 10}), 0.1),  // cut, too faint
+                              internal_label(4, {90, 70}, {10, 10}),  // touches the corner
+                              internal_label(5, {-50, -50}, {10, 10}, false)}));  // hidden
+    CHECK(m.cut == 2);
+    CHECK(m.outside_image == 3);  // (every drawn box)
+  }
+
+  TEST_CASE("fading_boxes_overlap_only_both_above_a_tenth_of_opacity") {
+    const FrameMetrics m = frame_metrics(layout(
+        100, 100,
+        {internal_label(1, {0, 0}, {20, 20}),
+         fading(internal_label(2, {10, 10}, {20, 20}), 0.1),  // under 1: too faint
+         fading(internal_label(3, {15, 5}, {20, 10}), 0.2),   // over 1 (and 2)
+         internal_label(4, {60, 60}, {10, 10}), internal_label(5, {70, 60}, {10, 10}),  // touches 4
+         fading(internal_label(6, {62, 62}, {5, 5}), 0.0)}));  // in 4, not drawn
+    CHECK(m.apparent_overlaps == 1);
+    CHECK(m.overlaps == 3);  // (1-2, 1-3, 2-3: every drawn pair)
+  }
+
+  TEST_CASE("motion_is_a_share_of_the_image_width_per_second_and_a_jump_passes_4_percent") {
+    // 200 px wide, 0.1 s a frame. Label 1 moves 4 px against its anchor (2 % of the width:
+    // 0.2 a second), label 2 10 px (5 %: a jump), label 3 exactly 8 px (4 %: no jump), label 4
+    // 100 px while fading (not opaque in frame 1: not counted), label 5 follows its anchor.
+    const Layout f0 =
+        timed(layout(200, 100,
+                     {offset_label(1, {10, 10}, {20, 0}), offset_label(2, {50, 50}, {0, 30}),
+                      offset_label(3, {90, 90}, {0, 20}), offset_label(4, {20, 50}, {0, 0}),
+                      offset_label(5, {150, 50}, {0, 20})}),
+              0.1);
+    const Layout f1 =
+        timed(layout(200, 100,
+                     {offset_label(1, {10, 10}, {20, 4}), offset_label(2, {50, 50}, {6, 38}),
+                      offset_label(3, {90, 90}, {8, 20}),
+                      fading(offset_label(4, {20, 50}, {100, 0}), 0.4),
+                      offset_label(5, {170, 50}, {0, 20})}),
+              0.1);
+    const SequenceMetrics m = sequence_metrics({f0, f1});
+    CHECK(m.opaque_pairs == 4);
+    REQUIRE(m.seconds);
+    CHECK(*m.seconds == doctest::Approx(0.1));
+    REQUIRE(m.motion_mean);
+    CHECK(*m.motion_mean == doctest::Approx((0.2 + 0.5 + 0.4 + 0.0) / 4.0).epsilon(1e-12));
+    CHECK(*m.motion_p95 == doctest::Approx(0.5).epsilon(1e-12));
+    CHECK(m.opaque_jumps == 1);
+    CHECK(m.opaque_flips == 1);  // label 4
+    CHECK(m.jumps == 1);         // (40 px: label 4 only)
+  }
+
+  TEST_CASE("flips_are_changes_of_the_opaque_state_per_label_and_second") {
+    // Three frames, 0.5 s apart: label 1 goes 1, 0.4, 0.6 (two flips), label 2 0.5, 0.5, 1
+    // (none), label 3 is there in frame 0 only. 4 label-frame pairs of 0.5 s: 2 label-seconds.
+    const auto frame = [](double first, double second, bool third) {
+      std::vector<LayoutLabel> labels = {fading(offset_label(1, {10, 10}, {20, 0}), first),
+                                         fading(offset_label(2, {50, 50}, {0, 30}), second)};
+      if (third) labels.push_back(offset_label(3, {90, 90}, {0, 20}));
+      return timed(layout(200, 200, labels), 0.5);
+    };
+    const SequenceMetrics m =
+        sequence_metrics({frame(1.0, 0.5, true), frame(0.4, 0.5, false), frame(0.6, 1.0, false)});
+    CHECK(m.label_frame_pairs == 4);
+    CHECK(m.opaque_flips == 2);
+    CHECK(m.show_hide_flips == 0);  // (all placed throughout)
+    REQUIRE(m.opaque_flips_per_label_per_second);
+    CHECK(*m.opaque_flips_per_label_per_second == doctest::Approx(1.0));
+    CHECK(*m.seconds == doctest::Approx(1.0));
+  }
+
+  TEST_CASE("per_second_figures_are_null_when_a_frame_has_no_seconds") {
+    const Layout a = layout(100, 100, {offset_label(1, {10, 10}, {20, 0})});
+    const Layout b = layout(100, 100, {offset_label(1, {10, 10}, {30, 0})});
+    // Frame 0's seconds are not used: the step from k to k + 1 is frame k + 1's.
+    const SequenceMetrics first_only = sequence_metrics({timed(a, 0.1), b});
+    CHECK_FALSE(first_only.seconds);
+    CHECK_FALSE(first_only.motion_mean);
+    CHECK_FALSE(first_only.opaque_flips_per_label_per_second);
+    CHECK(first_only.opaque_jumps == 1);  // 10 px of 100: no time needed
+    const nlohmann::ordered_json report = to_json(first_only);
+    CHECK(report["sequence"]["motion_mean_of_width_per_second"].is_null());
+    CHECK(report["sequence"]["opaque_flips_per_label_per_second"].is_null());
+    const SequenceMetrics second_only = sequence_metrics({a, timed(b, 0.1)});
+    REQUIRE(second_only.motion_mean);
+    CHECK(*second_only.motion_mean == doctest::Approx(1.0));
+    CHECK_FALSE(sequence_metrics({timed(a, 0.1)}).seconds);  // one frame: no duration
+  }
+
+  TEST_CASE("opaque_labels_compare_with_stills_of_the_same_views") {
+    const auto frame = [](double opacity) {
+      return layout(
+          100, 100,
+          {fading(internal_label(1, {0, 0}, {10, 10}), opacity),
+           internal_label(2, {20, 0}, {10, 10}), internal_label(3, {40, 0}, {10, 10}, false)});
+    };
+    const Layout still =
+        layout(100, 100,
+               {internal_label(1, {0, 0}, {10, 10}), internal_label(2, {20, 0}, {10, 10}),
+                internal_label(3, {40, 0}, {10, 10})});
+    const SequenceMetrics m = sequence_metrics({frame(0.3), frame(1.0)}, {still, still});
+    REQUIRE(m.stills.size() == 2);
+    CHECK(m.stills_total.opaque == 6);
+    const nlohmann::ordered_json report = to_json(m);
+    CHECK(report["per_frame"][0]["still_opaque"] == 3);
+    CHECK(report["per_frame"][0]["opaque_of_still"].get<double>() == doctest::Approx(1.0 / 3.0));
+    CHECK(report["per_frame"][1]["opaque_of_still"].get<double>() == doctest::Approx(2.0 / 3.0));
+    CHECK(report["total"]["opaque_of_still"].get<double>() == doctest::Approx(0.5));
+    CHECK(report["total"]["still_leader_crossings"] == 0);
+    // Without stills the keys are left out; the summary leaves out the frames.
+    CHECK_FALSE(to_json(sequence_metrics({frame(1.0)}))["total"].contains("opaque_of_still"));
+    CHECK_FALSE(to_json(m, false).contains("per_frame"));
+    // A still of another size, or one still too few, is an error.
+    CHECK(test::error_of([&] {
+            sequence_metrics({frame(1.0)}, {layout(50, 100, {})});
+          }).find("a still of 50x100 for a frame of 100x100") != std::string::npos);
+    CHECK(test::error_of([&] {
+            sequence_metrics({frame(1.0), frame(1.0)}, {still});
+          }) == "stills: 1 layouts for 2 frames");
+  }
+
+  TEST_CASE("read_layout_reads_opacity_target_and_seconds_and_defaults_them_for_older_files") {
+    const auto folder = test::fresh_folder("cpu", "layout_metrics_read_motion");
+    const auto path =
+        test::write_file(folder / "layout.json",
+                         R"({"width": 128, "height": 96, "seconds": 0.0625, "labels": [
+          {"id": 1, "anchor": [10, 20], "box": [30, 40, 50, 12], "shown": true,
+           "opacity": 0.25, "target": [35, 45, 50, 12]},
+          {"id": 2, "anchor": [1, 2], "box": [1, 2, 4, 4], "shown": false, "target": null},
+          {"id": 3, "anchor": [1, 2], "box": [1, 2, 4, 4], "shown": true},
+          {"id": 4, "anchor": [1, 2], "box": [1, 2, 4, 4], "shown": false, "placed": true}]})");
+    const Layout l = read_layout(path);
+    REQUIRE(l.seconds);
+    CHECK(*l.seconds == 0.0625);
+    REQUIRE(l.labels.size() == 4);
+    CHECK(l.labels[0].opacity == 0.25);
+    REQUIRE(l.labels[0].target);
+    CHECK(l.labels[0].target->min == glm::dvec2(35, 45));
+    CHECK(l.labels[0].target->max == glm::dvec2(85, 57));
+    CHECK_FALSE(l.labels[1].target);
+    CHECK(l.labels[1].opacity == 0.0);
+    // Older files: opacity 1 when drawn (placed), else 0; the target is the box.
+    CHECK(l.labels[2].opacity == 1.0);
+    REQUIRE(l.labels[2].target);
+    CHECK(l.labels[2].target->min == glm::dvec2(1, 2));
+    CHECK(l.labels[2].target->max == glm::dvec2(5, 6));
+    CHECK(l.labels[3].opacity == 1.0);
+    const auto still = test::write_file(
+        folder / "still.json", R"({"width": 8, "height": 8, "seconds": null, "labels": []})");
+    CHECK_FALSE(read_layout(still).seconds);
   }
 
   TEST_CASE("read_layout_reads_what_render_writes") {
@@ -291,6 +479,14 @@ TEST_SUITE("cpu") {
               .ends_with("labels[1].id: duplicate id 1 (also labels[0])"));
     CHECK(layout_error("width", R"({"width": 0, "height": 64, "labels": []})")
               .ends_with("layout.json: width: expected a positive integer"));
+    CHECK(error("opacity", R"({"id": 2, "anchor": [1, 2], "box": [0, 0, 4, 4], "shown": true,
+                               "opacity": 1.5})")
+              .ends_with("labels[0].opacity: expected a number from 0 to 1"));
+    CHECK(error("target", R"({"id": 2, "anchor": [1, 2], "box": [0, 0, 4, 4], "shown": true,
+                              "target": [0, 0, 4]})")
+              .ends_with("labels[0].target: expected 4 numbers"));
+    CHECK(layout_error("seconds", R"({"width": 8, "height": 8, "seconds": 0, "labels": []})")
+              .ends_with("layout.json: seconds: expected a number > 0 or null"));
     CHECK(layout_error("labels", R"({"width": 8, "height": 64})")
               .ends_with("layout.json: missing key 'labels'"));
     CHECK(layout_error("syntax", R"({"width": 8,)").find("layout.json: parse error") !=
