@@ -597,7 +597,9 @@ TEST_SUITE("gpu") {
           PlacementLayout{.dispatch = LabelDispatch::indirect},
           PlacementLayout{.dispatch = LabelDispatch::indirect, .finish_lanes = 2},
           PlacementLayout{.dispatch = LabelDispatch::direct, .classify_tiles = 16},
-          PlacementLayout{.dispatch = LabelDispatch::indirect, .classify_tiles = 8}}) {
+          PlacementLayout{.dispatch = LabelDispatch::indirect, .classify_tiles = 8},
+          PlacementLayout{.dispatch = LabelDispatch::direct, .pass_per_label = true},
+          PlacementLayout{.dispatch = LabelDispatch::indirect, .pass_per_label = true}}) {
       CAPTURE(int(layout.dispatch));
       CAPTURE(layout.classify_tiles);
       CAPTURE(layout.direct_groups);
