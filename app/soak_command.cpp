@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -150,7 +150,7 @@ std::vector<Change> schedule(Viewer& viewer, HeadlessOutput& output, const Scene
   number("render.step", 2.0f, s.render.step);
   flag("forces.anchor_relative", !s.forces.anchor_relative);
   number("weights.integral_costs", w.integral_costs * 0.1f, w.integral_costs);
-  number("margin", s.placement.margin + 8.0f, s.placement.margin);
+  number("margin_em", s.placement.margin_em + 0.5f, s.placement.margin_em);
   if (!scene.labels.empty()) {
     const int id = scene.labels.front().id;
     out.push_back({"label " + std::to_string(id) + " hidden",

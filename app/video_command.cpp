@@ -217,9 +217,23 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--no-forces", o->no_forces, "place every frame from scratch (labels jump)");
   cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
   add_label_look_options(cmd, o->look);
-  cmd->add_option("--speed", o->forces.speed, "forces: pixels per second at full force")
+  cmd->add_option("--label-speed", o->forces.speed_widths,
+                  "forces: image widths per second a label moves at, at most")
       ->capture_default_str()
-      ->check(finite_range(1.0, 1e6));
+      ->check(finite_range(0.001, 10.0));
+  cmd->add_option("--ease-in", o->forces.ease_in_seconds,
+                  "seconds a label takes to get up to full speed (0: at once)")
+      ->capture_default_str()
+      ->check(finite_range(0.0, 10.0));
+  // (pixels per second once: the same speed moved labels 4 times as far at a quarter the size)
+  cmd->add_option_function<std::string>(
+         "--speed",
+         [](const std::string&) {
+           throw UsageError(
+               "--speed (pixels per second) is now --label-speed, in image widths per second "
+               "(90 px/s at 1024 px wide is 0.088)");
+         })
+      ->group("");
   cmd->add_option("--hold", o->forces.hold_share,
                   "a label keeps its target unless a position costs less by this share of its "
                   "cost (plus --hold-cost)")

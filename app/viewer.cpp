@@ -111,11 +111,10 @@ const std::vector<Parameter>& parameters() {
        [](S s) { return &s.labels.placement.occlusion_weight; }},
       {"integral.single_saliency", "eq. 3.4: saliency weight with one layer", 0.0f, 1.0f,
        [](S s) { return &s.labels.placement.single_saliency_weight; }},
-      {"margin", "pixels around boxes in the constraints", 0.0f, 256.0f,
-       [](S s) { return &s.labels.placement.margin; }},
+      {"margin_em", "label text sizes around boxes in the constraints", 0.0f, 16.0f,
+       [](S s) { return &s.labels.placement.margin_em; }},
       {"layers", "depth layers asked for, 1 to 8", 1.0f, 8.0f},
-      {"tidy_rounds", "rounds of the tidy-up per frame, 0 to 256", 0.0f,
-       float(TIDY_ROUNDS_MAX)},
+      {"tidy_rounds", "rounds of the tidy-up per frame, 0 to 256", 0.0f, float(TIDY_ROUNDS_MAX)},
       {"hard", "on: no constraint violations (labels may be hidden)", 0.0f, 0.0f, nullptr,
        [](S s) { return &s.labels.placement.hard; }},
       {"internal", "on: each label on its anchor", 0.0f, 0.0f, nullptr,
@@ -125,10 +124,12 @@ const std::vector<Parameter>& parameters() {
       {"layer_colors", "on: label borders in their layer's colour", 0.0f, 0.0f, nullptr,
        [](S s) { return &s.labels.layer_colors; }},
       // (speed / epsilon bounds the force steps of a frame: at most 2,000 in a 0.1 s frame)
-      {"forces.speed", "pixels per second at full force", 1.0f, 1e4f,
-       [](S s) { return &s.labels.forces.speed; }},
-      {"forces.epsilon", "pixels: nearer than this the force shrinks", 0.5f, 1000.0f,
-       [](S s) { return &s.labels.forces.epsilon; }},
+      {"forces.speed_widths", "image widths per second at full force", 0.001f, 10.0f,
+       [](S s) { return &s.labels.forces.speed_widths; }},
+      {"forces.epsilon_widths", "image widths: nearer than this the force shrinks", 0.0005f, 1.0f,
+       [](S s) { return &s.labels.forces.epsilon_widths; }},
+      {"forces.ease_in", "seconds a label takes to get up to full speed", 0.0f, 10.0f,
+       [](S s) { return &s.labels.forces.ease_in_seconds; }},
       {"forces.snap", "pixels: nearer than this a label lands on its target", 0.0f, 100.0f,
        [](S s) { return &s.labels.forces.snap; }},
       {"forces.hold_share", "hold: this share of the target's cost ...", 0.0f, 100.0f,
@@ -154,6 +155,15 @@ const std::vector<Parameter>& parameters() {
 const Parameter& parameter(const std::string& name) {
   for (const Parameter& p : parameters()) {
     if (name == p.name) return p;
+  }
+  // Pixels once; now relative to the image's width or to the label text's size.
+  static const std::pair<const char*, const char*> renamed[] = {
+      {"margin", "margin_em (label text sizes: 6 px at a 14 px font is 0.43)"},
+      {"forces.speed",
+       "forces.speed_widths (image widths per second: 90 px/s at 1024 px is 0.088)"},
+      {"forces.epsilon", "forces.epsilon_widths (image widths: 24 px at 1024 px is 0.0234)"}};
+  for (const auto& [old_name, now] : renamed) {
+    if (name == old_name) throw Error("parameter " + name + " (pixels) is now " + now);
   }
   std::string names;
   for (const Parameter& p : parameters())
@@ -558,7 +568,8 @@ void Viewer::set_flag(const std::string& name, bool value) {
 
 void Viewer::commit_settings(const LabellingSettings& labels, const RenderSettings& render,
                              const ViewerOptions& viewer, bool reproject) {
-  forces_params(labels.forces, 1, 0.0, labels.placement.hard);  // (throws on a bad force)
+  forces_params(labels.forces, labelled_->units(), 1, 0.0,
+                labels.placement.hard);  // (throws on a bad force)
   labelled_->settings() = labels;
   labelled_->renderer().settings() = render;
   options_ = viewer;
@@ -723,7 +734,7 @@ graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double 
   if (debug_choice_) {
     debug_.set(*debug_choice_);
     debug_.set_placement(uint32_t(labelled_->placement_order_count()),
-                         labelled_->settings().placement.margin);
+                         labelled_->settings().placement.margin_em * labelled_->units().em);
   }
   slots_[slot] = {generation_, serial_, trial};
   last_slot_ = slot;

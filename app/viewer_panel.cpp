@@ -125,7 +125,7 @@ void Viewer::panel_labelling() {
   slider(*this, "saliency (1 layer)", "integral.single_saliency",
          s.placement.single_saliency_weight, 0.0f, 1.0f);
   ImGui::Separator();
-  slider(*this, "margin (px)", "margin", s.placement.margin, 0.0f, 32.0f, "%.1f");
+  slider(*this, "margin (text sizes)", "margin_em", s.placement.margin_em, 0.0f, 2.0f, "%.2f");
   int layers = int(s.layer_count);
   if (ImGui::SliderInt("layers", &layers, 1, 8)) set_number("layers", float(layers));
   ImGui::Text("layers used: %u", labelled_->layering().layer_count);
@@ -157,9 +157,11 @@ void Viewer::panel_forces() {
   const ForceSettings f = labelled_->settings().forces;
   checkbox(*this, "held as anchor offsets (off: on screen)", "forces.anchor_relative",
            f.anchor_relative);
-  slider(*this, "speed (px/s)", "forces.speed", f.speed, 1.0f, 2000.0f, "%.0f",
+  slider(*this, "speed (widths/s)", "forces.speed_widths", f.speed_widths, 0.005f, 2.0f, "%.3f",
          ImGuiSliderFlags_Logarithmic);
-  slider(*this, "epsilon (px)", "forces.epsilon", f.epsilon, 0.5f, 100.0f, "%.1f");
+  slider(*this, "epsilon (widths)", "forces.epsilon_widths", f.epsilon_widths, 0.001f, 0.1f, "%.4f",
+         ImGuiSliderFlags_Logarithmic);
+  slider(*this, "ease-in (s)", "forces.ease_in", f.ease_in_seconds, 0.0f, 2.0f, "%.2f");
   slider(*this, "snap (px)", "forces.snap", f.snap, 0.0f, 5.0f, "%.2f");
   slider(*this, "hold: share of cost", "forces.hold_share", f.hold_share, 0.0f, 4.0f);
   slider(*this, "hold: fixed", "forces.hold_cost", f.hold_cost, 0.0f, 50.0f);

@@ -189,7 +189,7 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
   set_placement_frame(true, trial_order ? trial_within_ : within_);
   ForceSettings forces = settings_.forces;
   if (afresh_) forces.hold_share = forces.hold_cost = 0.0f;
-  parts_->forces.set_frame(forces, seconds, settings_.placement.hard);
+  parts_->forces.set_frame(forces, units(), seconds, settings_.placement.hard);
   parts_->forces.set_trial(trial);
   afresh_ = false;
   frame_seconds_ = seconds > 0.0 ? std::optional(seconds) : std::nullopt;  // (0 s: a still)
@@ -265,6 +265,7 @@ void LabelledRenderer::build_graph() {
 // of an animation with the forces' (toward the last targets).
 void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32_t>& within) {
   PlacementSettings settings = settings_.placement;
+  settings.text_pixels = units().em;
   if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
   parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within, priorities_),
                               settings);
@@ -328,7 +329,7 @@ void LabelledRenderer::run(const std::function<void(uint32_t done, uint32_t tota
   const auto run_still = [this] {
     set_placement_frame(false, within_);
     parts_->forces.reset();
-    parts_->forces.set_frame(settings_.forces, 0.0, settings_.placement.hard);
+    parts_->forces.set_frame(settings_.forces, units(), 0.0, settings_.placement.hard);
     frame_seconds_.reset();
     run_frame();
   };

@@ -143,6 +143,11 @@ class LabelledRenderer {
   // A new image size (a resized window): the anchors are projected again.
   void set_size(graph::Extent size);
   graph::Extent size() const { return size_; }
+  // What the relative lengths of the forces and the placement are in pixels now: the image's
+  // width and the label text's size.
+  LabelUnits units() const {
+    return {float(size_.width), settings_.font_pixels * settings_.label_scale};
+  }
   const Camera& camera() const { return camera_; }
   // Frames recorded before the earlier ones finished: a readback per frame slot.
   void set_frames_in_flight(uint32_t frames);

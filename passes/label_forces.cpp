@@ -9,26 +9,34 @@ namespace strata {
 
 using graph::Use;
 
-gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_count, double seconds,
-                                bool hard) {
-  if (!(settings.speed > 0.0f) || !(settings.epsilon > 0.0f) || !(settings.snap >= 0.0f)) {
+gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
+                                uint32_t label_count, double seconds, bool hard) {
+  if (!(settings.speed_widths > 0.0f) || !(settings.epsilon_widths > 0.0f) ||
+      !(settings.snap >= 0.0f)) {
     throw Error("forces: speed and epsilon must be > 0 and snap >= 0");
   }
   if (!(settings.hold_share >= 0.0f) || !(settings.hold_cost >= 0.0f) ||
-      !(settings.fade_seconds >= 0.0f) || !(settings.appear_padding >= 0.0f)) {
-    throw Error("forces: hold, fade and padding must be >= 0");
+      !(settings.fade_seconds >= 0.0f) || !(settings.ease_in_seconds >= 0.0f) ||
+      !(settings.appear_padding_em >= 0.0f)) {
+    throw Error("forces: hold, fade, ease-in and padding must be >= 0");
+  }
+  if (!(units.width >= 1.0f) || !(units.em > 0.0f)) {
+    throw Error("forces: an image " + std::to_string(units.width) + " px wide, text of " +
+                std::to_string(units.em) + " px");
   }
   if (!(seconds >= 0.0 && seconds <= 60.0)) {
     throw Error("forces: a frame of " + std::to_string(seconds) + " s");
   }
-  const double travel = seconds * double(settings.speed);
-  const auto steps = static_cast<uint32_t>(std::max(1.0, std::ceil(travel / settings.epsilon)));
+  const double travel = seconds * double(settings.speed_widths) / double(settings.epsilon_widths);
+  // (a frame of 1/30 s is 4 steps, not 5 for its rounding)
+  const double short_steps = std::ceil(seconds / kForceStepSeconds - 1e-6);
+  const auto steps = static_cast<uint32_t>(std::max({1.0, std::ceil(travel), short_steps}));
   gpu::ForcesParams p{};
   p.label_count = label_count;
   p.steps = steps;
   p.step_seconds = static_cast<float>(seconds / steps);
-  p.speed = settings.speed;
-  p.epsilon = settings.epsilon;
+  p.speed = settings.speed_widths * units.width;
+  p.epsilon = settings.epsilon_widths * units.width;
   p.snap = settings.snap;
   p.anchor_relative = settings.anchor_relative ? 1u : 0u;
   p.fade = seconds > 0.0 && settings.fade_seconds > 0.0f
@@ -36,14 +44,16 @@ gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_co
                : 1.0f;
   p.hold_share = settings.hold_share;
   p.hold_cost = settings.hold_cost;
-  p.appear_padding = hard ? settings.appear_padding : 0.0f;
+  p.appear_padding = hard ? settings.appear_padding_em * units.em : 0.0f;
+  p.trial = 0u;
+  p.acceleration = settings.ease_in_seconds > 0.0f ? p.speed / settings.ease_in_seconds : 0.0f;
   return p;
 }
 
 LabelForces::LabelForces(Context& ctx, uint32_t label_count)
     : ctx_(ctx),
       label_count_(label_count),
-      params_(forces_params({}, label_count, 0.0)),
+      params_(forces_params({}, {1024.0f, 14.0f}, label_count, 0.0)),
       forces_(ctx, "label_forces.comp"),
       previous_(ctx, "label_previous.comp"),
       state_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::LabelStateGpu),
@@ -59,8 +69,9 @@ void LabelForces::reset() {
   upload(ctx_, state_, as_bytes(empty));
 }
 
-void LabelForces::set_frame(const ForceSettings& settings, double seconds, bool hard) {
-  params_ = forces_params(settings, label_count_, seconds, hard);
+void LabelForces::set_frame(const ForceSettings& settings, LabelUnits units, double seconds,
+                            bool hard) {
+  params_ = forces_params(settings, units, label_count_, seconds, hard);
 }
 
 std::vector<gpu::LabelStateGpu> LabelForces::state() const {

@@ -18,14 +18,29 @@
 
 namespace strata {
 
+// What the settings' relative lengths are in pixels in one frame. Motion (the forces' speed and
+// distances) is in image widths, so that a camera path moves labels the same share of the image
+// at any image size; spacing (padding, margins) is in the label text's size, which is what keeps
+// two labels apart legibly, and which does not follow the image's size.
+struct LabelUnits {
+  float width = 0.0f;  // the image's width
+  float em = 0.0f;     // the label text's size: font pixels times the label scale
+};
+
 struct ForceSettings {
   // Where a label lives between frames: as an offset from its anchor, so that it moves rigidly
   // with the anchor while the camera turns and the forces act on the offset; or, as in the
   // thesis, as a position on screen.
   bool anchor_relative = true;
-  float speed = 90.0f;    // pixels per second at full force (3 px a frame at 30 fps)
-  float epsilon = 24.0f;  // pixels: within this the force shrinks toward the target (eq. 3.7)
-  float snap = 0.5f;      // pixels: within this the label is put on its target
+  // (defaults: what were 90 px/s and 24 px at 1024 px wide)
+  float speed_widths = 0.088f;     // image widths per second at full force
+  float epsilon_widths = 0.0234f;  // image widths: within this the force shrinks (eq. 3.7)
+  // Pixels: within this a label is put on its target. It rounds a sub-pixel remainder, which is
+  // as invisible at one image size as at any other, so it stays in pixels.
+  float snap = 0.5f;
+  // A label gets up to full speed over this long (a smooth start; 0: at once). Its stop is smooth
+  // already: within epsilon the force shrinks with the distance.
+  float ease_in_seconds = 0.25f;
   // The hold (eq. 3.1 with hysteresis): a label keeps heading for last frame's target unless
   // another position costs less by more than this share of the target's cost plus hold_cost.
   float hold_share = 0.5f;
@@ -34,15 +49,21 @@ struct ForceSettings {
   // label's last target costs this much per pixel, so a label that must move goes nearby.
   float previous_weight = 2.0f;
   float fade_seconds = 0.3f;  // a label fades in or out over this long (0: it pops)
-  // Hard mode: pixels of extra clear zone a label hidden in the last frame needs to appear.
-  float appear_padding = 8.0f;
+  // Hard mode: extra clear zone a label hidden in the last frame needs to appear, in ems (label
+  // text sizes; 8 px at the default 14 px font).
+  float appear_padding_em = 8.0f / 14.0f;
 };
 
-// The push constants of one frame of `seconds`: enough sub-steps that none moves a label by more
-// than epsilon, so no step overshoots its target. A frame of 0 s is a still: labels fade at once.
+// The forces integrate in sub-steps of at most this long, so that a frame moves a label as the
+// same time in shorter frames would, whatever the frame rate.
+inline constexpr double kForceStepSeconds = 1.0 / 120.0;
+
+// The push constants of one frame of `seconds` at `units`: sub-steps of at most
+// kForceStepSeconds, and enough that none moves a label by more than epsilon, so no step
+// overshoots its target. A frame of 0 s is a still: labels fade at once.
 // `hard`: the placement forbids violations (the appear padding applies).
-gpu::ForcesParams forces_params(const ForceSettings& settings, uint32_t label_count, double seconds,
-                                bool hard = false);
+gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
+                                uint32_t label_count, double seconds, bool hard = false);
 
 class LabelForces {
  public:
@@ -67,8 +88,10 @@ class LabelForces {
   // The forces pass, and a copy of the drawn placements for the host.
   Outputs add_to(graph::Graph& graph, const Inputs& in);
 
-  // The next frame's settings and duration (a fixed 1 / fps offline, so videos are repeatable).
-  void set_frame(const ForceSettings& settings, double seconds, bool hard = false);
+  // The next frame's settings, units and duration (a fixed 1 / fps offline, so videos are
+  // repeatable).
+  void set_frame(const ForceSettings& settings, LabelUnits units, double seconds,
+                 bool hard = false);
   // Marks the frame set last as a trial (ForcesParams::trial): labels are drawn where they were
   // and the state is not written, so several trial placements start from the same state.
   void set_trial(bool trial) { params_.trial = trial ? 1u : 0u; }

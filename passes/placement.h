@@ -24,11 +24,14 @@
 namespace strata {
 
 struct PlacementSettings {
-  CostWeights weights;            // eq. 3.1 (scene settings; defaults: the thesis's final paper)
-  float margin = 6.0f;            // pixels around label boxes in the constraints
-  bool hard = false;              // forbid constraint violations (labels may end up hidden)
-  float saliency_weight = 0.5f;   // eq. 3.3: how much saliency modulates the occlusion behind
-  float occlusion_weight = 0.5f;  // eq. 3.4 (one layer)
+  CostWeights weights;  // eq. 3.1 (scene settings; defaults: the thesis's final paper)
+  // Around label boxes in the constraints, in ems: label text sizes, which keep two labels apart
+  // legibly at any image size (6 px at the default 14 px font).
+  float margin_em = 6.0f / 14.0f;
+  float text_pixels = 14.0f;  // an em: the label text's size (LabelledRenderer sets it per frame)
+  bool hard = false;          // forbid constraint violations (labels may end up hidden)
+  float saliency_weight = 0.5f;         // eq. 3.3: how much saliency modulates the occlusion behind
+  float occlusion_weight = 0.5f;        // eq. 3.4 (one layer)
   float single_saliency_weight = 0.5f;  // eq. 3.4 (one layer)
   bool write_constraints = false;       // keep each label's constraint image (tests, debugging)
   // Cost above a label's lowest tile bound that its speculative pass covers (speed only:
@@ -39,6 +42,11 @@ struct PlacementSettings {
   // and overlaps counted); 0: none. Hard mode has none: its layouts have no conflicts.
   uint32_t tidy_rounds = 64;
 };
+
+// The margin in pixels.
+inline float margin_pixels(const PlacementSettings& s) {
+  return s.margin_em * s.text_pixels;
+}
 
 gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent viewport,
                                       uint32_t layer_count, uint32_t label_count, uint32_t step);

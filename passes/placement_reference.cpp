@@ -227,7 +227,8 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
     const gpu::LabelGpu& me = labels[label];
     for (uint32_t k = 0; k < step; ++k) {
       const uint32_t j = order[k];
-      placer.regions[j] = placer.pair_regions(me, labels[j], placer.placed(j), settings.margin);
+      placer.regions[j] =
+          placer.pair_regions(me, labels[j], placer.placed(j), margin_pixels(settings));
     }
     for (uint32_t y = 0; y < h; ++y) {
       for (uint32_t x = 0; x < w; ++x) {

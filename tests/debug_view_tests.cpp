@@ -369,9 +369,9 @@ TEST_SUITE("gpu") {
     runner.set_viewport(size);
     PlacementSettings settings;
     settings.write_constraints = true;
-    settings.margin = 2.0f;
+    settings.margin_em = 2.0f / settings.text_pixels;
     placement.set_frame(labels, order, settings);
-    view.set_placement(static_cast<uint32_t>(order.size()), settings.margin);
+    view.set_placement(static_cast<uint32_t>(order.size()), margin_pixels(settings));
 
     const std::vector<DebugViewChoice> choices = {
         {.buffer = DebugBuffer::fragments, .scale = 0.25f},
@@ -395,8 +395,9 @@ TEST_SUITE("gpu") {
       const auto frame = as<gpu::FrameGpu>(runner.download_buffer(inputs.frame));
       REQUIRE(frame.size() == 1);
       REQUIRE(frame[0].table_size == keys.size());
-      const DebugViewData data{size,       2,          saliency, costs,           layers,
-                               label_data, placements, order,    settings.margin, keys};
+      const DebugViewData data{
+          size, 2, saliency, costs, layers, label_data, placements, order, margin_pixels(settings),
+          keys};
       const std::vector<uint8_t> shown = as<uint8_t>(runner.download_image(image));
       check_view(shown, debug_view_reference(data, choice), size, choice);
       if (std::getenv("STRATA_KEEP_IMAGES")) {

@@ -215,7 +215,7 @@ TEST_SUITE("gpu") {
     Camera moved = start;  // 8 degrees around the head's vertical axis
     moved.view = start.view * glm::rotate(glm::mat4(1.0f), glm::radians(8.0f), {0.0f, 0.0f, 1.0f});
     LabellingSettings settings;
-    settings.forces.speed = 300.0f;  // 10 px per frame at 30 frames per second
+    settings.forces.speed_widths = 300.0f / 128.0f;  // 10 px per frame at 30 frames per second
     settings.forces.hold_share = settings.forces.hold_cost = 0.0f;
     settings.forces.previous_weight = 0.0f;
     LabelledRenderer renderer(ctx, scene, start, size, settings);

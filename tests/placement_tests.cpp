@@ -26,6 +26,7 @@ namespace strata {
 namespace {
 
 constexpr double kFrameSeconds = 1.0 / 30.0;  // a frame of a 30 fps animation
+constexpr LabelUnits kUnits{1024.0f, 14.0f};  // the forces' image width and text size
 
 struct Inputs {
   graph::Extent size{96, 72};
@@ -117,7 +118,7 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
   if (!previous.empty()) upload(ctx, state, as_bytes(previous));
   LabelForces last_frame(ctx, uint32_t(in.labels.size()));
-  last_frame.set_frame(forces, kFrameSeconds, settings.hard);
+  last_frame.set_frame(forces, kUnits, kFrameSeconds, settings.hard);
   Placement::AdjustLabels adjust;
   if (!previous.empty()) {
     const graph::ResourceId state_id =
@@ -406,7 +407,7 @@ TEST_SUITE("gpu") {
       settings.weights.previous_position = 0.2f;
       const ForceSettings forces{.anchor_relative = relative};
       const gpu::ForcesParams params =
-          forces_params(forces, uint32_t(in.labels.size()), kFrameSeconds);
+          forces_params(forces, kUnits, uint32_t(in.labels.size()), kFrameSeconds);
       const GpuPlacement gpu = place_on_gpu(ctx, in, settings, {}, state, forces);
       const std::vector<gpu::LabelGpu> expected = previous_reference(in.labels, state, params);
       for (size_t i = 0; i < 3; ++i) {
@@ -450,7 +451,7 @@ TEST_SUITE("gpu") {
       CAPTURE(hold);
       const ForceSettings forces{.hold_share = 0.0f, .hold_cost = hold};
       const gpu::ForcesParams params =
-          forces_params(forces, uint32_t(in.labels.size()), kFrameSeconds);
+          forces_params(forces, kUnits, uint32_t(in.labels.size()), kFrameSeconds);
       const std::vector<gpu::LabelGpu> labels = previous_reference(in.labels, state, params);
       const ReferencePlacement cpu =
           place_reference(in.final_rgba8, in.layers, in.layer_count, labels, in.order, {}, in.size);
@@ -468,7 +469,7 @@ TEST_SUITE("gpu") {
     }
   }
 
-  // Hard mode's asymmetric clear zone: labels hidden last frame need `appear_padding` more room,
+  // Hard mode's asymmetric clear zone: labels hidden last frame need `appear_padding_em` more room,
   // so in a crowded scene fewer of them appear than labels shown last frame keep their place.
   TEST_CASE_FIXTURE(test::GpuTest, "in_hard_mode_a_label_needs_more_room_to_appear_than_to_stay") {
     const Inputs in = disc_scene(12, 2.5f);
@@ -483,11 +484,11 @@ TEST_SUITE("gpu") {
     for (const uint32_t flags : {LABEL_STATE_SEEN | LABEL_STATE_SHOWN, LABEL_STATE_SEEN}) {
       CAPTURE(flags);
       const std::vector<gpu::LabelStateGpu> state(in.labels.size(), {.flags = flags});
-      const ForceSettings forces{.appear_padding = 12.0f};
+      const ForceSettings forces{.appear_padding_em = 1.0f};
       const gpu::ForcesParams params =
-          forces_params(forces, uint32_t(in.labels.size()), kFrameSeconds, true);
+          forces_params(forces, kUnits, uint32_t(in.labels.size()), kFrameSeconds, true);
       const std::vector<gpu::LabelGpu> labels = previous_reference(in.labels, state, params);
-      CHECK(labels[0].padding == (flags & LABEL_STATE_SHOWN ? 0.0f : 12.0f));
+      CHECK(labels[0].padding == (flags & LABEL_STATE_SHOWN ? 0.0f : kUnits.em));
       const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                      labels, in.order, settings, in.size);
       check_placements(place_on_gpu(ctx, in, settings, {}, state, forces), cpu);
@@ -664,7 +665,7 @@ TEST_SUITE("gpu") {
     in.labels[1] = label({70.0f, 36.0f}, {10.0f, 6.0f}, 0);
     PlacementSettings settings;
     settings.write_constraints = true;
-    settings.margin = 0.0f;
+    settings.margin_em = 0.0f;
     const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
     const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                    in.labels, in.order, settings, in.size);

@@ -28,9 +28,10 @@ struct LabelStateGpu {
   float cost;     // eq. 3.1 at the target, without the hold (sizes the next frame's hold)
   vec2 target;    // where the label is heading: the placement's position, held as `position` is
   float opacity;  // 0: invisible, 1: fully drawn; fades toward 1 while shown, toward 0 when not
-  uint pad;
+  float speed;    // pixels per second the label moved at in its last sub-step (the easing's start)
 };
 
+// One frame's forces in pixels and seconds (forces_params converts ForceSettings' relative units).
 struct ForcesParams {
   uint label_count;
   uint steps;            // sub-steps this frame (each moves at most `epsilon`: no overshoot)
@@ -44,6 +45,7 @@ struct ForcesParams {
   float hold_cost;       // ... plus this
   float appear_padding;  // pixels of padding for a label hidden in the last frame (hard mode)
   uint trial;  // 1: a trial frame (the viewer's optimisation on idle): the state stays as it was
+  float acceleration;  // pixels per second per second a label speeds up by at most (0: at once)
 };
 
 // An opacity moved by `change`, kept in [0, 1]; within 1/512 of either end (less than a step of
@@ -53,13 +55,28 @@ STRATA_INLINE float faded(float opacity, float change) {
   return o < 1.0f / 512.0f ? 0.0f : (o > 1.0f - 1.0f / 512.0f ? 1.0f : o);
 }
 
-// Eq. 3.6-3.8 for one sub-step: the label at l moves toward p by the unit force (attenuated as
-// d / epsilon within epsilon of p) times the time step.
+// Eq. 3.6-3.8 for one sub-step: how far the label at l moves toward p, the unit force (attenuated
+// as d / epsilon within epsilon of p) times the time step.
 STRATA_INLINE vec2 force_step(vec2 l, vec2 p, float seconds, float speed, float epsilon) {
   vec2 d = p - l;
   float distance = length(d);
   vec2 force = distance >= epsilon ? d / distance : d / epsilon;
-  return l + (seconds * speed) * force;
+  return (seconds * speed) * force;
+}
+
+// The easing of a start: a sub-step `step` after one at `speed` pixels per second, cut to what
+// `acceleration` allows in `seconds` (none: 0). A stop is eased already: within epsilon the force
+// shrinks with the distance. Returns the step (xy) and the speed it moves at (z). (Steps, not
+// positions: (l + step) - l is step to a shader compiler, not to the CPU reference.)
+STRATA_INLINE vec3 eased_step(vec2 step, float speed, float seconds, float acceleration) {
+  if (!(seconds > 0.0f)) return vec3(0.0f);
+  float moved = length(step);
+  float most = (speed + acceleration * seconds) * seconds;
+  if (acceleration > 0.0f && moved > most) {
+    step = step * (most / moved);
+    moved = most;
+  }
+  return vec3(step.x, step.y, moved / seconds);
 }
 
 // A position of the state (offset or pixels) as pixels on screen for the label's anchor now.
@@ -99,6 +116,7 @@ STRATA_INLINE LabelStateGpu forces_update(LabelGpu label, PlacementGpu target, L
   bool shown = (label.flags & LABEL_ENABLED) != 0u && target.shown == PLACEMENT_SHOWN;
   if (!shown) {
     state.flags &= ~LABEL_STATE_SHOWN;
+    state.speed = 0.0f;
     state.opacity = faded(state.opacity, -params.fade);
     if ((label.flags & LABEL_ENABLED) != 0u && (state.flags & LABEL_STATE_PLACED) != 0u) {
       state.drawn = state_to_screen(label, state.position, params);
@@ -111,13 +129,23 @@ STRATA_INLINE LabelStateGpu forces_update(LabelGpu label, PlacementGpu target, L
       kept ? state.target
            : (params.anchor_relative != 0u ? target.position - label.anchor : target.position);
   vec2 l = goal;
+  float speed = 0.0f;
   if ((state.flags & LABEL_STATE_PLACED) != 0u) {
     l = state.position;
+    speed = state.speed;
     for (uint s = 0u; s < params.steps; ++s) {
-      l = force_step(l, goal, params.step_seconds, params.speed, params.epsilon);
-      if (length(goal - l) < params.snap) l = goal;
+      vec3 eased =
+          eased_step(force_step(l, goal, params.step_seconds, params.speed, params.epsilon), speed,
+                     params.step_seconds, params.acceleration);
+      l = l + vec2(eased.x, eased.y);
+      speed = eased.z;
+      if (length(goal - l) < params.snap) {
+        l = goal;
+        speed = 0.0f;
+      }
     }
   }
+  state.speed = speed;
   state.position = l;
   state.target = goal;
   state.cost = target.cost;
