@@ -66,12 +66,12 @@ PlacementPlan PlacementPlan::choose(const Context& ctx, uint32_t label_count,
                   (layout.dispatch == LabelDispatch::automatic &&
                    ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
   plan.skip_idle_blocks = !plan.indirect && layout.skip_idle_blocks && ctx.conditional_rendering();
-  plan.large = label_count > TIDY_SHARED_MAX;
+  plan.large = tidy_states_in_buffer(label_count);
   return plan;
 }
 
 std::vector<ComputePipeline> Placement::create_pipelines(Context& ctx, uint32_t label_count) {
-  const bool large = PlacementPlan::choose(ctx, label_count, {}).large;
+  const bool large = tidy_states_in_buffer(label_count);
   const std::array<std::string_view, 5> shaders{
       "integral_costs.comp", "placement_bounds.comp", "place_label.comp",
       large ? "placement_tidy_large.comp" : "placement_tidy.comp",
@@ -235,8 +235,8 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                     // (each speculative workgroup writes its tile's entry before anything reads it)
                     fill(b.speculative, 0xFFFFFFFFu);
                     fill(b.samples, 0xFFFFFFFFu);
-                    fill(b.tidy_args,
-                         0);  // (indirect: no round runs until the one before sizes it)
+                    // (indirect: no round runs until the one before sizes it)
+                    fill(b.tidy_args, 0);
                     // (placement.regions needs none: the loop writes each pair, from the placed
                     // label's result, before a later label reads it; a label never placed
                     // writes regions that constrain nobody)

@@ -86,13 +86,17 @@ struct PlacementLayout {
 // Tidy-up rounds per conditional block (PlacementLayout::skip_idle_blocks).
 inline constexpr uint32_t kTidyBlockRounds = 8;
 
+// More labels than a tidy-up workgroup keeps in shared memory: the tidy-up shaders that read the
+// states from the buffer.
+inline bool tidy_states_in_buffer(uint32_t label_count) {
+  return label_count > TIDY_SHARED_MAX;
+}
+
 // The dispatch plan, decided once from the device, the layout and the label count.
 struct PlacementPlan {
   bool indirect = false;          // LabelDispatch, resolved for the device
   bool skip_idle_blocks = false;  // conditional blocks of tidy-up rounds (direct only)
-  // More labels than a tidy-up workgroup keeps in shared memory (TIDY_SHARED_MAX): the tidy-up
-  // shaders that read the states from the buffer.
-  bool large = false;
+  bool large = false;             // tidy_states_in_buffer
   static PlacementPlan choose(const Context& ctx, uint32_t label_count,
                               const PlacementLayout& layout);
 };
