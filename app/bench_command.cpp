@@ -141,6 +141,7 @@ struct ViewBenchOptions {
   uint32_t labels = 0;  // 0: the scene's labels
   double degrees = 90.0;
   uint32_t tidy_rounds = kViewerTidyRounds;
+  bool keep_apart = true;
 };
 
 // The part of a group's name before its first dot ("placement.sat" is part of "placement"), or
@@ -206,6 +207,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   LabellingSettings settings;
   settings.placement.weights = scene.settings.weights;
   settings.placement.tidy_rounds = o.tidy_rounds;
+  settings.forces.keep_apart = o.keep_apart;
   const double fps = 30.0;
   const std::vector<Camera> cameras =
       sample(orbit_path(scene, scene.camera, o.degrees, double(o.frames) / fps), fps);
@@ -256,6 +258,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   out["scene"] = scene_file;
   out["size"] = {size.width, size.height};
   out["labels"] = scene.labels.size();
+  out["keep_apart"] = o.keep_apart;
   out["frames"] = cameras.size();
   out["frames_in_flight"] = output.frames_in_flight();
   out["frames_per_second"] = double(cameras.size()) / frames.seconds;
@@ -337,6 +340,9 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   view_cmd->add_option("--tidy-rounds", view->tidy_rounds, "rounds of the tidy-up per frame")
       ->check(whole_range(0, TIDY_ROUNDS_MAX))
       ->capture_default_str();
+  view_cmd->add_flag_callback(
+      "--let-overlap", [view] { view->keep_apart = false; },
+      "labels on their way may overlap (the forces alone, as `video --let-overlap`)");
   view_cmd->callback([&device, view] { bench::bench_view(device, *view); });
 
   add_soak_command(cmd, device);

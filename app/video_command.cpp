@@ -245,6 +245,15 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--fade", o->forces.fade_seconds, "seconds a label takes to fade in or out")
       ->capture_default_str()
       ->check(finite_range(0.0, 60.0));
+  cmd->add_flag_callback(
+      "--let-overlap", [o] { o->forces.keep_apart = false; },
+      "let labels on their way pass over others and the image's edge (the thesis); default: "
+      "drawn boxes are kept apart and inside the image");
+  cmd->add_option("--wait", o->forces.wait_seconds,
+                  "seconds a label whose way is taken waits before it fades out to fade in at "
+                  "its target")
+      ->capture_default_str()
+      ->check(finite_range(0.0, 60.0));
   cmd->add_option("--previous-weight", o->forces.previous_weight,
                   "eq. 3.1's eta after the first frame: cost per pixel of distance to a label's "
                   "last target")

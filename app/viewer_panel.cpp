@@ -166,6 +166,8 @@ void Viewer::panel_forces() {
   slider(*this, "hold: share of cost", "forces.hold_share", f.hold_share, 0.0f, 4.0f);
   slider(*this, "hold: fixed", "forces.hold_cost", f.hold_cost, 0.0f, 50.0f);
   slider(*this, "fade (s)", "forces.fade", f.fade_seconds, 0.0f, 2.0f, "%.2f");
+  checkbox(*this, "keep drawn labels apart", "forces.keep_apart", f.keep_apart);
+  slider(*this, "wait (s)", "forces.wait", f.wait_seconds, 0.0f, 2.0f, "%.2f");
 }
 
 void Viewer::panel_labels() {

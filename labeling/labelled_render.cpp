@@ -189,7 +189,8 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
   set_placement_frame(true, trial_order ? trial_within_ : within_);
   ForceSettings forces = settings_.forces;
   if (afresh_) forces.hold_share = forces.hold_cost = 0.0f;
-  parts_->forces.set_frame(forces, units(), seconds, settings_.placement.hard);
+  parts_->forces.set_frame(forces, units(), seconds, settings_.placement.hard,
+                           parts_->placement.order_count());
   parts_->forces.set_trial(trial);
   afresh_ = false;
   frame_seconds_ = seconds > 0.0 ? std::optional(seconds) : std::nullopt;  // (0 s: a still)
@@ -236,7 +237,10 @@ void LabelledRenderer::build_graph() {
                 p.forces.add_previous(g, labels, state);
               }});
   const LabelForces::Outputs moved = p.forces.add_to(
-      graph, {.labels = placed_.labels, .targets = placed_.placements, .state = state});
+      graph, {.labels = placed_.labels,
+              .targets = placed_.placements,
+              .state = state,
+              .order = placed_.order});
   layers_id_ = rendered.layers;
   const graph::ResourceId glyph_buffer =
       graph.import_buffer("labels.glyphs", {.buffer = p.glyphs.handle(), .has_content = true});

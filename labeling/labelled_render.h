@@ -146,7 +146,8 @@ class LabelledRenderer {
   // What the relative lengths of the forces and the placement are in pixels now: the image's
   // width and the label text's size.
   LabelUnits units() const {
-    return {float(size_.width), settings_.font_pixels * settings_.label_scale};
+    return {float(size_.width), settings_.font_pixels * settings_.label_scale,
+            float(size_.height)};
   }
   const Camera& camera() const { return camera_; }
   // Frames recorded before the earlier ones finished: a readback per frame slot.

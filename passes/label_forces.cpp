@@ -10,15 +10,17 @@ namespace strata {
 using graph::Use;
 
 gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
-                                uint32_t label_count, double seconds, bool hard) {
+                                uint32_t label_count, double seconds, bool hard,
+                                uint32_t order_count) {
   if (!(settings.speed_widths > 0.0f) || !(settings.epsilon_widths > 0.0f) ||
       !(settings.snap >= 0.0f)) {
     throw Error("forces: speed and epsilon must be > 0 and snap >= 0");
   }
   if (!(settings.hold_share >= 0.0f) || !(settings.hold_cost >= 0.0f) ||
       !(settings.fade_seconds >= 0.0f) || !(settings.ease_in_seconds >= 0.0f) ||
-      !(settings.appear_padding_em >= 0.0f)) {
-    throw Error("forces: hold, fade, ease-in and padding must be >= 0");
+      !(settings.appear_padding_em >= 0.0f) || !(settings.wait_seconds >= 0.0f) ||
+      !(settings.appear_margin_em >= 0.0f) || !(settings.min_hidden_seconds >= 0.0f)) {
+    throw Error("forces: hold, fade, ease-in, padding, wait, margin and hidden time must be >= 0");
   }
   if (!(units.width >= 1.0f) || !(units.em > 0.0f)) {
     throw Error("forces: an image " + std::to_string(units.width) + " px wide, text of " +
@@ -47,13 +49,24 @@ gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
   p.appear_padding = hard ? settings.appear_padding_em * units.em : 0.0f;
   p.trial = 0u;
   p.acceleration = settings.ease_in_seconds > 0.0f ? p.speed / settings.ease_in_seconds : 0.0f;
+  p.keep_apart = settings.keep_apart ? 1u : 0u;
+  if (p.keep_apart != 0u && !(units.height >= 1.0f)) {
+    throw Error("forces: keeping labels apart in an image " + std::to_string(units.height) +
+                " px high");
+  }
+  p.order_count = std::min(order_count, label_count);
+  p.image_width = units.width;
+  p.image_height = units.height;
+  p.wait = settings.wait_seconds;
+  p.appear_margin = seconds > 0.0 ? settings.appear_margin_em * units.em : 0.0f;  // (a still: none)
+  p.min_hidden = settings.min_hidden_seconds;
   return p;
 }
 
 LabelForces::LabelForces(Context& ctx, uint32_t label_count)
     : ctx_(ctx),
       label_count_(label_count),
-      params_(forces_params({}, {1024.0f, 14.0f}, label_count, 0.0)),
+      params_(forces_params({}, {1024.0f, 14.0f, 1024.0f}, label_count, 0.0)),
       forces_(ctx, "label_forces.comp"),
       previous_(ctx, "label_previous.comp"),
       state_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::LabelStateGpu),
@@ -70,8 +83,8 @@ void LabelForces::reset() {
 }
 
 void LabelForces::set_frame(const ForceSettings& settings, LabelUnits units, double seconds,
-                            bool hard) {
-  params_ = forces_params(settings, units, label_count_, seconds, hard);
+                            bool hard, uint32_t order_count) {
+  params_ = forces_params(settings, units, label_count_, seconds, hard, order_count);
 }
 
 std::vector<gpu::LabelStateGpu> LabelForces::state() const {
@@ -105,14 +118,18 @@ LabelForces::Outputs LabelForces::add_to(graph::Graph& graph, const Inputs& in) 
   Outputs out;
   out.drawn = graph.add_buffer(
       "forces.drawn", {[n](graph::Extent) { return VkDeviceSize{n} * sizeof(gpu::PlacementGpu); }});
+  const graph::ResourceId scratch = graph.add_buffer(
+      "forces.scratch", {[n](graph::Extent) { return VkDeviceSize{n} * sizeof(gpu::KeepApartGpu); }});
   graph.add_pass({"labels.forces",
                   graph::PassKind::compute,
                   {{in.labels, Use::storage_read, FORCES_BINDING_LABELS},
                    {in.targets, Use::storage_read, FORCES_BINDING_TARGETS},
                    {in.state, Use::storage_read_write, FORCES_BINDING_STATE},
-                   {out.drawn, Use::storage_write, FORCES_BINDING_DRAWN}},
+                   {out.drawn, Use::storage_write, FORCES_BINDING_DRAWN},
+                   {in.order, Use::storage_read, FORCES_BINDING_ORDER},
+                   {scratch, Use::storage_write, FORCES_BINDING_SCRATCH}},
                   [this](graph::PassContext& pc) {
-                    pc.dispatch(forces_, params_, {label_count_, 1, 1});
+                    pc.dispatch(forces_, params_, {KEEP_APART_GROUP, 1, 1});  // (one workgroup)
                   },
                   "labels"});
   const graph::ResourceId readback = readback_.import(graph, "forces.readback");
@@ -136,15 +153,65 @@ std::vector<gpu::LabelGpu> previous_reference(std::vector<gpu::LabelGpu> labels,
   return labels;
 }
 
+namespace {
+
+// Keeping apart on the CPU (label_forces.comp's turns, one after another): the labels taking part
+// in their settling order, each one's boxes against every other's obstacle.
+void keep_apart_reference(const std::vector<gpu::LabelGpu>& labels,
+                          const std::vector<gpu::PlacementGpu>& targets,
+                          std::vector<gpu::LabelStateGpu>& state, const gpu::ForcesParams& params,
+                          const std::vector<uint32_t>& order) {
+  const size_t n = labels.size();
+  std::vector<uint32_t> keys(n);
+  for (size_t i = 0; i < n; ++i) keys[i] = params.order_count + uint32_t(i);
+  for (uint32_t k = 0; k < params.order_count; ++k) {
+    if (order.at(k) < n) keys[order[k]] = k;
+  }
+  std::vector<glm::vec4> obstacles(n);
+  std::vector<uint32_t> turns;
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t c = gpu::keep_apart_class(labels[i], targets[i], state[i]);
+    keys[i] += c * KEEP_APART_CLASS_STRIDE;
+    obstacles[i] = gpu::keep_apart_stay(labels[i], state[i], params);
+    if (c != KEEP_APART_NONE) {
+      turns.push_back(uint32_t(i));
+    } else {  // (moves on its own)
+      state[i] = gpu::keep_apart_settle(labels[i], targets[i], state[i], params, 0u);
+    }
+  }
+  std::sort(turns.begin(), turns.end(), [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
+  std::vector<bool> settled(n, false);
+  for (const uint32_t i : turns) {
+    const glm::vec4 way = gpu::keep_apart_way(labels[i], targets[i], state[i], params);
+    const glm::vec4 stay = obstacles[i];
+    uint32_t clashes = gpu::keep_apart_cut(way, stay, params);
+    for (size_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      if (gpu::boxes_clash(way, obstacles[j])) clashes |= KEEP_APART_WAY;
+      if (settled[j] && gpu::boxes_clash(stay, obstacles[j])) clashes |= KEEP_APART_STAY;
+    }
+    state[i] = gpu::keep_apart_settle(labels[i], targets[i], state[i], params, clashes);
+    obstacles[i] = gpu::keep_apart_obstacle(labels[i], state[i]);
+    settled[i] = true;
+  }
+}
+
+}  // namespace
+
 std::vector<gpu::PlacementGpu> forces_reference(const std::vector<gpu::LabelGpu>& labels,
                                                 const std::vector<gpu::PlacementGpu>& targets,
                                                 std::vector<gpu::LabelStateGpu>& state,
-                                                const gpu::ForcesParams& params) {
-  std::vector<gpu::PlacementGpu> drawn(labels.size());
-  for (size_t i = 0; i < labels.size(); ++i) {
-    if (params.trial == 0u) state[i] = gpu::forces_update(labels[i], targets[i], state[i], params);
-    drawn[i] = gpu::forces_drawn(targets[i], state[i]);
+                                                const gpu::ForcesParams& params,
+                                                const std::vector<uint32_t>& order) {
+  if (params.trial == 0u && params.keep_apart != 0u) {
+    keep_apart_reference(labels, targets, state, params, order);
+  } else if (params.trial == 0u) {
+    for (size_t i = 0; i < labels.size(); ++i) {
+      state[i] = gpu::forces_update(labels[i], targets[i], state[i], params);
+    }
   }
+  std::vector<gpu::PlacementGpu> drawn(labels.size());
+  for (size_t i = 0; i < labels.size(); ++i) drawn[i] = gpu::forces_drawn(targets[i], state[i]);
   return drawn;
 }
 

@@ -14,7 +14,7 @@
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/readback.h"
 #include "engine/graph/render_graph.h"
-#include "shared/forces.h"
+#include "shared/keep_apart.h"
 
 namespace strata {
 
@@ -23,8 +23,9 @@ namespace strata {
 // at any image size; spacing (padding, margins) is in the label text's size, which is what keeps
 // two labels apart legibly, and which does not follow the image's size.
 struct LabelUnits {
-  float width = 0.0f;  // the image's width
-  float em = 0.0f;     // the label text's size: font pixels times the label scale
+  float width = 0.0f;   // the image's width
+  float em = 0.0f;      // the label text's size: font pixels times the label scale
+  float height = 0.0f;  // the image's height (keeping labels inside it)
 };
 
 struct ForceSettings {
@@ -49,6 +50,16 @@ struct ForceSettings {
   // label's last target costs this much per pixel, so a label that must move goes nearby.
   float previous_weight = 2.0f;
   float fade_seconds = 0.3f;  // a label fades in or out over this long (0: it pops)
+  // The drawn layout is a constraint (shaders/shared/keep_apart.h): drawn boxes never overlap or
+  // leave the image; a label whose way is taken waits, and after `wait_seconds` fades out where
+  // it is to fade in at its target. Off: each label moves on its own, as in the thesis.
+  bool keep_apart = true;
+  float wait_seconds = 0.4f;
+  // In motion a label appears only with this much room around its box (in ems: label text sizes;
+  // less than the placement's margin, which its targets keep), and once it went, not before
+  // `min_hidden_seconds`: so that a label where room is short does not flicker.
+  float appear_margin_em = 0.25f;
+  float min_hidden_seconds = 0.5f;
   // Hard mode: extra clear zone a label hidden in the last frame needs to appear, in ems (label
   // text sizes; 8 px at the default 14 px font).
   float appear_padding_em = 8.0f / 14.0f;
@@ -60,10 +71,12 @@ inline constexpr double kForceStepSeconds = 1.0 / 120.0;
 
 // The push constants of one frame of `seconds` at `units`: sub-steps of at most
 // kForceStepSeconds, and enough that none moves a label by more than epsilon, so no step
-// overshoots its target. A frame of 0 s is a still: labels fade at once.
-// `hard`: the placement forbids violations (the appear padding applies).
+// overshoots its target. A frame of 0 s is a still: labels fade at once (and where kept apart,
+// each appears on its target if that is free of the boxes before it in the order). `hard`: the placement forbids violations (the appear
+// padding applies). `order_count`: labels in the placement's insertion order.
 gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
-                                uint32_t label_count, double seconds, bool hard = false);
+                                uint32_t label_count, double seconds, bool hard = false,
+                                uint32_t order_count = 0);
 
 class LabelForces {
  public:
@@ -71,6 +84,7 @@ class LabelForces {
     graph::ResourceId labels;   // LabelGpu[]: this frame's anchors and flags
     graph::ResourceId targets;  // PlacementGpu[]: the placement's result
     graph::ResourceId state;    // import_state()'s
+    graph::ResourceId order;    // uint[]: the placement's insertion order (keeping apart's priority)
   };
   struct Outputs {
     graph::ResourceId drawn;  // PlacementGpu[]: where the labels are drawn
@@ -91,7 +105,7 @@ class LabelForces {
   // The next frame's settings, units and duration (a fixed 1 / fps offline, so videos are
   // repeatable).
   void set_frame(const ForceSettings& settings, LabelUnits units, double seconds,
-                 bool hard = false);
+                 bool hard = false, uint32_t order_count = 0);
   // Marks the frame set last as a trial (ForcesParams::trial): labels are drawn where they were
   // and the state is not written, so several trial placements start from the same state.
   void set_trial(bool trial) { params_.trial = trial ? 1u : 0u; }
@@ -119,11 +133,13 @@ std::vector<gpu::LabelGpu> previous_reference(std::vector<gpu::LabelGpu> labels,
                                               const std::vector<gpu::LabelStateGpu>& state,
                                               const gpu::ForcesParams& params);
 
-// The CPU reference: one frame of forces over every label. `state` is updated in place (kept in a
-// trial frame); returns where each label is drawn.
+// The CPU reference: one frame of forces over every label, kept apart in the placement's `order`
+// (its first params.order_count entries) where params.keep_apart says. `state` is updated in
+// place (kept in a trial frame); returns where each label is drawn.
 std::vector<gpu::PlacementGpu> forces_reference(const std::vector<gpu::LabelGpu>& labels,
                                                 const std::vector<gpu::PlacementGpu>& targets,
                                                 std::vector<gpu::LabelStateGpu>& state,
-                                                const gpu::ForcesParams& params);
+                                                const gpu::ForcesParams& params,
+                                                const std::vector<uint32_t>& order = {});
 
 }  // namespace strata

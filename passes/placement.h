@@ -145,6 +145,9 @@ class Placement {
   void set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_t> order,
                  const PlacementSettings& settings);
 
+  // Labels in this frame's insertion order.
+  uint32_t order_count() const { return uint32_t(order_.size()); }
+
   // The placements of the last completed frame (of the readback's current slot).
   std::span<const gpu::PlacementGpu> results() const;
   graph::Readback& readback() { return readback_; }

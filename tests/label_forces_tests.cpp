@@ -17,8 +17,10 @@
 namespace strata {
 namespace {
 
-// An image 1024 px wide (a pixel is 1/1024 of its width, exact in a float) and 14 px text.
-constexpr LabelUnits kUnits{1024.0f, 14.0f};
+// An image 1024 px square (a pixel is 1/1024 of its width, exact in a float) and 14 px text.
+constexpr LabelUnits kUnits{1024.0f, 14.0f, 1024.0f};
+// The forces alone, each label on its own (what the tests of their arithmetic follow).
+constexpr ForceSettings kAlone{.keep_apart = false};
 constexpr float widths(float pixels) {
   return pixels / kUnits.width;
 }
@@ -42,9 +44,11 @@ gpu::LabelStateGpu placed_at(glm::vec2 position) {
   return s;
 }
 
-// One label followed over frames of `seconds` toward a fixed target: the distances, frame by frame.
-std::vector<float> approach(const ForceSettings& settings, glm::vec2 start, glm::vec2 goal,
-                            int frames, double seconds = 1.0 / 30.0) {
+// One label followed over frames of `seconds` toward a fixed target, on its own (the image's edge
+// not in the way): the distances, frame by frame.
+std::vector<float> approach(ForceSettings settings, glm::vec2 start, glm::vec2 goal, int frames,
+                            double seconds = 1.0 / 30.0) {
+  settings.keep_apart = false;
   const gpu::ForcesParams params = forces_params(settings, kUnits, 1, seconds);
   std::vector<gpu::LabelStateGpu> state{placed_at(start)};
   std::vector<float> distances;
@@ -92,7 +96,7 @@ std::vector<std::vector<glm::vec2>> offsets_along_path(float width, int fps,
       labels.push_back(label_at(anchor));
       targets.push_back(target_at(anchor + offset));
     }
-    const auto drawn = run(labels, targets, {width, 14.0f}, f == 0 ? 0.0 : 1.0 / fps);
+    const auto drawn = run(labels, targets, {width, 14.0f, width}, f == 0 ? 0.0 : 1.0 / fps);
     std::vector<glm::vec2> offsets;
     for (int i = 0; i < kPathLabels; ++i) {
       offsets.push_back((drawn[size_t(i)].position - labels[size_t(i)].anchor) / width);
@@ -138,6 +142,8 @@ class GpuForces {
                 MemoryKind::device_local),
         targets_(ctx, count * sizeof(gpu::PlacementGpu), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                  MemoryKind::device_local),
+        order_(ctx, count * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+               MemoryKind::device_local),
         forces_(ctx, count) {
     graph::Graph g;
     const graph::ResourceId state = forces_.import_state(g);
@@ -147,20 +153,23 @@ class GpuForces {
     drawn_ = forces_
                  .add_to(g, {.labels = imported("labels", labels_),
                              .targets = imported("targets", targets_),
-                             .state = state})
+                             .state = state,
+                             .order = imported("order", order_)})
                  .drawn;
     runner_ = std::make_unique<graph::GraphRunner>(ctx, std::move(g));
     runner_->set_viewport({512, 512});
   }
 
-  // One frame: where the labels are drawn.
+  // One frame: where the labels are drawn. `order`: the placement's insertion order (none: the
+  // labels' own).
   std::vector<gpu::PlacementGpu> frame(const std::vector<gpu::LabelGpu>& labels,
                                        const std::vector<gpu::PlacementGpu>& targets,
                                        const ForceSettings& settings, LabelUnits units,
-                                       double seconds) {
+                                       double seconds, const std::vector<uint32_t>& order = {}) {
     upload(ctx_, labels_, as_bytes(labels));
     upload(ctx_, targets_, as_bytes(targets));
-    forces_.set_frame(settings, units, seconds);
+    if (!order.empty()) upload(ctx_, order_, as_bytes(order));
+    forces_.set_frame(settings, units, seconds, false, uint32_t(order.size()));
     runner_->run_now();
     return as<gpu::PlacementGpu>(runner_->download_buffer(drawn_));
   }
@@ -168,7 +177,7 @@ class GpuForces {
 
  private:
   Context& ctx_;
-  Buffer labels_, targets_;
+  Buffer labels_, targets_, order_;
   LabelForces forces_;
   graph::ResourceId drawn_{};
   std::unique_ptr<graph::GraphRunner> runner_;
@@ -188,13 +197,16 @@ TEST_SUITE("cpu") {
     CHECK(forces_params({}, kUnits, 1, 1.0 / 12.0).steps == 10);
     CHECK(forces_params({}, kUnits, 1, 0.0).steps == 1);
     CHECK_THROWS_AS(forces_params({.speed_widths = 0.0f}, kUnits, 1, 0.1), Error);
-    CHECK_THROWS_AS(forces_params({}, {0.0f, 14.0f}, 1, 0.1), Error);
+    CHECK_THROWS_AS(forces_params({}, {0.0f, 14.0f, 1024.0f}, 1, 0.1), Error);
+    CHECK_THROWS_AS(forces_params({}, {1024.0f, 14.0f}, 1, 0.1), Error);  // no height to keep in
+    CHECK(forces_params({}, kUnits, 1, 0.1).keep_apart == 1u);
+    CHECK(forces_params(kAlone, kUnits, 1, 0.1).keep_apart == 0u);
   }
 
   TEST_CASE("speeds_and_distances_are_shares_of_the_width_paddings_of_the_text_size") {
     const ForceSettings s{.appear_padding_em = 0.5f};
     for (const float width : {128.0f, 1920.0f}) {
-      const gpu::ForcesParams p = forces_params(s, {width, 20.0f}, 1, 1.0 / 30.0, true);
+      const gpu::ForcesParams p = forces_params(s, {width, 20.0f, width}, 1, 1.0 / 30.0, true);
       CHECK(p.speed == doctest::Approx(s.speed_widths * width));
       CHECK(p.epsilon == doctest::Approx(s.epsilon_widths * width));
       CHECK(p.snap == s.snap);  // a sub-pixel rounding: pixels at any size
@@ -232,7 +244,7 @@ TEST_SUITE("cpu") {
   // differ by the snap's half pixel per approach at most (two per label); the 95th percentile
   // (full speed: most of the motion) by rounding.
   TEST_CASE("labels_move_the_same_share_of_the_image_per_second_at_any_size_and_frame_rate") {
-    const ForceSettings settings;
+    const ForceSettings settings = kAlone;
     const auto base = offsets_along_path(512.0f, 60, reference_frames(settings));
     const auto [base_mean, base_p95] = motion_per_second(base, 60);
     MESSAGE("512 px, 60 fps: mean " << base_mean << ", p95 " << base_p95 << " widths/s");
@@ -362,20 +374,166 @@ TEST_SUITE("cpu") {
     forces_reference({held}, {target_at(elsewhere)}, state, p);
     CHECK(state[0].target == elsewhere - anchor);
   }
+
+  // Keeping apart (shaders/shared/keep_apart.h): a label's way through another's box is taken; it
+  // waits, then fades out where it is and fades in at its target. No frame has two apparent boxes
+  // overlapping.
+  TEST_CASE("a_label_whose_way_is_taken_waits_then_fades_out_and_appears_at_its_target") {
+    const ForceSettings settings{
+        .fade_seconds = 0.3f, .wait_seconds = 0.4f, .min_hidden_seconds = 0.2f};
+    const gpu::ForcesParams still = forces_params(settings, kUnits, 2, 0.0, false, 2);
+    const gpu::ForcesParams p = forces_params(settings, kUnits, 2, 1.0 / 30.0, false, 2);
+    // Label 0 (first in the order) sits still at (500, 300); label 1 starts at (400, 300) and
+    // heads for (600, 300), through label 0's box (60 x 16).
+    const std::vector<gpu::LabelGpu> labels{label_at({500.0f, 300.0f}), label_at({400.0f, 300.0f})};
+    std::vector<gpu::LabelStateGpu> state(2);
+    forces_reference(labels, {target_at({500.0f, 300.0f}), target_at({400.0f, 300.0f})}, state,
+                     still, {0, 1});
+    const std::vector<gpu::PlacementGpu> targets{target_at({500.0f, 300.0f}),
+                                                 target_at({600.0f, 300.0f})};
+    int waited = 0, faded = -1, appeared = -1;
+    for (int f = 1; f <= 60; ++f) {
+      CAPTURE(f);
+      const auto drawn = forces_reference(labels, targets, state, p, {0, 1});
+      CHECK(drawn[0].position == glm::vec2(500.0f, 300.0f));
+      CHECK(drawn[0].opacity == 1.0f);
+      const glm::vec4 a = gpu::box_around(drawn[0].position, labels[0].size);
+      const glm::vec4 b = gpu::box_around(drawn[1].position, labels[1].size);
+      if (drawn[1].opacity > 0.0f) CHECK_FALSE(gpu::boxes_clash(a, b));
+      if (faded < 0 && drawn[1].position.x < 440.0f && drawn[1].position.x > 400.0f) ++waited;
+      if (faded < 0 && drawn[1].opacity < 1.0f) faded = f;
+      if (appeared < 0 && drawn[1].position.x == 600.0f && drawn[1].opacity > 0.0f) appeared = f;
+    }
+    // It moved up to the other's box (30 px apart at most), waited 0.4 s (12 frames), faded out
+    // over 0.3 s (9 frames), stayed hidden 0.2 s (6 frames, 7 where the sum of the frames'
+    // seconds rounds below) and came in at its target.
+    CHECK(waited >= 12);
+    CHECK(faded > 12);
+    CHECK(appeared >= faded + 9 + 6);
+    CHECK(appeared <= faded + 9 + 7);
+    CHECK(state[1].opacity == 1.0f);
+    CHECK(state[1].position == glm::vec2(200.0f, 0.0f));  // its target's offset
+  }
+
+  TEST_CASE("boxes_brought_together_by_their_anchors_the_one_later_in_the_order_goes_at_once") {
+    const gpu::ForcesParams still = forces_params({}, kUnits, 2, 0.0, false, 2);
+    const gpu::ForcesParams p = forces_params({}, kUnits, 2, 1.0 / 30.0, false, 2);
+    // Two labels on their targets, 100 px apart; their anchors close in at 300 px/s. The order
+    // puts label 1 first: label 0 goes when the boxes would touch.
+    const std::vector<uint32_t> order{1, 0};
+    std::vector<gpu::LabelStateGpu> state(2);
+    bool gone = false;
+    for (int f = 0; f < 30; ++f) {
+      CAPTURE(f);
+      const float x = 400.0f + 5.0f * float(f);
+      const std::vector<gpu::LabelGpu> labels{label_at({x, 300.0f}), label_at({600.0f, 300.0f})};
+      const std::vector<gpu::PlacementGpu> targets{target_at({x, 280.0f}),
+                                                   target_at({600.0f, 280.0f})};
+      const auto drawn = forces_reference(labels, targets, state, f == 0 ? still : p, order);
+      CHECK(drawn[1].opacity == 1.0f);
+      const glm::vec4 a = gpu::box_around(drawn[0].position, labels[0].size);
+      const glm::vec4 b = gpu::box_around(drawn[1].position, labels[1].size);
+      if (gpu::boxes_clash(a, b)) CHECK(drawn[0].opacity == 0.0f);
+      gone = gone || drawn[0].opacity == 0.0f;
+    }
+    CHECK(gone);
+  }
+
+  TEST_CASE("a_box_leaving_the_image_goes_and_comes_back_only_inside_it") {
+    const gpu::ForcesParams still = forces_params({}, kUnits, 1, 0.0, false, 1);
+    const gpu::ForcesParams p = forces_params({}, kUnits, 1, 1.0 / 30.0, false, 1);
+    std::vector<gpu::LabelStateGpu> state(1);
+    const glm::vec2 offset{0.0f, -20.0f};
+    for (int f = 0; f < 40; ++f) {
+      CAPTURE(f);
+      // The anchor runs out of the image's right edge and back in.
+      const float x = f < 20 ? 960.0f + 5.0f * float(f) : 1060.0f - 5.0f * float(f - 20);
+      const auto drawn = forces_reference({label_at({x, 300.0f})}, {target_at({x, 280.0f})},
+                                          state, f == 0 ? still : p, {0});
+      const glm::vec4 box = gpu::box_around(drawn[0].position, {60.0f, 16.0f});
+      if (drawn[0].opacity > 0.0f) CHECK(gpu::box_inside(box, p));
+      if (f == 19) CHECK(drawn[0].opacity == 0.0f);
+      if (f == 39) CHECK(drawn[0].opacity > 0.0f);  // back in, fading in
+    }
+  }
+
+  // Many labels on random paths: no two drawn boxes ever overlap, none is cut, and the forces'
+  // speed still bounds every move of a drawn label.
+  TEST_CASE("kept_apart_no_drawn_boxes_overlap_or_leave_the_image_in_any_frame") {
+    const uint32_t count = 40;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::vector<glm::vec2> start(count), velocity(count), offset(count);
+    for (uint32_t i = 0; i < count; ++i) {
+      start[i] = {100.0f + 824.0f * unit(rng), 100.0f + 824.0f * unit(rng)};
+      velocity[i] = {200.0f * unit(rng) - 100.0f, 200.0f * unit(rng) - 100.0f};
+      offset[i] = {160.0f * unit(rng) - 80.0f, 160.0f * unit(rng) - 80.0f};
+    }
+    std::vector<uint32_t> order(count);
+    for (uint32_t i = 0; i < count; ++i) order[i] = (i * 7) % count;
+    std::vector<gpu::LabelStateGpu> state(count);
+    const gpu::ForcesParams p = forces_params({}, kUnits, count, 1.0 / 30.0, false, count);
+    std::vector<gpu::PlacementGpu> last;
+    int shown = 0;
+    for (int f = 0; f < 120; ++f) {
+      const float t = float(f) / 30.0f;
+      std::vector<gpu::LabelGpu> labels;
+      std::vector<gpu::PlacementGpu> targets;
+      for (uint32_t i = 0; i < count; ++i) {
+        labels.push_back(label_at(start[i] + t * velocity[i]));
+        // a new offset every second
+        const float turn = float(f / 30) * 1.3f + float(i);
+        targets.push_back(target_at(labels.back().anchor + offset[i] +
+                                    40.0f * glm::vec2(std::cos(turn), std::sin(turn))));
+      }
+      const auto drawn = forces_reference(
+          labels, targets, state,
+          f == 0 ? forces_params({}, kUnits, count, 0.0, false, count) : p, order);
+      for (uint32_t i = 0; i < count && f > 0; ++i) {
+        if (!(drawn[i].opacity > 0.0f)) continue;
+        ++shown;
+        const glm::vec4 a = gpu::box_around(drawn[i].position, labels[i].size);
+        CHECK(gpu::box_inside(a, p));
+        for (uint32_t j = i + 1; j < count; ++j) {
+          if (drawn[j].opacity > 0.0f) {
+            CHECK_FALSE(gpu::boxes_clash(a, gpu::box_around(drawn[j].position, labels[j].size)));
+          }
+        }
+        // Relative to its anchor, a label drawn in both frames moves at most the forces' speed,
+        // and as much again where the image's edge pushes it in.
+        if (last[i].opacity > 0.0f && drawn[i].opacity < 1.0f && last[i].opacity < 1.0f) continue;
+        if (last[i].opacity > 0.0f) {
+          const glm::vec2 moved = (drawn[i].position - labels[i].anchor) -
+                                  (last[i].position - (start[i] + (t - 1.0f / 30.0f) * velocity[i]));
+          CHECK(glm::length(moved) <= 2.0f * p.speed / 30.0f + 1e-3f);
+        }
+      }
+      last = drawn;
+    }
+    MESSAGE("drawn labels per frame: " << double(shown) / 119.0);
+    CHECK(shown > 119 * int(count) / 2);  // most labels stay drawn
+  }
 }
 
 TEST_SUITE("gpu") {
   TEST_CASE_FIXTURE(test::GpuTest, "forces_pass_matches_cpu_reference_over_frames") {
-    const uint32_t count = 150;  // more than one workgroup
+    const uint32_t count = 300;  // more labels than the workgroup has invocations
     std::mt19937 rng(11);
-    std::uniform_real_distribution<float> pixel(0.0f, 512.0f);
+    std::uniform_real_distribution<float> pixel(0.0f, 1024.0f);
     std::vector<gpu::LabelGpu> labels(count);
     std::vector<gpu::PlacementGpu> targets(count);
-    for (const bool anchored : {true, false}) {
+    // The placement's order: the enabled labels, shuffled.
+    std::vector<uint32_t> order;
+    for (uint32_t i = 0; i < count; ++i) {
+      if (i % 7 != 0) order.push_back(i);
+    }
+    std::shuffle(order.begin(), order.end(), rng);
+    for (const auto& [anchored, apart] : {std::pair{true, true}, {false, true}, {true, false}}) {
       CAPTURE(anchored);
+      CAPTURE(apart);
       GpuForces forces(ctx, count);
       std::vector<gpu::LabelStateGpu> state(count);
-      for (int frame = 0; frame < 6; ++frame) {
+      for (int frame = 0; frame < 10; ++frame) {
         CAPTURE(frame);
         for (uint32_t i = 0; i < count; ++i) {
           labels[i] = label_at({pixel(rng), pixel(rng)}, i % 7 != 0);
@@ -387,10 +545,14 @@ TEST_SUITE("gpu") {
         }
         // Frames of varied length: one sub-step, several, and a still frame.
         const double seconds = frame == 3 ? 0.0 : 0.02 * (frame + 1);
-        const ForceSettings settings{.anchor_relative = anchored, .speed_widths = widths(900.0f)};
-        const auto drawn = forces.frame(labels, targets, settings, kUnits, seconds);
-        const std::vector<gpu::PlacementGpu> expected = forces_reference(
-            labels, targets, state, forces_params(settings, kUnits, count, seconds));
+        const ForceSettings settings{
+            .anchor_relative = anchored, .speed_widths = widths(900.0f), .keep_apart = apart};
+        const auto drawn = forces.frame(labels, targets, settings, kUnits, seconds, order);
+        const std::vector<gpu::PlacementGpu> expected =
+            forces_reference(labels, targets, state,
+                             forces_params(settings, kUnits, count, seconds, false,
+                                           uint32_t(order.size())),
+                             order);
         const std::vector<gpu::LabelStateGpu> gpu_state = forces.state();
         // Bit for bit on a CPU device (lavapipe rounds as the C++ does); elsewhere within 1e-3 px:
         // Vulkan lets a GPU divide and take square roots to a few ulps, and fuse multiply-adds.
@@ -408,10 +570,14 @@ TEST_SUITE("gpu") {
               close(gpu_state[i].drawn, state[i].drawn) &&
               close(gpu_state[i].target, state[i].target) && gpu_state[i].cost == state[i].cost &&
               gpu_state[i].opacity == state[i].opacity && drawn[i].opacity == expected[i].opacity &&
-              gpu_state[i].flags == state[i].flags;
+              gpu_state[i].flags == state[i].flags &&
+              std::abs(gpu_state[i].blocked - state[i].blocked) <= 1e-6f;
           if (!same && mismatches++ < 3) {
             MESSAGE("label " << i << ": gpu " << drawn[i].position.x << "," << drawn[i].position.y
-                             << " cpu " << expected[i].position.x << "," << expected[i].position.y);
+                             << " opacity " << gpu_state[i].opacity << " waited "
+                             << gpu_state[i].blocked << ", cpu " << expected[i].position.x << ","
+                             << expected[i].position.y << " opacity " << state[i].opacity
+                             << " waited " << state[i].blocked);
           }
         }
         // The state the next frame starts from is the reference's (tolerance does not build up).
@@ -424,7 +590,7 @@ TEST_SUITE("gpu") {
   // The path of the size and frame rate test once on the GPU: the CPU reference's positions.
   TEST_CASE_FIXTURE(test::GpuTest, "forces_pass_follows_a_camera_path_as_the_cpu_reference") {
     GpuForces forces(ctx, kPathLabels);
-    const ForceSettings settings;
+    const ForceSettings settings = kAlone;
     const ForcesFrame on_gpu = [&](const std::vector<gpu::LabelGpu>& labels,
                                    const std::vector<gpu::PlacementGpu>& targets, LabelUnits units,
                                    double seconds) {

@@ -26,7 +26,7 @@ namespace strata {
 namespace {
 
 constexpr double kFrameSeconds = 1.0 / 30.0;  // a frame of a 30 fps animation
-constexpr LabelUnits kUnits{1024.0f, 14.0f};  // the forces' image width and text size
+constexpr LabelUnits kUnits{1024.0f, 14.0f, 1024.0f};  // the forces' image and text size
 
 struct Inputs {
   graph::Extent size{96, 72};

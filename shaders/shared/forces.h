@@ -29,6 +29,8 @@ struct LabelStateGpu {
   vec2 target;    // where the label is heading: the placement's position, held as `position` is
   float opacity;  // 0: invisible, 1: fully drawn; fades toward 1 while shown, toward 0 when not
   float speed;    // pixels per second the label moved at in its last sub-step (the easing's start)
+  float blocked;  // seconds the label has waited for its way to be free (keep_apart.h)
+  float hidden;   // seconds since the label was last drawn (keep_apart.h; 0 while drawn)
 };
 
 // One frame's forces in pixels and seconds (forces_params converts ForceSettings' relative units).
@@ -46,6 +48,13 @@ struct ForcesParams {
   float appear_padding;  // pixels of padding for a label hidden in the last frame (hard mode)
   uint trial;  // 1: a trial frame (the viewer's optimisation on idle): the state stays as it was
   float acceleration;  // pixels per second per second a label speeds up by at most (0: at once)
+  uint keep_apart;     // 1: drawn boxes are kept apart and inside the image (keep_apart.h)
+  uint order_count;    // labels in the placement's insertion order (the settling's priority)
+  float image_width;   // pixels
+  float image_height;
+  float wait;  // seconds a label waits for its way before it fades out to appear at its target
+  float appear_margin;  // pixels of room a label needs around its box to appear (keep_apart.h)
+  float min_hidden;     // seconds a label that was drawn stays hidden before it appears again
 };
 
 // An opacity moved by `change`, kept in [0, 1]; within 1/512 of either end (less than a step of

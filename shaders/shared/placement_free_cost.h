@@ -27,15 +27,16 @@ bool box_legible(LabelGpu me, vec2 origin) {
   return on_screen - hidden >= LEGIBLE_SHARE * float(int(me.size.x) * int(me.size.y));
 }
 
-// Whether pixel p may hold the label at all: its box lies on screen (internal labels: only the
-// anchor's own pixel) and, in hard mode, is legible.
+// Whether pixel p may hold the label at all: its box lies on screen with the constraints' margin
+// to spare (internal labels: only the anchor's own pixel) and, in hard mode, is legible.
 bool candidate_allowed(LabelGpu me, uvec2 p) {
   if ((me.flags & LABEL_INTERNAL) != 0u) {
     if (uvec2(me.anchor) != p) return false;
   } else {
     vec2 o = box_origin(p, me.size);
-    if (o.x < 0.0f || o.y < 0.0f || o.x + me.size.x > float(params.width) ||
-        o.y + me.size.y > float(params.height)) {
+    float m = params.margin;
+    if (o.x < m || o.y < m || o.x + me.size.x > float(params.width) - m ||
+        o.y + me.size.y > float(params.height) - m) {
       return false;
     }
   }
