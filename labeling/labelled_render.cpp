@@ -270,7 +270,10 @@ void LabelledRenderer::build_graph() {
 void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32_t>& within) {
   PlacementSettings settings = settings_.placement;
   settings.text_pixels = units().em;
-  if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
+  if (moving && !afresh_) {
+    settings.weights.previous_position = settings_.forces.previous_weight;
+    settings.edge_em = settings.margin_em;
+  }
   parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within, priorities_),
                               settings);
   parts_->drawing->set_layer_frames(settings_.layer_colors);

@@ -60,6 +60,7 @@ gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
   p.wait = settings.wait_seconds;
   p.appear_margin = seconds > 0.0 ? settings.appear_margin_em * units.em : 0.0f;  // (a still: none)
   p.min_hidden = settings.min_hidden_seconds;
+  p.clearance = seconds > 0.0 ? 0.01f : 0.0f;
   return p;
 }
 
@@ -167,32 +168,47 @@ void keep_apart_reference(const std::vector<gpu::LabelGpu>& labels,
   for (uint32_t k = 0; k < params.order_count; ++k) {
     if (order.at(k) < n) keys[order[k]] = k;
   }
-  std::vector<glm::vec4> obstacles(n);
-  std::vector<uint32_t> turns;
+  std::vector<glm::vec4> ways(n), stays(n);
+  std::vector<uint32_t> turns, alone;
   for (size_t i = 0; i < n; ++i) {
     const uint32_t c = gpu::keep_apart_class(labels[i], targets[i], state[i]);
     keys[i] += c * KEEP_APART_CLASS_STRIDE;
-    obstacles[i] = gpu::keep_apart_stay(labels[i], state[i], params);
-    if (c != KEEP_APART_NONE) {
-      turns.push_back(uint32_t(i));
-    } else {  // (moves on its own)
-      state[i] = gpu::keep_apart_settle(labels[i], targets[i], state[i], params, 0u);
-    }
+    ways[i] = gpu::keep_apart_way(labels[i], targets[i], state[i], params);
+    stays[i] = gpu::keep_apart_stay(labels[i], state[i], params);
+    (c != KEEP_APART_NONE ? turns : alone).push_back(uint32_t(i));
   }
   std::sort(turns.begin(), turns.end(), [&](uint32_t a, uint32_t b) { return keys[a] < keys[b]; });
+  std::vector<glm::vec4> obstacles = stays;
   std::vector<bool> settled(n, false);
+  const float clearance = params.clearance;
   for (const uint32_t i : turns) {
-    const glm::vec4 way = gpu::keep_apart_way(labels[i], targets[i], state[i], params);
-    const glm::vec4 stay = obstacles[i];
-    uint32_t clashes = gpu::keep_apart_cut(way, stay, params);
+    uint32_t clashes = gpu::keep_apart_cut(ways[i], stays[i], params);
+    size_t from = n;  // the first label settled before whose box clashes with where i is
     for (size_t j = 0; j < n; ++j) {
       if (j == i) continue;
-      if (gpu::boxes_clash(way, obstacles[j])) clashes |= KEEP_APART_WAY;
-      if (settled[j] && gpu::boxes_clash(stay, obstacles[j])) clashes |= KEEP_APART_STAY;
+      if (gpu::boxes_clash(ways[i], obstacles[j], clearance)) clashes |= KEEP_APART_WAY;
+      if (settled[j] && gpu::boxes_clash(stays[i], obstacles[j], clearance)) {
+        clashes |= KEEP_APART_STAY;
+        from = std::min(from, j);
+      }
     }
-    state[i] = gpu::keep_apart_settle(labels[i], targets[i], state[i], params, clashes);
+    glm::vec4 pushed = gpu::keep_apart_none();
+    if ((clashes & KEEP_APART_WAY) != 0u && from < n) {  // (where it is clashes with a box)
+      pushed = gpu::keep_apart_push(stays[i], obstacles[from], params);
+      bool free = gpu::box_inside(pushed, params);
+      for (size_t j = 0; j < n && free; ++j) {
+        free = j == i || !(gpu::boxes_clash(pushed, ways[j], clearance) ||
+                           gpu::boxes_clash(pushed, stays[j], clearance));
+      }
+      if (!free) clashes |= KEEP_APART_PUSH;
+    }
+    state[i] = gpu::keep_apart_settle(labels[i], targets[i], state[i], params, clashes, pushed);
     obstacles[i] = gpu::keep_apart_obstacle(labels[i], state[i]);
     settled[i] = true;
+  }
+  for (const uint32_t i : alone) {  // (taking no part: they move on their own)
+    state[i] =
+        gpu::keep_apart_settle(labels[i], targets[i], state[i], params, 0u, gpu::keep_apart_none());
   }
 }
 

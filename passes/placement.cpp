@@ -51,6 +51,7 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   p.hard = s.hard ? 1u : 0u;
   p.write_constraints = s.write_constraints ? 1u : 0u;
   p.margin = margin_pixels(s);
+  p.edge = s.edge_em * s.text_pixels;
   p.saliency_weight = s.saliency_weight;
   p.occlusion_weight = s.occlusion_weight;
   p.single_saliency_weight = s.single_saliency_weight;

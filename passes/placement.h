@@ -29,6 +29,10 @@ struct PlacementSettings {
   // legibly at any image size (6 px at the default 14 px font).
   float margin_em = 6.0f / 14.0f;
   float text_pixels = 14.0f;  // an em: the label text's size (LabelledRenderer sets it per frame)
+  // How far from the image's edges a box stays, in ems. A still uses the whole image; in motion
+  // LabelledRenderer keeps the margin here too, so that a label whose anchor moves outward has
+  // room to slide before the edge would cut it.
+  float edge_em = 0.0f;
   bool hard = false;          // forbid constraint violations (labels may end up hidden)
   float saliency_weight = 0.5f;         // eq. 3.3: how much saliency modulates the occlusion behind
   float occlusion_weight = 0.5f;        // eq. 3.4 (one layer)

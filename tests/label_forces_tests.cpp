@@ -392,14 +392,14 @@ TEST_SUITE("cpu") {
     const std::vector<gpu::PlacementGpu> targets{target_at({500.0f, 300.0f}),
                                                  target_at({600.0f, 300.0f})};
     int waited = 0, faded = -1, appeared = -1;
-    for (int f = 1; f <= 60; ++f) {
+    for (int f = 1; f <= 75; ++f) {
       CAPTURE(f);
       const auto drawn = forces_reference(labels, targets, state, p, {0, 1});
       CHECK(drawn[0].position == glm::vec2(500.0f, 300.0f));
       CHECK(drawn[0].opacity == 1.0f);
       const glm::vec4 a = gpu::box_around(drawn[0].position, labels[0].size);
       const glm::vec4 b = gpu::box_around(drawn[1].position, labels[1].size);
-      if (drawn[1].opacity > 0.0f) CHECK_FALSE(gpu::boxes_clash(a, b));
+      if (drawn[1].opacity > 0.0f) CHECK_FALSE(gpu::boxes_clash(a, b, p.clearance));
       if (faded < 0 && drawn[1].position.x < 440.0f && drawn[1].position.x > 400.0f) ++waited;
       if (faded < 0 && drawn[1].opacity < 1.0f) faded = f;
       if (appeared < 0 && drawn[1].position.x == 600.0f && drawn[1].opacity > 0.0f) appeared = f;
@@ -433,7 +433,7 @@ TEST_SUITE("cpu") {
       CHECK(drawn[1].opacity == 1.0f);
       const glm::vec4 a = gpu::box_around(drawn[0].position, labels[0].size);
       const glm::vec4 b = gpu::box_around(drawn[1].position, labels[1].size);
-      if (gpu::boxes_clash(a, b)) CHECK(drawn[0].opacity == 0.0f);
+      if (gpu::boxes_clash(a, b, p.clearance)) CHECK(drawn[0].opacity == 0.0f);
       gone = gone || drawn[0].opacity == 0.0f;
     }
     CHECK(gone);
@@ -496,7 +496,8 @@ TEST_SUITE("cpu") {
         CHECK(gpu::box_inside(a, p));
         for (uint32_t j = i + 1; j < count; ++j) {
           if (drawn[j].opacity > 0.0f) {
-            CHECK_FALSE(gpu::boxes_clash(a, gpu::box_around(drawn[j].position, labels[j].size)));
+            const glm::vec4 b = gpu::box_around(drawn[j].position, labels[j].size);
+            CHECK_FALSE(gpu::boxes_clash(a, b, p.clearance));
           }
         }
         // Relative to its anchor, a label drawn in both frames moves at most the forces' speed,

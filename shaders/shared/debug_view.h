@@ -140,6 +140,7 @@ void view_setup() {
   params.layer_count = view.layer_count;
   params.label_count = view.label_count;
   params.margin = view.margin;
+  params.edge = 0.0f;  // (a still's candidates)
   view_position = view.order_count;
   if (view.label >= view.label_count) return;
   view_label = label_at(view.label);

@@ -55,6 +55,8 @@ struct ForcesParams {
   float wait;  // seconds a label waits for its way before it fades out to appear at its target
   float appear_margin;  // pixels of room a label needs around its box to appear (keep_apart.h)
   float min_hidden;     // seconds a label that was drawn stays hidden before it appears again
+  float clearance;      // pixels two drawn boxes keep apart (keep_apart.h: boxes_clash)
+  uint pad;
 };
 
 // An opacity moved by `change`, kept in [0, 1]; within 1/512 of either end (less than a step of

@@ -26,17 +26,23 @@
 #define KEEP_APART_CLASS_STRIDE (2u * LABEL_MAX)  // keys: class * stride + position in the order
 #define KEEP_APART_NO_RANK 0xFFFFFFFFu
 
-// Clash bits of a label's two boxes.
+// Clash bits of a label's boxes.
 #define KEEP_APART_WAY 1u   // where it would move (or appear) is taken by a drawn box, or is cut
 #define KEEP_APART_STAY 2u  // where it is clashes with a box settled before it, or is cut
+#define KEEP_APART_PUSH 4u  // where it would slide out of that clash (keep_apart_push) clashes with
+                            // any other label's boxes of this frame, or is cut
 
 STRATA_BEGIN
 
 // What the settling keeps per label.
 struct KeepApartGpu {
-  vec4 obstacle;  // the box the others must keep clear of (x0, y0, x1, y1), or keep_apart_none()
+  vec4 way;       // keep_apart_way's box
+  vec4 stay;      // keep_apart_stay's box
+  vec4 obstacle;  // the box the others must keep clear of (x0, y0, x1, y1), or keep_apart_none():
+                  // keep_apart_stay's until the label's turn, then keep_apart_obstacle's
   uint key;       // the label's place in the settling order (its position in the order first)
-  uint rank;      // its turn, or KEEP_APART_NO_RANK
+  uint rank;      // its turn, or KEEP_APART_NO_RANK: it takes no part, or no box of its can clash
+                  // with another's (it settles on its own, as it would in its turn)
   uint by_rank;   // the label whose turn this entry's index is
   uint pad;
 };
@@ -50,10 +56,12 @@ STRATA_INLINE vec4 box_around(vec2 centre, vec2 size) {
   return vec4(centre - 0.5f * size, centre + 0.5f * size);
 }
 
-// Two boxes clash where they overlap or come closer than a quarter pixel (so that no rounding
-// between the GPU's floats and a layout file's numbers makes touching boxes overlap).
-STRATA_INLINE bool boxes_clash(vec4 a, vec4 b) {
-  return min(a.z, b.z) - max(a.x, b.x) > -0.25f && min(a.w, b.w) - max(a.y, b.y) > -0.25f &&
+// Two boxes clash where they overlap, or in motion where they come closer than `clearance`
+// (ForcesParams: a hundredth of a pixel, so that no rounding between the GPU's floats and a
+// layout file's numbers makes boxes that touch overlap; a still's boxes lie on whole and half
+// pixels, where touching is exact). An empty box clashes with nothing.
+STRATA_INLINE bool boxes_clash(vec4 a, vec4 b, float clearance) {
+  return min(a.z, b.z) - max(a.x, b.x) > -clearance && min(a.w, b.w) - max(a.y, b.y) > -clearance &&
          a.x <= a.z && b.x <= b.z;
 }
 
@@ -62,24 +70,28 @@ STRATA_INLINE bool box_inside(vec4 box, ForcesParams params) {
          box.w <= params.image_height;
 }
 
+// (An internal label, drawn on its anchor, takes no part: it has no other place to go.)
 STRATA_INLINE uint keep_apart_class(LabelGpu label, PlacementGpu target, LabelStateGpu state) {
+  if ((label.flags & LABEL_INTERNAL) != 0u) return KEEP_APART_NONE;
   bool shown = (label.flags & LABEL_ENABLED) != 0u && target.shown == PLACEMENT_SHOWN;
   if (state.opacity > 0.0f) return shown ? KEEP_APART_STAYING : KEEP_APART_LEAVING;
   return shown ? KEEP_APART_COMING : KEEP_APART_NONE;
 }
 
-// A box centre moved into the image, by at most what the forces move a label in a frame: a label
-// at the edge whose anchor runs out of the image slides along with the edge while it can.
+// A box centre moved into the image (the clearance inside its edges, so that rounding does not
+// leave it a hair outside), by at most what the forces move a label in a frame: a label at the
+// edge whose anchor runs out of the image slides along with the edge while it can.
 STRATA_INLINE vec2 keep_apart_inward(vec2 centre, vec2 size, ForcesParams params) {
   float most = params.speed * float(params.steps) * params.step_seconds;
+  float c = params.clearance;
   vec2 lo = centre - 0.5f * size;
   vec2 hi = centre + 0.5f * size;
   vec2 image = vec2(params.image_width, params.image_height);
   vec2 shift = vec2(0.0f);
-  if (lo.x < 0.0f) shift.x = -lo.x;
-  if (hi.x > image.x) shift.x = image.x - hi.x;
-  if (lo.y < 0.0f) shift.y = -lo.y;
-  if (hi.y > image.y) shift.y = image.y - hi.y;
+  if (lo.x < 0.0f) shift.x = c - lo.x;
+  if (hi.x > image.x) shift.x = image.x - c - hi.x;
+  if (lo.y < 0.0f) shift.y = c - lo.y;
+  if (hi.y > image.y) shift.y = image.y - c - hi.y;
   return centre + clamp(shift, vec2(-most), vec2(most));
 }
 
@@ -135,10 +147,46 @@ STRATA_INLINE LabelStateGpu keep_apart_hidden(LabelStateGpu state, LabelStateGpu
   return next;
 }
 
-// A label's state after its turn, from its clash bits: it moves, stays, waits, fades or goes.
+// Where a box that clashes with `other` slides to be clear of it: the shortest move along an axis
+// (left, right, up, down, in this order on a tie), if that is no more than the forces move a
+// label in a frame; else none. Two labels whose anchors bring their boxes together so push apart,
+// while they can, instead of one going.
+STRATA_INLINE vec4 keep_apart_push(vec4 box, vec4 other, ForcesParams params) {
+  float most = params.speed * float(params.steps) * params.step_seconds;
+  float gap = 2.0f * params.clearance;
+  float left = other.x - gap - box.z;  // (<= 0 for boxes that clash)
+  float right = other.z + gap - box.x;
+  float up = other.y - gap - box.w;
+  float down = other.w + gap - box.y;
+  vec2 shift = vec2(left, 0.0f);
+  float best = -left;
+  if (right < best) {
+    shift = vec2(right, 0.0f);
+    best = right;
+  }
+  if (-up < best) {
+    shift = vec2(0.0f, up);
+    best = -up;
+  }
+  if (down < best) {
+    shift = vec2(0.0f, down);
+    best = down;
+  }
+  if (!(best <= most)) return keep_apart_none();
+  return box + vec4(shift, shift);
+}
+
+STRATA_INLINE vec2 box_centre(vec4 box) {
+  return 0.5f * vec2(box.x + box.z, box.y + box.w);
+}
+
+// A label's state after its turn, from its clash bits and where it would slide out of a clash
+// (keep_apart_push's box): it moves, stays, slides, waits, fades or goes.
 STRATA_INLINE LabelStateGpu keep_apart_move(LabelGpu label, PlacementGpu target,
                                             LabelStateGpu state, ForcesParams params,
-                                            uint clashes) {
+                                            uint clashes, vec4 pushed) {
+  bool slides = (clashes & KEEP_APART_STAY) != 0u && (clashes & KEEP_APART_PUSH) == 0u &&
+                pushed.x <= pushed.z;
   uint c = keep_apart_class(label, target, state);
   LabelStateGpu moved = forces_update(label, target, state, params);
   moved.blocked = 0.0f;
@@ -152,8 +200,9 @@ STRATA_INLINE LabelStateGpu keep_apart_move(LabelGpu label, PlacementGpu target,
     return moved;
   }
   if (c == KEEP_APART_LEAVING) {  // fades out where it is: at once where that clashes
-    moved = keep_apart_moved_to(moved, keep_apart_stay_centre(label, state, params));
-    if ((clashes & KEEP_APART_STAY) != 0u) moved.opacity = 0.0f;
+    moved = keep_apart_moved_to(
+        moved, slides ? box_centre(pushed) : keep_apart_stay_centre(label, state, params));
+    if ((clashes & KEEP_APART_STAY) != 0u && !slides) moved.opacity = 0.0f;
     return moved;
   }
   if ((clashes & KEEP_APART_WAY) == 0u) {
@@ -163,11 +212,12 @@ STRATA_INLINE LabelStateGpu keep_apart_move(LabelGpu label, PlacementGpu target,
   LabelStateGpu stays = moved;
   stays.position = state.position;
   stays.drawn = state_to_screen(label, state.position, params);
-  stays = keep_apart_moved_to(stays, keep_apart_stay_centre(label, state, params));
+  stays = keep_apart_moved_to(
+      stays, slides ? box_centre(pushed) : keep_apart_stay_centre(label, state, params));
   stays.speed = 0.0f;
   bool wants_to_move = moved.position.x != state.position.x || moved.position.y != state.position.y;
   stays.blocked = wants_to_move ? state.blocked + float(params.steps) * params.step_seconds : 0.0f;
-  if ((clashes & KEEP_APART_STAY) != 0u) {
+  if ((clashes & KEEP_APART_STAY) != 0u && !slides) {
     stays.opacity = 0.0f;
   } else if (stays.blocked >= params.wait) {
     stays.opacity = faded(state.opacity, -params.fade);
@@ -177,8 +227,9 @@ STRATA_INLINE LabelStateGpu keep_apart_move(LabelGpu label, PlacementGpu target,
 
 STRATA_INLINE LabelStateGpu keep_apart_settle(LabelGpu label, PlacementGpu target,
                                               LabelStateGpu state, ForcesParams params,
-                                              uint clashes) {
-  return keep_apart_hidden(state, keep_apart_move(label, target, state, params, clashes), params);
+                                              uint clashes, vec4 pushed) {
+  return keep_apart_hidden(state, keep_apart_move(label, target, state, params, clashes, pushed),
+                           params);
 }
 
 // The box the others keep clear of after a label's turn: where it is drawn, while it is.

@@ -158,6 +158,7 @@ struct PlacementParams {
   uint classify_tiles;  // place_label: list entries per classifying workgroup (4, 8 or 16)
   uint tidy_rounds;     // placement_tidy: rounds of the tidy-up at most (0: none)
   uint indirect;        // 1: the tidy-up rounds are indirect dispatches (PlacementPlan)
+  float edge;           // pixels a box keeps clear of the image's edges
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,

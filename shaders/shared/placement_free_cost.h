@@ -27,14 +27,14 @@ bool box_legible(LabelGpu me, vec2 origin) {
   return on_screen - hidden >= LEGIBLE_SHARE * float(int(me.size.x) * int(me.size.y));
 }
 
-// Whether pixel p may hold the label at all: its box lies on screen with the constraints' margin
-// to spare (internal labels: only the anchor's own pixel) and, in hard mode, is legible.
+// Whether pixel p may hold the label at all: its box lies on screen, params.edge clear of its
+// edges (internal labels: only the anchor's own pixel) and, in hard mode, is legible.
 bool candidate_allowed(LabelGpu me, uvec2 p) {
   if ((me.flags & LABEL_INTERNAL) != 0u) {
     if (uvec2(me.anchor) != p) return false;
   } else {
     vec2 o = box_origin(p, me.size);
-    float m = params.margin;
+    float m = params.edge;
     if (o.x < m || o.y < m || o.x + me.size.x > float(params.width) - m ||
         o.y + me.size.y > float(params.height) - m) {
       return false;
