@@ -709,7 +709,9 @@ void Viewer::read_slot(uint32_t slot) {
     // the placement's pixel-centred position)
     const bool on_target = glm::length(drawn[i].position - targets[i].position) < 0.75f ||
                            (drawn[i].opacity == 0.0f && targets[i].shown != PLACEMENT_SHOWN);
-    still = on_target && (drawn[i].opacity == 0.0f || drawn[i].opacity == 1.0f);
+    // (a label kept apart that may soon appear again is not settled: PLACEMENT_PENDING)
+    still = on_target && (drawn[i].opacity == 0.0f || drawn[i].opacity == 1.0f) &&
+            (drawn[i].pad & PLACEMENT_PENDING) == 0u;
   }
   if (still) {
     settled_ = true;

@@ -193,6 +193,7 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
                            parts_->placement.order_count());
   parts_->forces.set_trial(trial);
   afresh_ = false;
+  camera_moved_ = false;
   frame_seconds_ = seconds > 0.0 ? std::optional(seconds) : std::nullopt;  // (0 s: a still)
 }
 
@@ -270,10 +271,9 @@ void LabelledRenderer::build_graph() {
 void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32_t>& within) {
   PlacementSettings settings = settings_.placement;
   settings.text_pixels = units().em;
-  if (moving && !afresh_) {
-    settings.weights.previous_position = settings_.forces.previous_weight;
-    settings.edge_em = settings.margin_em;
-  }
+  if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
+  // While the camera moves, kept-apart labels keep room to slide along the image's edge.
+  if (moving && camera_moved_ && settings_.forces.keep_apart) settings.edge_em = settings.margin_em;
   parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within, priorities_),
                               settings);
   parts_->drawing->set_layer_frames(settings_.layer_colors);
@@ -281,6 +281,7 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
 
 void LabelledRenderer::set_camera(const Camera& camera) {
   camera_ = camera;
+  camera_moved_ = true;
   project_and_layer(camera);
   parts_->renderer.set_camera(camera);
   parts_->renderer.settings().splits = layering_.split_depths;

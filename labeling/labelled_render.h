@@ -226,6 +226,9 @@ class LabelledRenderer {
   std::vector<uint32_t> within_;  // the order inside each layer set_order() was last given
   std::vector<uint32_t> trial_within_;
   bool afresh_ = false;
+  // set_camera was called since the last frame: the placement keeps its edge margin (a camera at
+  // rest lets the labels settle where a still would put them).
+  bool camera_moved_ = false;
   std::optional<double> frame_seconds_;  // of the last frame set up; none: a still
   void build_labels();  // glyphs and box sizes from the texts at settings_.font_pixels
   void set_label_text(float pixels, float scale);

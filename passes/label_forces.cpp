@@ -169,11 +169,13 @@ void keep_apart_reference(const std::vector<gpu::LabelGpu>& labels,
     if (order.at(k) < n) keys[order[k]] = k;
   }
   std::vector<glm::vec4> ways(n), stays(n);
+  std::vector<gpu::LabelStateGpu> moved(n);
   std::vector<uint32_t> turns, alone;
   for (size_t i = 0; i < n; ++i) {
     const uint32_t c = gpu::keep_apart_class(labels[i], targets[i], state[i]);
     keys[i] += c * KEEP_APART_CLASS_STRIDE;
-    ways[i] = gpu::keep_apart_way(labels[i], targets[i], state[i], params);
+    moved[i] = gpu::forces_update(labels[i], targets[i], state[i], params);
+    ways[i] = gpu::keep_apart_way(labels[i], targets[i], state[i], moved[i], params);
     stays[i] = gpu::keep_apart_stay(labels[i], state[i], params);
     (c != KEEP_APART_NONE ? turns : alone).push_back(uint32_t(i));
   }
@@ -202,13 +204,14 @@ void keep_apart_reference(const std::vector<gpu::LabelGpu>& labels,
       }
       if (!free) clashes |= KEEP_APART_PUSH;
     }
-    state[i] = gpu::keep_apart_settle(labels[i], targets[i], state[i], params, clashes, pushed);
+    state[i] = gpu::keep_apart_settle(labels[i], targets[i], state[i], moved[i], params, clashes,
+                                      pushed);
     obstacles[i] = gpu::keep_apart_obstacle(labels[i], state[i]);
     settled[i] = true;
   }
   for (const uint32_t i : alone) {  // (taking no part: they move on their own)
-    state[i] =
-        gpu::keep_apart_settle(labels[i], targets[i], state[i], params, 0u, gpu::keep_apart_none());
+    state[i] = gpu::keep_apart_settle(labels[i], targets[i], state[i], moved[i], params, 0u,
+                                      gpu::keep_apart_none());
   }
 }
 
@@ -227,7 +230,11 @@ std::vector<gpu::PlacementGpu> forces_reference(const std::vector<gpu::LabelGpu>
     }
   }
   std::vector<gpu::PlacementGpu> drawn(labels.size());
-  for (size_t i = 0; i < labels.size(); ++i) drawn[i] = gpu::forces_drawn(targets[i], state[i]);
+  for (size_t i = 0; i < labels.size(); ++i) {
+    drawn[i] = params.trial == 0u && params.keep_apart != 0u
+                   ? gpu::keep_apart_drawn(labels[i], targets[i], state[i], params)
+                   : gpu::forces_drawn(targets[i], state[i]);
+  }
   return drawn;
 }
 

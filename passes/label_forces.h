@@ -55,10 +55,10 @@ struct ForceSettings {
   // it is to fade in at its target. Off: each label moves on its own, as in the thesis.
   bool keep_apart = true;
   float wait_seconds = 0.4f;
-  // In motion a label appears only with this much room around its box (in ems: label text sizes;
-  // less than the placement's margin, which its targets keep), and once it went, not before
-  // `min_hidden_seconds`: so that a label where room is short does not flicker.
-  float appear_margin_em = 0.25f;
+  // Once it went, a label appears again not before `min_hidden_seconds` (so that one where room
+  // is short does not flicker), and in motion only with this much room around its box (in ems:
+  // label text sizes; 0: its box's own room, as the placement's soft margin may leave less).
+  float appear_margin_em = 0.0f;
   float min_hidden_seconds = 0.5f;
   // Hard mode: extra clear zone a label hidden in the last frame needs to appear, in ems (label
   // text sizes; 8 px at the default 14 px font).

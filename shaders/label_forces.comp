@@ -27,14 +27,24 @@ shared uint turns;                        // labels taking turns
 shared uint turn_label[LABEL_MAX / 2u];   // two 16-bit label indices per entry, by turn
 shared uint clashes[3];  // turn r's clash bits in slot r % 3 (turn r clears the next turn's)
 shared vec4 turn_way, turn_stay, turn_push;
+shared uint chunk_key[KEEP_APART_CHUNK];  // stage(): a chunk of the labels' keys and boxes
+shared vec4 chunk_way[KEEP_APART_CHUNK], chunk_stay[KEEP_APART_CHUNK];
 shared uint push_from[3];  // turn r's first settled label clashing with turn_stay, by slot
 
 // Label t's (the invocation's own): its boxes and turn, as scratch holds them.
 vec4 my_way = keep_apart_none(), my_stay = keep_apart_none(), my_obstacle = keep_apart_none();
 uint my_rank = KEEP_APART_NO_RANK;
 
+// The group's barrier, after which what any invocation wrote to scratch is visible to all.
 void sync() {
   memoryBarrierBuffer();
+  memoryBarrierShared();
+  barrier();
+}
+
+// The group's barrier for the turns, which share only shared memory (each invocation's scratch
+// entries are its own then): no device-wide fence per turn.
+void sync_shared() {
   memoryBarrierShared();
   barrier();
 }
@@ -49,10 +59,10 @@ void move_alone(uint i) {
 }
 
 void settle(uint i, uint clash_bits) {
-  LabelStateGpu state = keep_apart_settle(labels[i], targets[i], states[i], params, clash_bits,
-                                          keep_apart_none());
+  LabelStateGpu state = keep_apart_settle(labels[i], targets[i], states[i], scratch[i].moved,
+                                          params, clash_bits, keep_apart_none());
   states[i] = state;
-  drawn[i] = forces_drawn(targets[i], state);
+  drawn[i] = keep_apart_drawn(labels[i], targets[i], state, params);
   scratch[i].obstacle = keep_apart_obstacle(labels[i], state);
 }
 
@@ -74,7 +84,9 @@ void start(uint t) {
   for (uint i = t; i < params.label_count; i += KEEP_APART_GROUP) {
     uint c = keep_apart_class(labels[i], targets[i], states[i]);
     scratch[i].key = c * KEEP_APART_CLASS_STRIDE + scratch[i].key;
-    scratch[i].way = keep_apart_way(labels[i], targets[i], states[i], params);
+    const LabelStateGpu moved = forces_update(labels[i], targets[i], states[i], params);
+    scratch[i].moved = moved;
+    scratch[i].way = keep_apart_way(labels[i], targets[i], states[i], moved, params);
     scratch[i].stay = keep_apart_stay(labels[i], states[i], params);
     scratch[i].obstacle = scratch[i].stay;
   }
@@ -85,40 +97,70 @@ void start(uint t) {
   sync();
 }
 
-// Which labels take turns: those taking part with a box that may clash with another's. The
-// others settle now (their state and obstacle are final; their key leaves the ranking).
-void sort_out(uint t) {
-  for (uint i = t; i < params.label_count; i += KEEP_APART_GROUP) {
-    const uint key = scratch[i].key;
-    const vec4 way = scratch[i].way, stay = scratch[i].obstacle;
-    bool alone = true;
-    for (uint j = 0u; j < params.label_count && alone && key < kNone; ++j) {
-      if (j == i || scratch[j].key >= kNone) continue;
-      const vec4 other_way = scratch[j].way, other_stay = scratch[j].obstacle;
-      const float c = params.clearance;
-      alone = !(boxes_clash(way, other_way, c) || boxes_clash(way, other_stay, c) ||
-                boxes_clash(stay, other_way, c) || boxes_clash(stay, other_stay, c));
-    }
-    scratch[i].rank = alone ? KEEP_APART_NO_RANK : 0u;
-  }
+// The labels [base, base + KEEP_APART_CHUNK) staged in shared memory for the group's scans over
+// every label (each invocation reads all of them: from shared memory, not one after another from
+// the buffer).
+void stage(uint t, uint base) {
   sync();
-  for (uint i = t; i < params.label_count; i += KEEP_APART_GROUP) {
-    if (scratch[i].rank != KEEP_APART_NO_RANK) continue;
-    settle(i, keep_apart_cut(scratch[i].way, scratch[i].stay, params));
-    scratch[i].key = kNone;  // (after every read of it above: scratch[i] is this invocation's)
-    if (i == t) my_obstacle = scratch[i].obstacle;
+  if (t < KEEP_APART_CHUNK && base + t < params.label_count) {
+    chunk_key[t] = scratch[base + t].key;
+    chunk_way[t] = scratch[base + t].way;
+    chunk_stay[t] = scratch[base + t].stay;
   }
   sync();
 }
 
+// Which labels take turns: those taking part with a box that may clash with another's. The
+// others settle now (their state and obstacle are final; their key leaves the ranking). (rank
+// holds whether a label is alone while the chunks are scanned.)
+void sort_out(uint t) {
+  for (uint i = t; i < params.label_count; i += KEEP_APART_GROUP) {
+    scratch[i].rank = KEEP_APART_NO_RANK;
+  }
+  for (uint base = 0u; base < params.label_count; base += KEEP_APART_CHUNK) {
+    stage(t, base);
+    const uint end = min(base + KEEP_APART_CHUNK, params.label_count);
+    for (uint i = t; i < params.label_count; i += KEEP_APART_GROUP) {
+      if (scratch[i].key >= kNone || scratch[i].rank != KEEP_APART_NO_RANK) continue;
+      const vec4 way = scratch[i].way, stay = scratch[i].stay;
+      const float c = params.clearance;
+      bool alone = true;
+      for (uint j = base; j < end; ++j) {
+        if (j == i || chunk_key[j - base] >= kNone) continue;
+        const vec4 other_way = chunk_way[j - base], other_stay = chunk_stay[j - base];
+        alone = alone && !(boxes_clash(way, other_way, c) || boxes_clash(way, other_stay, c) ||
+                           boxes_clash(stay, other_way, c) || boxes_clash(stay, other_stay, c));
+      }
+      if (!alone) scratch[i].rank = 0u;
+    }
+  }
+  sync();
+  for (uint i = t; i < params.label_count; i += KEEP_APART_GROUP) {
+    if (scratch[i].key >= kNone || scratch[i].rank == KEEP_APART_NO_RANK) {
+      settle(i, keep_apart_cut(scratch[i].way, scratch[i].stay, params));
+      scratch[i].key = kNone;
+      if (i == t) my_obstacle = scratch[i].obstacle;
+    }
+  }
+}
+
 // Each turn: how many labels taking turns come before it.
 void rank(uint t) {
+  for (uint base = 0u; base < params.label_count; base += KEEP_APART_CHUNK) {
+    stage(t, base);
+    const uint end = min(base + KEEP_APART_CHUNK, params.label_count);
+    for (uint i = t; i < params.label_count; i += KEEP_APART_GROUP) {
+      const uint key = scratch[i].key;
+      if (key >= kNone) continue;
+      uint before = 0u;
+      for (uint j = base; j < end; ++j) before += chunk_key[j - base] < key ? 1u : 0u;
+      scratch[i].rank += before;
+    }
+  }
+  sync();
   for (uint i = t; i < params.label_count; i += KEEP_APART_GROUP) {
-    const uint key = scratch[i].key;
-    if (key >= kNone) continue;
-    uint r = 0u;
-    for (uint j = 0u; j < params.label_count; ++j) r += scratch[j].key < key ? 1u : 0u;
-    scratch[i].rank = r;
+    if (scratch[i].key >= kNone) continue;
+    const uint r = scratch[i].rank;
     if (i == t) my_rank = r;
     atomicOr(turn_label[r / 2u], i << (16u * (r % 2u)));
     atomicAdd(turns, 1u);
@@ -152,13 +194,13 @@ vec4 try_push(uint t, uint i, uint r) {
   if (from % KEEP_APART_GROUP == t) {
     turn_push = keep_apart_push(turn_stay, from == t ? my_obstacle : scratch[from].obstacle, params);
   }
-  sync();
+  sync_shared();
   uint bits = t < params.label_count ? push_bits(t, my_way, my_stay, i) : 0u;
   for (uint j = t + KEEP_APART_GROUP; j < params.label_count; j += KEEP_APART_GROUP) {
     bits |= push_bits(j, scratch[j].way, scratch[j].stay, i);
   }
   if (bits != 0u) atomicOr(clashes[r % 3u], bits);
-  sync();
+  sync_shared();
   return turn_push;
 }
 
@@ -168,7 +210,7 @@ void take_turns(uint t) {
     const bool owner = i % KEEP_APART_GROUP == t;
     LabelGpu label;
     PlacementGpu target;
-    LabelStateGpu state;
+    LabelStateGpu state, moved;
     if (owner) {
       const vec4 way = i == t ? my_way : scratch[i].way;
       const vec4 stay = i == t ? my_stay : scratch[i].stay;
@@ -181,23 +223,24 @@ void take_turns(uint t) {
       label = labels[i];  // (loaded while the group waits)
       target = targets[i];
       state = states[i];
+      moved = scratch[i].moved;
     }
-    sync();
+    sync_shared();
     uint bits = t < params.label_count ? clash_bits(t, my_rank, my_obstacle, i, r) : 0u;
     for (uint j = t + KEEP_APART_GROUP; j < params.label_count; j += KEEP_APART_GROUP) {
       bits |= clash_bits(j, scratch[j].rank, scratch[j].obstacle, i, r);
     }
     if (bits != 0u) atomicOr(clashes[r % 3u], bits);
-    sync();
+    sync_shared();
     // Its way taken, and where it is clashing with a box: it may slide out (the same for all).
     const bool push = (clashes[r % 3u] & KEEP_APART_WAY) != 0u && push_from[r % 3u] != kNoLabel;
     const vec4 pushed = push ? try_push(t, i, r) : keep_apart_none();
     if (owner) {
       uint c = clashes[r % 3u];
       if (push && !box_inside(pushed, params)) c |= KEEP_APART_PUSH;
-      state = keep_apart_settle(label, target, state, params, c, pushed);
+      state = keep_apart_settle(label, target, state, moved, params, c, pushed);
       states[i] = state;
-      drawn[i] = forces_drawn(target, state);
+      drawn[i] = keep_apart_drawn(label, target, state, params);
       const vec4 obstacle = keep_apart_obstacle(label, state);
       if (i == t) {
         my_obstacle = obstacle;

@@ -324,7 +324,8 @@ TEST_SUITE("cpu") {
 
   TEST_CASE("labels_fade_out_where_they_were_and_fade_in_over_the_fade_time") {
     // 0.3 s at 30 frames per second: 1/9 of the way each frame.
-    const ForceSettings settings{.anchor_relative = true, .fade_seconds = 0.3f};
+    const ForceSettings settings{
+        .anchor_relative = true, .fade_seconds = 0.3f, .min_hidden_seconds = 0.0f};
     const gpu::ForcesParams p = forces_params(settings, kUnits, 1, 1.0 / 30.0);
     CHECK(p.fade == doctest::Approx(1.0f / 9.0f));
     CHECK(forces_params(settings, kUnits, 1, 0.0).fade == 1.0f);  // a still: at once

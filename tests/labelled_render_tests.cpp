@@ -207,7 +207,8 @@ TEST_SUITE("gpu") {
 TEST_SUITE("gpu") {
   // Dynamic labelling: after a camera move the drawn labels glide to the new placement at the
   // forces' speed (never more per frame), reach it, and then stay. (No hold and no eta: with
-  // them, a label may keep a target that is nearly as good as the fresh placement's.)
+  // them, a label may keep a target that is nearly as good as the fresh placement's; the forces
+  // alone: kept apart, a label may wait for another's way.)
   TEST_CASE_FIXTURE(test::GpuTest, "labels_glide_to_the_new_placement_after_a_camera_move") {
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
     const graph::Extent size{128, 128};
@@ -218,6 +219,7 @@ TEST_SUITE("gpu") {
     settings.forces.speed_widths = 300.0f / 128.0f;  // 10 px per frame at 30 frames per second
     settings.forces.hold_share = settings.forces.hold_cost = 0.0f;
     settings.forces.previous_weight = 0.0f;
+    settings.forces.keep_apart = false;
     LabelledRenderer renderer(ctx, scene, start, size, settings);
     renderer.run();
     LabelledFrame last = renderer.result();

@@ -14,7 +14,8 @@
 
 #include "forces.h"
 
-#define KEEP_APART_GROUP 256      // label_forces.comp: one workgroup settles every label
+#define KEEP_APART_GROUP 256      // label_forces.comp: one workgroup settles every label ...
+#define KEEP_APART_CHUNK 128      // ... scanning them all in chunks of this many
 #define FORCES_BINDING_ORDER 4    // uint[]: the placement's insertion order (label indices)
 #define FORCES_BINDING_SCRATCH 5  // KeepApartGpu[]: the settling's working state per label
 
@@ -26,6 +27,10 @@
 #define KEEP_APART_CLASS_STRIDE (2u * LABEL_MAX)  // keys: class * stride + position in the order
 #define KEEP_APART_NO_RANK 0xFFFFFFFFu
 
+// PlacementGpu.pad of a drawn label: hidden, and may appear once it has been for min_hidden
+// (the viewer's view is not settled while one is).
+#define PLACEMENT_PENDING 1u
+
 // Clash bits of a label's boxes.
 #define KEEP_APART_WAY 1u   // where it would move (or appear) is taken by a drawn box, or is cut
 #define KEEP_APART_STAY 2u  // where it is clashes with a box settled before it, or is cut
@@ -36,6 +41,7 @@ STRATA_BEGIN
 
 // What the settling keeps per label.
 struct KeepApartGpu {
+  LabelStateGpu moved;  // the label's state after forces_update
   vec4 way;       // keep_apart_way's box
   vec4 stay;      // keep_apart_stay's box
   vec4 obstacle;  // the box the others must keep clear of (x0, y0, x1, y1), or keep_apart_none():
@@ -119,10 +125,10 @@ STRATA_INLINE LabelStateGpu keep_apart_moved_to(LabelStateGpu state, vec2 centre
 
 // The box a label heads into this frame: where the forces move a staying one, the target of one
 // coming with the room it needs around it; none for the others.
+// (`moved`: forces_update's state, as for every function below that takes it.)
 STRATA_INLINE vec4 keep_apart_way(LabelGpu label, PlacementGpu target, LabelStateGpu state,
-                                  ForcesParams params) {
+                                  LabelStateGpu moved, ForcesParams params) {
   uint c = keep_apart_class(label, target, state);
-  LabelStateGpu moved = forces_update(label, target, state, params);
   if (c == KEEP_APART_STAYING) {
     return box_around(keep_apart_inward(moved.drawn, label.size, params), label.size);
   }
@@ -183,12 +189,11 @@ STRATA_INLINE vec2 box_centre(vec4 box) {
 // A label's state after its turn, from its clash bits and where it would slide out of a clash
 // (keep_apart_push's box): it moves, stays, slides, waits, fades or goes.
 STRATA_INLINE LabelStateGpu keep_apart_move(LabelGpu label, PlacementGpu target,
-                                            LabelStateGpu state, ForcesParams params,
-                                            uint clashes, vec4 pushed) {
+                                            LabelStateGpu state, LabelStateGpu moved,
+                                            ForcesParams params, uint clashes, vec4 pushed) {
   bool slides = (clashes & KEEP_APART_STAY) != 0u && (clashes & KEEP_APART_PUSH) == 0u &&
                 pushed.x <= pushed.z;
   uint c = keep_apart_class(label, target, state);
-  LabelStateGpu moved = forces_update(label, target, state, params);
   moved.blocked = 0.0f;
   if (c == KEEP_APART_NONE) return moved;
   if (c == KEEP_APART_COMING) {  // appears at its target, when that is free
@@ -226,16 +231,26 @@ STRATA_INLINE LabelStateGpu keep_apart_move(LabelGpu label, PlacementGpu target,
 }
 
 STRATA_INLINE LabelStateGpu keep_apart_settle(LabelGpu label, PlacementGpu target,
-                                              LabelStateGpu state, ForcesParams params,
-                                              uint clashes, vec4 pushed) {
-  return keep_apart_hidden(state, keep_apart_move(label, target, state, params, clashes, pushed),
-                           params);
+                                              LabelStateGpu state, LabelStateGpu moved,
+                                              ForcesParams params, uint clashes, vec4 pushed) {
+  return keep_apart_hidden(
+      state, keep_apart_move(label, target, state, moved, params, clashes, pushed), params);
 }
 
 // The box the others keep clear of after a label's turn: where it is drawn, while it is.
 STRATA_INLINE vec4 keep_apart_obstacle(LabelGpu label, LabelStateGpu state) {
   if (!(state.opacity > 0.0f)) return keep_apart_none();
   return box_around(state.drawn, label.size);
+}
+
+// Where and how opaque the label is drawn (forces_drawn), and whether it is pending.
+STRATA_INLINE PlacementGpu keep_apart_drawn(LabelGpu label, PlacementGpu target,
+                                            LabelStateGpu state, ForcesParams params) {
+  PlacementGpu drawn = forces_drawn(target, state);
+  bool coming = keep_apart_class(label, target, state) == KEEP_APART_COMING;
+  bool resting = (state.flags & LABEL_STATE_PLACED) != 0u && state.hidden < params.min_hidden;
+  drawn.pad = coming && resting ? PLACEMENT_PENDING : 0u;
+  return drawn;
 }
 
 STRATA_END
