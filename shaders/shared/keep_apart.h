@@ -49,8 +49,7 @@ struct KeepApartGpu {
   uint key;       // the label's place in the settling order (its position in the order first)
   uint rank;      // its turn, or KEEP_APART_NO_RANK: it takes no part, or no box of its can clash
                   // with another's (it settles on its own, as it would in its turn)
-  uint by_rank;   // the label whose turn this entry's index is
-  uint pad;
+  uint pad0, pad1;
 };
 
 // Boxes are (x0, y0, x1, y1). An empty box: clashes with nothing.
