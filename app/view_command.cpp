@@ -19,6 +19,7 @@
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/window_target.h"
 #include "engine/scene/io/scene_loader.h"
+#include "engine/scene/value_limits.h"
 #include "labeling/camera_path.h"
 #include "passes/test_pattern.h"
 
@@ -35,6 +36,7 @@ struct ViewOptions {
   uint32_t tidy_rounds = kViewerTidyRounds;
   uint32_t blur = 12;
   uint32_t frames_in_flight = 2;
+  double settle_limit = 120.0;  // seconds a script waits for the view to settle
   bool no_optimize = false;
   bool no_panel = false;
   float label_scale = 1.0f;  // times the display's content scale
@@ -94,8 +96,8 @@ AnatomicalView view_named(const std::string& name) {
 // a script does the same whatever the device's speed.
 class Script {
  public:
-  Script(std::string path, std::vector<ScriptCommand> lines)
-      : path_(std::move(path)), lines_(std::move(lines)) {}
+  Script(std::string path, std::vector<ScriptCommand> lines, double settle_limit)
+      : path_(std::move(path)), lines_(std::move(lines)), settle_limit_(settle_limit) {}
 
   bool done() const { return next_ >= lines_.size(); }
   // Frames the last command asked for that are still due.
@@ -107,17 +109,35 @@ class Script {
   bool sleeping() const { return std::chrono::steady_clock::now() < wake_; }
 
   void run_next(Viewer& viewer);
+  // The script waits for a busy viewer (no frames due, no sleep): an Error naming the line and
+  // what had not settled once that wait has lasted the settle limit.
+  void wait_for(const Viewer& viewer);
 
  private:
   void run(Viewer& viewer, const ScriptCommand& c);
   std::string path_;
   std::vector<ScriptCommand> lines_;
   size_t next_ = 0;
+  double settle_limit_;  // seconds (--settle-limit, the script's settle-limit)
   uint32_t frames_ = 0;
   std::chrono::steady_clock::time_point wake_{};
+  std::optional<std::chrono::steady_clock::time_point> waiting_since_;
 };
 
+void Script::wait_for(const Viewer& viewer) {
+  const double limit = settle_limit_;
+  const auto now = std::chrono::steady_clock::now();
+  if (!waiting_since_) waiting_since_ = now;
+  const double waited = std::chrono::duration<double>(now - *waiting_since_).count();
+  if (waited < limit) return;
+  const std::string where = done() ? path_ + ": after the last line"
+                                   : path_ + ":" + std::to_string(lines_[next_].line);
+  throw Error(where + ": the view did not settle within " + value_limits::shown(limit) +
+ " s (--settle-limit, settle-limit); still busy: " + viewer.unsettled());
+}
+
 void Script::run_next(Viewer& viewer) {
+  waiting_since_.reset();
   const ScriptCommand& line = lines_[next_++];
   try {
     run(viewer, line);
@@ -181,6 +201,9 @@ void Script::run(Viewer& viewer, const ScriptCommand& c) {
       wake_ = std::chrono::steady_clock::now() +
               std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                   std::chrono::duration<double>(n[0]));
+      break;
+    case ScriptOp::settle_limit:
+      settle_limit_ = n[0];
       break;
     case ScriptOp::save_position:
       viewer.save_position(c.word);
@@ -282,7 +305,7 @@ void print_summary(const Viewer& viewer, const std::string& scene) {
 
 void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size) {
   std::optional<Script> script;  // (a script's mistakes are found before the window opens)
-  if (!o.script.empty()) script.emplace(o.script, read_script(o.script));
+  if (!o.script.empty()) script.emplace(o.script, read_script(o.script), o.settle_limit);
   Glfw glfw;
   ContextOptions context = device.context();
   context.instance_extensions = glfw.instance_extensions();
@@ -323,10 +346,13 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
 
   while (!viewer.quit_requested()) {
     glfwPollEvents();
-    if (script && !viewer.busy() && script->frames_due() == 0 && !script->sleeping()) {
-      if (script->done()) break;
-      script->run_next(viewer);
-      continue;
+    if (script && script->frames_due() == 0 && !script->sleeping()) {
+      if (!viewer.busy()) {
+        if (script->done()) break;
+        script->run_next(viewer);
+        continue;
+      }
+      script->wait_for(viewer);
     }
     // (a recording draws every frame, at its fixed time step; under a script, only those the
     // script asks for, so that its frame count is known)
@@ -411,6 +437,11 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--script", o->script,
                   "input script: events and actions run one by one, each once the view has "
                   "settled (docs/viewer.md)");
+  cmd->add_option("--settle-limit", o->settle_limit,
+                  "seconds a script step waits for the view to settle before the script stops "
+                  "with an error")
+      ->check(finite_range(0.001, kScriptMaxSettle))
+      ->capture_default_str();
   cmd->add_option("--screenshot-dir", o->screenshot_dir,
                   "where F12, the screenshot button and recordings write")
       ->capture_default_str();

@@ -632,6 +632,33 @@ bool Viewer::busy() const {
          seconds_between(last_change_, Clock::now()) >= options_.idle_seconds;
 }
 
+std::string Viewer::unsettled() const {
+  std::vector<std::string> parts;
+  if (ui_frames_ > 0) parts.push_back("the panel's frames");
+  if (control_.animating()) parts.push_back("the camera's animation");
+  if (!same_view(control_.camera(), applied_camera_)) parts.push_back("the camera's last move");
+  if (!settled_ && checked_serial_ != serial_) {
+    parts.push_back("the first frames after the last change");
+  } else if (!settled_) {
+    std::string text = std::to_string(moving_labels_.size()) + " label" +
+                       (moving_labels_.size() == 1 ? "" : "s") + " moving or fading (";
+    for (size_t k = 0; k < moving_labels_.size() && k < 3; ++k) {
+      text += (k ? ", " : "") + scene_.labels[moving_labels_[k]].text;
+    }
+    parts.push_back(text + (moving_labels_.size() > 3 ? ", ...)" : ")"));
+  }
+  if (settled_ && busy()) {
+    const Optimisation& o = optimisation_;
+    const auto back = std::count_if(o.costs.begin(), o.costs.end(),
+                                    [](double c) { return !std::isnan(c); });
+    parts.push_back("the optimisation on idle (" + std::to_string(back) + " of " +
+                    std::to_string(options_.optimize_tries) + " trials back)");
+  }
+  std::string out;
+  for (size_t k = 0; k < parts.size(); ++k) out += (k ? ", " : "") + parts[k];
+  return out.empty() ? "nothing" : out;
+}
+
 std::optional<double> Viewer::wake_in() const {
   if (!options_.optimize_on_idle || optimisation_.done || scene_.labels.size() < 2) return {};
   return std::max(0.0, options_.idle_seconds - seconds_between(last_change_, Clock::now()));
@@ -701,19 +728,21 @@ void Viewer::read_slot(uint32_t slot) {
   // A normal frame: settled when every label is on its target and fully faded in or out.
   const auto targets = labelled_->placement_results();
   const auto drawn = labelled_->drawn();
-  bool still = true;
   const auto& labels = labelled_->labels();
-  for (size_t i = 0; i < drawn.size() && still; ++i) {
+  moving_labels_.clear();
+  checked_serial_ = serial_;
+  for (size_t i = 0; i < drawn.size(); ++i) {
     if ((labels[i].flags & LABEL_ENABLED) == 0u && drawn[i].opacity == 0.0f) continue;
     // (a held label keeps its exact offset from its anchor: within half a pixel per axis of
     // the placement's pixel-centred position)
     const bool on_target = glm::length(drawn[i].position - targets[i].position) < 0.75f ||
                            (drawn[i].opacity == 0.0f && targets[i].shown != PLACEMENT_SHOWN);
     // (a label kept apart that may soon appear again is not settled: PLACEMENT_PENDING)
-    still = on_target && (drawn[i].opacity == 0.0f || drawn[i].opacity == 1.0f) &&
-            (drawn[i].pad & PLACEMENT_PENDING) == 0u;
+    const bool still = on_target && (drawn[i].opacity == 0.0f || drawn[i].opacity == 1.0f) &&
+                       (drawn[i].pad & PLACEMENT_PENDING) == 0u;
+    if (!still) moving_labels_.push_back(uint32_t(i));
   }
-  if (still) {
+  if (moving_labels_.empty()) {
     settled_ = true;
     if (o.orders.empty()) o.baseline = labelled_->total_cost();  // the kept order's cost
   }

@@ -131,6 +131,8 @@ class Viewer {
   bool busy() const;
   // Seconds until something happens without input (the optimisation on idle), if anything will.
   std::optional<double> wake_in() const;
+  // What keeps the viewer busy, in words ("2 labels moving or fading (Thalamus R, Insula L)").
+  std::string unsettled() const;
   // One frame: UI, camera, labels, drawn and handed to the output. `seconds`: the time step
   // (default: the wall clock since the last frame, at most 0.1 s; a recording's 1 / fps).
   // A lost device is a DeviceLost naming the frame; a wait past the GPU timeout a GpuTimeout.
@@ -226,6 +228,8 @@ class Viewer {
   glm::vec2 mouse_{0.0f};
   bool quit_ = false;
   int ui_frames_ = 3;  // frames the UI still needs
+  std::vector<uint32_t> moving_labels_;  // labels not yet on their targets (the last frame's)
+  uint64_t checked_serial_ = ~0ull;      // the serial of that frame
 
   // Change tracking and idle.
   uint64_t serial_ = 1;

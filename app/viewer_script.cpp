@@ -130,6 +130,10 @@ ScriptCommand command(const std::vector<std::string>& w) {
     need(2, "sleep SECONDS");
     out.op = ScriptOp::sleep;
     out.numbers = {number(w[1], 0.0, kScriptMaxSleep)};
+  } else if (c == "settle-limit") {
+    need(2, "settle-limit SECONDS");
+    out.op = ScriptOp::settle_limit;
+    out.numbers = {number(w[1], 0.001, kScriptMaxSettle)};
   } else if (c == "save-position") {
     need(2, "save-position NAME");
     out.op = ScriptOp::save_position;
@@ -140,7 +144,7 @@ ScriptCommand command(const std::vector<std::string>& w) {
   } else {
     throw Error("no command '" + c +
                 "' (drag, scroll, key, view, preset, set, hide, show, screenshot, capture, layout, "
-                "record, frames, sleep, save-position, report, quit)");
+                "record, frames, sleep, settle-limit, save-position, report, quit)");
   }
   return out;
 }

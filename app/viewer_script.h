@@ -15,6 +15,7 @@ inline constexpr double kScriptMaxCoordinate = 16384.0;  // drag: window pixels,
 inline constexpr double kScriptMaxScroll = 100.0;        // scroll: wheel ticks, either sign
 inline constexpr double kScriptMaxFrames = 100000.0;     // frames N
 inline constexpr double kScriptMaxSleep = 600.0;         // sleep SECONDS
+inline constexpr double kScriptMaxSettle = 86400.0;      // settle-limit SECONDS
 inline constexpr double kScriptMaxVolume = 1023.0;       // preset NAME VOLUME (the scene has fewer)
 inline constexpr double kScriptMaxLabelId = 2147483647.0;
 
@@ -35,6 +36,7 @@ enum class ScriptOp {
   frames,
   sleep,
   save_position,
+  settle_limit,
   report,
   quit
 };
