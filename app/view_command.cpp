@@ -217,6 +217,7 @@ void Script::run(Viewer& viewer, const ScriptCommand& c) {
                                      {"settled", viewer.settled()},
                                      {"busy", viewer.busy()},
                                      {"trials", viewer.summary().trials},
+                                     {"panel", viewer.panel_rect()},
                                      {"view", view}};
       write_text_file(c.word, report.dump() + "\n");
       break;

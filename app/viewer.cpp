@@ -807,8 +807,13 @@ void Viewer::draw_frame(std::optional<double> step) {
   graph::Extent extent = output_.extent();
   if (extent.width == 0 || extent.height == 0) return;  // minimised
   ui_.begin_frame(extent, seconds);
+  panel_ = glm::uvec4(0u);
   if (options_.show_panel) build_panel();
   ui_.end_frame();
+  if (panel_ != labelled_->settings().placement.keep_out) {
+    labelled_->settings().placement.keep_out = panel_;  // (the panel moved, or was shown or hidden)
+    changed();
+  }
   if (ui_frames_ > 0) --ui_frames_;
 
   control_.update(seconds);

@@ -133,6 +133,11 @@ class Viewer {
   std::optional<double> wake_in() const;
   // What keeps the viewer busy, in words ("2 labels moving or fading (Thalamus R, Insula L)").
   std::string unsettled() const;
+  // The panel's rectangle in the last frame, [x0, y0, x1, y1] in pixels; empty when hidden.
+  std::vector<uint32_t> panel_rect() const {
+    if (panel_.x >= panel_.z) return {};
+    return {panel_.x, panel_.y, panel_.z, panel_.w};
+  }
   // One frame: UI, camera, labels, drawn and handed to the output. `seconds`: the time step
   // (default: the wall clock since the last frame, at most 0.1 s; a recording's 1 / fps).
   // A lost device is a DeviceLost naming the frame; a wait past the GPU timeout a GpuTimeout.
@@ -228,6 +233,7 @@ class Viewer {
   glm::vec2 mouse_{0.0f};
   bool quit_ = false;
   int ui_frames_ = 3;  // frames the UI still needs
+  glm::uvec4 panel_{0u};  // the panel's rectangle this frame, x0 y0 x1 y1 (none: hidden)
   std::vector<uint32_t> moving_labels_;  // labels not yet on their targets (the last frame's)
   uint64_t checked_serial_ = ~0ull;      // the serial of that frame
 

@@ -37,7 +37,11 @@ void Viewer::build_panel() {
   ImGui::SetNextWindowSize(ImVec2(360.0f * scale, float(output_.extent().height) - 16.0f * scale),
                            ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowBgAlpha(0.85f);
-  if (!ImGui::Begin("strata")) {
+  const bool open = ImGui::Begin("strata");
+  // (labels are placed off the panel: its rectangle, collapsed or not, is the placement's keep-out)
+  const ImVec2 at = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  panel_ = glm::uvec4(glm::max(glm::vec4(at.x, at.y, at.x + size.x, at.y + size.y), 0.0f));
+  if (!open) {
     ImGui::End();
     return;
   }

@@ -52,6 +52,11 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   p.write_constraints = s.write_constraints ? 1u : 0u;
   p.margin = margin_pixels(s);
   p.edge = s.edge_em * s.text_pixels;
+  const glm::uvec4 k = glm::min(s.keep_out, glm::uvec4(0xFFFFu));
+  if (k.x < k.z && k.y < k.w) {
+    p.keep_out_lo = k.x | k.y << 16u;
+    p.keep_out_hi = k.z | k.w << 16u;
+  }
   p.saliency_weight = s.saliency_weight;
   p.occlusion_weight = s.occlusion_weight;
   p.single_saliency_weight = s.single_saliency_weight;

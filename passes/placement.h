@@ -33,6 +33,9 @@ struct PlacementSettings {
   // LabelledRenderer keeps the margin here too, so that a label whose anchor moves outward has
   // room to slide before the edge would cut it.
   float edge_em = 0.0f;
+  // A rectangle of the image no box may touch, x0, y0, x1, y1 in pixels (the viewer's panel);
+  // empty (x0 >= x1 or y0 >= y1): none. Labels whose boxes fit nowhere else are hidden.
+  glm::uvec4 keep_out{0u};
   bool hard = false;          // forbid constraint violations (labels may end up hidden)
   float saliency_weight = 0.5f;         // eq. 3.3: how much saliency modulates the occlusion behind
   float occlusion_weight = 0.5f;        // eq. 3.4 (one layer)

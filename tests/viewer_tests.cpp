@@ -228,6 +228,53 @@ TEST_SUITE("window") {
 #endif
   }
 
+  // Labels are placed off the panel: with it open, no drawn box touches its rectangle (and some
+  // labels are drawn beside it); without it, labels take that room.
+  TEST_CASE("viewer_places_no_label_under_its_panel") {
+    const auto dir = test::fresh_folder("viewer", "panel-room");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto script = test::write_file(
+        dir / "script.txt", "report " + d("open.json") + "\nlayout " + d("open-layout.json") +
+                                "\nscreenshot " + d("open.png") + "\nquit\n");
+    const auto r = run_strata("--validate view " + kScene + " --size 640x240 --no-optimize --script " +
+                              script.string());
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    const auto panel = nlohmann::json::parse(test::read_file(d("open.json"))).at("panel");
+    REQUIRE(panel.size() == 4);
+    const glm::vec4 rect(panel[0].get<float>(), panel[1].get<float>(), panel[2].get<float>(),
+                         panel[3].get<float>());
+    CHECK(rect.z - rect.x > 100.0f);
+    // Drawn boxes (opacity above 0) that touch the panel's rectangle, and drawn boxes.
+    const auto count = [&](const char* layout) {
+      int touching = 0, drawn = 0;
+      const auto json = nlohmann::json::parse(test::read_file(d(layout)));
+      for (const auto& l : json.at("labels")) {
+        if (l.value("opacity", 1.0) <= 0.0 || !l.contains("box") || l.at("box").is_null()) continue;
+        const auto& b = l.at("box");
+        const float x = b[0].get<float>(), y = b[1].get<float>();
+        const float w = b[2].get<float>(), h = b[3].get<float>();
+        ++drawn;
+        if (x < rect.z && rect.x < x + w && y < rect.w && rect.y < y + h) ++touching;
+      }
+      return std::pair{touching, drawn};
+    };
+    const auto [open_touching, open_drawn] = count("open-layout.json");
+    CHECK(open_touching == 0);
+    CHECK(open_drawn >= 3);
+    // Without the panel, labels take that room.
+    const auto bare = run_strata("--validate view " + kScene +
+                                 " --size 640x240 --no-optimize --no-panel --script " +
+                                 test::write_file(dir / "bare.txt", "layout " + d("bare-layout.json") +
+                                                                        "\nquit\n")
+                                     .string());
+    INFO(bare.output);
+    REQUIRE(bare.exit_code == 0);
+    const auto [bare_touching, bare_drawn] = count("bare-layout.json");
+    CHECK(bare_touching >= 1);
+    CHECK(bare_drawn >= open_drawn);
+  }
+
   TEST_CASE("viewer_tries_insertion_orders_when_the_camera_rests") {
     // Optimisation on idle: once the view has rested, trial frames try random orders (labels
     // stay where they are meanwhile); a camera move starts it again; then nothing is drawn.

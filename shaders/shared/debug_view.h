@@ -141,6 +141,8 @@ void view_setup() {
   params.label_count = view.label_count;
   params.margin = view.margin;
   params.edge = 0.0f;  // (a still's candidates)
+  params.keep_out_lo = 0u;
+  params.keep_out_hi = 0u;
   view_position = view.order_count;
   if (view.label >= view.label_count) return;
   view_label = label_at(view.label);

@@ -159,6 +159,8 @@ struct PlacementParams {
   uint tidy_rounds;     // placement_tidy: rounds of the tidy-up at most (0: none)
   uint indirect;        // 1: the tidy-up rounds are indirect dispatches (PlacementPlan)
   float edge;           // pixels a box keeps clear of the image's edges
+  uint keep_out_lo;     // a rectangle no box may touch (the viewer's panel): its corners x | y << 16,
+  uint keep_out_hi;     // [lo, hi) in pixels; lo == hi: none
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,

@@ -27,9 +27,18 @@ bool box_legible(LabelGpu me, vec2 origin) {
   return on_screen - hidden >= LEGIBLE_SHARE * float(int(me.size.x) * int(me.size.y));
 }
 
+// Whether the box at origin o touches the keep-out rectangle (params.keep_out_*).
+bool box_kept_out(LabelGpu me, vec2 o) {
+  vec2 lo = vec2(float(params.keep_out_lo & 0xFFFFu), float(params.keep_out_lo >> 16u));
+  vec2 hi = vec2(float(params.keep_out_hi & 0xFFFFu), float(params.keep_out_hi >> 16u));
+  return all(lessThan(lo, hi)) && all(lessThan(o, hi)) && all(lessThan(lo, o + me.size));
+}
+
 // Whether pixel p may hold the label at all: its box lies on screen, params.edge clear of its
-// edges (internal labels: only the anchor's own pixel) and, in hard mode, is legible.
+// edges (internal labels: only the anchor's own pixel), off the keep-out rectangle and, in hard
+// mode, is legible.
 bool candidate_allowed(LabelGpu me, uvec2 p) {
+  if (box_kept_out(me, box_origin(p, me.size))) return false;
   if ((me.flags & LABEL_INTERNAL) != 0u) {
     if (uvec2(me.anchor) != p) return false;
   } else {
