@@ -390,6 +390,30 @@ TEST_SUITE("gpu") {
     }
   }
 
+  // A keep-out rectangle (the viewer's panel): no box touches it, and the GPU still equals the
+  // reference, which places at least one label elsewhere than without it.
+  TEST_CASE_FIXTURE(test::GpuTest, "no_box_is_placed_on_the_keep_out_rectangle") {
+    const Inputs in = disc_scene(6);
+    const ReferencePlacement free = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                    in.labels, in.order, {}, in.size);
+    PlacementSettings settings;
+    settings.keep_out = {0u, 0u, in.size.width / 2u, in.size.height};
+    const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
+    const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                   in.labels, in.order, settings, in.size);
+    check_placements(gpu, cpu);
+    size_t moved = 0, shown = 0;
+    for (size_t i = 0; i < gpu.placements.size(); ++i) {
+      const gpu::PlacementGpu& p = gpu.placements[i];
+      moved += glm::length(p.position - free.placements[i].position) > 0.5f;
+      if (p.shown != PLACEMENT_SHOWN) continue;
+      ++shown;
+      CHECK(p.position.x - in.labels[i].size.x * 0.5f >= float(settings.keep_out.z));
+    }
+    CHECK(shown >= 3);
+    CHECK(moved >= 1);
+  }
+
   // Eq. 3.1's eta with last frame's drawn positions (from the forces' state, on the GPU) gives
   // the reference's positions for those previous positions.
   TEST_CASE_FIXTURE(test::GpuTest, "previous_positions_come_from_the_forces_state") {
