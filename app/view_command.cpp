@@ -125,15 +125,13 @@ class Script {
 };
 
 void Script::wait_for(const Viewer& viewer) {
-  const double limit = settle_limit_;
   const auto now = std::chrono::steady_clock::now();
   if (!waiting_since_) waiting_since_ = now;
-  const double waited = std::chrono::duration<double>(now - *waiting_since_).count();
-  if (waited < limit) return;
-  const std::string where = done() ? path_ + ": after the last line"
-                                   : path_ + ":" + std::to_string(lines_[next_].line);
-  throw Error(where + ": the view did not settle within " + value_limits::shown(limit) +
- " s (--settle-limit, settle-limit); still busy: " + viewer.unsettled());
+  if (std::chrono::duration<double>(now - *waiting_since_).count() < settle_limit_) return;
+  const std::string where =
+      done() ? path_ + ": after the last line" : path_ + ":" + std::to_string(lines_[next_].line);
+  throw Error(where + ": the view did not settle within " + value_limits::shown(settle_limit_) +
+              " s (--settle-limit, settle-limit); still busy: " + viewer.unsettled());
 }
 
 void Script::run_next(Viewer& viewer) {

@@ -649,8 +649,8 @@ std::string Viewer::unsettled() const {
   }
   if (settled_ && busy()) {
     const Optimisation& o = optimisation_;
-    const auto back = std::count_if(o.costs.begin(), o.costs.end(),
-                                    [](double c) { return !std::isnan(c); });
+    const auto back =
+        std::count_if(o.costs.begin(), o.costs.end(), [](double c) { return !std::isnan(c); });
     parts.push_back("the optimisation on idle (" + std::to_string(back) + " of " +
                     std::to_string(options_.optimize_tries) + " trials back)");
   }

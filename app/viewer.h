@@ -232,7 +232,7 @@ class Viewer {
   bool drag_pan_ = false;
   glm::vec2 mouse_{0.0f};
   bool quit_ = false;
-  int ui_frames_ = 3;  // frames the UI still needs
+  int ui_frames_ = 3;     // frames the UI still needs
   glm::uvec4 panel_{0u};  // the panel's rectangle this frame, x0 y0 x1 y1 (none: hidden)
   std::vector<uint32_t> moving_labels_;  // labels not yet on their targets (the last frame's)
   uint64_t checked_serial_ = ~0ull;      // the serial of that frame

@@ -236,8 +236,8 @@ TEST_SUITE("window") {
     const auto script = test::write_file(
         dir / "script.txt", "report " + d("open.json") + "\nlayout " + d("open-layout.json") +
                                 "\nscreenshot " + d("open.png") + "\nquit\n");
-    const auto r = run_strata("--validate view " + kScene + " --size 640x240 --no-optimize --script " +
-                              script.string());
+    const auto r = run_strata("--validate view " + kScene +
+                              " --size 640x240 --no-optimize --script " + script.string());
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     const auto panel = nlohmann::json::parse(test::read_file(d("open.json"))).at("panel");
@@ -263,11 +263,10 @@ TEST_SUITE("window") {
     CHECK(open_touching == 0);
     CHECK(open_drawn >= 3);
     // Without the panel, labels take that room.
-    const auto bare = run_strata("--validate view " + kScene +
-                                 " --size 640x240 --no-optimize --no-panel --script " +
-                                 test::write_file(dir / "bare.txt", "layout " + d("bare-layout.json") +
-                                                                        "\nquit\n")
-                                     .string());
+    const auto bare = run_strata(
+        "--validate view " + kScene + " --size 640x240 --no-optimize --no-panel --script " +
+        test::write_file(dir / "bare.txt", "layout " + d("bare-layout.json") + "\nquit\n")
+            .string());
     INFO(bare.output);
     REQUIRE(bare.exit_code == 0);
     const auto [bare_touching, bare_drawn] = count("bare-layout.json");
