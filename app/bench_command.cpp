@@ -323,6 +323,7 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       [&device, render, options] { bench::bench_render(device, *render, options->runs); });
 
   add_placement_bench(cmd, device);
+  add_encode_bench(cmd);
 
   auto view = std::make_shared<bench::ViewBenchOptions>();
   CLI::App* view_cmd = cmd->add_subcommand(

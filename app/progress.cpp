@@ -22,4 +22,8 @@ void Progress::step_done(size_t done) {
                terminal_ && !last ? "" : "\n");
 }
 
+double Progress::seconds() const {
+  return std::chrono::duration<double>(Clock::now() - start_).count();
+}
+
 }  // namespace strata::app

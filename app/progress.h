@@ -14,6 +14,8 @@ class Progress {
   // `what` names the steps: "frame", "order".
   Progress(std::string what, size_t total);
   void step_done(size_t done);
+  // Seconds since the progress began.
+  double seconds() const;
 
  private:
   using Clock = std::chrono::steady_clock;

@@ -12,9 +12,8 @@
 
 #include "app/commands.h"
 #include "app/progress.h"
-#include "engine/core/png.h"
+#include "engine/core/frame_writer.h"
 #include "engine/core/text_file.h"
-#include "engine/core/video_file.h"
 #include "labeling/camera_path.h"
 #include "labeling/labelled_render.h"
 #include "labeling/layout_metrics.h"
@@ -41,6 +40,7 @@ struct VideoOptions {
   ForceSettings forces;
   float layer_margin = LayerHysteresis{}.margin;
   uint32_t tidy_rounds = PlacementSettings{}.tidy_rounds;
+  unsigned threads = 0;  // frames compressed at once (0: writer_threads decides)
 };
 
 CameraPath camera_path(const Scene& scene, const VideoOptions& o) {
@@ -57,12 +57,6 @@ CameraPath camera_path(const Scene& scene, const VideoOptions& o) {
     throw UsageError("video: give a camera path (--path) or a turntable (--orbit)");
   const double seconds = o.seconds > 0.0 ? o.seconds : std::abs(o.orbit) / 30.0;
   return orbit_path(scene, camera_for(scene, o.camera), o.orbit, seconds);
-}
-
-std::string frame_name(size_t frame, const char* extension) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame-%05zu.%s", frame, extension);
-  return name;
 }
 
 // -o: NAME.mp4, or a folder for PNG frames (no extension, or one that exists). Anything else
@@ -91,7 +85,7 @@ void create_folder(const std::string& option, const std::filesystem::path& folde
 void record_layout(const std::string& folder, size_t f, const LabelledFrame& frame,
                    std::vector<Layout>* kept) {
   const std::string text = layout_json(frame);
-  const std::filesystem::path path = std::filesystem::path(folder) / frame_name(f, "json");
+  const std::filesystem::path path = std::filesystem::path(folder) / frame_file_name(f, "json");
   if (!folder.empty()) write_text_file(path, text);
   if (kept) kept->push_back(parse_layout(nlohmann::json::parse(text), path));
 }
@@ -110,31 +104,76 @@ LabellingSettings labelling_settings(const Scene& scene, const VideoOptions& o) 
   return settings;
 }
 
+// The cameras sampled along the path, a usage error past kMaxVideoFrames (checked before sample()
+// allocates a camera a frame).
+std::vector<Camera> sampled_cameras(const CameraPath& path, double fps) {
+  if (const double frames = sampled_frames(path, fps); frames > double(kMaxVideoFrames)) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "--fps: %g frames a second for %g s is %.0f frames, more than %u", fps,
+                  path.duration(), frames, kMaxVideoFrames);
+    throw UsageError(text);
+  }
+  return sample(path, fps);
+}
+
+// Frames are compressed on a thread per core while a GPU renders the next one. A CPU device
+// (lavapipe) renders on every core itself: there the frames are written one after another.
+unsigned writer_threads(const Context& ctx, const VideoOptions& o) {
+  if (o.threads) return o.threads;
+  return ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 1 : default_frame_threads();
+}
+
+FrameWriter::Settings writer_settings(const Context& ctx, bool mp4, graph::Extent size,
+                                      const VideoOptions& o) {
+  return {.format = mp4 ? FrameWriter::Format::mp4 : FrameWriter::Format::png_folder,
+          .width = size.width,
+          .height = size.height,
+          .fps = o.fps,
+          .threads = writer_threads(ctx, o)};
+}
+
+// Frame `f` of the sequence: the first is the still that run() placed, every other one a time
+// step of the forces (or, with --no-forces, placed from scratch) at its camera.
+LabelledFrame next_frame(LabelledRenderer& renderer, const Camera& camera, size_t f,
+                         const VideoOptions& o, bool measured) {
+  if (f > 0) {
+    renderer.set_camera(camera);
+    if (o.no_forces) {
+      renderer.run();  // every frame placed from scratch: today's behaviour, for comparison
+    } else {
+      renderer.advance(1.0 / o.fps);
+    }
+  }
+  LabelledFrame frame = renderer.result(measured);
+  if (f > 0) frame.seconds = 1.0 / o.fps;  // (with --no-forces too: a frame of the sequence)
+  return frame;
+}
+
+// "wrote 31 frames (1920x1080, 30 fps) to DIR in 1.2 s, 25.8 frames/s"
+void print_written(const VideoOptions& o, graph::Extent size, size_t frames, double seconds) {
+  const double rate = seconds > 0.0 ? double(frames) / seconds : 0.0;
+  std::printf("wrote %zu frames (%ux%u, %g fps) to %s in %.1f s, %.*f frames/s\n", frames,
+              size.width, size.height, o.fps, o.output.c_str(), seconds, rate < 10.0 ? 2 : 1, rate);
+}
+
 void video(DeviceOptions& device, const VideoOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const std::filesystem::path output = o.output;
   const bool mp4 = is_mp4(output);
   Context ctx(device.context());
   const Scene scene = load_scene_reporting(o.scene, ctx);
-  const CameraPath path = camera_path(scene, o);
-  // (checked before sample() allocates a camera a frame)
-  if (const double frames = sampled_frames(path, o.fps); frames > double(kMaxVideoFrames)) {
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  "--fps: %g frames a second for %g s is %.0f frames, more than %u", o.fps,
-                  path.duration(), frames, kMaxVideoFrames);
-    throw UsageError(text);
-  }
-  const std::vector<Camera> cameras = sample(path, o.fps);
+  const std::vector<Camera> cameras = sampled_cameras(camera_path(scene, o), o.fps);
   if (!mp4) create_folder("-o", output);
   if (!o.layout_dir.empty()) create_folder("--layout-dir", o.layout_dir);
   if (!o.still_layouts.empty()) create_folder("--still-layouts", o.still_layouts);
-  // Frames go to a temporary file, put in place by finish(): an error on the way leaves no MP4.
-  std::unique_ptr<VideoFile> file;
-  if (mp4) file = std::make_unique<VideoFile>(o.output, size.width, size.height, o.fps);
+  // Frames are compressed on worker threads while the next one renders; an MP4 goes to a
+  // temporary file, put in place by finish(): an error on the way leaves no MP4.
+  FrameWriter writer(output, writer_settings(ctx, mp4, size, o));
 
   const LabellingSettings settings = labelling_settings(scene, o);
   LabelledRenderer renderer(ctx, scene, cameras.front(), size, settings);
+  Progress progress("frame", cameras.size());
   renderer.run();  // the first frame: the labels settled on their placement
   // --still-layouts: a second renderer places every frame's camera afresh, as a still.
   std::unique_ptr<LabelledRenderer> still;
@@ -144,34 +183,20 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   // (legibility only where a layout is used: it reads the layers back)
   const bool measured = !o.layout_dir.empty() || o.report;
   std::vector<Layout> frame_layouts, still_layouts;  // for the report
-  Progress progress("frame", cameras.size());
   for (size_t f = 0; f < cameras.size(); ++f) {
-    if (f > 0) {
-      renderer.set_camera(cameras[f]);
-      if (o.no_forces) {
-        renderer.run();  // every frame placed from scratch: today's behaviour, for comparison
-      } else {
-        renderer.advance(1.0 / o.fps);
-      }
-    }
-    LabelledFrame frame = renderer.result(measured);
-    if (f > 0) frame.seconds = 1.0 / o.fps;  // (with --no-forces too: a frame of the sequence)
-    if (file) {
-      file->write(frame.image);
-    } else {
-      write_png((output / frame_name(f, "png")).string(), size.width, size.height, frame.image);
-    }
+    LabelledFrame frame = next_frame(renderer, cameras[f], f, o, measured);
+    writer.write(std::move(frame.image));  // (the picture is the frame's own copy)
     if (measured) record_layout(o.layout_dir, f, frame, o.report ? &frame_layouts : nullptr);
     if (still) {
       still->set_camera(cameras[f]);
       still->run();
       record_layout(o.still_layouts, f, still->result(), o.report ? &still_layouts : nullptr);
     }
-    progress.step_done(f + 1);
+    if (f + 1 < cameras.size()) progress.step_done(f + 1);  // (the last once it is written)
   }
-  if (file) file->finish();
-  std::printf("wrote %zu frames (%ux%u, %g fps) to %s\n", cameras.size(), size.width, size.height,
-              o.fps, o.output.c_str());
+  writer.finish();
+  progress.step_done(cameras.size());
+  print_written(o, size, cameras.size(), progress.seconds());
   if (o.report) {
     const std::string report =
         to_json(sequence_metrics(frame_layouts, still_layouts), false).dump(2);
@@ -264,6 +289,11 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
                   "changes layer, as a share of the distance to the next plane")
       ->capture_default_str()
       ->check(finite_range(0.0, 100.0));
+  // (1: every frame written before the next renders, as before the worker threads)
+  cmd->add_option("--threads", o->threads,
+                  "threads compressing frames (default: one per core; 1 on a CPU device)")
+      ->check(whole_range(1, 1024))
+      ->group("");
   cmd->callback([&device, o] { video(device, *o); });
 }
 

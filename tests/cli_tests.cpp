@@ -259,6 +259,67 @@ TEST_SUITE("cli") {
     CHECK(evaluated["per_frame"].size() == frames);
   }
 
+  // Frames compressed on worker threads are the files of frames written one after another, and
+  // the last line says how fast the frames came.
+  TEST_CASE("video_frames_written_on_threads_are_the_bytes_of_frames_written_one_by_one") {
+    const std::string dir = empty_folder("video-threads");
+    const std::string video = "video " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --orbit 12 --seconds 0.1 --fps 30 "
+                              "--size 64 -o " +
+                              dir;
+    const auto serial = run_strata(video + "/serial --threads 1");
+    REQUIRE(serial.exit_code == 0);
+    const auto threaded = run_strata(video + "/threaded --threads 3");
+    REQUIRE(threaded.exit_code == 0);
+    CHECK(threaded.output.find("wrote 4 frames (64x64, 30 fps) to " + dir + "/threaded in ") !=
+          std::string::npos);
+    CHECK(threaded.output.find(" frames/s\n") != std::string::npos);
+    const auto frames = test::folder_bytes(dir + "/serial");
+    CHECK(frames.size() == 4);
+    CHECK(test::folder_bytes(dir + "/threaded") == frames);
+  }
+
+  // A write that fails on a worker thread (files limited to one block, as on a full disk) ends
+  // the run with the first frame's error and exit 1, and leaves no frame and no MP4.
+  TEST_CASE("video_whose_frames_fail_on_worker_threads_exits_1_with_the_first_frames_error") {
+    const std::string dir = empty_folder("video-threads-full");
+    const std::string video = "video " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --orbit 12 --seconds 0.1 --fps 30 "
+                              "--size 64 --threads 3 -o " +
+                              dir;
+    const std::string small_files = "trap '' XFSZ; ulimit -f 1;";
+    const auto png = run_strata(video + "/frames", small_files);
+    CHECK(png.exit_code == 1);
+    CHECK(png.output.find("strata: error: " + dir +
+                          "/frames/frame-00000.png: cannot write PNG: File too large") !=
+          std::string::npos);
+    CHECK(std::filesystem::is_empty(dir + "/frames"));
+#if STRATA_VIDEO
+    const auto mp4 = run_strata(video + "/video.mp4", small_files);
+    CHECK(mp4.exit_code == 1);
+    CHECK(mp4.output.find("File too large") != std::string::npos);
+    CHECK(!std::filesystem::exists(dir + "/video.mp4"));
+#endif
+  }
+
+  // The video's writers alone: frames a second of each, and the files they wrote kept.
+  TEST_CASE("bench_encode_reports_the_frames_a_second_of_the_png_and_mp4_writers") {
+    const std::string dir = empty_folder("bench-encode");
+    const auto r = run_strata("bench encode --size 64x48 --frames 5 --threads 2 --output " + dir);
+    REQUIRE(r.exit_code == 0);
+    const nlohmann::json report = bench_report(r.output);
+    CHECK(report["benchmark"] == "encode");
+    CHECK(report["threads"] == 2);
+    CHECK(report["png"]["frames_per_second"].get<double>() > 0.0);
+    CHECK(read_png(dir + "/frames/frame-00004.png").width == 64);
+#if STRATA_VIDEO
+    CHECK(report["mp4"]["frames_per_second"].get<double>() > 0.0);
+    CHECK(test::probe_video(dir + "/video.mp4", "width,height,nb_read_frames") == "64,48,5");
+#else
+    CHECK(report["mp4"].is_null());
+#endif
+  }
+
   TEST_CASE("video_with_two_paths_or_none_is_one_clear_error") {
     const auto both = run_strata("video " STRATA_SOURCE_DIR
                                  "/assets/scenes/head.json --orbit 10 --path front -o x.mp4");

@@ -91,6 +91,7 @@ VideoFile::VideoFile(const std::string& path, uint32_t width, uint32_t height, d
   c.encoder->framerate = rate;
   c.encoder->pix_fmt = AV_PIX_FMT_YUV420P;
   c.encoder->gop_size = int(2 * fps);
+  c.encoder->thread_count = 0;  // the encoder's own threads, as many as it sees fit (libx264's)
   if (c.format->oformat->flags & AVFMT_GLOBALHEADER) {
     c.encoder->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
   }
@@ -115,6 +116,10 @@ VideoFile::VideoFile(const std::string& path, uint32_t width, uint32_t height, d
 }
 
 VideoFile::~VideoFile() = default;
+
+bool VideoFile::built() {
+  return true;
+}
 
 void VideoFile::write(std::span<const uint8_t> rgba) {
   Codec& c = *codec_;
@@ -154,6 +159,9 @@ VideoFile::VideoFile(const std::string& path, uint32_t, uint32_t, double) {
               "frames to a folder instead");
 }
 VideoFile::~VideoFile() = default;
+bool VideoFile::built() {
+  return false;
+}
 void VideoFile::write(std::span<const uint8_t>) {}
 void VideoFile::finish() {}
 

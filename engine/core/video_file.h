@@ -18,6 +18,10 @@ class VideoFile {
   VideoFile(const VideoFile&) = delete;
   VideoFile& operator=(const VideoFile&) = delete;
 
+  // Whether this build writes MP4 (STRATA_VIDEO): without, the constructor throws an Error that
+  // says so.
+  static bool built();
+
   // Appends one frame of width x height RGBA8 pixels, rows top to bottom.
   void write(std::span<const uint8_t> rgba);
   // Flushes the encoder, writes the file's index and puts the file in place. Until then the frames
