@@ -349,12 +349,13 @@ TEST_SUITE("window") {
   TEST_CASE("viewer_tries_insertion_orders_when_the_camera_rests") {
     // Optimisation on idle: once the view has rested, trial frames try random orders (labels
     // stay where they are meanwhile); a camera move starts it again; then nothing is drawn.
+    // (Trials are frames that place: the placement in the frame, no interactive rendering.)
     const auto dir = test::fresh_folder("viewer", "optimize");
     const auto d = [&](const char* name) { return (dir / name).string(); };
     const auto r = view(dir,
                         "report " + d("opened.json") + "\ndrag left 80 60 90 60\nreport " +
                             d("moved.json") + "\nsleep 1.5\nreport " + d("still.json") + "\nquit\n",
-                        "--no-panel");
+                        "--no-panel --frame-budget 0");
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     const auto field = [&](const char* name, const char* key) {
