@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <random>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -142,6 +143,8 @@ struct ViewBenchOptions {
   double degrees = 90.0;
   uint32_t tidy_rounds = kViewerTidyRounds;
   bool keep_apart = true;
+  std::string placement = "auto";
+  double pace = 0.0;  // frames a second the frames are started at (a display's); 0: at once
 };
 
 // The part of a group's name before its first dot ("placement.sat" is part of "placement"), or
@@ -178,6 +181,41 @@ struct ViewRun {
     return out;
   }
 };
+
+// The placement's own figures over a run: placements finished and taken up, their rate, GPU time
+// and latency (frames from the frame that started one to the frame that took it up). In the
+// frame: one a frame, no latency, the placement group's time.
+ordered_json placement_json(const ViewRun& r, size_t frames, bool beside, double group_ms) {
+  const double frame_ms = 1e3 * r.seconds / double(frames);
+  if (!beside) {
+    return {{"mode", "frame"},
+            {"placements", frames},
+            {"per_second", double(frames) / r.seconds},
+            {"gpu_ms_mean", ms_json(group_ms)},
+            {"latency_frames_mean", 0},
+            {"latency_frames_max", 0},
+            {"latency_ms_mean", 0}};
+  }
+  const uint64_t count = r.after.placements - r.before.placements;
+  const std::vector<uint32_t> latency(
+      r.after.placement_latency_frames.begin() + long(r.before.placement_latency_frames.size()),
+      r.after.placement_latency_frames.end());
+  double sum = 0.0;
+  uint32_t most = 0;
+  for (const uint32_t l : latency) {
+    sum += l;
+    most = std::max(most, l);
+  }
+  const double mean = latency.empty() ? 0.0 : sum / double(latency.size());
+  const double gpu = r.after.placement_gpu_ms - r.before.placement_gpu_ms;
+  return {{"mode", "beside"},
+          {"placements", count},
+          {"per_second", double(count) / r.seconds},
+          {"gpu_ms_mean", ms_json(count ? gpu / double(count) : 0.0)},
+          {"latency_frames_mean", mean},
+          {"latency_frames_max", most},
+          {"latency_ms_mean", ms_json(mean * frame_ms)}};
+}
 
 ordered_json means_json(const std::map<std::string, double>& means) {
   ordered_json out = ordered_json::object();
@@ -216,6 +254,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   options.scene_path = o.scene;
   options.optimize_on_idle = false;
   options.keep_frame_spans = true;
+  options.placement_beside = placement_beside(o.placement, ctx);
   Viewer viewer(ctx, scene, cameras.front(), settings, options, output, nullptr);
   for (int i = 0; i < 10; ++i) viewer.frame(1.0 / fps);  // warm up: the HA-Buffer grows
   // The path three times: with a timestamp around every pass (the time of each), with stamps only
@@ -231,8 +270,11 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
     output.wait_idle();
     ViewRun r{viewer.summary(), {}, 0.0};
     const auto start = std::chrono::steady_clock::now();
-    for (const Camera& camera : cameras) {
-      viewer.set_camera(camera);
+    for (size_t f = 0; f < cameras.size(); ++f) {
+      if (o.pace > 0.0) {
+        std::this_thread::sleep_until(start + std::chrono::duration<double>(double(f) / o.pace));
+      }
+      viewer.set_camera(cameras[f]);
       viewer.frame(1.0 / fps);
     }
     output.wait_idle();
@@ -261,11 +303,16 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   out["keep_apart"] = o.keep_apart;
   out["frames"] = cameras.size();
   out["frames_in_flight"] = output.frames_in_flight();
+  out["pace"] = o.pace;
   out["frames_per_second"] = double(cameras.size()) / frames.seconds;
   out["gpu_frame_ms"] = frames.frame_quantiles();
   out["gpu_frame_ms_stamped_per_group"] = groups.frame_quantiles();
   out["mean_group_ms"] = means_json(group_means);
   out["mean_group_total_ms"] = means_json(totals);
+  const auto placement_group = totals.find("placement");
+  out["placement"] =
+      placement_json(frames, cameras.size(), options.placement_beside,
+                     placement_group == totals.end() ? 0.0 : placement_group->second);
   out["gpu_frame_ms_stamped_per_pass"] = passes.frame_quantiles();
   out["mean_pass_ms"] = means_json(passes.means());
   out["mean_group_total_ms_stamped_per_pass"] = means_json(group_totals(passes.means(), group_of));
@@ -282,6 +329,14 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   }
   const auto other = totals.find("ungrouped");
   std::fprintf(stderr, " ungrouped %.3f ms\n", other == totals.end() ? 0.0 : other->second);
+  const ordered_json& placed = out["placement"];
+  std::fprintf(stderr,
+               "bench view: placement %s: %.1f a second, GPU %.3f ms each, latency %.2f frames "
+               "(max %u, %.3f ms); %.1f frames a second\n",
+               placed["mode"].get<std::string>().c_str(), placed["per_second"].get<double>(),
+               placed["gpu_ms_mean"].get<double>(), placed["latency_frames_mean"].get<double>(),
+               placed["latency_frames_max"].get<uint32_t>(),
+               placed["latency_ms_mean"].get<double>(), out["frames_per_second"].get<double>());
 }
 
 }  // namespace
@@ -344,6 +399,13 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   view_cmd->add_flag_callback(
       "--let-overlap", [view] { view->keep_apart = false; },
       "labels on their way may overlap (the forces alone, as `video --let-overlap`)");
+  add_placement_option(view_cmd, view->placement);
+  view_cmd
+      ->add_option("--pace", view->pace,
+                   "start a frame this many times a second, as a display's refresh would "
+                   "(0: each as soon as the last is submitted)")
+      ->check(finite_range(0.0, 10000.0))
+      ->capture_default_str();
   view_cmd->callback([&device, view] { bench::bench_view(device, *view); });
 
   add_soak_command(cmd, device);

@@ -72,6 +72,11 @@ graph::Extent parse_size(const std::string& text, const char* option);
 // A UsageError naming the option and the device's limit when `size` is over maxImageDimension2D.
 void check_image_size(const Context& ctx, graph::Extent size, const char* option);
 
+// --placement (view, bench view): "beside" the frames on a queue of its own, in the "frame", or
+// "auto": beside where the device has a second queue (Context::separate_placement_queue).
+void add_placement_option(CLI::App* cmd, std::string& mode);
+bool placement_beside(const std::string& mode, const Context& ctx);
+
 void add_devices_command(CLI::App& app, DeviceOptions& device);
 void add_render_command(CLI::App& app, DeviceOptions& device);
 void add_view_command(CLI::App& app, DeviceOptions& device);

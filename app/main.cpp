@@ -107,6 +107,18 @@ void check_image_size(const Context& ctx, graph::Extent size, const char* option
   }
 }
 
+void add_placement_option(CLI::App* cmd, std::string& mode) {
+  cmd->add_option("--placement", mode,
+                  "beside: the placement runs beside the frames, which never wait for it; frame: "
+                  "in every frame; auto: beside where the device has a second queue")
+      ->check(CLI::IsMember({"auto", "beside", "frame"}))
+      ->capture_default_str();
+}
+
+bool placement_beside(const std::string& mode, const Context& ctx) {
+  return mode == "beside" || (mode == "auto" && ctx.separate_placement_queue());
+}
+
 graph::Extent parse_size(const std::string& text, const char* option) {
   unsigned w = 0, h = 0;
   char x = 0, extra = 0;

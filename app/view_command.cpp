@@ -39,7 +39,9 @@ struct ViewOptions {
   double settle_limit = 120.0;  // seconds a script waits for the view to settle
   bool no_optimize = false;
   bool no_panel = false;
-  float label_scale = 1.0f;  // times the display's content scale
+  std::string placement = "auto";
+  std::optional<double> frame_budget;  // ms; none: by the device's type
+  float label_scale = 1.0f;            // times the display's content scale
 };
 
 struct Window {
@@ -280,6 +282,12 @@ void on_refresh(GLFWwindow*) {
 
 // --- the labelled scene ------------------------------------------------------------------------
 
+// A CPU device draws a frame of 512 x 512 in seconds: it renders fewer pixels while the camera
+// moves, for 8 frames a second; a GPU renders every pixel.
+double default_frame_budget_ms(const Context& ctx) {
+  return ctx.report().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 125.0 : 0.0;
+}
+
 void print_summary(const Viewer& viewer, const std::string& scene) {
   const ViewerSummary& s = viewer.summary();
   const graph::Extent e = viewer.extent();
@@ -290,6 +298,30 @@ void print_summary(const Viewer& viewer, const std::string& scene) {
       scene.c_str(), static_cast<unsigned long long>(s.frames), e.width, e.height,
       s.busy_seconds > 0 ? double(s.frames) / s.busy_seconds : 0.0, stats.load_factor(),
       stats.overflow);
+  if (s.moving_frames > 0 || !s.refine_seconds.empty()) {
+    double refine = 0.0, worst = 0.0;
+    for (const double r : s.refine_seconds) {
+      refine += r;
+      worst = std::max(worst, r);
+    }
+    std::printf(
+        "view: while the camera moved %llu frames, %.1f frames/s, %u x %u pixels to a ray at "
+        "most; full quality %.2f s after it rested (mean of %zu, at most %.2f)\n",
+        static_cast<unsigned long long>(s.moving_frames),
+        s.moving_seconds > 0 ? double(s.moving_frames) / s.moving_seconds : 0.0, s.largest_divisor,
+        s.largest_divisor,
+        s.refine_seconds.empty() ? 0.0 : refine / double(s.refine_seconds.size()),
+        s.refine_seconds.size(), worst);
+  }
+  if (s.placements > 0) {
+    uint64_t latency = 0;
+    for (const uint32_t l : s.placement_latency_frames) latency += l;
+    std::printf(
+        "view: placement beside the frames: %llu placements taken up, %.3f GPU ms each, %.2f "
+        "frames from start to take-up\n",
+        static_cast<unsigned long long>(s.placements), s.placement_gpu_ms / double(s.placements),
+        double(latency) / double(s.placement_latency_frames.size()));
+  }
   if (s.timed_frames == 0) return;
   double total = 0.0;
   std::printf("view: mean GPU ms per pass over %llu frames:",
@@ -329,6 +361,8 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   options.optimize_on_idle = !o.no_optimize;
   options.ui_scale = std::max(scale_x, scale_y);
   options.show_panel = !o.no_panel;
+  options.placement_beside = placement_beside(o.placement, ctx);
+  options.frame_budget_ms = o.frame_budget.value_or(default_frame_budget_ms(ctx));
   WindowOutput output(ctx, window.handle, o.frames_in_flight);
   Viewer viewer(ctx, scene, camera, settings, options, output, window.handle);
   g_viewer = &viewer;
@@ -451,6 +485,11 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--no-optimize", o->no_optimize,
                 "do not try random insertion orders when the camera rests");
   cmd->add_flag("--no-panel", o->no_panel, "start with the panel hidden (h shows it)");
+  add_placement_option(cmd, o->placement);
+  cmd->add_option("--frame-budget", o->frame_budget,
+                  "ms a frame may take while the camera moves: rays for fewer pixels then, full "
+                  "resolution at rest (default: 125 on a CPU device, 0 = off on a GPU)")
+      ->check(finite_range(0.0, 10000.0));
   cmd->add_option("--label-scale", o->label_scale,
                   "label text and boxes times this and the display's content scale (0.25 to 4)")
       ->check(finite_range(0.25, 4.0))

@@ -203,7 +203,9 @@ bool HeadlessOutput::draw(const WindowTarget::Prepare& prepare) {
   runner.set_viewport(size_);
   const VkCommandBuffer cmd = slots_.begin(slot);
   runner.record(cmd, slot);
-  slots_.submit(slot);
+  const graph::FrameSubmission& extra = runner.submission();
+  slots_.submit(slot, extra.wait, extra.signal);
+  if (extra.submitted) extra.submitted();
   return true;
 }
 
@@ -243,7 +245,9 @@ Viewer::Viewer(Context& ctx, Scene& scene, const Camera& camera, const Labelling
       slots_(output.frames_in_flight()) {
   graph::Extent size = output.extent();
   if (size.width == 0 || size.height == 0) size = {64, 64};  // (a minimised window: resized later)
-  labelled_ = std::make_unique<LabelledRenderer>(ctx, scene, camera, size, settings);
+  LabellingSettings labelling = settings;
+  labelling.render.interactive = options.frame_budget_ms > 0.0;
+  labelled_ = std::make_unique<LabelledRenderer>(ctx, scene, camera, size, labelling);
   labelled_->set_extension([this](graph::Graph& graph, const LabelledRenderer::GraphIds& ids) {
     extend_graph(graph, ids);
   });
@@ -268,17 +272,20 @@ Viewer::~Viewer() {
 // image, the UI drawn onto it, then the output (the window's present).
 void Viewer::extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds& ids) {
   ++generation_;
+  // (beside the frames, the placement's buffers are not in the frame's graph: no debug view)
   const graph::ResourceId debug_image =
-      debug_.add_to(graph, {.saliency = ids.placed.saliency,
-                            .costs = ids.placed.costs,
-                            .labels = ids.placed.labels,
-                            .placements = ids.placed.placements,
-                            .order = ids.placed.order,
-                            .layers = ids.rendered.layers,
-                            .frame = ids.rendered.frame,
-                            .keys = ids.rendered.keys,
-                            .layer_count = ids.layer_count,
-                            .label_count = uint32_t(scene_.labels.size())});
+      !ids.placement_in_frame
+          ? ids.labelled
+          : debug_.add_to(graph, {.saliency = ids.placed.saliency,
+                                  .costs = ids.placed.costs,
+                                  .labels = ids.placed.labels,
+                                  .placements = ids.placed.placements,
+                                  .order = ids.placed.order,
+                                  .layers = ids.rendered.layers,
+                                  .frame = ids.rendered.frame,
+                                  .keys = ids.rendered.keys,
+                                  .layer_count = ids.layer_count,
+                                  .label_count = uint32_t(scene_.labels.size())});
   display_id_ = graph.add_image("view.display", {VK_FORMAT_R8G8B8A8_UNORM});
   const graph::ResourceId labelled = ids.labelled, display = display_id_;
   graph.add_pass({"view.copy",
@@ -608,6 +615,8 @@ void Viewer::set_transfer(uint32_t volume) {
 
 void Viewer::changed() {
   ++serial_;
+  change_frame_ = labelled_->frame_number() + 1;
+  labelled_->placement_due();
   settled_ = false;
   last_change_ = Clock::now();
   optimisation_ = {};  // (trials of an earlier serial are ignored when they come back)
@@ -618,6 +627,7 @@ void Viewer::apply_camera() {
   if (same_view(camera, applied_camera_)) return;
   applied_camera_ = camera;
   labelled_->set_camera(camera);  // (the order goes back to the scene's)
+  last_move_ = Clock::now();
   changed();
 }
 
@@ -639,6 +649,8 @@ std::string Viewer::unsettled() const {
   if (!same_view(control_.camera(), applied_camera_)) parts.push_back("the camera's last move");
   if (!settled_ && checked_serial_ != serial_) {
     parts.push_back("the first frames after the last change");
+  } else if (!settled_ && placement_due_) {
+    parts.push_back("the placement beside the frames since the last change");
   } else if (!settled_) {
     std::string text = std::to_string(moving_labels_.size()) + " label" +
                        (moving_labels_.size() == 1 ? "" : "s") + " moving or fading (";
@@ -725,6 +737,16 @@ void Viewer::read_slot(uint32_t slot) {
     }
     return;
   }
+  // Beside the frames, the labels head for a placement made before the last change: not settled.
+  placement_due_ = labelled_->placed_frame_number() < change_frame_;
+  if (placement_due_) {
+    checked_serial_ = serial_;
+    return;
+  }
+  if (refining_ && done.divisor == 1 && !camera_moving()) {
+    refining_ = false;
+    summary_.refine_seconds.push_back(seconds_between(last_move_, Clock::now()));
+  }
   // A normal frame: settled when every label is on its target and fully faded in or out.
   const auto targets = labelled_->placement_results();
   const auto drawn = labelled_->drawn();
@@ -762,18 +784,54 @@ graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double 
     apollonius_serial_ = serial_;
     settled_ = false;
   }
-  const int trial = next_trial();
+  const bool interactive = options_.frame_budget_ms > 0.0;
+  labelled_->set_placement_beside((options_.placement_beside || interactive) && !debug_choice_);
+  const int trial = labelled_->placement_beside() ? -1 : next_trial();
   if (trial >= 0) labelled_->set_trial_order(optimisation_.orders[size_t(trial)]);
   labelled_->prepare_frame(seconds, trial >= 0);
+  count_placements();
   debug_.set_enabled(debug_choice_.has_value());
   if (debug_choice_) {
     debug_.set(*debug_choice_);
     debug_.set_placement(uint32_t(labelled_->placement_order_count()),
                          labelled_->settings().placement.margin_em * labelled_->units().em);
   }
-  slots_[slot] = {generation_, serial_, trial};
+  slots_[slot] = {generation_, serial_, trial, labelled_->renderer().settings().divisor};
   last_slot_ = slot;
   return labelled_->runner();
+}
+
+// The camera moves: an animation, a drag in progress, or a move in the last quarter second (the
+// frames between a drag's events keep the interactive resolution).
+bool Viewer::camera_moving() const {
+  return control_.animating() || drag_button_ >= 0 ||
+         seconds_between(last_move_, Clock::now()) < 0.25;
+}
+
+// While the camera moves, the divisor that keeps a frame within the budget; at rest, 1 (and the
+// placement beside the frames, paused while moving, places the resting view).
+void Viewer::choose_divisor(bool moving) {
+  if (options_.frame_budget_ms <= 0.0) return;
+  uint32_t d = 1;
+  if (moving && full_frame_ms_ > options_.frame_budget_ms) {
+    d = uint32_t(std::ceil(std::sqrt(full_frame_ms_ / options_.frame_budget_ms)));
+  }
+  divisor_ = std::clamp(d, 1u, 8u);
+  summary_.largest_divisor = std::max(summary_.largest_divisor, divisor_);
+  labelled_->renderer().settings().divisor = debug_choice_ ? 1u : divisor_;
+  labelled_->pause_placement(moving);
+  if (moving) refining_ = true;
+}
+
+// The placements beside the frames taken up since the last frame: their GPU time and latency.
+void Viewer::count_placements() {
+  const PlacementBeside* beside = labelled_->beside();
+  if (!beside || beside->stats().adopted == summary_.placements) return;
+  summary_.placements = beside->stats().adopted;
+  summary_.placement_latency_frames.push_back(beside->stats().latency_frames.back());
+  const auto& timings = beside->placement_timings();
+  if (!timings.empty())
+    summary_.placement_gpu_ms += timings.back().end_ms - timings.front().begin_ms;
 }
 
 void Viewer::set_habuffer_slots(uint32_t slots) {
@@ -818,13 +876,25 @@ void Viewer::draw_frame(std::optional<double> step) {
 
   control_.update(seconds);
   apply_camera();
+  const bool moving = camera_moving();
+  choose_divisor(moving);
   const bool drawn =
       output_.draw([this, seconds](uint32_t slot, graph::Extent e) -> graph::GraphRunner& {
         return prepare(slot, e, seconds);
       });
   if (!drawn) return;
   ++summary_.frames;
-  summary_.busy_seconds += seconds_between(now, Clock::now());
+  const double busy = seconds_between(now, Clock::now());
+  summary_.busy_seconds += busy;
+  if (moving) {
+    ++summary_.moving_frames;
+    summary_.moving_seconds += busy;
+  }
+  if (options_.frame_budget_ms > 0.0) {
+    // (a frame of d-th pixels costs about 1 / d^2 of a full one, and a little more)
+    const double full = 1e3 * busy * double(divisor_) * double(divisor_);
+    full_frame_ms_ = full_frame_ms_ > 0.0 ? 0.5 * (full_frame_ms_ + full) : full;
+  }
   if (video_) {
     const std::vector<uint8_t> pixels = download(labelled_->labelled_image());
     const graph::Extent e = labelled_->size();

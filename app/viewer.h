@@ -96,6 +96,15 @@ struct ViewerOptions {
   // ViewerSummary::gpu_span_ms gets every frame's span (for `bench view`'s quantiles); off, a
   // viewer left running for hours keeps no per-frame list.
   bool keep_frame_spans = false;
+  // The placement beside the frames (LabelledRenderer::set_placement_beside): frames never wait
+  // for it. Off while a debug view of the placement's buffers is shown, and no optimisation on
+  // idle with it (its trials are frames that place).
+  bool placement_beside = false;
+  // Interactive rendering (a CPU device's default): while the camera moves, rays are cast for
+  // every d-th pixel each way only, d chosen so that a frame takes about this long, and the
+  // placement beside the frames waits until the camera rests; at rest, full resolution again.
+  // 0: off.
+  double frame_budget_ms = 0.0;
 };
 
 // Totals over a run, printed when the viewer closes and by `strata bench view`.
@@ -107,6 +116,17 @@ struct ViewerSummary {
   std::vector<double> gpu_span_ms;  // per frame read (keep_frame_spans): first to last pass's end
   uint64_t trials = 0;              // optimisation on idle: orders tried ...
   uint64_t adopted = 0;             // ... and kept
+  // The placement beside the frames: placements the frames took up, their GPU time (first pass's
+  // start to last pass's end) and the frames from each one's start to its take-up.
+  uint64_t placements = 0;
+  double placement_gpu_ms = 0.0;
+  std::vector<uint32_t> placement_latency_frames;
+  // Frames drawn while the camera moved, and their time; for each rest, the seconds from the
+  // camera's last move to the first frame at full resolution with the placement of the rest.
+  uint64_t moving_frames = 0;
+  double moving_seconds = 0.0;
+  uint32_t largest_divisor = 1;
+  std::vector<double> refine_seconds;
 };
 
 class Viewer {
@@ -191,6 +211,7 @@ class Viewer {
     uint64_t generation = 0;  // LabelledRenderer's graph when recorded (0: never used)
     uint64_t serial = 0;      // the change serial the frame was made for
     int trial = -1;           // a trial frame's index, or -1
+    uint32_t divisor = 1;     // every divisor-th pixel each way cast (interactive rendering)
   };
   void changed();
   void apply_camera();
@@ -236,6 +257,10 @@ class Viewer {
   glm::uvec4 panel_{0u};  // the panel's rectangle this frame, x0 y0 x1 y1 (none: hidden)
   std::vector<uint32_t> moving_labels_;  // labels not yet on their targets (the last frame's)
   uint64_t checked_serial_ = ~0ull;      // the serial of that frame
+  // Beside the frames: the first frame after the last change (LabelledRenderer::frame_number);
+  // the view is not settled before a placement started from it or later is taken up.
+  uint64_t change_frame_ = 0;
+  bool placement_due_ = false;  // the last frame read had no such placement yet
 
   // Change tracking and idle.
   uint64_t serial_ = 1;
@@ -245,6 +270,14 @@ class Viewer {
   bool settled_ = false;
   std::vector<SlotFrame> slots_;
   uint32_t last_slot_ = 0;
+  void count_placements();
+  // Interactive rendering: whether the camera moves now, and the divisor for this frame.
+  bool camera_moving() const;
+  void choose_divisor(bool moving);
+  double full_frame_ms_ = 0.0;  // the estimated time of a frame at full resolution
+  uint32_t divisor_ = 1;
+  std::chrono::steady_clock::time_point last_move_;
+  bool refining_ = false;  // the camera rested; its full-quality frame has not come back yet
 
   // Optimisation on idle: random orders tried in trial frames, the cheapest kept.
   struct Optimisation {

@@ -138,6 +138,7 @@ void LabelledRenderer::set_size(graph::Extent size) {
   size_ = size;
   runner_->set_viewport(size);
   set_camera(camera_);
+  if (beside_) beside_->build(layering_.layer_count, size_);
 }
 
 std::span<const gpu::PlacementGpu> LabelledRenderer::placement_results() const {
@@ -172,16 +173,17 @@ void LabelledRenderer::set_frames_in_flight(uint32_t frames) {
   frames_in_flight_ = frames;
   runner_->set_frames_in_flight(frames);
   parts_->renderer.readback().set_slots(frames);
-  parts_->placement.readback().set_slots(frames);
+  if (!beside_) parts_->placement.readback().set_slots(frames);
   parts_->forces.readback().set_slots(frames);
   use_slot(0);
 }
 
 void LabelledRenderer::use_slot(uint32_t slot) {
   parts_->renderer.readback().use_slot(*runner_, slot);
-  parts_->placement.readback().use_slot(*runner_, slot);
+  if (!beside_) parts_->placement.readback().use_slot(*runner_, slot);
   parts_->forces.readback().use_slot(*runner_, slot);
   stats_ = parts_->renderer.collect(*runner_);
+  if (stats_.overflow > 0) placement_due();  // (the next frames show what this one missed)
 }
 
 void LabelledRenderer::prepare_frame(double seconds, bool trial) {
@@ -189,8 +191,14 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
   set_placement_frame(true, trial_order ? trial_within_ : within_);
   ForceSettings forces = settings_.forces;
   if (afresh_) forces.hold_share = forces.hold_cost = 0.0f;
+  ++frame_number_;
   parts_->forces.set_frame(forces, units(), seconds, settings_.placement.hard,
                            parts_->placement.order_count());
+  if (beside_) {
+    beside_->set_frame_number(frame_number_);
+    beside_->prepare(*runner_, labels_);  // (a placement started now takes this frame's params)
+    parts_->forces.set_order_count(beside_->adopted_order_count());
+  }
   parts_->forces.set_trial(trial);
   afresh_ = false;
   camera_moved_ = false;
@@ -229,19 +237,9 @@ void LabelledRenderer::build_graph() {
 
   graph::Graph graph;
   const VolumeRenderer::Outputs rendered = p.renderer.add_to(graph);
-  const graph::ResourceId state = p.forces.import_state(graph);
-  placed_ = p.placement.add_to(
-      graph, {.final_image = rendered.final,
-              .layers = rendered.layers,
-              .layer_count = render.layer_count,
-              .adjust_labels = [&p, state](graph::Graph& g, graph::ResourceId labels) {
-                p.forces.add_previous(g, labels, state);
-              }});
-  const LabelForces::Outputs moved = p.forces.add_to(
-      graph, {.labels = placed_.labels,
-              .targets = placed_.placements,
-              .state = state,
-              .order = placed_.order});
+  graph::ResourceId labels = 0;
+  const LabelForces::Outputs moved = beside_ ? add_placement_beside(graph, rendered, labels)
+                                             : add_placement_in_frame(graph, rendered, labels);
   layers_id_ = rendered.layers;
   const graph::ResourceId glyph_buffer =
       graph.import_buffer("labels.glyphs", {.buffer = p.glyphs.handle(), .has_content = true});
@@ -249,13 +247,14 @@ void LabelledRenderer::build_graph() {
   labelled_id_ = labelled;
   p.drawing->add_to(graph, {.layers = rendered.layers,
                             .layer_count = render.layer_count,
-                            .labels = placed_.labels,
+                            .labels = labels,
                             .placements = moved.drawn,
                             .glyphs = glyph_buffer,
                             .output = labelled,
                             .background = render.background});
   if (extension_) {
-    extension_(graph, {labelled, rendered, placed_, moved.drawn, render.layer_count});
+    extension_(graph,
+               {labelled, rendered, placed_, moved.drawn, render.layer_count, beside_ == nullptr});
   } else {
     p.target.add_output(graph, labelled);
   }
@@ -264,6 +263,58 @@ void LabelledRenderer::build_graph() {
   runner_->set_viewport(size_);
   if (!extension_) p.target.bind(*runner_);
   if (frames_in_flight_ > 1) runner_->set_frames_in_flight(frames_in_flight_);
+  if (beside_) beside_->build(render.layer_count, size_);
+}
+
+LabelForces::Outputs LabelledRenderer::add_placement_in_frame(
+    graph::Graph& graph, const VolumeRenderer::Outputs& rendered, graph::ResourceId& labels) {
+  Parts& p = *parts_;
+  const graph::ResourceId state = p.forces.import_state(graph);
+  placed_ = p.placement.add_to(
+      graph, {.final_image = rendered.final,
+              .layers = rendered.layers,
+              .layer_count = p.renderer.settings().layer_count,
+              .adjust_labels = [&p, state](graph::Graph& g, graph::ResourceId ids) {
+                p.forces.add_previous(g, ids, state);
+              }});
+  labels = placed_.labels;
+  return p.forces.add_to(graph, {.labels = placed_.labels,
+                                 .targets = placed_.placements,
+                                 .state = state,
+                                 .order = placed_.order});
+}
+
+LabelForces::Outputs LabelledRenderer::add_placement_beside(graph::Graph& graph,
+                                                            const VolumeRenderer::Outputs& rendered,
+                                                            graph::ResourceId& labels) {
+  Parts& p = *parts_;
+  const graph::ResourceId state = p.forces.import_state(graph);
+  const PlacementBeside::FrameIds ids = beside_->add_to_frame(graph, rendered, state);
+  placed_ = {};
+  labels = ids.labels;
+  const LabelForces::Outputs moved = p.forces.add_to(
+      graph, {.labels = ids.labels, .targets = ids.targets, .state = state, .order = ids.order});
+  beside_->add_state_snapshot(graph, state);
+  return moved;
+}
+
+void LabelledRenderer::set_placement_beside(bool beside) {
+  if (beside == placement_beside()) return;
+  ctx_.wait_idle("the placement moving beside the frames or back");
+  runner_.reset();
+  beside_.reset();
+  if (beside) {
+    beside_ = std::make_unique<PlacementBeside>(ctx_, parts_->placement, parts_->forces,
+                                                uint32_t(labels_.size()));
+  } else {
+    parts_->placement.readback().set_slots(frames_in_flight_);
+  }
+  build_graph();
+  if (!beside) use_slot(0);
+}
+
+uint64_t LabelledRenderer::placed_frame_number() const {
+  return beside_ ? beside_->adopted_frame() : frame_number_;
 }
 
 // The labels and order of the next frame for the placement: a still with the scene's eta, a frame
@@ -282,6 +333,7 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
 void LabelledRenderer::set_camera(const Camera& camera) {
   camera_ = camera;
   camera_moved_ = true;
+  placement_due();
   project_and_layer(camera);
   parts_->renderer.set_camera(camera);
   parts_->renderer.settings().splits = layering_.split_depths;
@@ -301,6 +353,7 @@ std::vector<PipelineReport> LabelledRenderer::placement_pipelines() const {
 }
 
 void LabelledRenderer::run_frame() {
+  if (beside_) throw Error("a still needs the placement in the frame (set_placement_beside)");
   stats_ = parts_->renderer.run_until_no_overflow(*runner_);
 }
 

@@ -15,6 +15,7 @@
 #include "engine/core/font.h"
 #include "engine/scene/scene.h"
 #include "labeling/layering.h"
+#include "labeling/placement_beside.h"
 #include "passes/label_forces.h"
 #include "passes/placement.h"
 #include "passes/volume_renderer.h"
@@ -116,6 +117,8 @@ class LabelledRenderer {
     Placement::Outputs placed;
     graph::ResourceId drawn;  // PlacementGpu[]: where the labels are drawn
     uint32_t layer_count = 1;
+    // The placement is in the frame's graph (`placed` is valid), not beside it.
+    bool placement_in_frame = true;
   };
   using Extension = std::function<void(graph::Graph&, const GraphIds&)>;
 
@@ -146,8 +149,7 @@ class LabelledRenderer {
   // What the relative lengths of the forces and the placement are in pixels now: the image's
   // width and the label text's size.
   LabelUnits units() const {
-    return {float(size_.width), settings_.font_pixels * settings_.label_scale,
-            float(size_.height)};
+    return {float(size_.width), settings_.font_pixels * settings_.label_scale, float(size_.height)};
   }
   const Camera& camera() const { return camera_; }
   // Frames recorded before the earlier ones finished: a readback per frame slot.
@@ -160,6 +162,27 @@ class LabelledRenderer {
   // runner() into its own command buffer). A trial frame places the labels (in the order given
   // to set_trial_order) but leaves the forces' state as it was (optimisation on idle).
   void prepare_frame(double seconds, bool trial = false);
+  // The placement beside the frames (labeling/placement_beside.h): the viewer's frames render
+  // and move the labels toward the newest finished placement without waiting for one; stills,
+  // trial frames and run() need it off (the default). Rebuilds the graph.
+  void set_placement_beside(bool beside);
+  bool placement_beside() const { return beside_ != nullptr; }
+  // Beside the frames: the placement's own GPU time of the placement adopted last, and what the
+  // frames saw of the placements (started, adopted, frames from a start to its adoption).
+  const PlacementBeside* beside() const { return beside_.get(); }
+  // Beside the frames: no new placement starts while paused (the interactive viewer's camera
+  // moves); the labels keep heading for the last one's targets, which follow their anchors.
+  void pause_placement(bool paused) {
+    if (beside_) beside_->set_paused(paused);
+  }
+  // Beside the frames: a change the next placement must see (set_camera says it itself).
+  void placement_due() {
+    if (beside_) beside_->set_due();
+  }
+  // The frames prepared so far (from 1), and the one whose placement the labels head for now
+  // (each frame's own without the placement beside).
+  uint64_t frame_number() const { return frame_number_; }
+  uint64_t placed_frame_number() const;
   // The order inside each layer (a permutation of the label indices): trial frames place the
   // labels in the trial order, the other frames in the one set last (the scene's after
   // set_camera).
@@ -219,7 +242,16 @@ class LabelledRenderer {
   std::vector<gpu::LabelGpu> labels_;
   std::unique_ptr<Parts> parts_;
   std::unique_ptr<graph::GraphRunner> runner_;
+  std::unique_ptr<PlacementBeside> beside_;
+  uint64_t frame_number_ = 0;
   void run_frame();
+  // The frame's placement and forces: in the frame's graph, or beside it.
+  LabelForces::Outputs add_placement_in_frame(graph::Graph& graph,
+                                              const VolumeRenderer::Outputs& rendered,
+                                              graph::ResourceId& labels);
+  LabelForces::Outputs add_placement_beside(graph::Graph& graph,
+                                            const VolumeRenderer::Outputs& rendered,
+                                            graph::ResourceId& labels);
   void project_and_layer(const Camera& camera);
   void build_graph();
   void set_placement_frame(bool moving, const std::vector<uint32_t>& within);

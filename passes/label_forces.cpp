@@ -70,6 +70,7 @@ LabelForces::LabelForces(Context& ctx, uint32_t label_count)
       params_(forces_params({}, {1024.0f, 14.0f, 1024.0f}, label_count, 0.0)),
       forces_(ctx, "label_forces.comp"),
       previous_(ctx, "label_previous.comp"),
+      follow_(ctx, "label_follow.comp"),
       state_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::LabelStateGpu),
              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                  VK_BUFFER_USAGE_TRANSFER_DST_BIT,
@@ -120,7 +121,8 @@ LabelForces::Outputs LabelForces::add_to(graph::Graph& graph, const Inputs& in) 
   out.drawn = graph.add_buffer(
       "forces.drawn", {[n](graph::Extent) { return VkDeviceSize{n} * sizeof(gpu::PlacementGpu); }});
   const graph::ResourceId scratch = graph.add_buffer(
-      "forces.scratch", {[n](graph::Extent) { return VkDeviceSize{n} * sizeof(gpu::KeepApartGpu); }});
+      "forces.scratch",
+      {[n](graph::Extent) { return VkDeviceSize{n} * sizeof(gpu::KeepApartGpu); }});
   graph.add_pass({"labels.forces",
                   graph::PassKind::compute,
                   {{in.labels, Use::storage_read, FORCES_BINDING_LABELS},
@@ -143,6 +145,36 @@ LabelForces::Outputs LabelForces::add_to(graph::Graph& graph, const Inputs& in) 
                     vkCmdCopyBuffer(pc.cmd, pc.buffer(drawn), pc.buffer(readback), 1, &region);
                   }});
   return out;
+}
+
+graph::ResourceId LabelForces::add_follow(graph::Graph& graph, graph::ResourceId labels,
+                                          graph::ResourceId placed,
+                                          graph::ResourceId targets) const {
+  const uint32_t n = std::max(label_count_, 1u);
+  const graph::ResourceId followed = graph.add_buffer(
+      "forces.followed",
+      {[n](graph::Extent) { return VkDeviceSize{n} * sizeof(gpu::PlacementGpu); }});
+  graph.add_pass({"labels.follow",
+                  graph::PassKind::compute,
+                  {{labels, Use::storage_read, FORCES_BINDING_LABELS},
+                   {placed, Use::storage_read, FORCES_BINDING_PLACED},
+                   {targets, Use::storage_read, FORCES_BINDING_TARGETS},
+                   {followed, Use::storage_write, FORCES_BINDING_FOLLOWED}},
+                  [this](graph::PassContext& pc) {
+                    pc.dispatch(follow_, params_, {label_count_, 1, 1});
+                  },
+                  "labels"});
+  return followed;
+}
+
+std::vector<gpu::PlacementGpu> follow_reference(std::vector<gpu::PlacementGpu> targets,
+                                                const std::vector<gpu::LabelGpu>& placed,
+                                                const std::vector<gpu::LabelGpu>& labels,
+                                                const gpu::ForcesParams& params) {
+  for (size_t i = 0; i < targets.size(); ++i) {
+    targets[i] = gpu::follow_anchor(targets[i], placed.at(i), labels.at(i), params);
+  }
+  return targets;
 }
 
 std::vector<gpu::LabelGpu> previous_reference(std::vector<gpu::LabelGpu> labels,
@@ -204,8 +236,8 @@ void keep_apart_reference(const std::vector<gpu::LabelGpu>& labels,
       }
       if (!free) clashes |= KEEP_APART_PUSH;
     }
-    state[i] = gpu::keep_apart_settle(labels[i], targets[i], state[i], moved[i], params, clashes,
-                                      pushed);
+    state[i] =
+        gpu::keep_apart_settle(labels[i], targets[i], state[i], moved[i], params, clashes, pushed);
     obstacles[i] = gpu::keep_apart_obstacle(labels[i], state[i]);
     settled[i] = true;
   }

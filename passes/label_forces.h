@@ -72,8 +72,9 @@ inline constexpr double kForceStepSeconds = 1.0 / 120.0;
 // The push constants of one frame of `seconds` at `units`: sub-steps of at most
 // kForceStepSeconds, and enough that none moves a label by more than epsilon, so no step
 // overshoots its target. A frame of 0 s is a still: labels fade at once (and where kept apart,
-// each appears on its target if that is free of the boxes before it in the order). `hard`: the placement forbids violations (the appear
-// padding applies). `order_count`: labels in the placement's insertion order.
+// each appears on its target if that is free of the boxes before it in the order). `hard`: the
+// placement forbids violations (the appear padding applies). `order_count`: labels in the
+// placement's insertion order.
 gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
                                 uint32_t label_count, double seconds, bool hard = false,
                                 uint32_t order_count = 0);
@@ -84,7 +85,7 @@ class LabelForces {
     graph::ResourceId labels;   // LabelGpu[]: this frame's anchors and flags
     graph::ResourceId targets;  // PlacementGpu[]: the placement's result
     graph::ResourceId state;    // import_state()'s
-    graph::ResourceId order;    // uint[]: the placement's insertion order (keeping apart's priority)
+    graph::ResourceId order;  // uint[]: the placement's insertion order (keeping apart's priority)
   };
   struct Outputs {
     graph::ResourceId drawn;  // PlacementGpu[]: where the labels are drawn
@@ -101,11 +102,18 @@ class LabelForces {
   void add_previous(graph::Graph& graph, graph::ResourceId labels, graph::ResourceId state) const;
   // The forces pass, and a copy of the drawn placements for the host.
   Outputs add_to(graph::Graph& graph, const Inputs& in);
+  // The targets of a placement made beside the frames (PlacementGpu[] `targets` of the labels
+  // `placed` as it saw them) moved into this frame of `labels` (follow_anchor): returns them.
+  graph::ResourceId add_follow(graph::Graph& graph, graph::ResourceId labels,
+                               graph::ResourceId placed, graph::ResourceId targets) const;
 
   // The next frame's settings, units and duration (a fixed 1 / fps offline, so videos are
   // repeatable).
-  void set_frame(const ForceSettings& settings, LabelUnits units, double seconds,
-                 bool hard = false, uint32_t order_count = 0);
+  void set_frame(const ForceSettings& settings, LabelUnits units, double seconds, bool hard = false,
+                 uint32_t order_count = 0);
+  // The frame's count of labels in the insertion order the forces read (a placement's older than
+  // the frame: labeling/placement_beside.h).
+  void set_order_count(uint32_t count) { params_.order_count = std::min(count, label_count_); }
   // Marks the frame set last as a trial (ForcesParams::trial): labels are drawn where they were
   // and the state is not written, so several trial placements start from the same state.
   void set_trial(bool trial) { params_.trial = trial ? 1u : 0u; }
@@ -123,7 +131,7 @@ class LabelForces {
   Context& ctx_;
   uint32_t label_count_;
   gpu::ForcesParams params_{};
-  ComputePipeline forces_, previous_;
+  ComputePipeline forces_, previous_, follow_;
   Buffer state_;
   graph::Readback readback_;
 };
@@ -132,6 +140,12 @@ class LabelForces {
 std::vector<gpu::LabelGpu> previous_reference(std::vector<gpu::LabelGpu> labels,
                                               const std::vector<gpu::LabelStateGpu>& state,
                                               const gpu::ForcesParams& params);
+
+// The CPU reference of add_follow's pass.
+std::vector<gpu::PlacementGpu> follow_reference(std::vector<gpu::PlacementGpu> targets,
+                                                const std::vector<gpu::LabelGpu>& placed,
+                                                const std::vector<gpu::LabelGpu>& labels,
+                                                const gpu::ForcesParams& params);
 
 // The CPU reference: one frame of forces over every label, kept apart in the placement's `order`
 // (its first params.order_count entries) where params.keep_apart says. `state` is updated in

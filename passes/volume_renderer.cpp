@@ -364,7 +364,8 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
       // (one volume and no meshes, the common case: a resolve the compiler specialises)
       resolve_(ctx, inputs_.volumes.size() == 1 && inputs_.meshes.empty()
                         ? "habuffer_resolve_one_volume.comp"
-                        : "habuffer_resolve.comp") {
+                        : "habuffer_resolve.comp"),
+      upscale_(ctx, "volume_upscale.comp") {
   frame_data(inputs_, camera_, settings_, {1, 1}, 1);  // checks the settings early
   const glm::uvec3 d = inputs_.atlas_dims;
   atlas_ =
@@ -389,6 +390,7 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
 }
 
 void VolumeRenderer::upload_transfer() {
+  ++transfer_version_;
   if (!inputs_.occupancy.empty()) upload(ctx_, occupancy_, as_bytes(inputs_.occupancy));
 }
 
@@ -423,13 +425,22 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
   const ResourceId counters = graph.add_buffer(
       "render.counters",
       {[](graph::Extent) { return VkDeviceSize{VR_COUNTER_COUNT * sizeof(uint32_t)}; }});
-  Outputs out;
-  out.layers = graph.add_image("render.layers",
-                               {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count, true});
-  out.final = graph.add_image("render.final", {VK_FORMAT_R8G8B8A8_UNORM});
-  out.depth = graph.add_image("render.depth", {VK_FORMAT_R32_SFLOAT});
+  const auto images = [&graph, this](const std::string& suffix, bool keep) {
+    Outputs o;
+    o.layers =
+        graph.add_image("render.layers" + suffix,
+                        {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count, true, keep});
+    o.final =
+        graph.add_image("render.final" + suffix, {VK_FORMAT_R8G8B8A8_UNORM, {}, 1, false, keep});
+    o.depth = graph.add_image("render.depth" + suffix, {VK_FORMAT_R32_SFLOAT, {}, 1, false, keep});
+    return o;
+  };
+  Outputs out = images("", false);
   out.frame = frame;
   out.keys = keys;
+  // (interactive: the resolve writes the cast pixels, the upscale the images everyone reads)
+  last_cast_.reset();  // (a new graph: new images)
+  const Outputs cast = settings_.interactive ? images(".cast", true) : out;
   const auto uploaded = [&graph](const char* name, const Buffer& buffer) {
     return graph.import_buffer(name, {.buffer = buffer.handle(), .has_content = true});
   };
@@ -452,15 +463,19 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {keys, Use::transfer_dst},
                    {counters, Use::transfer_dst}},
                   [this, frame, transfer, keys, counters](graph::PassContext& pc) {
-                    gpu::FrameGpu data = frame_data(inputs_, camera_, settings_, pc.viewport,
-                                                    slots_for(pc.viewport));
+                    gpu::FrameGpu data = frame_data(inputs_, camera_, settings_,
+                                                    cast_size(pc.viewport), slots_for(pc.viewport));
                     data.group_order = group_order_;
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
+                    const Cast now{data, transfer_version_, pc.allocation()};
+                    reuse_cast_ = settings_.interactive && same_cast(now);
+                    if (reuse_cast_) return;
+                    if (settings_.interactive) last_cast_ = now;
                     vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
                     const std::vector<glm::vec4> table = corrected_transfer(inputs_, data.step);
                     vkCmdUpdateBuffer(pc.cmd, pc.buffer(transfer), 0,
                                       table.size() * sizeof(glm::vec4), table.data());
                     vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
                   },
                   "render"});
   graph.add_pass({"render.habuffer_build",
@@ -471,7 +486,9 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {keys, Use::storage_read_write, VR_BINDING_KEYS},
                    {payload, Use::storage_write, VR_BINDING_PAYLOAD},
                    {counters, Use::storage_read_write, VR_BINDING_COUNTERS}},
-                  [this](graph::PassContext& pc) { record_build(pc); },
+                  [this](graph::PassContext& pc) {
+                    if (!reuse_cast_) record_build(pc);
+                  },
                   "render"});
   graph.add_pass({"render.resolve",
                   graph::PassKind::compute,
@@ -483,13 +500,16 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                    {ids_.atlas, Use::sampled, VR_BINDING_ATLAS},
                    {transfer, Use::storage_read, VR_BINDING_TRANSFER},
                    {ids_.occupancy, Use::storage_read, VR_BINDING_OCCUPANCY},
-                   {out.layers, Use::storage_write, VR_BINDING_LAYERS},
-                   {out.final, Use::storage_write, VR_BINDING_FINAL},
-                   {out.depth, Use::storage_write, VR_BINDING_DEPTH}},
+                   {cast.layers, Use::storage_write, VR_BINDING_LAYERS},
+                   {cast.final, Use::storage_write, VR_BINDING_FINAL},
+                   {cast.depth, Use::storage_write, VR_BINDING_DEPTH}},
                   [this](graph::PassContext& pc) {
-                    pc.dispatch(resolve_, {pc.viewport.width, pc.viewport.height, 1});
+                    if (reuse_cast_) return;
+                    const graph::Extent e = cast_size(pc.viewport);
+                    pc.dispatch(resolve_, {e.width, e.height, 1});
                   },
                   "render"});
+  if (settings_.interactive) add_upscale(graph, cast, out);
   const ResourceId readback = ids_.readback;
   graph.add_pass({"render.counters",
                   graph::PassKind::transfer,
@@ -501,14 +521,72 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
   return out;
 }
 
+void VolumeRenderer::add_upscale(graph::Graph& graph, const Outputs& cast, const Outputs& out) {
+  graph.add_pass({"render.upscale",
+                  graph::PassKind::compute,
+                  {{cast.layers, Use::storage_read, UPSCALE_BINDING_LOW_LAYERS},
+                   {cast.final, Use::storage_read, UPSCALE_BINDING_LOW_FINAL},
+                   {cast.depth, Use::storage_read, UPSCALE_BINDING_LOW_DEPTH},
+                   {out.layers, Use::storage_write, UPSCALE_BINDING_LAYERS},
+                   {out.final, Use::storage_write, UPSCALE_BINDING_FINAL},
+                   {out.depth, Use::storage_write, UPSCALE_BINDING_DEPTH}},
+                  [this](graph::PassContext& pc) {
+                    const graph::Extent low = cast_size(pc.viewport);
+                    const gpu::UpscaleParams p{{pc.viewport.width, pc.viewport.height},
+                                               {low.width, low.height},
+                                               std::max(settings_.divisor, 1u),
+                                               settings_.layer_count};
+                    pc.dispatch(upscale_, p, {pc.viewport.width, pc.viewport.height, 1});
+                  },
+                  "render"});
+}
+
+graph::Extent cast_extent(graph::Extent viewport, uint32_t divisor) {
+  divisor = std::max(divisor, 1u);
+  return {(viewport.width + divisor - 1) / divisor, (viewport.height + divisor - 1) / divisor};
+}
+
+std::vector<glm::vec4> upscale_reference(std::span<const glm::vec4> low, graph::Extent size,
+                                         uint32_t divisor, uint32_t layer_count) {
+  const graph::Extent cast = cast_extent(size, divisor);
+  const gpu::UpscaleParams p{
+      {size.width, size.height}, {cast.width, cast.height}, divisor, layer_count};
+  const size_t low_pixels = size_t(cast.width) * cast.height;
+  const auto at = [&](uint32_t l, glm::ivec2 q) {
+    return low[l * low_pixels + size_t(q.y) * cast.width + size_t(q.x)];
+  };
+  std::vector<glm::vec4> out;
+  for (uint32_t l = 0; l < layer_count; ++l) {
+    for (uint32_t y = 0; y < size.height; ++y) {
+      for (uint32_t x = 0; x < size.width; ++x) {
+        const gpu::UpscaleTap t = gpu::upscale_tap({x, y}, p);
+        const glm::vec4 top = glm::mix(at(l, t.p0), at(l, {t.p1.x, t.p0.y}), t.t.x);
+        const glm::vec4 bottom = glm::mix(at(l, {t.p0.x, t.p1.y}), at(l, t.p1), t.t.x);
+        out.push_back(glm::mix(top, bottom, t.t.y));
+      }
+    }
+  }
+  return out;
+}
+
+bool VolumeRenderer::same_cast(const Cast& c) const {
+  return last_cast_ && last_cast_->transfer == c.transfer &&
+         last_cast_->allocation == c.allocation &&
+         std::memcmp(&last_cast_->frame, &c.frame, sizeof c.frame) == 0;
+}
+
+graph::Extent VolumeRenderer::cast_size(graph::Extent viewport) const {
+  return cast_extent(viewport, settings_.interactive ? settings_.divisor : 1u);
+}
+
 void VolumeRenderer::record_build(graph::PassContext& pc) const {
   if (inputs_.meshes.empty()) return;  // volume boxes are the resolve's ray-box tests
+  const graph::Extent e = cast_size(pc.viewport);
   VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-  rendering.renderArea = {{0, 0}, {pc.viewport.width, pc.viewport.height}};
+  rendering.renderArea = {{0, 0}, {e.width, e.height}};
   rendering.layerCount = 1;
   vkCmdBeginRendering(pc.cmd, &rendering);
-  const VkViewport viewport{0.0f, 0.0f, float(pc.viewport.width), float(pc.viewport.height),
-                            0.0f, 1.0f};
+  const VkViewport viewport{0.0f, 0.0f, float(e.width), float(e.height), 0.0f, 1.0f};
   vkCmdSetViewport(pc.cmd, 0, 1, &viewport);
   vkCmdSetScissor(pc.cmd, 0, 1, &rendering.renderArea);
   pc.bind(build_);

@@ -7,6 +7,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "engine/gpu/resources.h"
@@ -16,6 +18,7 @@
 #include "engine/graph/render_graph.h"
 #include "engine/scene/io/volume_loader.h"
 #include "engine/scene/scene.h"
+#include "shared/upscale.h"
 #include "shared/volume_render.h"
 
 namespace strata {
@@ -30,7 +33,20 @@ struct RenderSettings {
   glm::vec3 background{0.0f};
   float expected_depth_complexity = 4.0f;  // HA-Buffer sizing: mesh fragments per pixel expected
   float load_factor = 0.5f;                // ... and the share of slots they should fill
+  // Interactive rendering (shared/upscale.h): the graph casts rays into lower-resolution images
+  // and upscales them (a graph shape: add_to reads it), and each frame casts every `divisor`-th
+  // pixel each way (1: all of them; read when the frame is recorded).
+  bool interactive = false;
+  uint32_t divisor = 1;
 };
+
+// The pixels a frame casts rays for: `viewport` divided by `divisor`, rounded up.
+graph::Extent cast_extent(graph::Extent viewport, uint32_t divisor);
+
+// The CPU reference of the upscale's layers: `size` images (layer after layer) from the cast
+// pixels `low` (cast_extent(size, divisor) images, layer after layer).
+std::vector<glm::vec4> upscale_reference(std::span<const glm::vec4> low, graph::Extent size,
+                                         uint32_t divisor, uint32_t layer_count);
 
 // What the GPU counted during the last completed frame.
 struct RenderStats {
@@ -152,9 +168,22 @@ class VolumeRenderer {
   Buffer volumes_, occupancy_, vertices_, indices_;
   graph::Readback counters_readback_;
   uint32_t forced_slots_ = 0;  // 0: sized from the viewport
+  // Interactive rendering at rest: the cast images of the last frame are kept, and a frame that
+  // would cast the same rays (the same frame data, transfer functions and images) casts none.
+  struct Cast {
+    gpu::FrameGpu frame{};
+    uint64_t transfer = 0, allocation = 0;
+  };
+  std::optional<Cast> last_cast_;
+  uint64_t transfer_version_ = 0;
+  bool reuse_cast_ = false;  // the frame being recorded casts no rays
+  bool same_cast(const Cast& c) const;
 
   GraphicsPipeline build_;
   ComputePipeline resolve_;
+  ComputePipeline upscale_;
+  void add_upscale(graph::Graph& graph, const Outputs& cast, const Outputs& out);
+  graph::Extent cast_size(graph::Extent viewport) const;
   struct Ids {
     graph::ResourceId atlas, volumes, occupancy, vertices, indices, readback;
   } ids_{};

@@ -449,8 +449,8 @@ TEST_SUITE("cpu") {
       CAPTURE(f);
       // The anchor runs out of the image's right edge and back in.
       const float x = f < 20 ? 960.0f + 5.0f * float(f) : 1060.0f - 5.0f * float(f - 20);
-      const auto drawn = forces_reference({label_at({x, 300.0f})}, {target_at({x, 280.0f})},
-                                          state, f == 0 ? still : p, {0});
+      const auto drawn = forces_reference({label_at({x, 300.0f})}, {target_at({x, 280.0f})}, state,
+                                          f == 0 ? still : p, {0});
       const glm::vec4 box = gpu::box_around(drawn[0].position, {60.0f, 16.0f});
       if (drawn[0].opacity > 0.0f) CHECK(gpu::box_inside(box, p));
       if (f == 19) CHECK(drawn[0].opacity == 0.0f);
@@ -487,9 +487,9 @@ TEST_SUITE("cpu") {
         targets.push_back(target_at(labels.back().anchor + offset[i] +
                                     40.0f * glm::vec2(std::cos(turn), std::sin(turn))));
       }
-      const auto drawn = forces_reference(
-          labels, targets, state,
-          f == 0 ? forces_params({}, kUnits, count, 0.0, false, count) : p, order);
+      const auto drawn =
+          forces_reference(labels, targets, state,
+                           f == 0 ? forces_params({}, kUnits, count, 0.0, false, count) : p, order);
       for (uint32_t i = 0; i < count && f > 0; ++i) {
         if (!(drawn[i].opacity > 0.0f)) continue;
         ++shown;
@@ -505,8 +505,9 @@ TEST_SUITE("cpu") {
         // and as much again where the image's edge pushes it in.
         if (last[i].opacity > 0.0f && drawn[i].opacity < 1.0f && last[i].opacity < 1.0f) continue;
         if (last[i].opacity > 0.0f) {
-          const glm::vec2 moved = (drawn[i].position - labels[i].anchor) -
-                                  (last[i].position - (start[i] + (t - 1.0f / 30.0f) * velocity[i]));
+          const glm::vec2 moved =
+              (drawn[i].position - labels[i].anchor) -
+              (last[i].position - (start[i] + (t - 1.0f / 30.0f) * velocity[i]));
           CHECK(glm::length(moved) <= 2.0f * p.speed / 30.0f + 1e-3f);
         }
       }
@@ -550,11 +551,9 @@ TEST_SUITE("gpu") {
         const ForceSettings settings{
             .anchor_relative = anchored, .speed_widths = widths(900.0f), .keep_apart = apart};
         const auto drawn = forces.frame(labels, targets, settings, kUnits, seconds, order);
-        const std::vector<gpu::PlacementGpu> expected =
-            forces_reference(labels, targets, state,
-                             forces_params(settings, kUnits, count, seconds, false,
-                                           uint32_t(order.size())),
-                             order);
+        const std::vector<gpu::PlacementGpu> expected = forces_reference(
+            labels, targets, state,
+            forces_params(settings, kUnits, count, seconds, false, uint32_t(order.size())), order);
         const std::vector<gpu::LabelStateGpu> gpu_state = forces.state();
         // Bit for bit on a CPU device (lavapipe rounds as the C++ does); elsewhere within 1e-3 px:
         // Vulkan lets a GPU divide and take square roots to a few ulps, and fuse multiply-adds.
@@ -610,6 +609,60 @@ TEST_SUITE("gpu") {
       }
     }
     CHECK(largest <= tolerance);
+  }
+
+  // Beside the frames, each frame moves the targets of an older placement with their anchors.
+  TEST_CASE_FIXTURE(test::GpuTest,
+                    "follow_pass_moves_targets_with_their_anchors_as_the_reference") {
+    const uint32_t count = 100;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> pixel(0.0f, 512.0f);
+    std::vector<gpu::LabelGpu> labels(count), placed(count);
+    std::vector<gpu::PlacementGpu> targets(count);
+    for (uint32_t i = 0; i < count; ++i) {
+      placed[i] = label_at({pixel(rng), pixel(rng)}, i % 6 != 0);  // (some unseen then)
+      labels[i] = label_at({pixel(rng), pixel(rng)});
+      targets[i] = target_at({pixel(rng), pixel(rng)}, i % 4 != 0);
+    }
+    const auto buffer = [this](const auto& values) {
+      Buffer b(ctx, values.size() * sizeof(values[0]), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+               MemoryKind::device_local);
+      upload(ctx, b, as_bytes(values));
+      return b;
+    };
+    const Buffer labels_buffer = buffer(labels), placed_buffer = buffer(placed),
+                 targets_buffer = buffer(targets);
+    for (const bool anchored : {true, false}) {
+      CAPTURE(anchored);
+      LabelForces forces(ctx, count);
+      graph::Graph g;
+      const auto imported = [&g](const char* name, const Buffer& b) {
+        return g.import_buffer(name, {.buffer = b.handle(), .has_content = true});
+      };
+      const graph::ResourceId followed =
+          forces.add_follow(g, imported("labels", labels_buffer), imported("placed", placed_buffer),
+                            imported("targets", targets_buffer));
+      graph::GraphRunner runner(ctx, std::move(g));
+      runner.set_viewport({512, 512});
+      const ForceSettings settings{.anchor_relative = anchored};
+      forces.set_frame(settings, kUnits, 1.0 / 30.0);
+      runner.run_now();
+      const auto gpu = as<gpu::PlacementGpu>(runner.download_buffer(followed));
+      const auto cpu = follow_reference(targets, placed, labels, forces.params());
+      int mismatches = 0, moved = 0;
+      for (uint32_t i = 0; i < count; ++i) {
+        if (gpu[i].position != cpu[i].position || gpu[i].shown != cpu[i].shown) ++mismatches;
+        if (cpu[i].position != targets[i].position) ++moved;
+        // A label the placement did not see has no target; the others keep theirs.
+        CHECK(cpu[i].shown == (i % 6 != 0 && i % 4 != 0 ? PLACEMENT_SHOWN : PLACEMENT_HIDDEN));
+        if (anchored) {
+          const glm::vec2 offset = cpu[i].position - labels[i].anchor;
+          CHECK(glm::length(offset - (targets[i].position - placed[i].anchor)) < 1e-3f);
+        }
+      }
+      CHECK(mismatches == 0);
+      CHECK(moved == (anchored ? int(count) : 0));
+    }
   }
 }
 

@@ -123,7 +123,8 @@ TEST_SUITE("window") {
                  d("left.json") + "\nscreenshot " + d("left.png") + "\nhide 3\nlayout " +
                  d("hidden.json") + "\nscreenshot " + d("hidden.png") +
                  "\nset forces.keep_apart off\nhide 60\nhide 52\nhide 81\nhide 29\nhide 31\nhide 37"
-                 "\nlayout " + d("few.json") +
+                 "\nlayout " +
+                 d("few.json") +
                  "\nset weights.anchor_constraint 0\nset weights.distance_to_anchor 1\n"
                  "set weights.leader_crossing 0\nlayout " +
                  d("weighted.json") + "\nquit\n");
@@ -274,15 +275,87 @@ TEST_SUITE("window") {
     CHECK(bare_drawn >= open_drawn);
   }
 
+  // The placement beside the frames (on lavapipe's one queue: its own submissions after the
+  // frames that feed it): the frames draw the newest finished placement's layout, which follows
+  // the camera and settles as clean as the placement in each frame does.
+  TEST_CASE("viewer_with_the_placement_beside_the_frames_settles_on_a_clean_layout") {
+    const auto dir = test::fresh_folder("viewer", "beside");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto script = test::write_file(
+        dir / "script.txt", "layout " + d("rest.json") + "\ndrag left 40 60 120 60\nlayout " +
+                                d("turned.json") + "\nquit\n");
+    const auto r =
+        run_strata("--validate view " + kScene + " --size " + std::to_string(kWidth) + "x" +
+                   std::to_string(kHeight) +
+                   " --no-panel --no-optimize --placement beside --script " + script.string());
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    CHECK(r.output.find("view: placement beside the frames: ") != std::string::npos);
+    for (const char* layout : {"rest.json", "turned.json"}) {
+      CAPTURE(layout);
+      const std::vector<LabelBox> labels = read_layout(d(layout));
+      int shown = 0, overlapping = 0, outside = 0;
+      for (size_t i = 0; i < labels.size(); ++i) {
+        if (!labels[i].shown) continue;
+        ++shown;
+        const glm::vec4 a = labels[i].box;
+        if (a.x < -0.5f || a.y < -0.5f || a.x + a.z > kWidth + 0.5f || a.y + a.w > kHeight + 0.5f) {
+          ++outside;
+        }
+        for (size_t j = i + 1; j < labels.size(); ++j) {
+          const glm::vec4 b = labels[j].box;
+          if (labels[j].shown && a.x < b.x + b.z && b.x < a.x + a.z && a.y < b.y + b.w &&
+              b.y < a.y + a.w) {
+            ++overlapping;
+          }
+        }
+      }
+      CHECK(shown >= 3);
+      CHECK(overlapping == 0);
+      CHECK(outside == 0);
+    }
+    // The drag turned the head: the labels followed their anchors.
+    CHECK(read_layout(d("rest.json"))[0].anchor != read_layout(d("turned.json"))[0].anchor);
+  }
+
+  // Interactive rendering: while the camera moves (a named view's animation) rays are cast for
+  // fewer pixels to hold the frame budget; at rest the full picture again.
+  TEST_CASE("viewer_casts_fewer_rays_while_the_camera_moves_and_refines_at_rest") {
+    const auto dir = test::fresh_folder("viewer", "interactive");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const std::string size = " --size " + std::to_string(kWidth) + "x" + std::to_string(kHeight);
+    const auto run = [&](const char* budget, const char* name) {
+      const auto script = test::write_file(dir / (std::string(name) + ".txt"),
+                                           "view left\ncapture " + d(name) + ".png\nquit\n");
+      // (the head's volume alone: no labels to tell the pictures apart)
+      return run_strata("--validate view " STRATA_SOURCE_DIR "/assets/cache/mricron/ch2.nii.gz" +
+                        size + " --no-panel --no-optimize --frame-budget " + budget + " --script " +
+                        script.string());
+    };
+    const auto fast = run("1", "fast");
+    INFO(fast.output);
+    REQUIRE(fast.exit_code == 0);
+    // (a budget of 1 ms: the largest divisor while moving)
+    CHECK(fast.output.find("8 x 8 pixels to a ray at most") != std::string::npos);
+    CHECK(fast.output.find("full quality ") != std::string::npos);
+    const auto full = run("0", "full");
+    INFO(full.output);
+    REQUIRE(full.exit_code == 0);
+    CHECK(full.output.find("1 x 1 pixels to a ray at most") != std::string::npos);
+    // At rest, the same picture as without interactive rendering.
+    CHECK(changed_pixels(read_png(d("fast.png")), read_png(d("full.png"))) == 0);
+  }
+
   TEST_CASE("viewer_tries_insertion_orders_when_the_camera_rests") {
     // Optimisation on idle: once the view has rested, trial frames try random orders (labels
     // stay where they are meanwhile); a camera move starts it again; then nothing is drawn.
+    // (Trials are frames that place: the placement in the frame, no interactive rendering.)
     const auto dir = test::fresh_folder("viewer", "optimize");
     const auto d = [&](const char* name) { return (dir / name).string(); };
     const auto r = view(dir,
                         "report " + d("opened.json") + "\ndrag left 80 60 90 60\nreport " +
                             d("moved.json") + "\nsleep 1.5\nreport " + d("still.json") + "\nquit\n",
-                        "--no-panel");
+                        "--no-panel --frame-budget 0");
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     const auto field = [&](const char* name, const char* key) {

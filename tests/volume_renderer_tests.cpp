@@ -210,6 +210,35 @@ TEST_SUITE("gpu") {
     CHECK(a.final == b.final);  // the HA-Buffer sorts: draw order cannot matter
   }
 
+  // Interactive rendering: at divisor 1 the same picture as without it; at divisor 3 the cast
+  // pixels are the picture of a third the size, upscaled as the reference does.
+  TEST_CASE_FIXTURE(test::GpuTest, "interactive_rendering_casts_fewer_pixels_and_upscales_them") {
+    Scene scene;
+    add_volume(scene, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.6f, 0.3f}));
+    const Camera camera = camera_at({12.0f, 9.0f, 32.0f});
+    const graph::Extent size{70, 52};
+    RenderSettings settings;
+    settings.layer_count = 2;
+    const GpuResult plain = render_gpu(ctx, scene, camera, settings, size);
+    settings.interactive = true;
+    const GpuResult full = render_gpu(ctx, scene, camera, settings, size);
+    CHECK(full.final == plain.final);
+    CHECK(full.layers == plain.layers);
+    settings.divisor = 3;
+    const GpuResult upscaled = render_gpu(ctx, scene, camera, settings, size);
+    settings.interactive = false;
+    const GpuResult small = render_gpu(ctx, scene, camera, settings, cast_extent(size, 3));
+    REQUIRE(small.layers.size() == size_t(24) * 18 * 2);
+    const std::vector<glm::vec4> expected = upscale_reference(small.layers, size, 3, 2);
+    REQUIRE(upscaled.layers.size() == expected.size());
+    float worst = 0.0f;
+    for (size_t i = 0; i < expected.size(); ++i) {
+      worst = std::max(worst, glm::length(upscaled.layers[i] - expected[i]));
+    }
+    CHECK(worst < 4e-3f);                  // (half floats)
+    CHECK(upscaled.final != plain.final);  // fewer rays: not the same picture
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "one_volume_matches_the_reference") {
     Scene scene;
     add_volume(scene, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.6f, 0.3f}));

@@ -59,6 +59,30 @@ int graphics_compute_family(VkPhysicalDevice device) {
   return -1;
 }
 
+// A queue family with compute and timestamps but no graphics (asynchronous compute), or -1.
+int compute_only_family(VkPhysicalDevice device) {
+  uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
+  for (uint32_t i = 0; i < count; ++i) {
+    const VkQueueFlags flags = families[i].queueFlags;
+    if ((flags & VK_QUEUE_COMPUTE_BIT) != 0u && (flags & VK_QUEUE_GRAPHICS_BIT) == 0u &&
+        families[i].timestampValidBits > 0) {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+uint32_t queue_count(VkPhysicalDevice device, uint32_t family) {
+  uint32_t count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(count);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
+  return families.at(family).queueCount;
+}
+
 // Whether the device has `extension` and its feature `flag`, asked through `feature` (the
 // extension's feature struct).
 template <typename Feature>
@@ -385,18 +409,33 @@ Context::Context(const ContextOptions& options)
     enable(VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME, conditional);
   }
 
-  const float priority = 1.0f;
-  VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-  queue.queueFamilyIndex = queue_family_;
-  queue.queueCount = 1;
-  queue.pQueuePriorities = &priority;
+  // The placement beside the frames gets a queue of a compute-only family (asynchronous compute)
+  // or else a second one of the frames' family, where the device has either (the frames' queue
+  // first: the placement may wait, the picture not).
+  const float priorities[] = {1.0f, 0.5f};
+  const int compute = compute_only_family(physical_);
+  placement_family_ = compute >= 0 ? uint32_t(compute) : queue_family_;
+  VkDeviceQueueCreateInfo queues[2] = {{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO},
+                                       {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO}};
+  queues[0].queueFamilyIndex = queue_family_;
+  queues[0].queueCount = compute < 0 && queue_count(physical_, queue_family_) >= 2 ? 2 : 1;
+  queues[0].pQueuePriorities = priorities;
+  queues[1].queueFamilyIndex = placement_family_;
+  queues[1].queueCount = 1;
+  queues[1].pQueuePriorities = priorities + 1;
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features};
-  info.queueCreateInfoCount = 1;
-  info.pQueueCreateInfos = &queue;
+  info.queueCreateInfoCount = compute >= 0 ? 2 : 1;
+  info.pQueueCreateInfos = queues;
   info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
   info.ppEnabledExtensionNames = extensions.data();
   STRATA_VK(vkCreateDevice(physical_, &info, nullptr, &device_));
   vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  placement_queue_ = queue_;
+  if (compute >= 0) {
+    vkGetDeviceQueue(device_, placement_family_, 0, &placement_queue_);
+  } else if (queues[0].queueCount == 2) {
+    vkGetDeviceQueue(device_, queue_family_, 1, &placement_queue_);
+  }
 
   VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pool.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
@@ -501,11 +540,16 @@ void Context::wait_for(VkFence fence, const std::string& what) {
 }
 
 void Context::wait_idle(const std::string& what) {
+  if (placement_queue_ != queue_) wait_queue_idle(placement_queue_, what);
+  wait_queue_idle(queue_, what);
+}
+
+void Context::wait_queue_idle(VkQueue queue, const std::string& what) {
   VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VkFence fence = VK_NULL_HANDLE;
   STRATA_VK(vkCreateFence(device_, &fence_info, nullptr, &fence));
   // (no command buffers: the fence signals once everything submitted before it has finished)
-  const VkResult result = vkQueueSubmit2(queue_, 0, nullptr, fence);
+  const VkResult result = vkQueueSubmit2(queue, 0, nullptr, fence);
   if (result == VK_ERROR_DEVICE_LOST) lost_ = true;
   try {
     check_vk(result, "vkQueueSubmit2");

@@ -1,4 +1,5 @@
-// The Vulkan instance, the chosen device and its one graphics+compute queue.
+// The Vulkan instance, the chosen device, its graphics+compute queue and, where it has one, a
+// second queue (compute-only where it can) for the placement beside the frames.
 //
 // Device choice: discrete GPU first, then integrated, virtual, CPU (lavapipe). `--device
 // NAME|INDEX` or STRATA_DEVICE overrides. What strata needs (64-bit buffer atomics, fragment stores
@@ -119,6 +120,12 @@ class Context {
   VkDevice device() const { return device_; }
   VkQueue queue() const { return queue_; }
   uint32_t queue_family() const { return queue_family_; }
+  // The queue a placement beside the frames is submitted to: one of a compute-only family where
+  // the device has one (asynchronous compute: it runs alongside the frames), else a second queue
+  // of the frames' family, else the frames' own queue.
+  VkQueue placement_queue() const { return placement_queue_; }
+  uint32_t placement_family() const { return placement_family_; }
+  bool separate_placement_queue() const { return placement_queue_ != queue_; }
   const DeviceReport& report() const { return report_; }
   // Pipelines are created with their statistics captured (VK_KHR_pipeline_executable_properties).
   bool pipeline_statistics() const { return report_.caps.pipeline_statistics; }
@@ -142,8 +149,8 @@ class Context {
   void set_gpu_timeout(std::chrono::nanoseconds timeout) { timeout_ = timeout; }
   // Waits for `fence`; GpuTimeout or DeviceLost naming `what` ("frame 12") when it does not end.
   void wait_for(VkFence fence, const std::string& what);
-  // Waits until the queue has finished all work submitted so far (a fence submitted behind it:
-  // one queue, so it signals after everything before it), like wait_for.
+  // Waits until the queues have finished all work submitted so far (a fence submitted behind the
+  // work of each: it signals after everything before it), like wait_for.
   void wait_idle(const std::string& what);
   // For destructors: wait_idle that never throws. False when the device is lost or a wait timed
   // out; then nothing is waited for, and objects the GPU may still use are left, not destroyed.
@@ -172,6 +179,7 @@ class Context {
   // its release.
   VkCommandBuffer begin_commands();
   void submit_and_wait(VkCommandBuffer cmd);
+  void wait_queue_idle(VkQueue queue, const std::string& what);
 
   Instance instance_;
   DeviceReport report_;
@@ -180,6 +188,8 @@ class Context {
   VkPhysicalDeviceMemoryProperties memory_{};
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
+  VkQueue placement_queue_ = VK_NULL_HANDLE;
+  uint32_t placement_family_ = 0;
   uint32_t queue_family_ = 0;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   std::chrono::nanoseconds timeout_{0};

@@ -66,7 +66,8 @@ void copy_to_host_barrier(VkCommandBuffer cmd) {
 
 }  // namespace
 
-Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind)
+Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind,
+               bool both_queues)
     : size_(size) {
   // (past maxBufferSize, vkCreateBuffer itself would be invalid usage)
   if (ctx.max_buffer() != 0 && size > ctx.max_buffer()) {
@@ -81,7 +82,12 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   info.size = size;
   info.usage = usage;
-  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  const uint32_t families[] = {ctx.queue_family(), ctx.placement_family()};
+  if (both_queues && families[0] != families[1]) {
+    info.sharingMode = VK_SHARING_MODE_CONCURRENT;
+    info.queueFamilyIndexCount = 2;
+    info.pQueueFamilyIndices = families;
+  }
   STRATA_VK(vkCreateBuffer(device, &info, nullptr, &buffer_));
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(device, buffer_, &req);
@@ -146,6 +152,12 @@ Image::Image(Context& ctx, const ImageDesc& desc) : desc_(desc) {
   info.tiling = VK_IMAGE_TILING_OPTIMAL;
   info.usage = desc.usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
   info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  const uint32_t families[] = {ctx.queue_family(), ctx.placement_family()};
+  if (desc.both_queues && families[0] != families[1]) {
+    info.sharingMode = VK_SHARING_MODE_CONCURRENT;
+    info.queueFamilyIndexCount = 2;
+    info.pQueueFamilyIndices = families;
+  }
   STRATA_VK(vkCreateImage(device, &info, nullptr, &image_));
   VkMemoryRequirements req;
   vkGetImageMemoryRequirements(device, image_, &req);

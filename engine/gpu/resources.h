@@ -22,7 +22,10 @@ enum class MemoryKind { device_local, host_upload, host_readback };
 class Buffer {
  public:
   Buffer() = default;
-  Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind);
+  // `both_queues`: used by the frames' queue family and the placement's where they differ
+  // (concurrent sharing: no ownership transfers).
+  Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, MemoryKind kind,
+         bool both_queues = false);
   ~Buffer();
   Buffer(Buffer&& other) noexcept;
   Buffer& operator=(Buffer&& other) noexcept;
@@ -48,8 +51,9 @@ struct ImageDesc {
   VkExtent3D extent{1, 1, 1};
   VkImageType type = VK_IMAGE_TYPE_2D;
   VkImageUsageFlags usage = 0;
-  uint32_t layers = 1;  // array layers (2D only)
-  bool array = false;   // a 2D-array view even with one layer (shaders declare image2DArray)
+  uint32_t layers = 1;       // array layers (2D only)
+  bool array = false;        // a 2D-array view even with one layer (shaders declare image2DArray)
+  bool both_queues = false;  // as Buffer's
 };
 
 class Image {

@@ -6,11 +6,12 @@
 
 namespace strata {
 
-FrameSlots::FrameSlots(Context& ctx, uint32_t count) : ctx_(ctx) {
+FrameSlots::FrameSlots(Context& ctx, uint32_t count, VkQueue queue, uint32_t family)
+    : ctx_(ctx), queue_(queue ? queue : ctx.queue()) {
   if (count == 0) throw Error("frame slots: none asked for");
   VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pool.queueFamilyIndex = ctx.queue_family();
+  pool.queueFamilyIndex = queue ? family : ctx.queue_family();
   STRATA_VK(vkCreateCommandPool(ctx.device(), &pool, nullptr, &pool_));
   slots_.resize(count);
   for (Slot& s : slots_) {
@@ -70,7 +71,7 @@ void FrameSlots::submit(uint32_t slot, std::span<const VkSemaphoreSubmitInfo> wa
   submit.signalSemaphoreInfoCount = static_cast<uint32_t>(signal.size());
   submit.pSignalSemaphoreInfos = signal.data();
   s.frame = ++submitted_;
-  const VkResult result = vkQueueSubmit2(ctx_.queue(), 1, &submit, s.done);
+  const VkResult result = vkQueueSubmit2(queue_, 1, &submit, s.done);
   if (result == VK_ERROR_DEVICE_LOST)
     throw DeviceLost("submitting frame " + std::to_string(s.frame));
   check_vk(result, "vkQueueSubmit2");

@@ -15,7 +15,8 @@ class Context;
 
 class FrameSlots {
  public:
-  FrameSlots(Context& ctx, uint32_t count);
+  // Submits to `queue` of queue family `family` (none: the frames' queue).
+  FrameSlots(Context& ctx, uint32_t count, VkQueue queue = VK_NULL_HANDLE, uint32_t family = 0);
   ~FrameSlots();
   FrameSlots(const FrameSlots&) = delete;
   FrameSlots& operator=(const FrameSlots&) = delete;
@@ -43,6 +44,7 @@ class FrameSlots {
   };
   void wait(Slot& slot);
   Context& ctx_;
+  VkQueue queue_;
   VkCommandPool pool_ = VK_NULL_HANDLE;
   std::vector<Slot> slots_;
   uint32_t turn_ = 0;

@@ -28,6 +28,10 @@ VkImage PassContext::image(ResourceId id) const {
   declared(id);
   return runner_->bound_[id].image;
 }
+uint64_t PassContext::allocation() const {
+  return runner_->allocation();
+}
+
 VkImageView PassContext::view(ResourceId id) const {
   declared(id);
   return runner_->bound_[id].view;
@@ -200,6 +204,7 @@ void GraphRunner::set_viewport(Extent viewport) {
     ctx_.wait_idle("the frames in flight (the graph's resources are replaced)");
   }
   viewport_ = viewport;
+  ++allocation_;
   for (size_t i = 0; i < graph_.resources().size(); ++i) {
     const ResourceInfo& r = graph_.resources()[i];
     if (r.imported) continue;
@@ -210,6 +215,7 @@ void GraphRunner::set_viewport(Extent viewport) {
                        compiled_.usage[i], r.image.layers,         r.image.array};
         Image& image = owned_[i].emplace<Image>(ctx_, desc);
         bound_[i] = {VK_NULL_HANDLE, image.handle(), image.view(), r.image.format};
+        if (r.image.keep) put_in_layout(image, compiled_.kept_layout[i]);
       } else {
         const VkDeviceSize size = std::max<VkDeviceSize>(4, r.buffer.size(viewport));
         Buffer& buffer =
@@ -227,6 +233,24 @@ void GraphRunner::set_viewport(Extent viewport) {
                   std::to_string(viewport.height) + " viewport: " + e.what());
     }
   }
+}
+
+// A new kept image, empty, in the layout every run expects it in.
+void GraphRunner::put_in_layout(const Image& image, VkImageLayout layout) {
+  ctx_.run_now([&](VkCommandBuffer cmd) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    b.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = layout;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image.handle();
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, VK_REMAINING_ARRAY_LAYERS};
+    VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dependency.imageMemoryBarrierCount = 1;
+    dependency.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dependency);
+  });
 }
 
 void GraphRunner::reallocate() {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -34,6 +35,8 @@ class PassContext {
   VkBuffer buffer(ResourceId id) const;
   VkImage image(ResourceId id) const;
   VkImageView view(ResourceId id) const;
+  // GraphRunner::allocation() of the runner recording the pass.
+  uint64_t allocation() const;
   // Binds `pipeline` and pushes every resource this pass declared with a binding index (sampled
   // images with the graph's linear clamp-to-edge sampler).
   void bind(const Pipeline& pipeline);
@@ -107,6 +110,14 @@ struct PassTiming {
   double end_ms = 0.0;
 };
 
+// What the submission of a frame adds to the semaphores its output waits for and signals, and
+// what follows it (a placement beside the frames waits for the frame that feeds it and is
+// submitted after it): set while the frame is prepared, read by whoever submits it.
+struct FrameSubmission {
+  std::vector<VkSemaphoreSubmitInfo> wait, signal;
+  std::function<void()> submitted;  // called once the frame is submitted
+};
+
 class GraphRunner {
  public:
   GraphRunner(Context& ctx, Graph graph);
@@ -115,6 +126,8 @@ class GraphRunner {
   // Creates (or re-creates, when it changed) every transient resource for `viewport`.
   void set_viewport(Extent viewport);
   Extent viewport() const { return viewport_; }
+  // Counts the times the transient resources were made (a kept image made anew has no content).
+  uint64_t allocation() const { return allocation_; }
 
   // Re-binds an import whose handle changes between runs (a swapchain image, a resized
   // readback); the others keep the handle they were imported with.
@@ -162,6 +175,7 @@ class GraphRunner {
   std::vector<PassTiming> timings(uint32_t slot = 0) const;
 
   const Graph& graph() const { return graph_; }
+  FrameSubmission& submission() { return submission_; }
   // Mutable so that a test can drop a barrier and show that validation catches it.
   CompiledGraph& compiled() { return compiled_; }
   const CompiledGraph& compiled() const { return compiled_; }
@@ -177,6 +191,7 @@ class GraphRunner {
   void emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) const;
   void check_bound() const;
   void record_pass(VkCommandBuffer cmd, uint32_t pass);
+  void put_in_layout(const Image& image, VkImageLayout layout);
   // Whether pass p stamps its begin / its end (every pass, or a group's first / last).
   bool stamps_begin(uint32_t pass) const;
   bool stamps_end(uint32_t pass) const;
@@ -191,6 +206,8 @@ class GraphRunner {
   std::vector<Bound> bound_;
   std::vector<VkQueryPool> queries_;  // one per frame slot
   uint32_t slot_ = 0;                 // the slot being recorded
+  uint64_t allocation_ = 0;
+  FrameSubmission submission_;
   VkSampler linear_sampler_ = VK_NULL_HANDLE;
   PFN_vkCmdBeginConditionalRenderingEXT begin_conditional_ = nullptr;  // with the extension only
   PFN_vkCmdEndConditionalRenderingEXT end_conditional_ = nullptr;

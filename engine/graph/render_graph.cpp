@@ -303,6 +303,22 @@ CompiledGraph compile(const Graph& graph) {
 
   CompiledGraph out;
   out.usage.assign(resources.size(), 0);
+  out.kept_layout.assign(resources.size(), VK_IMAGE_LAYOUT_UNDEFINED);
+  // A kept image starts each run as the last run left it: its one layout, after its last use.
+  for (const PassInfo& pass : graph.passes()) {
+    for (const MergedUse& m : merge_uses(pass, graph)) {
+      const ResourceInfo& r = resources[m.resource];
+      if (r.imported || !r.is_image || !r.image.keep) continue;
+      State& s = states[m.resource];
+      if (s.has_content && s.layout != m.access.layout) {
+        throw GraphError("kept image '" + r.name + "' is used in two layouts");
+      }
+      s.has_content = true;
+      s.layout = m.access.layout;
+      s.write_stage = m.access.stage;
+      out.kept_layout[m.resource] = m.access.layout;
+    }
+  }
   for (const PassInfo& pass : graph.passes()) {
     std::vector<Barrier> barriers;
     std::vector<VkImageLayout> layouts(resources.size(), VK_IMAGE_LAYOUT_UNDEFINED);

@@ -70,6 +70,10 @@ struct ImageInfo {
   Extent fixed{};
   uint32_t layers = 1;  // more than one: a 2D array image (e.g. one layer per depth layer)
   bool array = false;   // a 2D-array view even with one layer
+  // Its content is kept from one run to the next (a pass may skip writing it): each run starts
+  // with the layout its last use left (every use must have the same one), and the runner puts a
+  // new image in that layout (GraphRunner::allocation() counts new images).
+  bool keep = false;
 };
 
 struct BufferInfo {
@@ -171,6 +175,7 @@ struct CompiledGraph {
                                                     // VkBufferUsageFlags derived from its uses
   // The layout of `resource` while `pass` runs (images; UNDEFINED when the pass does not use it).
   std::vector<std::vector<VkImageLayout>> layout;  // [pass][resource]
+  std::vector<VkImageLayout> kept_layout;          // per resource: a kept image's one layout
 };
 
 // A graph that cannot run: the message names the pass and the resource.

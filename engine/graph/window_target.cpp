@@ -192,13 +192,18 @@ bool WindowTarget::draw(const Prepare& prepare) {
   const VkCommandBuffer cmd = slots_.begin(slot);
   runner.record(cmd, slot);
 
-  VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  const graph::FrameSubmission& extra = runner.submission();
+  std::vector<VkSemaphoreSubmitInfo> waits = extra.wait, signals = extra.signal;
+  VkSemaphoreSubmitInfo& wait =
+      waits.emplace_back(VkSemaphoreSubmitInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO});
   wait.semaphore = acquired_[slot];
   wait.stageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;  // the blit; matches initial_stage
-  VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  VkSemaphoreSubmitInfo& signal =
+      signals.emplace_back(VkSemaphoreSubmitInfo{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO});
   signal.semaphore = rendered_[index];
   signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-  slots_.submit(slot, {&wait, 1}, {&signal, 1});
+  slots_.submit(slot, waits, signals);
+  if (extra.submitted) extra.submitted();
 
   VkPresentInfoKHR present{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
   present.waitSemaphoreCount = 1;

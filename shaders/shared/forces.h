@@ -12,6 +12,8 @@
 #define FORCES_BINDING_TARGETS 1  // PlacementGpu[]: the placement's positions (the targets)
 #define FORCES_BINDING_STATE 2    // LabelStateGpu[]: drawn positions, kept across frames
 #define FORCES_BINDING_DRAWN 3    // PlacementGpu[]: where the labels are drawn this frame
+#define FORCES_BINDING_PLACED 6  // LabelGpu[]: the labels as a placement beside the frames saw them
+#define FORCES_BINDING_FOLLOWED 7  // PlacementGpu[]: that placement's targets, in this frame
 
 // LabelStateGpu.flags
 #define LABEL_STATE_PLACED 1u  // the label has a drawn position (it was shown before)
@@ -164,6 +166,16 @@ STRATA_INLINE LabelStateGpu forces_update(LabelGpu label, PlacementGpu target, L
   state.opacity = faded(state.opacity, params.fade);
   state.drawn = state_to_screen(label, l, params);
   return state;
+}
+
+// A target of a placement made beside the frames, some frames ago, in this frame: anchored labels
+// keep its offset from their anchor, which has moved since; labels on screen keep its position.
+// A label that placement did not see (not enabled then) has no target.
+STRATA_INLINE PlacementGpu follow_anchor(PlacementGpu target, LabelGpu placed, LabelGpu label,
+                                         ForcesParams params) {
+  if ((placed.flags & LABEL_ENABLED) == 0u) target.shown = PLACEMENT_HIDDEN;
+  if (params.anchor_relative != 0u) target.position += label.anchor - placed.anchor;
+  return target;
 }
 
 // Where the label is drawn this frame, and how opaque: its state's position while it is shown or

@@ -1,0 +1,301 @@
+#include "labeling/placement_beside.h"
+
+#include <algorithm>
+
+#include "engine/core/error.h"
+#include "engine/gpu/context.h"
+#include "engine/gpu/vulkan_check.h"
+
+namespace strata {
+
+using graph::Use;
+
+namespace {
+
+constexpr VkBufferUsageFlags kCopied = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                       VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+
+// (used by both queues' families)
+Buffer zeroed_buffer(Context& ctx, VkDeviceSize size) {
+  Buffer buffer(ctx, size, kCopied, MemoryKind::device_local, true);
+  upload(ctx, buffer, std::vector<std::byte>(size));
+  return buffer;
+}
+
+VkSemaphore timeline(Context& ctx) {
+  VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
+  type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
+  VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
+  VkSemaphore semaphore = VK_NULL_HANDLE;
+  STRATA_VK(vkCreateSemaphore(ctx.device(), &info, nullptr, &semaphore));
+  return semaphore;
+}
+
+void copy_buffer(const graph::PassContext& pc, graph::ResourceId from, graph::ResourceId to,
+                 VkDeviceSize size) {
+  const VkBufferCopy region{0, 0, size};
+  vkCmdCopyBuffer(pc.cmd, pc.buffer(from), pc.buffer(to), 1, &region);
+}
+
+void copy_image(const graph::PassContext& pc, graph::ResourceId from, graph::ResourceId to,
+                uint32_t layers) {
+  VkImageCopy region{};
+  region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, layers};
+  region.dstSubresource = region.srcSubresource;
+  region.extent = {pc.viewport.width, pc.viewport.height, 1};
+  vkCmdCopyImage(pc.cmd, pc.image(from), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.image(to),
+                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+}
+
+}  // namespace
+
+PlacementBeside::PlacementBeside(Context& ctx, Placement& placement, LabelForces& forces,
+                                 uint32_t label_count)
+    : ctx_(ctx),
+      placement_(placement),
+      forces_(forces),
+      label_count_(std::max(label_count, 1u)),
+      published_targets_(zeroed_buffer(ctx, label_count_ * sizeof(gpu::PlacementGpu))),
+      published_labels_(zeroed_buffer(ctx, label_count_ * sizeof(gpu::LabelGpu))),
+      published_order_(zeroed_buffer(ctx, label_count_ * sizeof(uint32_t))),
+      adopted_targets_(zeroed_buffer(ctx, label_count_ * sizeof(gpu::PlacementGpu))),
+      adopted_labels_(zeroed_buffer(ctx, label_count_ * sizeof(gpu::LabelGpu))),
+      adopted_order_(zeroed_buffer(ctx, label_count_ * sizeof(uint32_t))),
+      slots_(ctx, 1, ctx.placement_queue(), ctx.placement_family()),
+      fed_(timeline(ctx)),
+      placed_(timeline(ctx)) {}
+
+PlacementBeside::~PlacementBeside() {
+  if (ctx_.drain() || ctx_.may_destroy()) {
+    vkDestroySemaphore(ctx_.device(), fed_, nullptr);
+    vkDestroySemaphore(ctx_.device(), placed_, nullptr);
+  }
+}
+
+void PlacementBeside::wait_idle() {
+  slots_.wait_all();
+}
+
+void PlacementBeside::build(uint32_t layer_count, graph::Extent size) {
+  wait_idle();
+  layer_count_ = layer_count;
+  placement_.readback().set_slots(2);
+  for (Snapshot& s : snapshots_) {
+    const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    s.final = Image(ctx_, {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                           .extent = {size.width, size.height, 1},
+                           .usage = usage,
+                           .both_queues = true});
+    s.layers = Image(ctx_, {.format = VK_FORMAT_R16G16B16A16_SFLOAT,
+                            .extent = {size.width, size.height, 1},
+                            .usage = usage,
+                            .layers = layer_count,
+                            .array = true,
+                            .both_queues = true});
+    s.state = Buffer(ctx_, label_count_ * sizeof(gpu::LabelStateGpu), kCopied,
+                     MemoryKind::device_local, true);
+  }
+  graph::Graph graph;
+  const auto snapshot_image = [&graph](const char* name, VkFormat format) {
+    // (as the frame that started the placement left it; its submission's signal is waited for
+    // at every stage)
+    return graph.import_image(name, {.format = format,
+                                     .has_content = true,
+                                     .initial_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                     .initial_stage = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT});
+  };
+  const graph::ResourceId final_image = snapshot_image("beside.final", VK_FORMAT_R8G8B8A8_UNORM);
+  const graph::ResourceId layers = snapshot_image("beside.layers", VK_FORMAT_R16G16B16A16_SFLOAT);
+  const graph::ResourceId state = graph.import_buffer("beside.state", {.has_content = true});
+  runner_snapshot_ids_ = {final_image, layers, state};
+  const Placement::Outputs placed = placement_.add_to(
+      graph, {.final_image = final_image,
+              .layers = layers,
+              .layer_count = layer_count,
+              .adjust_labels = [this, state](graph::Graph& g, graph::ResourceId labels) {
+                forces_.add_previous(g, labels, state);
+              }});
+  const auto published = [&graph](const char* name, const Buffer& buffer) {
+    return graph.import_buffer(name, {.buffer = buffer.handle()});
+  };
+  const graph::ResourceId targets = published("beside.published_targets", published_targets_);
+  const graph::ResourceId labels = published("beside.published_labels", published_labels_);
+  const graph::ResourceId order = published("beside.published_order", published_order_);
+  const VkDeviceSize n = label_count_;
+  graph.add_pass({"placement.publish",
+                  graph::PassKind::transfer,
+                  {{placed.placements, Use::transfer_src},
+                   {placed.labels, Use::transfer_src},
+                   {placed.order, Use::transfer_src},
+                   {targets, Use::transfer_dst},
+                   {labels, Use::transfer_dst},
+                   {order, Use::transfer_dst}},
+                  [=](graph::PassContext& pc) {
+                    copy_buffer(pc, placed.placements, targets, n * sizeof(gpu::PlacementGpu));
+                    copy_buffer(pc, placed.labels, labels, n * sizeof(gpu::LabelGpu));
+                    copy_buffer(pc, placed.order, order, n * sizeof(uint32_t));
+                  },
+                  "placement"});
+  runner_ = std::make_unique<graph::GraphRunner>(ctx_, std::move(graph));
+  runner_->set_viewport(size);
+}
+
+PlacementBeside::FrameIds PlacementBeside::add_to_frame(graph::Graph& graph,
+                                                        const VolumeRenderer::Outputs& rendered,
+                                                        graph::ResourceId state) {
+  // The snapshot the next placement reads (bound in prepare): written only by the frame that
+  // starts it, left as the copy leaves it.
+  const auto snapshot_image = [&graph](const char* name, VkFormat format) {
+    return graph.import_image(name, {.format = format});
+  };
+  const graph::ResourceId final_image = snapshot_image("beside.final", VK_FORMAT_R8G8B8A8_UNORM);
+  const graph::ResourceId layers = snapshot_image("beside.layers", VK_FORMAT_R16G16B16A16_SFLOAT);
+  frame_snapshot_ids_[0] = final_image;
+  frame_snapshot_ids_[1] = layers;
+  const VkDeviceSize n = label_count_;
+  graph.add_pass({"placement.snapshot",
+                  graph::PassKind::transfer,
+                  {{rendered.final, Use::transfer_src},
+                   {rendered.layers, Use::transfer_src},
+                   {final_image, Use::transfer_dst},
+                   {layers, Use::transfer_dst}},
+                  [=, this](graph::PassContext& pc) {
+                    if (!start_now_) return;
+                    copy_image(pc, rendered.final, final_image, 1);
+                    copy_image(pc, rendered.layers, layers, layer_count_);
+                  },
+                  "placement"});
+  const auto imported = [&graph](const char* name, const Buffer& buffer) {
+    return graph.import_buffer(name, {.buffer = buffer.handle(), .has_content = true});
+  };
+  const graph::ResourceId published_targets =
+      imported("beside.published_targets", published_targets_);
+  const graph::ResourceId published_labels = imported("beside.published_labels", published_labels_);
+  const graph::ResourceId published_order = imported("beside.published_order", published_order_);
+  const graph::ResourceId targets = imported("beside.adopted_targets", adopted_targets_);
+  const graph::ResourceId placed = imported("beside.adopted_labels", adopted_labels_);
+  const graph::ResourceId order = imported("beside.adopted_order", adopted_order_);
+  graph.add_pass({"placement.adopt",
+                  graph::PassKind::transfer,
+                  {{published_targets, Use::transfer_src},
+                   {published_labels, Use::transfer_src},
+                   {published_order, Use::transfer_src},
+                   {targets, Use::transfer_dst},
+                   {placed, Use::transfer_dst},
+                   {order, Use::transfer_dst}},
+                  [=, this](graph::PassContext& pc) {
+                    if (!adopt_now_) return;
+                    copy_buffer(pc, published_targets, targets, n * sizeof(gpu::PlacementGpu));
+                    copy_buffer(pc, published_labels, placed, n * sizeof(gpu::LabelGpu));
+                    copy_buffer(pc, published_order, order, n * sizeof(uint32_t));
+                  },
+                  "placement"});
+  const graph::ResourceId labels =
+      graph.add_buffer("frame.labels", {[n](graph::Extent) { return n * sizeof(gpu::LabelGpu); }});
+  graph.add_pass({"labels.upload",
+                  graph::PassKind::transfer,
+                  {{labels, Use::transfer_dst}},
+                  [this, labels](graph::PassContext& pc) {
+                    // (vkCmdUpdateBuffer takes at most 65536 bytes at once)
+                    const auto* bytes = reinterpret_cast<const std::byte*>(frame_labels_.data());
+                    const size_t size = frame_labels_.size() * sizeof(gpu::LabelGpu);
+                    for (size_t at = 0; at < size; at += 65536) {
+                      vkCmdUpdateBuffer(pc.cmd, pc.buffer(labels), at,
+                                        std::min<size_t>(65536, size - at), bytes + at);
+                    }
+                  },
+                  "labels"});
+  forces_.add_previous(graph, labels, state);
+  return {labels, forces_.add_follow(graph, labels, placed, targets), order};
+}
+
+void PlacementBeside::add_state_snapshot(graph::Graph& graph, graph::ResourceId state) {
+  const graph::ResourceId saved = graph.import_buffer("beside.state", {});
+  frame_snapshot_ids_[2] = saved;
+  const VkDeviceSize bytes = label_count_ * sizeof(gpu::LabelStateGpu);
+  graph.add_pass({"placement.snapshot_state",
+                  graph::PassKind::transfer,
+                  {{state, Use::transfer_src}, {saved, Use::transfer_dst}},
+                  [=, this](graph::PassContext& pc) {
+                    if (start_now_) copy_buffer(pc, state, saved, bytes);
+                  },
+                  "labels"});
+}
+
+bool PlacementBeside::finished() const {
+  uint64_t value = 0;
+  STRATA_VK(vkGetSemaphoreCounterValue(ctx_.device(), placed_, &value));
+  return value >= started_;
+}
+
+VkSemaphoreSubmitInfo PlacementBeside::at(VkSemaphore semaphore, uint64_t value) const {
+  VkSemaphoreSubmitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+  info.semaphore = semaphore;
+  info.value = value;
+  info.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+  return info;
+}
+
+void PlacementBeside::prepare(graph::GraphRunner& frame, const std::vector<gpu::LabelGpu>& labels) {
+  if (!runner_) throw Error("placement beside the frames: build() before prepare()");
+  frame_labels_ = labels;
+  graph::FrameSubmission& submission = frame.submission();
+  submission = {};
+  adopt_now_ = start_now_ = false;
+  if (started_ > adopted_ && finished()) {
+    adopt();
+    submission.wait.push_back(at(placed_, adopted_));
+  }
+  // (the frames write the snapshot of the placement after the one in flight)
+  const Snapshot& next = snapshots_[(started_ + 1) % 2];
+  frame.bind_image(frame_snapshot_ids_[0], next.final.handle(), next.final.view(),
+                   VK_FORMAT_R8G8B8A8_UNORM);
+  frame.bind_image(frame_snapshot_ids_[1], next.layers.handle(), next.layers.view(),
+                   VK_FORMAT_R16G16B16A16_SFLOAT);
+  frame.bind_buffer(frame_snapshot_ids_[2], next.state.handle());
+  if (started_ == adopted_ && !paused_ && due_) start(frame);
+}
+
+void PlacementBeside::adopt() {
+  adopted_ = started_;
+  adopt_now_ = true;
+  adopted_order_count_ = started_order_count_;
+  adopted_frame_ = start_frame_;
+  ++stats_.adopted;
+  stats_.latency_frames.push_back(uint32_t(frame_ - start_frame_));
+  timings_ = runner_->timings();
+  placement_.readback().use_slot(*runner_, uint32_t(adopted_ % 2));
+}
+
+// Records the next placement now (the placement's labels and order are this frame's) and submits
+// it after the frame, which feeds it.
+void PlacementBeside::start(graph::GraphRunner& frame) {
+  const uint64_t k = ++started_;
+  start_now_ = true;
+  due_ = false;
+  start_frame_ = frame_;
+  started_order_count_ = placement_.order_count();
+  ++stats_.started;
+  const Snapshot& s = snapshots_[k % 2];
+  runner_->bind_image(runner_snapshot_ids_[0], s.final.handle(), s.final.view(),
+                      VK_FORMAT_R8G8B8A8_UNORM);
+  runner_->bind_image(runner_snapshot_ids_[1], s.layers.handle(), s.layers.view(),
+                      VK_FORMAT_R16G16B16A16_SFLOAT);
+  runner_->bind_buffer(runner_snapshot_ids_[2], s.state.handle());
+  placement_.readback().use_slot(*runner_, uint32_t(k % 2));
+  const uint32_t slot = slots_.next();
+  const VkCommandBuffer cmd = slots_.begin(slot);
+  runner_->record(cmd, slot);
+  // (the host reads the adopted placement's results until this one is adopted)
+  placement_.readback().use_slot(*runner_, uint32_t(adopted_ % 2));
+  graph::FrameSubmission& submission = frame.submission();
+  submission.signal.push_back(at(fed_, k));
+  submission.submitted = [this, slot, k] {
+    const VkSemaphoreSubmitInfo waits[] = {at(fed_, k), at(placed_, k - 1)};
+    const VkSemaphoreSubmitInfo signal = at(placed_, k);
+    slots_.submit(slot, waits, {&signal, 1});
+  };
+}
+
+}  // namespace strata

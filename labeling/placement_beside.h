@@ -1,0 +1,115 @@
+// The placement beside the frames. The placement (layers' costs, summed-area tables, the label
+// loop, the tidy-up) runs in a graph of its own, submitted to Context::placement_queue() at its
+// own pace, while every frame renders, moves the labels toward the targets of the newest finished
+// placement and draws them, without waiting for a placement.
+//
+// A frame that finds the last placement finished adopts it (copies its targets, insertion order
+// and the labels as it saw them into buffers the frames read) and starts the next one: it copies
+// what the placement reads (the label-free final image, the layers, the forces' state) into a
+// snapshot, and its submission signals the timeline the placement's submission waits for. There
+// are two snapshots: the frames write only the one no placement reads. Each frame moves the
+// adopted targets with the anchors (follow_anchor), so labels follow the camera in between.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "engine/graph/frame_slots.h"
+#include "engine/graph/graph_runner.h"
+#include "passes/label_forces.h"
+#include "passes/placement.h"
+#include "passes/volume_renderer.h"
+
+namespace strata {
+
+class PlacementBeside {
+ public:
+  PlacementBeside(Context& ctx, Placement& placement, LabelForces& forces, uint32_t label_count);
+  ~PlacementBeside();
+  PlacementBeside(const PlacementBeside&) = delete;
+  PlacementBeside& operator=(const PlacementBeside&) = delete;
+
+  struct FrameIds {
+    graph::ResourceId labels;   // LabelGpu[]: this frame's, with what they take from the last
+    graph::ResourceId targets;  // PlacementGpu[]: the adopted placement's, moved into this frame
+    graph::ResourceId order;    // uint[]: the adopted placement's insertion order
+  };
+  // The frame's side before its forces: the snapshot of the placement's images, the adoption,
+  // this frame's labels (forces.previous on them) and the targets that follow the anchors.
+  // `state`: the forces'.
+  FrameIds add_to_frame(graph::Graph& graph, const VolumeRenderer::Outputs& rendered,
+                        graph::ResourceId state);
+  // After the frame's forces: the forces' `state` for the placement this frame starts (it holds
+  // the targets of the placement the frame took up, as the frame after it would find them).
+  void add_state_snapshot(graph::Graph& graph, graph::ResourceId state);
+  // The placement's own graph, for `layer_count` layers of `size` (waits for a placement in
+  // flight); the snapshots sized to match.
+  void build(uint32_t layer_count, graph::Extent size);
+
+  // Before the frame is recorded, with the frame's `labels` (Placement::set_frame was given them,
+  // LabelForces::set_frame not yet): adopts a finished placement, starts the next one, and sets
+  // the frame's submission (its waits and signals, and the placement's submission after it).
+  void prepare(graph::GraphRunner& frame, const std::vector<gpu::LabelGpu>& labels);
+  // Labels in the adopted placement's insertion order (the forces' keeping apart).
+  uint32_t adopted_order_count() const { return adopted_order_count_; }
+  // The frame that started the adopted placement (LabelledRenderer counts them from 1; 0: none
+  // adopted yet).
+  uint64_t adopted_frame() const { return adopted_frame_; }
+  // The placement's own GPU time, of the adopted one.
+  const std::vector<graph::PassTiming>& placement_timings() const { return timings_; }
+  // Placements started and adopted so far, and the frames from each start to its adoption.
+  struct Stats {
+    uint64_t started = 0, adopted = 0;
+    std::vector<uint32_t> latency_frames;
+  };
+  const Stats& stats() const { return stats_; }
+  // The frame being prepared (its number, counted by the caller).
+  void set_frame_number(uint64_t frame) { frame_ = frame; }
+  // While paused, no placement starts (one in flight is still taken up).
+  void set_paused(bool paused) { paused_ = paused; }
+  // Something the placement reads changed (the camera, the labels, the settings): the next
+  // placement is due. Without a change since the last one started, none starts: at rest the
+  // frames only move the labels to the last placement's targets.
+  void set_due() { due_ = true; }
+  // Waits for a placement in flight (at most the Context's GPU timeout).
+  void wait_idle();
+
+ private:
+  struct Snapshot {
+    Image final, layers;
+    Buffer state;
+  };
+  bool finished() const;
+  void adopt();
+  void start(graph::GraphRunner& frame);
+  VkSemaphoreSubmitInfo at(VkSemaphore semaphore, uint64_t value) const;
+
+  Context& ctx_;
+  Placement& placement_;
+  LabelForces& forces_;
+  uint32_t label_count_;
+  std::array<Snapshot, 2> snapshots_;
+  Buffer published_targets_, published_labels_, published_order_;
+  Buffer adopted_targets_, adopted_labels_, adopted_order_;
+  std::unique_ptr<graph::GraphRunner> runner_;              // the placement's graph
+  std::array<graph::ResourceId, 3> runner_snapshot_ids_{};  // final, layers, state
+  std::array<graph::ResourceId, 3> frame_snapshot_ids_{};
+  FrameSlots slots_;
+  VkSemaphore fed_ = VK_NULL_HANDLE;     // frame k fed placement k (its snapshot is written)
+  VkSemaphore placed_ = VK_NULL_HANDLE;  // placement k finished
+  uint64_t started_ = 0, adopted_ = 0;   // placements, counted from 1
+  uint64_t frame_ = 0, start_frame_ = 0, adopted_frame_ = 0;
+  uint32_t layer_count_ = 1;
+  uint32_t order_count_ = 0, adopted_order_count_ = 0, started_order_count_ = 0;
+  bool adopt_now_ = false, start_now_ = false;  // what the frame being prepared does
+  bool paused_ = false;
+  bool due_ = true;
+  std::vector<gpu::LabelGpu> frame_labels_;
+  std::vector<graph::PassTiming> timings_;
+  Stats stats_;
+};
+
+}  // namespace strata
