@@ -44,43 +44,38 @@ bool has_device_extension(VkPhysicalDevice device, const char* name) {
   });
 }
 
-// The first queue family that does graphics and compute and writes timestamps; -1 if none.
-int graphics_compute_family(VkPhysicalDevice device) {
+std::vector<VkQueueFamilyProperties> queue_families(VkPhysicalDevice device) {
   uint32_t count = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
   std::vector<VkQueueFamilyProperties> families(count);
   vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
-  for (uint32_t i = 0; i < count; ++i) {
-    const VkQueueFlags need = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
-    if ((families[i].queueFlags & need) == need && families[i].timestampValidBits > 0) {
+  return families;
+}
+
+// The first queue family with all of `need`, none of `exclude`, and timestamps; -1 if none.
+int queue_family_with(VkPhysicalDevice device, VkQueueFlags need, VkQueueFlags exclude) {
+  const std::vector<VkQueueFamilyProperties> families = queue_families(device);
+  for (size_t i = 0; i < families.size(); ++i) {
+    const VkQueueFlags flags = families[i].queueFlags;
+    if ((flags & need) == need && (flags & exclude) == 0u && families[i].timestampValidBits > 0) {
       return static_cast<int>(i);
     }
   }
   return -1;
 }
 
-// A queue family with compute and timestamps but no graphics (asynchronous compute), or -1.
+// The family of the frames' queue: graphics and compute.
+int graphics_compute_family(VkPhysicalDevice device) {
+  return queue_family_with(device, VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT, 0);
+}
+
+// A family for the placement beside the frames: compute without graphics (asynchronous compute).
 int compute_only_family(VkPhysicalDevice device) {
-  uint32_t count = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(count);
-  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
-  for (uint32_t i = 0; i < count; ++i) {
-    const VkQueueFlags flags = families[i].queueFlags;
-    if ((flags & VK_QUEUE_COMPUTE_BIT) != 0u && (flags & VK_QUEUE_GRAPHICS_BIT) == 0u &&
-        families[i].timestampValidBits > 0) {
-      return static_cast<int>(i);
-    }
-  }
-  return -1;
+  return queue_family_with(device, VK_QUEUE_COMPUTE_BIT, VK_QUEUE_GRAPHICS_BIT);
 }
 
 uint32_t queue_count(VkPhysicalDevice device, uint32_t family) {
-  uint32_t count = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(count);
-  vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
-  return families.at(family).queueCount;
+  return queue_families(device).at(family).queueCount;
 }
 
 // Whether the device has `extension` and its feature `flag`, asked through `feature` (the
