@@ -276,7 +276,6 @@ void PlacementBeside::start(graph::GraphRunner& frame) {
   due_ = false;
   start_frame_ = frame_;
   started_order_count_ = placement_.order_count();
-  ++stats_.started;
   const Snapshot& s = snapshots_[k % 2];
   runner_->bind_image(runner_snapshot_ids_[0], s.final.handle(), s.final.view(),
                       VK_FORMAT_R8G8B8A8_UNORM);

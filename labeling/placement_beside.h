@@ -14,7 +14,6 @@
 #include <array>
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <vector>
 
 #include "engine/graph/frame_slots.h"
@@ -60,9 +59,9 @@ class PlacementBeside {
   uint64_t adopted_frame() const { return adopted_frame_; }
   // The placement's own GPU time, of the adopted one.
   const std::vector<graph::PassTiming>& placement_timings() const { return timings_; }
-  // Placements started and adopted so far, and the frames from each start to its adoption.
+  // Placements taken up so far, and the frames from each one's start to its take-up.
   struct Stats {
-    uint64_t started = 0, adopted = 0;
+    uint64_t adopted = 0;
     std::vector<uint32_t> latency_frames;
   };
   const Stats& stats() const { return stats_; }
