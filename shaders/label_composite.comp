@@ -21,13 +21,13 @@ shared uint tile_labels[LABEL_MAX / 32u];
 void main() {
   const uint lane = gl_LocalInvocationIndex;
   const uint lanes = LABEL_DRAW_GROUP * LABEL_DRAW_GROUP;
-  for (uint w = lane; w < LABEL_MAX / 32u; w += lanes) tile_labels[w] = 0u;
+  const uint count = min(min(params.label_count, LABEL_MAX),
+                         uint(min(labels.length(), placements.length())));
+  const uint words = (count + 31u) / 32u;  // (the bit set's words in use: only those are cleared)
+  for (uint w = lane; w < words; w += lanes) tile_labels[w] = 0u;
   barrier();
   const vec2 tile_lo = vec2(gl_WorkGroupID.xy * LABEL_DRAW_GROUP) + 0.5f;
   const vec2 tile_hi = tile_lo + float(LABEL_DRAW_GROUP - 1u);
-  const uint count = min(min(params.label_count, LABEL_MAX),
-                         uint(min(labels.length(), placements.length())));
-  const uint words = (count + 31u) / 32u;  // (the bit set's words in use)
   const uint layer_count = min(params.layer_count, uint(VR_MAX_LAYERS));
   for (uint i = lane; i < count; i += lanes) {
     const LabelGpu label = labels[i];

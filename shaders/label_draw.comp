@@ -38,14 +38,12 @@ void main() {
   const uint lane = gl_LocalInvocationIndex;
   const uint lanes = LABEL_DRAW_GROUP * LABEL_DRAW_GROUP;
   const uint layer_count = min(params.layer_count, uint(VR_MAX_LAYERS));
-  for (uint w = lane; w < VR_MAX_LAYERS * (LABEL_MAX / 32u); w += lanes) {
-    tile_labels[w / (LABEL_MAX / 32u)][w % (LABEL_MAX / 32u)] = 0u;
-  }
+  const uint count = min(label_count(), LABEL_MAX);
+  const uint words = (count + 31u) / 32u;  // (the bit sets' words in use: only those are cleared)
+  for (uint w = lane; w < layer_count * words; w += lanes) tile_labels[w / words][w % words] = 0u;
   barrier();
   const vec2 tile_lo = vec2(gl_WorkGroupID.xy * LABEL_DRAW_GROUP) + 0.5f;
   const vec2 tile_hi = tile_lo + float(LABEL_DRAW_GROUP - 1u);
-  const uint count = min(label_count(), LABEL_MAX);
-  const uint words = (count + 31u) / 32u;  // (the bit sets' words in use)
   for (uint i = lane; i < count; i += lanes) {
     const LabelGpu label = labels[i];
     if ((label.flags & LABEL_ENABLED) == 0u || label.layer >= layer_count) continue;
@@ -65,17 +63,27 @@ void main() {
     uint any_label = 0u;
     for (uint w = 0u; w < words; ++w) any_label |= tile_labels[layer][w];
     if (any_label == 0u) continue;  // (most tiles of a layer hold no label: left unread)
+    // (the layer is read only where a label comes near the pixel)
     const ivec3 texel = ivec3(id, layer);
-    const vec4 content = imageLoad(layers, texel);
-    vec4 drawn = content;
+    bool loaded = false;
+    vec4 content = vec4(0.0), drawn = vec4(0.0);
     for (uint w = 0u; w < words; ++w) {
       uint bits = tile_labels[layer][w];
       while (bits != 0u) {
-        const uint b = uint(findLSB(bits));
+        const uint i = w * 32u + uint(findLSB(bits));
         bits &= bits - 1u;
-        drawn = draw_label_at(w * 32u + b, p, layer, drawn);
+        if (!loaded) {
+          const LabelGpu label = labels[i];
+          const bool internal = (label.flags & LABEL_INTERNAL) != 0u;
+          const vec2 centre = internal ? label.anchor : placements[i].position;
+          if (label_far_from(p, label.anchor, centre, label.size)) continue;
+          content = imageLoad(layers, texel);
+          drawn = content;
+          loaded = true;
+        }
+        drawn = draw_label_at(i, p, layer, drawn);
       }
     }
-    if (drawn != content) imageStore(layers, texel, drawn);
+    if (loaded && drawn != content) imageStore(layers, texel, drawn);
   }
 }

@@ -605,6 +605,52 @@ TEST_SUITE("cpu") {
     for (gpu::LabelGpu& label : s.labels) label.flags &= ~LABEL_ENABLED;
     CHECK(reference_layers(s) == s.layers);
   }
+
+  TEST_CASE("a_tile_far_from_a_label_holds_none_of_its_shapes") {
+    // The drawing passes leave a label out of a 16 x 16 tile when label_far_from_tile says so:
+    // then none of what it draws (frame, connector, marker, the composite's dashed connector with
+    // its halo, anything inside its box) may reach a pixel centre of the tile. Random labels with
+    // long connectors, tiles all around them; the test also asserts the tight test leaves out
+    // tiles that the connector's bounding rectangle would keep.
+    uint32_t seed = 12345u;
+    const auto next = [&seed](float lo, float hi) {
+      seed = seed * 1664525u + 1013904223u;
+      return lo + (hi - lo) * float(seed >> 8) / float(1u << 24);
+    };
+    size_t far_tiles = 0, inside_rectangle = 0, touched = 0;
+    for (int n = 0; n < 120; ++n) {
+      gpu::LabelGpu label = label_on(1, {next(0.0f, 256.0f), next(0.0f, 256.0f)});
+      label.size = {next(10.0f, 120.0f), next(10.0f, 40.0f)};
+      gpu::PlacementGpu placement{{next(0.0f, 256.0f), next(0.0f, 256.0f)}, 0.0f, PLACEMENT_SHOWN};
+      placement.opacity = 1.0f;
+      const glm::vec2 centre = placement.position, half = 0.5f * label.size;
+      for (uint32_t ty = 0; ty < 16; ++ty) {
+        for (uint32_t tx = 0; tx < 16; ++tx) {
+          const glm::vec2 lo = glm::vec2(tx * 16, ty * 16) + 0.5f, hi = lo + 15.0f;
+          if (!gpu::label_far_from_tile(lo, hi, label.anchor, centre, label.size)) continue;
+          ++far_tiles;
+          bool near_rectangle = true;
+          for (float y = lo.y; y <= hi.y; y += 1.0f) {
+            for (float x = lo.x; x <= hi.x; x += 1.0f) {
+              const glm::vec2 p{x, y};
+              near_rectangle =
+                  near_rectangle && !gpu::label_far_from(p, label.anchor, centre, label.size);
+              const glm::vec4 none(0.0f);
+              touched += gpu::label_frame(p, label.anchor, centre, label.size, true,
+                                          gpu::LABEL_BORDER_COLOR) != none ||
+                         gpu::label_anchor_marker(p, label.anchor) != none ||
+                         gpu::label_box_distance(p, centre, half, 0.0f) <= 1.0f ||
+                         gpu::label_behind(label, placement, p, 1.0f) != none;
+            }
+          }
+          inside_rectangle += near_rectangle;
+        }
+      }
+    }
+    CHECK(touched == 0);
+    CHECK(far_tiles > 4000);
+    CHECK(inside_rectangle > 40);
+  }
 }
 
 TEST_SUITE("gpu") {

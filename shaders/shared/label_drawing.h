@@ -167,14 +167,51 @@ STRATA_INLINE bool label_far_from(vec2 p, vec2 anchor, vec2 centre, vec2 size) {
   return p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y;
 }
 
-// Whether label_far_from holds for every pixel centre in [tile_lo, tile_hi] (a workgroup's tile
-// can leave the label out).
+// Whether the segment a-b misses the box [lo, hi] (Liang and Barsky's clipping).
+STRATA_INLINE bool label_segment_misses_box(vec2 a, vec2 b, vec2 lo, vec2 hi) {
+  float t0 = 0.0f;
+  float t1 = 1.0f;
+  for (int k = 0; k < 2; ++k) {
+    float d = b[k] - a[k];
+    if (d == 0.0f) {
+      if (a[k] < lo[k] || a[k] > hi[k]) return true;
+      continue;
+    }
+    float ta = (lo[k] - a[k]) / d;
+    float tb = (hi[k] - a[k]) / d;
+    t0 = max(t0, min(ta, tb));
+    t1 = min(t1, max(ta, tb));
+  }
+  return t0 > t1;
+}
+
+// Whether every pixel centre in [tile_lo, tile_hi] lies outside everything a label draws (a
+// workgroup's tile can leave the label out): its box, picture and text (inside the box), its
+// anchor marker and its connector, with the composite's halo, each with a pixel to spare beyond
+// its ramp. Tighter than label_far_from's rectangle: a long connector's rectangle covers tiles
+// the connector never comes near.
 STRATA_INLINE bool label_far_from_tile(vec2 tile_lo, vec2 tile_hi, vec2 anchor, vec2 centre,
                                        vec2 size) {
-  float margin = LABEL_MARKER_RADIUS + 1.0f;
+  float margin = LABEL_MARKER_RADIUS + 1.0f;  // (label_far_from's rectangle first)
   vec2 lo = min(centre - 0.5f * size, anchor) - margin;
   vec2 hi = max(centre + 0.5f * size, anchor) + margin;
-  return tile_hi.x < lo.x || tile_hi.y < lo.y || tile_lo.x > hi.x || tile_lo.y > hi.y;
+  if (tile_hi.x < lo.x || tile_hi.y < lo.y || tile_lo.x > hi.x || tile_lo.y > hi.y) return true;
+  vec2 half_size = 0.5f * size;
+  float box_margin = 2.0f;
+  if (!(tile_hi.x < centre.x - half_size.x - box_margin ||
+        tile_lo.x > centre.x + half_size.x + box_margin ||
+        tile_hi.y < centre.y - half_size.y - box_margin ||
+        tile_lo.y > centre.y + half_size.y + box_margin)) {
+    return false;
+  }
+  float marker_margin = LABEL_MARKER_RADIUS + 1.5f;
+  if (!(tile_hi.x < anchor.x - marker_margin || tile_lo.x > anchor.x + marker_margin ||
+        tile_hi.y < anchor.y - marker_margin || tile_lo.y > anchor.y + marker_margin)) {
+    return false;
+  }
+  vec2 end = clamp(anchor, centre - half_size, centre + half_size);
+  float line_margin = LABEL_LINE_HALF_WIDTH + LABEL_HALO_WIDTH + 1.5f;
+  return label_segment_misses_box(anchor, end, tile_lo - line_margin, tile_hi + line_margin);
 }
 
 // The final pixel: the layers' front-to-back composite over the background, opaque.
