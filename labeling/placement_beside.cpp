@@ -4,6 +4,7 @@
 
 #include "engine/core/error.h"
 #include "engine/gpu/context.h"
+#include "engine/gpu/resources.h"
 #include "engine/gpu/vulkan_check.h"
 
 namespace strata {
@@ -197,13 +198,7 @@ PlacementBeside::FrameIds PlacementBeside::add_to_frame(graph::Graph& graph,
                   graph::PassKind::transfer,
                   {{labels, Use::transfer_dst}},
                   [this, labels](graph::PassContext& pc) {
-                    // (vkCmdUpdateBuffer takes at most 65536 bytes at once)
-                    const auto* bytes = reinterpret_cast<const std::byte*>(frame_labels_.data());
-                    const size_t size = frame_labels_.size() * sizeof(gpu::LabelGpu);
-                    for (size_t at = 0; at < size; at += 65536) {
-                      vkCmdUpdateBuffer(pc.cmd, pc.buffer(labels), at,
-                                        std::min<size_t>(65536, size - at), bytes + at);
-                    }
+                    record_update(pc.cmd, pc.buffer(labels), 0, as_bytes(frame_labels_));
                   },
                   "labels"});
   forces_.add_previous(graph, labels, state);

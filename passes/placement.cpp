@@ -8,6 +8,7 @@
 
 #include "engine/core/error.h"
 #include "engine/gpu/context.h"
+#include "engine/gpu/resources.h"
 #include "shared/tidy_gpu.h"
 
 static_assert(sizeof(strata::gpu::TidyGpu) == 112, "TidyGpu: the layout GLSL's std430 gives it");
@@ -223,14 +224,8 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                    {b.samples, Use::transfer_dst},
                    {b.tidy_args, Use::transfer_dst}},
                   [this, b](graph::PassContext& pc) {
-                    if (!labels_.empty()) {
-                      vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.labels), 0,
-                                        labels_.size() * sizeof(gpu::LabelGpu), labels_.data());
-                    }
-                    if (!order_.empty()) {
-                      vkCmdUpdateBuffer(pc.cmd, pc.buffer(b.order), 0,
-                                        order_.size() * sizeof(uint32_t), order_.data());
-                    }
+                    record_update(pc.cmd, pc.buffer(b.labels), 0, as_bytes(labels_));
+                    record_update(pc.cmd, pc.buffer(b.order), 0, as_bytes(order_));
                     const auto fill = [&pc](ResourceId id, uint32_t value) {
                       vkCmdFillBuffer(pc.cmd, pc.buffer(id), 0, VK_WHOLE_SIZE, value);
                     };

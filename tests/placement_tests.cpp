@@ -25,7 +25,7 @@
 namespace strata {
 namespace {
 
-constexpr double kFrameSeconds = 1.0 / 30.0;  // a frame of a 30 fps animation
+constexpr double kFrameSeconds = 1.0 / 30.0;           // a frame of a 30 fps animation
 constexpr LabelUnits kUnits{1024.0f, 14.0f, 1024.0f};  // the forces' image and text size
 
 struct Inputs {
@@ -254,6 +254,27 @@ TEST_SUITE("gpu") {
     check_placements(gpu, cpu);
     REQUIRE(gpu.tidy_rounds.size() > 1);
     CHECK(gpu.tidy_rounds[1] > 0);  // (round 0 applied changes)
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "past_1024_labels_the_upload_holds_every_label") {
+    // 1030 labels are 65920 bytes: more than one vkCmdUpdateBuffer may take (65536).
+    Inputs in = disc_scene(0);
+    in.size = {16, 12};
+    const size_t pixels = size_t{in.size.width} * in.size.height;
+    in.final_rgba8.assign(pixels * 4, 40);
+    in.layers.assign(pixels * in.layer_count, glm::vec4(0.0f));
+    const uint32_t count = 1030;
+    for (uint32_t i = 0; i < count; ++i) {
+      const glm::vec2 anchor(2.0f + float(i * 7 % 12), 2.0f + float(i * 5 % 8));
+      in.labels.push_back(label(anchor, {2.0f, 2.0f}, i % 2));
+      in.order.push_back(count - 1 - i);  // (the labels past the first 1024 go first)
+    }
+    PlacementSettings settings;
+    settings.tidy_rounds = 0;
+    const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
+    const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                   in.labels, in.order, settings, in.size);
+    check_placements(gpu, cpu);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "the_layout_tidy_up_removes_leader_crossings") {

@@ -450,10 +450,13 @@ Context::~Context() {
   vkDestroyDevice(device_, nullptr);
 }
 
-uint32_t Context::memory_type(uint32_t allowed_types, VkMemoryPropertyFlags wanted) const {
-  for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
-    if ((allowed_types & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & wanted) == wanted) {
-      return i;
+uint32_t Context::memory_type(uint32_t allowed_types, VkMemoryPropertyFlags wanted,
+                              VkMemoryPropertyFlags preferred) const {
+  for (const VkMemoryPropertyFlags flags : {wanted | preferred, wanted}) {
+    for (uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
+      if ((allowed_types & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & flags) == flags) {
+        return i;
+      }
     }
   }
   throw Error("device '" + report_.name + "' has no memory type with the properties needed");

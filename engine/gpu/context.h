@@ -135,7 +135,10 @@ class Context {
   double timestamp_period_ns() const { return properties_.limits.timestampPeriod; }
   ValidationLog& validation_log() { return instance_.validation_log(); }
 
-  uint32_t memory_type(uint32_t allowed_types, VkMemoryPropertyFlags wanted) const;
+  // The first memory type with `wanted` and `preferred` among `allowed_types`, else the first
+  // with `wanted`.
+  uint32_t memory_type(uint32_t allowed_types, VkMemoryPropertyFlags wanted,
+                       VkMemoryPropertyFlags preferred = 0) const;
 
   // Records `record` into a fresh command buffer, submits it and waits: for uploads, readbacks and
   // tests, never inside a frame.

@@ -1,5 +1,6 @@
 #include "engine/gpu/resources.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "engine/gpu/context.h"
@@ -20,13 +21,19 @@ VkMemoryPropertyFlags properties_for(MemoryKind kind) {
   return 0;
 }
 
+// Readbacks are read by the CPU: from cached memory where the device has it (a GPU's uncached
+// host memory reads a 1080p picture many times slower).
+VkMemoryPropertyFlags preferred_for(MemoryKind kind) {
+  return kind == MemoryKind::host_readback ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT : 0;
+}
+
 // Memory for a buffer or an image (`what`), checked against the device's limits first and
 // counted; `type` is set to the memory type taken.
 VkDeviceMemory allocate(Context& ctx, const VkMemoryRequirements& req, VkMemoryPropertyFlags props,
-                        const char* what, uint32_t& type) {
+                        const char* what, uint32_t& type, VkMemoryPropertyFlags preferred = 0) {
   VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   info.allocationSize = req.size;
-  info.memoryTypeIndex = type = ctx.memory_type(req.memoryTypeBits, props);
+  info.memoryTypeIndex = type = ctx.memory_type(req.memoryTypeBits, props, preferred);
   ctx.check_allocation(req.size, type, what);
   VkDeviceMemory memory = VK_NULL_HANDLE;
   const VkResult result = vkAllocateMemory(ctx.device(), &info, nullptr, &memory);
@@ -92,7 +99,8 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(device, buffer_, &req);
   try {
-    memory_ = allocate(ctx, req, properties_for(kind), "a buffer", memory_type_);
+    memory_ =
+        allocate(ctx, req, properties_for(kind), "a buffer", memory_type_, preferred_for(kind));
   } catch (...) {
     vkDestroyBuffer(device, buffer_, nullptr);
     throw;
@@ -212,6 +220,15 @@ void Image::release() {
     ctx_->count_free(memory_type_, allocated_);
   }
   ctx_ = nullptr;
+}
+
+void record_update(VkCommandBuffer cmd, VkBuffer buffer, VkDeviceSize offset,
+                   std::span<const std::byte> data) {
+  constexpr size_t kMost = 65536;
+  for (size_t at = 0; at < data.size(); at += kMost) {
+    vkCmdUpdateBuffer(cmd, buffer, offset + at, std::min(kMost, data.size() - at),
+                      data.data() + at);
+  }
 }
 
 uint32_t texel_size(VkFormat format) {

@@ -82,6 +82,11 @@ class Image {
 // Bytes per texel of the colour formats strata uses; throws for others.
 uint32_t texel_size(VkFormat format);
 
+// Records the update of `buffer` at `offset` with `data` (vkCmdUpdateBuffer, in pieces of at most
+// the 65536 bytes it takes at once).
+void record_update(VkCommandBuffer cmd, VkBuffer buffer, VkDeviceSize offset,
+                   std::span<const std::byte> data);
+
 // Copies `data` into a device-local buffer at offset 0 and waits.
 void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data);
 // Fills a whole image (2D or 3D, tightly packed texels) and leaves it in `final_layout`; waits.
