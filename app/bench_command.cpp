@@ -145,6 +145,7 @@ struct ViewBenchOptions {
   bool keep_apart = true;
   std::string placement = "auto";
   double pace = 0.0;  // frames a second the frames are started at (a display's); 0: at once
+  double frame_budget_ms = 0.0;  // the viewer's interactive rendering (`view --frame-budget`)
 };
 
 // The part of a group's name before its first dot ("placement.sat" is part of "placement"), or
@@ -254,7 +255,9 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   options.scene_path = o.scene;
   options.optimize_on_idle = false;
   options.keep_frame_spans = true;
-  options.placement_beside = placement_beside(o.placement, ctx);
+  options.frame_budget_ms = o.frame_budget_ms;
+  // (the viewer keeps the placement beside the frames with interactive rendering)
+  options.placement_beside = placement_beside(o.placement, ctx) || o.frame_budget_ms > 0.0;
   Viewer viewer(ctx, scene, cameras.front(), settings, options, output, nullptr);
   for (int i = 0; i < 10; ++i) viewer.frame(1.0 / fps);  // warm up: the HA-Buffer grows
   // The path three times: with a timestamp around every pass (the time of each), with stamps only
@@ -304,6 +307,8 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   out["frames"] = cameras.size();
   out["frames_in_flight"] = output.frames_in_flight();
   out["pace"] = o.pace;
+  out["frame_budget_ms"] = o.frame_budget_ms;
+  out["largest_divisor"] = frames.after.largest_divisor;
   out["frames_per_second"] = double(cameras.size()) / frames.seconds;
   out["gpu_frame_ms"] = frames.frame_quantiles();
   out["gpu_frame_ms_stamped_per_group"] = groups.frame_quantiles();
@@ -404,6 +409,12 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       ->add_option("--pace", view->pace,
                    "start a frame this many times a second, as a display's refresh would "
                    "(0: each as soon as the last is submitted)")
+      ->check(finite_range(0.0, 10000.0))
+      ->capture_default_str();
+  view_cmd
+      ->add_option("--frame-budget", view->frame_budget_ms,
+                   "as `view --frame-budget`: while the camera moves (every frame here) cast fewer "
+                   "rays to keep a frame within this many ms (0: off)")
       ->check(finite_range(0.0, 10000.0))
       ->capture_default_str();
   view_cmd->callback([&device, view] { bench::bench_view(device, *view); });
