@@ -6,6 +6,7 @@
 // pixel. Cost ties are broken by the lowest pixel index (row-major), on both sides.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -201,6 +202,24 @@ FrameMetrics metrics_of(const Inputs& in, const std::vector<gpu::PlacementGpu>& 
   return frame_metrics(layout);
 }
 
+// `count` labels of size `box` on a grey picture with empty layers, their anchors spread over
+// it `margin` pixels from its edges, two layers alternating, in label order.
+Inputs crowded_scene(graph::Extent size, float margin, uint32_t count, glm::vec2 box) {
+  Inputs in = disc_scene(0);
+  in.size = size;
+  const size_t pixels = size_t{size.width} * size.height;
+  in.final_rgba8.assign(pixels * 4, 40);
+  in.layers.assign(pixels * in.layer_count, glm::vec4(0.0f));
+  const uint32_t w = uint32_t(float(size.width) - 2.0f * margin);
+  const uint32_t h = uint32_t(float(size.height) - 2.0f * margin);
+  for (uint32_t i = 0; i < count; ++i) {
+    const glm::vec2 anchor(margin + float(i * 7 % w), margin + float(i * 5 % h));
+    in.labels.push_back(label(anchor, box, i % 2));
+    in.order.push_back(i);
+  }
+  return in;
+}
+
 }  // namespace
 
 TEST_SUITE("cpu") {
@@ -235,17 +254,7 @@ TEST_SUITE("gpu") {
   // (placement_tidy_large.comp, placement_tidy_search_large.comp): the same layout as the
   // reference, with rounds that change it.
   TEST_CASE_FIXTURE(test::GpuTest, "past_256_labels_the_tidy_up_reads_the_states_from_the_buffer") {
-    Inputs in = disc_scene(0);
-    in.size = {64, 48};
-    const size_t pixels = size_t{in.size.width} * in.size.height;
-    in.final_rgba8.assign(pixels * 4, 40);
-    in.layers.assign(pixels * in.layer_count, glm::vec4(0.0f));
-    const uint32_t count = TIDY_SHARED_MAX + 4;
-    for (uint32_t i = 0; i < count; ++i) {
-      const glm::vec2 anchor(4.0f + float(i * 7 % 56), 4.0f + float(i * 5 % 40));
-      in.labels.push_back(label(anchor, {6.0f, 4.0f}, i % 2));
-      in.order.push_back(i);
-    }
+    const Inputs in = crowded_scene({64, 48}, 4.0f, TIDY_SHARED_MAX + 4, {6.0f, 4.0f});
     PlacementSettings settings;
     settings.tidy_rounds = 2;
     const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
@@ -258,17 +267,8 @@ TEST_SUITE("gpu") {
 
   TEST_CASE_FIXTURE(test::GpuTest, "past_1024_labels_the_upload_holds_every_label") {
     // 1030 labels are 65920 bytes: more than one vkCmdUpdateBuffer may take (65536).
-    Inputs in = disc_scene(0);
-    in.size = {16, 12};
-    const size_t pixels = size_t{in.size.width} * in.size.height;
-    in.final_rgba8.assign(pixels * 4, 40);
-    in.layers.assign(pixels * in.layer_count, glm::vec4(0.0f));
-    const uint32_t count = 1030;
-    for (uint32_t i = 0; i < count; ++i) {
-      const glm::vec2 anchor(2.0f + float(i * 7 % 12), 2.0f + float(i * 5 % 8));
-      in.labels.push_back(label(anchor, {2.0f, 2.0f}, i % 2));
-      in.order.push_back(count - 1 - i);  // (the labels past the first 1024 go first)
-    }
+    Inputs in = crowded_scene({16, 12}, 2.0f, 1030, {2.0f, 2.0f});
+    std::reverse(in.order.begin(), in.order.end());  // (the labels past the first 1024 go first)
     PlacementSettings settings;
     settings.tidy_rounds = 0;
     const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
