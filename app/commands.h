@@ -10,6 +10,10 @@
 #include "engine/graph/render_graph.h"
 #include "engine/scene/scene.h"
 
+namespace strata {
+struct Ghosting;  // labeling/labelled_render.h
+}
+
 namespace strata::app {
 
 // An option's value that cannot be used (--size 0, --fps 1000, --camera ','): like CLI11's own
@@ -59,12 +63,16 @@ Scene load_scene_reporting(const std::string& path);
 // the program (build/app/strata: the source tree's; bin/strata: share/strata/), else an Error.
 std::string find_data_file(const std::string& relative);
 
-// How labels look (render and video): --label-scale and --layer-colors.
+// How labels look (render and video): --label-scale, --layer-colors and ghosting.
 struct LabelLookOptions {
   float label_scale = 1.0f;
   bool layer_colors = false;
+  float ghost = 0.0f;
+  float ghost_radius = 0.06f;
+  bool ghost_leaders = false;
 };
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o);
+Ghosting look_ghosting(const LabelLookOptions& o);
 
 // "1024" or "1024x768"; throws UsageError naming the option when it is neither or a side is outside
 // 1 to 16384 (the device's own limit is checked when it is open: check_image_size).

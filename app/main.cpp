@@ -8,6 +8,7 @@
 #include "engine/core/error.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/transfer_function_presets.h"
+#include "labeling/labelled_render.h"
 #include "labeling/text_layout.h"
 #include "passes/volume_renderer.h"
 
@@ -130,6 +131,11 @@ graph::Extent parse_size(const std::string& text, const char* option) {
   return {w, h};
 }
 
+Ghosting look_ghosting(const LabelLookOptions& o) {
+  // (a connector's lens a third of the anchor's wide)
+  return {o.ghost, o.ghost_radius, o.ghost_leaders ? o.ghost_radius / 3.0f : 0.0f};
+}
+
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {
   cmd->add_option("--label-scale", o.label_scale, "label text and boxes times this (0.25 to 4)")
       ->check(finite_range(0.25, 4.0))
@@ -137,6 +143,17 @@ void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {
   cmd->add_flag("--layer-colors", o.layer_colors,
                 "label borders in their depth layer's colour (front to back: orange, blue, green, "
                 "pink, ...)");
+  cmd->add_option("--ghost", o.ghost,
+                  "ghosting: the layers in front of a rear label's anchor made this much more "
+                  "transparent around it (0: off, 1: fully open at the anchor)")
+      ->check(finite_range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--ghost-radius", o.ghost_radius,
+                  "the ghosting lens's radius, a share of the picture's shorter side")
+      ->check(finite_range(0.005, 0.5))
+      ->capture_default_str();
+  cmd->add_flag("--ghost-leaders", o.ghost_leaders,
+                "ghosting opens the layers along each rear label's connector too");
 }
 
 }  // namespace strata::app

@@ -234,6 +234,7 @@ void LabelledRenderer::build_graph() {
   render.layer_count = layering_.layer_count;
   render.splits = layering_.split_depths;
   graph_layers_ = layering_.layer_count;
+  graph_ghost_ = settings_.ghost.strength > 0.0f;
 
   graph::Graph graph;
   const VolumeRenderer::Outputs rendered = p.renderer.add_to(graph);
@@ -251,7 +252,8 @@ void LabelledRenderer::build_graph() {
                             .placements = moved.drawn,
                             .glyphs = glyph_buffer,
                             .output = labelled,
-                            .background = render.background});
+                            .background = render.background,
+                            .ghost = graph_ghost_});
   if (extension_) {
     extension_(graph,
                {labelled, rendered, placed_, moved.drawn, render.layer_count, beside_ == nullptr});
@@ -328,6 +330,10 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
   parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within, priorities_),
                               settings);
   parts_->drawing->set_layer_frames(settings_.layer_colors);
+  if ((settings_.ghost.strength > 0.0f) != graph_ghost_) build_graph();
+  const float side = float(std::min(size_.width, size_.height));
+  parts_->drawing->set_ghost(
+      {settings_.ghost.strength, settings_.ghost.radius * side, settings_.ghost.leader * side});
 }
 
 void LabelledRenderer::set_camera(const Camera& camera) {

@@ -29,6 +29,14 @@ enum class InsertionOrder {
   optimized,   // random orders, each kept when its total cost is lower (offline, several frames)
 };
 
+// Ghosting (shared/ghost.h): the layers in front of each shown rear label opened around its
+// anchor; sizes are shares of the picture's shorter side.
+struct Ghosting {
+  float strength = 0.0f;  // 0: off, 1: fully open at an anchor
+  float radius = 0.06f;   // the lens around an anchor
+  float leader = 0.0f;    // the lens along a connector (0: none)
+};
+
 struct LabellingSettings {
   uint32_t layer_count = 4;  // asked for; fewer when the anchors have fewer distinct depths
   InsertionOrder order = InsertionOrder::scene;
@@ -44,8 +52,9 @@ struct LabellingSettings {
   // Pixels (before the scale) past which a line of label text wraps at a space; 0: never.
   float wrap_width = 240.0f;
   bool layer_colors = false;  // label borders in their layer's colour (the thesis's depth cue)
-  uint64_t seed = 1;          // k-means++
-  RenderSettings render;      // its layer_count and splits come from the layering
+  Ghosting ghost;
+  uint64_t seed = 1;      // k-means++
+  RenderSettings render;  // its layer_count and splits come from the layering
 };
 
 // A layer image array (rgba16f, premultiplied) read back after the frame: layer after layer.
@@ -275,6 +284,7 @@ class LabelledRenderer {
   Placement::Outputs placed_{};
   graph::ResourceId layers_id_ = 0;
   uint32_t graph_layers_ = 0;  // the layer count the graph was built for
+  bool graph_ghost_ = false;   // the graph has the ghosting pass (LabellingSettings::ghost)
   LabellingSettings settings_;
 };
 

@@ -80,6 +80,7 @@ LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas
                     {images.width, images.height, 1},
                     VK_IMAGE_TYPE_2D,
                     VK_IMAGE_USAGE_SAMPLED_BIT}),
+      ghost_pipeline_(ctx, "labels_ghost.comp"),
       draw_(ctx, "label_draw.comp"),
       composite_(ctx, "label_composite.comp") {
   upload(ctx, atlas_, as_bytes(font.coverage), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
@@ -113,6 +114,20 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
                              .format = VK_FORMAT_R8G8B8A8_UNORM,
                              .has_content = true,
                              .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  if (in.ghost) {
+    graph.add_pass({"labels.ghost",
+                    graph::PassKind::compute,
+                    {{in.layers, Use::storage_read_write, GHOST_BINDING_LAYERS},
+                     {in.labels, Use::storage_read, GHOST_BINDING_LABELS},
+                     {in.placements, Use::storage_read, GHOST_BINDING_PLACEMENTS}},
+                    [this](graph::PassContext& pc) {
+                      if (ghost_.strength <= 0.0f) return;
+                      pc.dispatch(ghost_pipeline_,
+                                  ghost_params(ghost_, pc.viewport, layer_count_, label_count_),
+                                  {pc.viewport.width, pc.viewport.height, 1});
+                    },
+                    "labels"});
+  }
   graph.add_pass(
       {"labels.draw",
        graph::PassKind::compute,
@@ -168,6 +183,42 @@ std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, 
         const glm::vec2 p = glm::vec2(float(x), float(y)) + 0.5f;
         out[i] = to_half_precision(reference.draw_labels_at(p, l, layers[i]));
       }
+    }
+  }
+  return out;
+}
+
+gpu::GhostParams ghost_params(const GhostSettings& ghost, graph::Extent size, uint32_t layer_count,
+                              uint32_t label_count) {
+  return {size.width,     size.height,  layer_count,         label_count,
+          ghost.strength, ghost.radius, ghost.leader_radius, 0u};
+}
+
+std::vector<glm::vec4> ghost_reference(std::span<const glm::vec4> layers, graph::Extent size,
+                                       uint32_t layer_count, const LabelDrawData& data,
+                                       const GhostSettings& ghost) {
+  check_layers(layers, size, layer_count);
+  const size_t pixels = size_t{size.width} * size.height;
+  const size_t count = std::min(data.labels.size(), data.placements.size());
+  const gpu::GhostParams g = ghost_params(ghost, size, layer_count, uint32_t(count));
+  std::vector<glm::vec4> out(layers.begin(), layers.end());
+  if (ghost.strength <= 0.0f) return out;
+  std::vector<float> open_on(layer_count);
+  for (size_t q = 0; q < pixels; ++q) {
+    const glm::vec2 p(float(q % size.width) + 0.5f, float(q / size.width) + 0.5f);
+    std::fill(open_on.begin(), open_on.end(), 0.0f);
+    for (size_t i = 0; i < count; ++i) {
+      const gpu::LabelGpu& label = data.labels[i];
+      if (label.layer >= layer_count) continue;
+      open_on[label.layer] =
+          std::max(open_on[label.layer], gpu::ghost_opening(label, data.placements[i], p, g));
+    }
+    float behind = 0.0f;
+    for (int k = int(layer_count) - 2; k >= 0; --k) {
+      behind = std::max(behind, open_on[size_t(k) + 1]);
+      if (behind <= 0.0f) continue;
+      glm::vec4& c = out[size_t(k) * pixels + q];
+      c = to_half_precision(c * gpu::ghost_keep(behind, g));
     }
   }
   return out;

@@ -1,5 +1,7 @@
 // Labels drawn into the depth layers, then the layers composited into the final image (the
 // thesis's depth cue: a label on a rear layer is partly covered by what lies in front of it).
+//   labels.ghost      with ghosting on: the layers in front of each shown rear label made more
+//                     transparent around its anchor and connector, in place (shared/ghost.h)
 //   labels.draw       per pixel of each layer: its shown labels (connector, box, text, anchor
 //                     marker) over the layer's content, in place
 //   labels.composite  the layers front to back over the background into an rgba8 image
@@ -19,9 +21,21 @@
 #include "engine/gpu/shader_library.h"
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/render_graph.h"
+#include "shared/ghost.h"
 #include "shared/label_drawing.h"
 
 namespace strata {
+
+// Ghosting's settings: how much the layers in front open (0 off, 1 fully at an anchor), the
+// lens's radius around an anchor and along a connector (0: none), in pixels.
+struct GhostSettings {
+  float strength = 0.0f;
+  float radius = 0.0f;
+  float leader_radius = 0.0f;
+};
+
+gpu::GhostParams ghost_params(const GhostSettings& ghost, graph::Extent size, uint32_t layer_count,
+                              uint32_t label_count);
 
 class LabelDrawing {
  public:
@@ -36,6 +50,7 @@ class LabelDrawing {
     graph::ResourceId glyphs;      // GlyphGpu[], with content
     graph::ResourceId output;      // a viewport-sized rgba8 image the composite overwrites
     glm::vec3 background{0.0f};
+    bool ghost = false;  // with the ghosting pass (its settings: set_ghost)
   };
   // Adds both passes; the font and image atlases are imported with their handles.
   void add_to(graph::Graph& graph, const Inputs& in);
@@ -46,14 +61,18 @@ class LabelDrawing {
   void set_background(glm::vec3 background) { background_ = background; }
   // Borders in their layer's colour (LABEL_LAYER_COLORS), read when the graph is recorded.
   void set_layer_frames(bool on) { layer_frames_ = on; }
+  // Ghosting's settings, read when the graph is recorded (strength 0: the pass records nothing).
+  void set_ghost(const GhostSettings& ghost) { ghost_ = ghost; }
 
  private:
   gpu::LabelDrawParams params(graph::Extent viewport) const;
 
   Image atlas_;
   Image images_;
+  ComputePipeline ghost_pipeline_;
   ComputePipeline draw_;
   ComputePipeline composite_;
+  GhostSettings ghost_;
   uint32_t layer_count_ = 0;
   uint32_t label_count_ = LABEL_MAX;
   glm::vec3 background_{0.0f};
@@ -74,6 +93,12 @@ struct LabelDrawData {
 std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, graph::Extent size,
                                              uint32_t layer_count, const LabelDrawData& data,
                                              const FontAtlas& font, const ImageAtlas& images = {});
+
+// labels.ghost on the CPU: the layers (shaped as for draw_labels_reference) with ghosting
+// applied, rounded to half precision.
+std::vector<glm::vec4> ghost_reference(std::span<const glm::vec4> layers, graph::Extent size,
+                                       uint32_t layer_count, const LabelDrawData& data,
+                                       const GhostSettings& ghost);
 
 // labels.composite on the CPU: rgba8, rows top to bottom, with the rear labels' connectors and
 // anchors drawn again where the layers in front hide them (label_behind).

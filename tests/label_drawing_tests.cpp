@@ -64,7 +64,8 @@ struct LabelScene {
   std::vector<gpu::GlyphGpu> glyphs;
   glm::vec3 background{0.2f, 0.25f, 0.3f};
   bool layer_frames = false;
-  ImageAtlas images;  // the labels' pictures (none: one transparent texel)
+  ImageAtlas images;    // the labels' pictures (none: one transparent texel)
+  GhostSettings ghost;  // (off)
 
   size_t pixels() const { return size_t{size.width} * size.height; }
   glm::vec4& at(uint32_t layer, uint32_t x, uint32_t y) {
@@ -145,6 +146,7 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
   LabelDrawing drawing(ctx, test_atlas(), s.images);
   drawing.set_label_count(static_cast<uint32_t>(s.labels.size()));
   drawing.set_layer_frames(s.layer_frames);
+  drawing.set_ghost(s.ghost);
 
   graph::Graph g;
   const auto filled = [&g](const char* name, const Buffer& buffer) {
@@ -163,7 +165,8 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
                      .placements = filled("placements", placements),
                      .glyphs = filled("glyphs", glyphs),
                      .output = final_id,
-                     .background = s.background});
+                     .background = s.background,
+                     .ghost = s.ghost.strength > 0.0f});
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(s.size);
   runner.run_now();
@@ -180,10 +183,12 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
   return out;
 }
 
+// The layers ghosted (when the scene asks for it), then the labels drawn.
 std::vector<glm::vec4> reference_layers(const LabelScene& s) {
-  return draw_labels_reference(s.layers, s.size, s.layer_count,
-                               {s.labels, s.placements, s.glyphs, s.layer_frames}, test_atlas(),
-                               s.images);
+  const LabelDrawData data{s.labels, s.placements, s.glyphs, s.layer_frames};
+  const std::vector<glm::vec4> ghosted =
+      ghost_reference(s.layers, s.size, s.layer_count, data, s.ghost);
+  return draw_labels_reference(ghosted, s.size, s.layer_count, data, test_atlas(), s.images);
 }
 
 // The largest difference per channel, and where it is.
@@ -687,6 +692,49 @@ TEST_SUITE("gpu") {
     s.glyphs = test_glyphs(texts, s.labels);
     const DrawnLabels gpu = draw_matching_the_reference(ctx, s);
     CHECK(gpu.layers != s.layers);
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest,
+                    "ghosting_opens_the_front_layers_at_rear_anchors_as_the_reference") {
+    // The rear label (layer 2, anchor 22,66) lies under the middle layer's ramp; the middle label
+    // (layer 1, anchor 92,78) under nothing in front. With ghosting the layers in front of each
+    // open around its anchor and along its connector; the GPU pass equals the reference, labels
+    // drawn after it included.
+    LabelScene s = make_scene();
+    for (uint32_t y = 0; y < s.size.height; ++y) {
+      for (uint32_t x = 0; x < s.size.width; ++x) {
+        s.at(0, x, y) = to_half_precision(glm::vec4(0.3f, 0.2f, 0.1f, 0.5f));  // a veil in front
+      }
+    }
+    s.ghost = {1.0f, 14.0f, 4.0f};
+    const DrawnLabels gpu = draw_matching_the_reference(ctx, s);
+    const LabelDrawData data{s.labels, s.placements, s.glyphs};
+    const std::vector<glm::vec4> ghosted =
+        ghost_reference(s.layers, s.size, s.layer_count, data, s.ghost);
+    const auto front_alpha = [&](const std::vector<glm::vec4>& layers, glm::vec2 p, uint32_t l) {
+      const size_t q = size_t(p.y) * s.size.width + size_t(p.x);
+      float a = 0.0f;
+      for (uint32_t k = 0; k < l; ++k) a += (1.0f - a) * layers[k * s.pixels() + q].a;
+      return a;
+    };
+    const glm::vec2 rear = s.labels[0].anchor, middle = s.labels[1].anchor;
+    CHECK(front_alpha(s.layers, rear, 2) > 0.5f);
+    CHECK(front_alpha(ghosted, rear, 2) <= 0.3f);
+    CHECK(front_alpha(ghosted, middle, 1) <= 0.3f);
+    // Far from every lens (twice the radius from both rear anchors, away from their connectors)
+    // nothing changed: the corner (104, 4).
+    const size_t corner = size_t{4} * s.size.width + 104;
+    for (uint32_t k = 0; k < s.layer_count; ++k) {
+      CHECK(ghosted[k * s.pixels() + corner] == s.layers[k * s.pixels() + corner]);
+    }
+    // A fading label's lens fades with it; off, nothing changes.
+    s.placements[0].opacity = 0.5f;
+    const std::vector<glm::vec4> half =
+        ghost_reference(s.layers, s.size, s.layer_count, data, s.ghost);
+    const float a_half = front_alpha(half, rear, 2);
+    CHECK(a_half > front_alpha(ghosted, rear, 2));
+    CHECK(a_half < front_alpha(s.layers, rear, 2));
+    CHECK(ghost_reference(s.layers, s.size, s.layer_count, data, {}) == s.layers);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "label_on_a_rear_layer_is_partly_covered_by_the_front_layer") {

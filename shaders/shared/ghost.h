@@ -1,0 +1,78 @@
+// Ghosting: the layers in front of a shown rear label's anchor made more transparent around it
+// (a lens), so that what the label names is seen through what hides it. Written once for GLSL and
+// C++: the GPU pass (labels_ghost.comp) and its CPU reference (ghost_reference in
+// passes/label_drawing.cpp) evaluate the same expressions.
+//
+// A label on layer L opens every layer k < L at p by its lens: 1 within half the radius of its
+// anchor, falling smoothly to 0 at the radius (and, with a leader radius, the same around its
+// connector), times the label's opacity (a fading label's lens fades with it). Layer k keeps
+// 1 - strength * (the largest opening at p) of its colour and alpha; nothing changes beyond every
+// lens. Labels are drawn after, so a box is never made harder to read.
+#ifndef STRATA_SHARED_GHOST_H
+#define STRATA_SHARED_GHOST_H
+
+#include "label_drawing.h"
+
+#define GHOST_GROUP 16
+#define GHOST_BINDING_LAYERS 0      // rgba16f 2D array, premultiplied, changed in place
+#define GHOST_BINDING_LABELS 1      // LabelGpu[]
+#define GHOST_BINDING_PLACEMENTS 2  // PlacementGpu[]: where the labels are drawn, their opacity
+
+STRATA_BEGIN
+
+struct GhostParams {
+  uint width;
+  uint height;
+  uint layer_count;
+  uint label_count;
+  float strength;       // 0: no ghosting, 1: the layers in front fully open at an anchor
+  float radius;         // pixels: the lens around an anchor
+  float leader_radius;  // pixels: the lens along a connector (0: none)
+  uint pad;
+};
+
+// A lens's opening at distance d from its centre (or line).
+STRATA_INLINE float ghost_lens(float d, float radius) {
+  return radius > 0.0f ? 1.0f - smoothstep(0.5f * radius, radius, d) : 0.0f;
+}
+
+// How far label `label`, drawn as `drawn`, opens the layers in front of its own at p (0 to 1),
+// or 0 for a front, internal, disabled or hidden label.
+STRATA_INLINE float ghost_opening(LabelGpu label, PlacementGpu drawn, vec2 p, GhostParams g) {
+  if ((label.flags & LABEL_ENABLED) == 0u || (label.flags & LABEL_INTERNAL) != 0u ||
+      label.layer == 0u || drawn.shown != PLACEMENT_SHOWN) {
+    return 0.0f;
+  }
+  float open = ghost_lens(length(p - label.anchor), g.radius);
+  if (g.leader_radius > 0.0f) {
+    vec2 half_size = 0.5f * label.size;
+    vec2 end = clamp(label.anchor, drawn.position - half_size, drawn.position + half_size);
+    open = max(open, ghost_lens(label_segment_distance(p, label.anchor, end), g.leader_radius));
+  }
+  return open * clamp(drawn.opacity, 0.0f, 1.0f);
+}
+
+// Whether no pixel centre in [tile_lo, tile_hi] lies within the label's lenses (with a pixel to
+// spare): a workgroup's tile can leave the label out.
+STRATA_INLINE bool ghost_far_from_tile(vec2 tile_lo, vec2 tile_hi, LabelGpu label,
+                                       PlacementGpu drawn, GhostParams g) {
+  float r = g.radius + 1.0f;
+  bool near_anchor = !(tile_hi.x < label.anchor.x - r || tile_lo.x > label.anchor.x + r ||
+                       tile_hi.y < label.anchor.y - r || tile_lo.y > label.anchor.y + r);
+  if (near_anchor) return false;
+  if (g.leader_radius <= 0.0f) return true;
+  vec2 half_size = 0.5f * label.size;
+  vec2 end = clamp(label.anchor, drawn.position - half_size, drawn.position + half_size);
+  float m = g.leader_radius + 1.0f;
+  return label_segment_misses_box(label.anchor, end, tile_lo - m, tile_hi + m);
+}
+
+// The share of its colour and alpha a layer keeps where the largest opening of the labels on
+// the layers behind it is `largest_behind`.
+STRATA_INLINE float ghost_keep(float largest_behind, GhostParams g) {
+  return 1.0f - clamp(g.strength, 0.0f, 1.0f) * largest_behind;
+}
+
+STRATA_END
+
+#endif
