@@ -214,11 +214,12 @@ std::vector<glm::vec4> ghost_reference(std::span<const glm::vec4> layers, graph:
           std::max(open_on[label.layer], gpu::ghost_opening(label, data.placements[i], p, g));
     }
     float behind = 0.0f;
-    for (int k = int(layer_count) - 2; k >= 0; --k) {
-      behind = std::max(behind, open_on[size_t(k) + 1]);
-      if (behind <= 0.0f) continue;
+    for (int k = int(layer_count) - 1; k >= 0; --k) {
       glm::vec4& c = out[size_t(k) * pixels + q];
-      c = to_half_precision(c * gpu::ghost_keep(behind, g));
+      if (behind > 0.0f) c = to_half_precision(c * gpu::ghost_keep(behind, g));
+      if (k > 0 && open_on[size_t(k)] > 0.0f) {
+        behind = std::max(behind, open_on[size_t(k)] * gpu::ghost_behind_weight(c.a));
+      }
     }
   }
   return out;

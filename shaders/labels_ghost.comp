@@ -59,12 +59,16 @@ void main() {
     }
   }
   if (!any) return;
-  // (back to front: the largest opening of the layers behind layer k)
+  // (back to front: the largest opening of the layers behind layer k, each as far as its content
+  // lets it)
   float behind = 0.0f;
-  for (int k = int(layer_count) - 2; k >= 0; --k) {
-    behind = max(behind, open_on[k + 1]);
-    if (behind <= 0.0f) continue;
+  for (int k = int(layer_count) - 1; k >= 0; --k) {
     const ivec3 texel = ivec3(px, k);
-    imageStore(layers, texel, imageLoad(layers, texel) * ghost_keep(behind, params));
+    if (behind > 0.0f) {
+      imageStore(layers, texel, imageLoad(layers, texel) * ghost_keep(behind, params));
+    }
+    if (k > 0 && open_on[k] > 0.0f) {
+      behind = max(behind, open_on[k] * ghost_behind_weight(imageLoad(layers, texel).a));
+    }
   }
 }

@@ -3,11 +3,12 @@
 // C++: the GPU pass (labels_ghost.comp) and its CPU reference (ghost_reference in
 // passes/label_drawing.cpp) evaluate the same expressions.
 //
-// A label on layer L opens every layer k < L at p by its lens: 1 within half the radius of its
-// anchor, falling smoothly to 0 at the radius (and, with a leader radius, the same around its
-// connector), times the label's opacity (a fading label's lens fades with it). Layer k keeps
-// 1 - strength * (the largest opening at p) of its colour and alpha; nothing changes beyond every
-// lens. Labels are drawn after, so a box is never made harder to read.
+// A label on layer L opens every layer k < L at p by its lens: 1 within a third of the radius of
+// its anchor, falling smoothly to 0 at the radius (and, with a leader radius, the same around its
+// connector), times the label's opacity (a fading label's lens fades with it), times how much
+// layer L holds at p (ghost_behind_weight). Layer k keeps 1 - strength * (the largest opening at
+// p) of its colour and alpha; nothing changes beyond every lens. Labels are drawn after, so a box
+// is never made harder to read.
 #ifndef STRATA_SHARED_GHOST_H
 #define STRATA_SHARED_GHOST_H
 
@@ -31,9 +32,16 @@ struct GhostParams {
   uint pad;
 };
 
-// A lens's opening at distance d from its centre (or line).
+// A lens's opening at distance d from its centre (or line): full within a third of the radius,
+// then a smooth falloff to nothing at the radius.
 STRATA_INLINE float ghost_lens(float d, float radius) {
-  return radius > 0.0f ? 1.0f - smoothstep(0.5f * radius, radius, d) : 0.0f;
+  return radius > 0.0f ? 1.0f - smoothstep(radius / 3.0f, radius, d) : 0.0f;
+}
+
+// How much of an opening a layer's content lets through: the layers in front open only where the
+// label's own layer holds something to see (no hole to the background at an object's edge).
+STRATA_INLINE float ghost_behind_weight(float layer_alpha) {
+  return smoothstep(0.05f, 0.35f, layer_alpha);
 }
 
 // How far label `label`, drawn as `drawn`, opens the layers in front of its own at p (0 to 1),
