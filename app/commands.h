@@ -1,6 +1,7 @@
 // The strata program's subcommands; main.cpp parses the command line and prints errors.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -67,12 +68,13 @@ std::string find_data_file(const std::string& relative);
 struct LabelLookOptions {
   float label_scale = 1.0f;
   bool layer_colors = false;
-  float ghost = 0.0f;
-  float ghost_radius = 0.06f;
+  std::optional<float> ghost;         // else the scene's settings.ghost
+  std::optional<float> ghost_radius;  // else the scene's settings.ghost_radius
   bool ghost_leaders = false;
 };
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o);
-Ghosting look_ghosting(const LabelLookOptions& o);
+// The ghosting asked for: the options, else the scene's settings.
+Ghosting look_ghosting(const LabelLookOptions& o, const Scene& scene);
 
 // "1024" or "1024x768"; throws UsageError naming the option when it is neither or a side is outside
 // 1 to 16384 (the device's own limit is checked when it is open: check_image_size).

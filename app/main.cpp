@@ -131,9 +131,10 @@ graph::Extent parse_size(const std::string& text, const char* option) {
   return {w, h};
 }
 
-Ghosting look_ghosting(const LabelLookOptions& o) {
+Ghosting look_ghosting(const LabelLookOptions& o, const Scene& scene) {
+  const float radius = o.ghost_radius.value_or(scene.settings.ghost_radius);
   // (a connector's lens a third of the anchor's wide)
-  return {o.ghost, o.ghost_radius, o.ghost_leaders ? o.ghost_radius / 3.0f : 0.0f};
+  return {o.ghost.value_or(scene.settings.ghost), radius, o.ghost_leaders ? radius / 3.0f : 0.0f};
 }
 
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {
@@ -145,13 +146,13 @@ void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {
                 "pink, ...)");
   cmd->add_option("--ghost", o.ghost,
                   "ghosting: the layers in front of a rear label's anchor made this much more "
-                  "transparent around it (0: off, 1: fully open at the anchor)")
-      ->check(finite_range(0.0, 1.0))
-      ->capture_default_str();
+                  "transparent around it (0: off, 1: fully open at the anchor; default: the "
+                  "scene's settings.ghost, else 0)")
+      ->check(finite_range(0.0, 1.0));
   cmd->add_option("--ghost-radius", o.ghost_radius,
-                  "the ghosting lens's radius, a share of the picture's shorter side")
-      ->check(finite_range(0.005, 0.5))
-      ->capture_default_str();
+                  "the ghosting lens's radius, a share of the picture's shorter side (default: the "
+                  "scene's settings.ghost_radius, else 0.1)")
+      ->check(finite_range(kGhostRadiusMin, kGhostRadiusMax));
   cmd->add_flag("--ghost-leaders", o.ghost_leaders,
                 "ghosting opens the layers along each rear label's connector too");
 }

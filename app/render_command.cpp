@@ -112,7 +112,7 @@ LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene)
   settings.internal = o.internal;
   settings.label_scale = o.look.label_scale;
   settings.layer_colors = o.look.layer_colors;
-  settings.ghost = look_ghosting(o.look);
+  settings.ghost = look_ghosting(o.look, scene);
   if (o.order == "apollonius") settings.order = InsertionOrder::apollonius;
   if (o.order == "optimized") settings.order = InsertionOrder::optimized;
   if (o.decoret) {  // Stein & Decoret's setting, as the thesis compares against it

@@ -98,7 +98,7 @@ LabellingSettings labelling_settings(const Scene& scene, const VideoOptions& o) 
   settings.placement.tidy_rounds = o.tidy_rounds;
   settings.label_scale = o.look.label_scale;
   settings.layer_colors = o.look.layer_colors;
-  settings.ghost = look_ghosting(o.look);
+  settings.ghost = look_ghosting(o.look, scene);
   settings.forces = o.forces;
   settings.forces.anchor_relative = !o.screen_space;
   settings.hysteresis.margin = o.layer_margin;

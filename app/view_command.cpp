@@ -353,6 +353,8 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   settings.layer_count = o.scene.layer_count(scene);
   settings.placement.weights = scene.settings.weights;
   settings.placement.tidy_rounds = o.tidy_rounds;
+  settings.ghost.strength = scene.settings.ghost;
+  settings.ghost.radius = scene.settings.ghost_radius;
   // HiDPI: label text and boxes follow the display's content scale, as the panel does.
   settings.label_scale = std::clamp(o.label_scale * std::max(scale_x, scale_y), 0.25f, 4.0f);
   ViewerOptions options;

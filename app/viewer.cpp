@@ -123,6 +123,13 @@ const std::vector<Parameter>& parameters() {
       {"label_scale", "label text and boxes times this (0.25 to 4)", 0.25f, 4.0f},
       {"layer_colors", "on: label borders in their layer's colour", 0.0f, 0.0f, nullptr,
        [](S s) { return &s.labels.layer_colors; }},
+      // (ghosting on or off changes the graph: set_camera rebuilds it)
+      {"ghost", "ghosting: how far the layers in front of a rear anchor open, 0 (off) to 1", 0.0f,
+       1.0f, [](S s) { return &s.labels.ghost.strength; }, nullptr, true},
+      {"ghost.radius", "the ghosting lens, a share of the picture's shorter side", kGhostRadiusMin,
+       kGhostRadiusMax, [](S s) { return &s.labels.ghost.radius; }},
+      {"ghost.leaders", "the lens along rear connectors, a share of the shorter side (0: none)",
+       0.0f, kGhostRadiusMax, [](S s) { return &s.labels.ghost.leader; }},
       // (speed / epsilon bounds the force steps of a frame: at most 2,000 in a 0.1 s frame)
       {"forces.speed_widths", "image widths per second at full force", 0.001f, 10.0f,
        [](S s) { return &s.labels.forces.speed_widths; }},

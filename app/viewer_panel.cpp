@@ -148,6 +148,12 @@ void Viewer::panel_labelling() {
   checkbox(*this, "hard constraints", "hard", s.placement.hard);
   checkbox(*this, "internal labelling", "internal", s.internal);
   checkbox(*this, "borders in layer colours", "layer_colors", s.layer_colors);
+  float ghost = s.ghost.strength;
+  ImGui::SliderFloat("ghosting", &ghost, 0.0f, 1.0f, "%.2f");
+  if (ImGui::IsItemDeactivatedAfterEdit()) set_number("ghost", ghost);
+  float lens = s.ghost.radius;
+  ImGui::SliderFloat("ghosting lens", &lens, kGhostRadiusMin, kGhostRadiusMax, "%.3f");
+  if (ImGui::IsItemDeactivatedAfterEdit()) set_number("ghost.radius", lens);
   // (applied when the slider is let go: the glyphs and the graph are rebuilt)
   float font = s.font_pixels;
   ImGui::SliderFloat("font size (px)", &font, 8.0f, 40.0f, "%.0f");

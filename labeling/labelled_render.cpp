@@ -330,7 +330,6 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
   parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within, priorities_),
                               settings);
   parts_->drawing->set_layer_frames(settings_.layer_colors);
-  if ((settings_.ghost.strength > 0.0f) != graph_ghost_) build_graph();
   const float side = float(std::min(size_.width, size_.height));
   parts_->drawing->set_ghost(
       {settings_.ghost.strength, settings_.ghost.radius * side, settings_.ghost.leader * side});
@@ -344,7 +343,8 @@ void LabelledRenderer::set_camera(const Camera& camera) {
   parts_->renderer.set_camera(camera);
   parts_->renderer.settings().splits = layering_.split_depths;
   set_order(scene_order(uint32_t(labels_.size())));
-  if (layering_.layer_count != graph_layers_) build_graph();
+  if (layering_.layer_count != graph_layers_ || (settings_.ghost.strength > 0.0f) != graph_ghost_)
+    build_graph();
 }
 
 void LabelledRenderer::advance(double seconds) {

@@ -33,7 +33,7 @@ enum class InsertionOrder {
 // anchor; sizes are shares of the picture's shorter side.
 struct Ghosting {
   float strength = 0.0f;  // 0: off, 1: fully open at an anchor
-  float radius = 0.06f;   // the lens around an anchor
+  float radius = 0.1f;    // the lens around an anchor
   float leader = 0.0f;    // the lens along a connector (0: none)
 };
 

@@ -372,6 +372,12 @@ TEST_SUITE("loaders") {
           prefix + "settings.layers: expected an integer from 1 to 8");
     CHECK(load(R"({"strata_scene": 1, "settings": {"layers": 9}})") ==
           prefix + "settings.layers: expected an integer from 1 to 8");
+    CHECK(load(R"({"strata_scene": 1, "settings": {"ghost": 1.5}})") ==
+          prefix + "settings.ghost: expected a number from 0 (off) to 1, got 1.5");
+    CHECK(load(R"({"strata_scene": 1, "settings": {"ghost_radius": 0}})") ==
+          prefix +
+              "settings.ghost_radius: expected a share of the picture's shorter side from 0.005 "
+              "to 0.5, got 0");
     // Numbers that would wrap or turn infinite, and matrices that flatten the scene.
     CHECK(load(R"({"strata_scene": 1, "labels": [{"id": 2147483648, "text": "a",
                    "anchor": [0, 0, 0]}]})") ==
@@ -475,6 +481,8 @@ TEST_SUITE("loaders") {
                   "transform": [1, 0, 0, 2,  0, 1, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]}]})"))
                        .meshes;
     scene.settings.weights.integral_costs = 3.5f;
+    scene.settings.ghost = 0.75f;
+    scene.settings.ghost_radius = 0.2f;
     const fs::path path = folder / "out/dice.json";
     fs::create_directories(path.parent_path());
     strata::save_scene_json(path, scene);
@@ -487,6 +495,8 @@ TEST_SUITE("loaders") {
       CHECK(back.labels[i].anchor == scene.labels[i].anchor);
       CHECK(back.labels[i].size == scene.labels[i].size);
     }
+    CHECK(back.settings.ghost == 0.75f);
+    CHECK(back.settings.ghost_radius == 0.2f);
     CHECK(back.camera.view == scene.camera.view);
     CHECK(back.camera.fov_y_degrees == scene.camera.fov_y_degrees);
     CHECK(back.camera.near_plane == scene.camera.near_plane);

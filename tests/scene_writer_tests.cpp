@@ -90,6 +90,8 @@ void check_same_scene(const Scene& a, const Scene& b) {
     CHECK(a.camera_positions[i].view == b.camera_positions[i].view);
   }
   CHECK(a.settings.layer_count == b.settings.layer_count);
+  CHECK(a.settings.ghost == b.settings.ghost);
+  CHECK(a.settings.ghost_radius == b.settings.ghost_radius);
   const CostWeights &w = a.settings.weights, &v = b.settings.weights;
   CHECK(w.label_shadow == v.label_shadow);
   CHECK(w.anchor_constraint == v.anchor_constraint);

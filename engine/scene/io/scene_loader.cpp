@@ -398,11 +398,25 @@ void SceneReader::camera(const json& object, const Field& field) {
 }
 
 void SceneReader::settings(const json& object, const Field& field) {
-  check_keys(object, field, {"layers", "weights"});
+  check_keys(object, field, {"layers", "weights", "ghost", "ghost_radius"});
   if (const json* layers = optional(object, "layers")) {
     scene_.settings.layer_count = integer(*layers, field / "layers");
     if (scene_.settings.layer_count < 1 || scene_.settings.layer_count > kMaxLayers)
       (field / "layers").fail("expected an integer from 1 to " + std::to_string(kMaxLayers));
+  }
+  if (const json* ghost = optional(object, "ghost")) {
+    scene_.settings.ghost = number(*ghost, field / "ghost");
+    if (scene_.settings.ghost < 0.0f || scene_.settings.ghost > 1.0f)
+      (field / "ghost").fail("expected a number from 0 (off) to 1, got " + ghost->dump());
+  }
+  if (const json* radius = optional(object, "ghost_radius")) {
+    scene_.settings.ghost_radius = number(*radius, field / "ghost_radius");
+    if (scene_.settings.ghost_radius < kGhostRadiusMin ||
+        scene_.settings.ghost_radius > kGhostRadiusMax) {
+      (field / "ghost_radius")
+          .fail("expected a share of the picture's shorter side from 0.005 to 0.5, got " +
+                radius->dump());
+    }
   }
   const json* weights = optional(object, "weights");
   if (!weights) return;

@@ -36,17 +36,22 @@ ordered_json position_json(const CameraPose& pose) {
 
 ordered_json settings_json(const SceneSettings& settings) {
   const CostWeights& w = settings.weights;
-  return {{"layers", settings.layer_count},
-          {"weights",
-           {{"label_shadow", shortest_double(w.label_shadow)},
-            {"anchor_constraint", shortest_double(w.anchor_constraint)},
-            {"connector_shadow", shortest_double(w.connector_shadow)},
-            {"integral_costs", shortest_double(w.integral_costs)},
-            {"distance_to_anchor", shortest_double(w.distance_to_anchor)},
-            {"connector_direction", shortest_double(w.connector_direction)},
-            {"previous_position", shortest_double(w.previous_position)},
-            {"leader_crossing", shortest_double(w.leader_crossing)},
-            {"illegible", shortest_double(w.illegible)}}}};
+  ordered_json out = {{"layers", settings.layer_count},
+                      {"weights",
+                       {{"label_shadow", shortest_double(w.label_shadow)},
+                        {"anchor_constraint", shortest_double(w.anchor_constraint)},
+                        {"connector_shadow", shortest_double(w.connector_shadow)},
+                        {"integral_costs", shortest_double(w.integral_costs)},
+                        {"distance_to_anchor", shortest_double(w.distance_to_anchor)},
+                        {"connector_direction", shortest_double(w.connector_direction)},
+                        {"previous_position", shortest_double(w.previous_position)},
+                        {"leader_crossing", shortest_double(w.leader_crossing)},
+                        {"illegible", shortest_double(w.illegible)}}}};
+  if (settings.ghost > 0.0f) out["ghost"] = shortest_double(settings.ghost);
+  if (settings.ghost_radius != SceneSettings{}.ghost_radius) {
+    out["ghost_radius"] = shortest_double(settings.ghost_radius);
+  }
+  return out;
 }
 
 ordered_json meshes_json(const std::vector<Mesh>& meshes, const auto& relative) {
