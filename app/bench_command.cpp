@@ -146,6 +146,7 @@ struct ViewBenchOptions {
   std::string placement = "auto";
   double pace = 0.0;  // frames a second the frames are started at (a display's); 0: at once
   double frame_budget_ms = 0.0;  // the viewer's interactive rendering (`view --frame-budget`)
+  float ghost = 0.0f;            // ghosting's strength (0: off), the default lens
 };
 
 // The part of a group's name before its first dot ("placement.sat" is part of "placement"), or
@@ -247,6 +248,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   settings.placement.weights = scene.settings.weights;
   settings.placement.tidy_rounds = o.tidy_rounds;
   settings.forces.keep_apart = o.keep_apart;
+  settings.ghost.strength = o.ghost;
   const double fps = 30.0;
   const std::vector<Camera> cameras =
       sample(orbit_path(scene, scene.camera, o.degrees, double(o.frames) / fps), fps);
@@ -308,6 +310,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   out["frames_in_flight"] = output.frames_in_flight();
   out["pace"] = o.pace;
   out["frame_budget_ms"] = o.frame_budget_ms;
+  out["ghost"] = o.ghost;
   out["largest_divisor"] = frames.after.largest_divisor;
   out["frames_per_second"] = double(cameras.size()) / frames.seconds;
   out["gpu_frame_ms"] = frames.frame_quantiles();
@@ -416,6 +419,9 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
                    "as `view --frame-budget`: while the camera moves (every frame here) cast fewer "
                    "rays to keep a frame within this many ms (0: off)")
       ->check(finite_range(0.0, 10000.0))
+      ->capture_default_str();
+  view_cmd->add_option("--ghost", view->ghost, "ghosting's strength, 0 (off) to 1")
+      ->check(finite_range(0.0, 1.0))
       ->capture_default_str();
   view_cmd->callback([&device, view] { bench::bench_view(device, *view); });
 
