@@ -473,9 +473,15 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
   }
   // Offline (no extension, nothing in flight): what the picture really shows of each box.
   if (measure_visibility && !extension_) {
+    const std::vector<glm::vec4> layers = download_layers();
     const std::vector<float> visible =
-        label_visibility(download_layers(), size_, layering_.layer_count, frame.labels);
-    for (size_t i = 0; i < frame.labels.size(); ++i) frame.labels[i].visible = visible[i];
+        label_visibility(layers, size_, layering_.layer_count, frame.labels);
+    const std::vector<float> front =
+        anchor_front_alpha(layers, size_, layering_.layer_count, frame.labels);
+    for (size_t i = 0; i < frame.labels.size(); ++i) {
+      frame.labels[i].visible = visible[i];
+      frame.labels[i].front_alpha = front[i];
+    }
   }
   for (LabelLayout& l : frame.labels) {
     l.shown = l.placed && (std::isnan(l.visible) || l.visible >= kLegibleShare);
@@ -516,6 +522,26 @@ std::vector<float> label_visibility(std::span<const glm::vec4> layers, graph::Ex
   return out;
 }
 
+std::vector<float> anchor_front_alpha(std::span<const glm::vec4> layers, graph::Extent size,
+                                      uint32_t layer_count, std::span<const LabelLayout> labels) {
+  const size_t pixels = size_t{size.width} * size.height;
+  std::vector<float> out;
+  for (const LabelLayout& l : labels) {
+    const glm::vec2 a = glm::floor(l.anchor);
+    if (a.x < 0.0f || a.y < 0.0f || a.x >= float(size.width) || a.y >= float(size.height)) {
+      out.push_back(0.0f);
+      continue;
+    }
+    const size_t p = size_t(a.y) * size.width + size_t(a.x);
+    float front = 0.0f;
+    for (uint32_t k = 0; k < std::min(l.layer, layer_count); ++k) {
+      front += (1.0f - front) * layers[k * pixels + p].a;
+    }
+    out.push_back(front);
+  }
+  return out;
+}
+
 LabelledFrame render_labelled(Context& ctx, const Scene& scene, const Camera& camera,
                               graph::Extent size, const LabellingSettings& settings) {
   LabelledRenderer renderer(ctx, scene, camera, size, settings);
@@ -539,6 +565,7 @@ std::string layout_json(const LabelledFrame& frame) {
                           {"visible", shortest_double(l.visible)},
                           {"cost", shortest_double(l.cost)},
                           {"opacity", shortest_double(l.opacity)},
+                          {"front_alpha", shortest_double(l.front_alpha)},
                           {"target", ordered_json()}};
     if (const auto& t = l.target_origin) {
       entry["target"] = {shortest_double(t->x), shortest_double(t->y),

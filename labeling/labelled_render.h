@@ -76,6 +76,9 @@ struct LabelLayout {
   bool shown = false;  // placed and legible: visible >= kLegibleShare (placed, when not measured)
   float cost = 0.0f;
   float opacity = 0.0f;  // as drawn: the forces fade it from 0 (hidden) to 1 (fully drawn)
+  // The alpha the layers in front of the label's own composite to at its anchor (what hides the
+  // anchor; ghosting lowers it); NaN where it was not measured, 0 on the front layer.
+  float front_alpha = std::numeric_limits<float>::quiet_NaN();
   // The top-left corner of the placement's box this frame, where the label is heading (its size
   // is box_size); none where the placement did not place it.
   std::optional<glm::vec2> target_origin;
@@ -92,6 +95,11 @@ inline constexpr float kHidingAlpha = HIDING_ALPHA;
 // them. Labels not placed get 0.
 std::vector<float> label_visibility(std::span<const glm::vec4> layers, graph::Extent size,
                                     uint32_t layer_count, std::span<const LabelLayout> labels);
+
+// LabelLayout::front_alpha of each label from the same layers: at the pixel of its anchor, 0
+// outside the image.
+std::vector<float> anchor_front_alpha(std::span<const glm::vec4> layers, graph::Extent size,
+                                      uint32_t layer_count, std::span<const LabelLayout> labels);
 
 struct LabelledFrame {
   graph::Extent size;

@@ -98,6 +98,9 @@ LayoutLabel read_label(const json& object, const Field& field) {
   if (const json* c = optional(object, "cost")) label.cost = cost(*c, field / "cost");
   label.opacity = label.placed ? 1.0 : 0.0;
   if (const json* o = optional(object, "opacity")) label.opacity = opacity(*o, field / "opacity");
+  if (const json* a = optional(object, "front_alpha"); a && !a->is_null()) {
+    label.front_alpha = opacity(*a, field / "front_alpha");
+  }
   label.target = drawn;
   if (const json* t = optional(object, "target")) {
     label.target = t->is_null() ? std::nullopt : std::optional(box(*t, field / "target"));

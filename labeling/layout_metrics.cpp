@@ -192,6 +192,15 @@ FrameMetrics frame_metrics(const Layout& layout) {
     if (anchor_covered(label, shown)) ++m.anchors_covered;
   }
   measure_leaders(layout, shown, m);
+  double front_sum = 0.0;
+  for (const LayoutLabel& label : layout.labels) {
+    if (!label.shown || label.layer == 0 || std::isnan(label.front_alpha)) continue;
+    ++m.rear_anchors;
+    m.rear_anchors_seen += label.front_alpha <= seen_front_alpha ? 1 : 0;
+    front_sum += label.front_alpha;
+    m.rear_front_alpha_max = std::max(m.rear_front_alpha_max, label.front_alpha);
+  }
+  m.rear_front_alpha_mean = m.rear_anchors == 0 ? 0.0 : front_sum / double(m.rear_anchors);
   return m;
 }
 
@@ -214,11 +223,17 @@ FrameMetrics sum_frame_metrics(const std::vector<FrameMetrics>& frames) {
     total.opaque += f.opaque;
     total.apparent_overlaps += f.apparent_overlaps;
     total.cut += f.cut;
+    total.rear_front_alpha_mean += f.rear_front_alpha_mean * double(f.rear_anchors);  // (a sum)
+    total.rear_anchors += f.rear_anchors;
+    total.rear_anchors_seen += f.rear_anchors_seen;
+    total.rear_front_alpha_max = std::max(total.rear_front_alpha_max, f.rear_front_alpha_max);
     leader_length_sum += f.leader_length_mean * double(f.shown + f.illegible);  // (drawn)
     total.leader_length_max = std::max(total.leader_length_max, f.leader_length_max);
   }
   const size_t drawn = total.shown + total.illegible;
   total.leader_length_mean = drawn == 0 ? 0.0 : leader_length_sum / double(drawn);
+  total.rear_front_alpha_mean =
+      total.rear_anchors == 0 ? 0.0 : total.rear_front_alpha_mean / double(total.rear_anchors);
   return total;
 }
 
@@ -385,7 +400,11 @@ ordered_json to_json(const FrameMetrics& m, const FrameMetrics* still) {
                       {"leader_length_max_of_diagonal", m.leader_length_max},
                       {"opaque", m.opaque},
                       {"apparent_overlaps", m.apparent_overlaps},
-                      {"cut", m.cut}};
+                      {"cut", m.cut},
+                      {"rear_anchors", m.rear_anchors},
+                      {"rear_anchors_seen", m.rear_anchors_seen},
+                      {"rear_front_alpha_mean", m.rear_front_alpha_mean},
+                      {"rear_front_alpha_max", m.rear_front_alpha_max}};
   if (still) {
     out["still_opaque"] = still->opaque;
     out["opaque_of_still"] = optional_number(ratio(m.opaque, still->opaque));

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -46,6 +47,9 @@ struct LayoutLabel {
   // The placement's box this frame, where the label is heading (the file's "target"; without
   // it, the box); none where the file has null (the placement did not place the label).
   std::optional<Rect> target;
+  // The alpha of the layers in front of the label's own at its anchor (the file's "front_alpha";
+  // NaN without it or with null).
+  double front_alpha = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct Layout {
@@ -122,7 +126,16 @@ struct FrameMetrics {
   size_t opaque = 0;             // labels with opacity >= opaque_opacity ("shown" in motion)
   size_t apparent_overlaps = 0;  // pairs, both opacity > apparent_opacity, interiors intersecting
   size_t cut = 0;                // opacity > apparent_opacity, box not wholly inside the image
+  // Shown labels on a rear layer whose front alpha was measured: how much hides their anchors
+  // (ghosting's measure), and how many of those anchors the front hides little
+  // (front_alpha <= seen_front_alpha).
+  size_t rear_anchors = 0;
+  size_t rear_anchors_seen = 0;
+  double rear_front_alpha_mean = 0.0;
+  double rear_front_alpha_max = 0.0;
 };
+
+inline constexpr double seen_front_alpha = 0.3;
 
 FrameMetrics frame_metrics(const Layout& layout);
 

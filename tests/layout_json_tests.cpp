@@ -93,6 +93,36 @@ TEST_SUITE("cpu") {
     CHECK(nlohmann::json::parse(layout_json(frame))["seconds"].is_null());
   }
 
+  TEST_CASE("front_alpha_is_written_read_back_and_summed_over_shown_rear_labels") {
+    // Two shown rear labels (front alpha 0.2 and 0.9), one on the front layer and one not
+    // measured: eval counts the two, one of them seen (<= 0.3).
+    LabelledFrame frame;
+    frame.size = {64, 48};
+    for (int i = 0; i < 4; ++i) {
+      LabelLayout l;
+      l.id = i + 1;
+      l.layer = i == 2 ? 0u : 1u;
+      l.box_origin = {float(i * 15), 4.0f};
+      l.box_size = {10.0f, 8.0f};
+      l.placed = l.shown = true;
+      l.opacity = 1.0f;
+      l.front_alpha = i == 0 ? 0.2f : i == 1 ? 0.9f : i == 2 ? 0.0f : std::nanf("");
+      frame.labels.push_back(l);
+    }
+    const nlohmann::json layout = nlohmann::json::parse(layout_json(frame));
+    CHECK(layout["labels"][0]["front_alpha"].get<double>() == doctest::Approx(0.2));
+    CHECK(layout["labels"][3]["front_alpha"].is_null());
+    const FrameMetrics m = frame_metrics(parse_layout(layout, "frame.json"));
+    CHECK(m.rear_anchors == 2);
+    CHECK(m.rear_anchors_seen == 1);
+    CHECK(m.rear_front_alpha_mean == doctest::Approx(0.55));
+    CHECK(m.rear_front_alpha_max == doctest::Approx(0.9));
+    nlohmann::json bad = layout;
+    bad["labels"][0]["front_alpha"] = 1.5;
+    CHECK_THROWS_WITH(parse_layout(bad, "frame.json"),
+                      doctest::Contains("labels[0].front_alpha: expected a number from 0 to 1"));
+  }
+
   TEST_CASE("layout_json_writes_non_finite_numbers_as_null") {
     // JSON has no inf or NaN: a label that was never placed must not make the file unreadable.
     LabelledFrame frame;
