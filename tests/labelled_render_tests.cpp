@@ -209,6 +209,56 @@ TEST_SUITE("gpu") {
   // forces' speed (never more per frame), reach it, and then stay. (No hold and no eta: with
   // them, a label may keep a target that is nearly as good as the fresh placement's; the forces
   // alone: kept apart, a label may wait for another's way.)
+  TEST_CASE_FIXTURE(test::GpuTest, "ghosting_opens_rear_anchors_and_leaves_the_rest_unchanged") {
+    // head.json from the front at 192²: with ghosting the layers in front of the shown rear
+    // labels' anchors open; the placement is the same, and so is every pixel of every layer
+    // farther than two lens radii from all of those anchors.
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    const graph::Extent size{192, 192};
+    const Camera camera = camera_for(scene, "front");
+    LabellingSettings plain, ghosted;
+    ghosted.ghost.strength = 1.0f;
+    LabelledRenderer a(ctx, scene, camera, size, plain), b(ctx, scene, camera, size, ghosted);
+    a.run();
+    b.run();
+    const LabelledFrame before = a.result(), after = b.result();
+    REQUIRE(before.layering.layer_count == after.layering.layer_count);
+    std::vector<glm::vec2> rear;
+    size_t seen_before = 0, seen_after = 0;
+    for (size_t i = 0; i < before.labels.size(); ++i) {
+      const LabelLayout &x = before.labels[i], &y = after.labels[i];
+      CAPTURE(x.text);
+      CHECK(x.placed == y.placed);
+      CHECK(x.box_origin == y.box_origin);
+      if (!x.placed || x.layer == 0) continue;
+      rear.push_back(x.anchor);
+      seen_before += x.front_alpha <= 0.3f ? 1 : 0;
+      seen_after += y.front_alpha <= 0.3f ? 1 : 0;
+      CHECK(y.front_alpha <= x.front_alpha);
+    }
+    REQUIRE(rear.size() >= 5);
+    MESSAGE(seen_before << " -> " << seen_after << " of " << rear.size()
+                        << " rear anchors with front alpha <= 0.3");
+    CHECK(seen_after >= seen_before + rear.size() / 2);
+    const std::vector<glm::vec4> la = a.download_layers(), lb = b.download_layers();
+    REQUIRE(la.size() == lb.size());
+    const float far = 2.0f * ghosted.ghost.radius * float(size.width);
+    const size_t pixels = size_t{size.width} * size.height;
+    size_t compared = 0, changed = 0;
+    for (size_t q = 0; q < pixels; ++q) {
+      const glm::vec2 p(float(q % size.width) + 0.5f, float(q / size.width) + 0.5f);
+      if (std::any_of(rear.begin(), rear.end(),
+                      [&](glm::vec2 anchor) { return glm::length(p - anchor) <= far; })) {
+        continue;
+      }
+      ++compared;
+      for (size_t l = 0; l < la.size() / pixels; ++l)
+        changed += la[l * pixels + q] != lb[l * pixels + q];
+    }
+    CHECK(compared > 1000);
+    CHECK(changed == 0);
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "labels_glide_to_the_new_placement_after_a_camera_move") {
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
     const graph::Extent size{128, 128};
