@@ -40,6 +40,13 @@ std::string empty_folder(const std::string& name) {
   return dir;
 }
 
+// `strata video` of head.json, four 64-pixel frames, into `dir` (options before -o: `extra`).
+std::string short_video(const std::string& dir, const std::string& extra = "") {
+  return "video " STRATA_SOURCE_DIR
+         "/assets/scenes/head.json --orbit 12 --seconds 0.1 --fps 30 --size 64 " +
+         extra + "-o " + dir;
+}
+
 }  // namespace
 
 TEST_SUITE("cli") {
@@ -263,10 +270,7 @@ TEST_SUITE("cli") {
   // the last line says how fast the frames came.
   TEST_CASE("video_frames_written_on_threads_are_the_bytes_of_frames_written_one_by_one") {
     const std::string dir = empty_folder("video-threads");
-    const std::string video = "video " STRATA_SOURCE_DIR
-                              "/assets/scenes/head.json --orbit 12 --seconds 0.1 --fps 30 "
-                              "--size 64 -o " +
-                              dir;
+    const std::string video = short_video(dir);
     const auto serial = run_strata(video + "/serial --threads 1");
     REQUIRE(serial.exit_code == 0);
     const auto threaded = run_strata(video + "/threaded --threads 3");
@@ -283,10 +287,7 @@ TEST_SUITE("cli") {
   // the run with the first frame's error and exit 1, and leaves no frame and no MP4.
   TEST_CASE("video_whose_frames_fail_on_worker_threads_exits_1_with_the_first_frames_error") {
     const std::string dir = empty_folder("video-threads-full");
-    const std::string video = "video " STRATA_SOURCE_DIR
-                              "/assets/scenes/head.json --orbit 12 --seconds 0.1 --fps 30 "
-                              "--size 64 --threads 3 -o " +
-                              dir;
+    const std::string video = short_video(dir, "--threads 3 ");
     const std::string small_files = "trap '' XFSZ; ulimit -f 1;";
     const auto png = run_strata(video + "/frames", small_files);
     CHECK(png.exit_code == 1);
