@@ -146,7 +146,7 @@ struct ViewBenchOptions {
   std::string placement = "auto";
   double pace = 0.0;  // frames a second the frames are started at (a display's); 0: at once
   double frame_budget_ms = 0.0;  // the viewer's interactive rendering (`view --frame-budget`)
-  float ghost = 0.0f;            // ghosting's strength (0: off), the default lens
+  float ghost = 1.0f;            // ghosting's strength (0: off), the default lens
 };
 
 // The part of a group's name before its first dot ("placement.sat" is part of "placement"), or
@@ -249,6 +249,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   settings.placement.tidy_rounds = o.tidy_rounds;
   settings.forces.keep_apart = o.keep_apart;
   settings.ghost.strength = o.ghost;
+  settings.ghost.radius = scene.settings.ghost_radius;
   const double fps = 30.0;
   const std::vector<Camera> cameras =
       sample(orbit_path(scene, scene.camera, o.degrees, double(o.frames) / fps), fps);

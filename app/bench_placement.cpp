@@ -45,6 +45,7 @@ struct PlacementBenchOptions {
   std::string labels;        // one count or a list ("10,50,100"); empty or 0: the scene's labels
   bool no_baseline = false;  // skip the readback-per-label baseline (slow with many labels)
   uint32_t runs = 50;
+  std::optional<float> ghost;  // ghosting's strength; none: the scene's settings.ghost
 };
 
 // --labels: "100" or "10,50,100", each 0 (the scene's own labels) to kMaxLabels.
@@ -159,6 +160,8 @@ uint32_t tidy_rounds_run(LabelledRenderer& frame, uint32_t rounds) {
 LabellingSettings labelling_settings(const Scene& scene) {
   LabellingSettings settings;
   settings.placement.weights = scene.settings.weights;
+  settings.ghost.strength = scene.settings.ghost;
+  settings.ghost.radius = scene.settings.ghost_radius;
   return settings;
 }
 
@@ -267,6 +270,7 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
   for (const uint32_t count : counts) {
     labels.push_back(resized_labels(scene.labels, count, scene_file));
   }
+  if (o.ghost) scene.settings.ghost = *o.ghost;
   Context ctx(device.context());
   const glm::uvec2 tiles = gpu::placement_tiles(size.width, size.height);
   // One renderer at a time (it keeps a reference to the scene, whose labels change between).
@@ -286,7 +290,7 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
     const ordered_json setup = {{"benchmark", "placement"}, {"scene", scene_file},
                                 {"width", size.width},      {"height", size.height},
                                 {"labels", r.labels},       {"labels_shown", r.labels_shown},
-                                {"layers", r.layers}};
+                                {"layers", r.layers},       {"ghost", scene.settings.ghost}};
     ordered_json results = placement_results(r);
     results["tiles"] = tiles.x * tiles.y;
     if (!r.pipelines.empty()) results["pipelines"] = r.pipelines;
@@ -298,6 +302,7 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
                          {"driver", ctx.report().driver},
                          {"benchmark", "placement"},
                          {"scene", scene_file},
+                         {"ghost", scene.settings.ghost},
                          {"width", size.width},
                          {"height", size.height},
                          {"tiles", tiles.x * tiles.y},
@@ -322,6 +327,10 @@ void add_placement_bench(CLI::App* bench_cmd, DeviceOptions& device) {
   place_cmd->add_option("--labels", place->labels,
                         "label count, or a list of them (10,50,100): the scene's labels cut or "
                         "repeated");
+  place_cmd
+      ->add_option("--ghost", place->ghost,
+                   "ghosting's strength, 0 (off) to 1 (default: the scene's settings.ghost)")
+      ->check(finite_range(0.0, 1.0));
   place_cmd->add_flag("--no-baseline", place->no_baseline,
                       "skip the baseline with a readback after every label (slow with many)");
   place_cmd->add_option("--runs", place->runs, "timed runs after 3 warm-up runs")

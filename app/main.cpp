@@ -147,7 +147,7 @@ void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {
   cmd->add_option("--ghost", o.ghost,
                   "ghosting: the layers in front of a rear label's anchor made this much more "
                   "transparent around it (0: off, 1: fully open at the anchor; default: the "
-                  "scene's settings.ghost, else 0)")
+                  "scene's settings.ghost, else 1)")
       ->check(finite_range(0.0, 1.0));
   cmd->add_option("--ghost-radius", o.ghost_radius,
                   "the ghosting lens's radius, a share of the picture's shorter side (default: the "

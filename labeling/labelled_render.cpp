@@ -246,6 +246,11 @@ void LabelledRenderer::build_graph() {
       graph.import_buffer("labels.glyphs", {.buffer = p.glyphs.handle(), .has_content = true});
   const graph::ResourceId labelled = graph.add_image("labels.final", {VK_FORMAT_R8G8B8A8_UNORM});
   labelled_id_ = labelled;
+  // (offline frames measure what hides each anchor: LabelLayout::front_alpha)
+  const uint32_t n = std::max(uint32_t(labels_.size()), 1u);
+  front_alpha_id_ = extension_ ? 0 : graph.add_buffer("labels.front_alpha", {[n](graph::Extent) {
+                                                        return VkDeviceSize{n} * sizeof(float);
+                                                      }});
   p.drawing->add_to(graph, {.layers = rendered.layers,
                             .layer_count = render.layer_count,
                             .labels = labels,
@@ -253,7 +258,8 @@ void LabelledRenderer::build_graph() {
                             .glyphs = glyph_buffer,
                             .output = labelled,
                             .background = render.background,
-                            .ghost = graph_ghost_});
+                            .ghost = graph_ghost_,
+                            .front_alpha = front_alpha_id_});
   if (extension_) {
     extension_(graph,
                {labelled, rendered, placed_, moved.drawn, render.layer_count, beside_ == nullptr});
@@ -324,13 +330,15 @@ uint64_t LabelledRenderer::placed_frame_number() const {
 void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32_t>& within) {
   PlacementSettings settings = settings_.placement;
   settings.text_pixels = units().em;
+  const float side = float(std::min(size_.width, size_.height));
+  settings.ghost_strength = settings_.ghost.strength;
+  settings.ghost_radius = settings_.ghost.radius * side;
   if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
   // While the camera moves, kept-apart labels keep room to slide along the image's edge.
   if (moving && camera_moved_ && settings_.forces.keep_apart) settings.edge_em = settings.margin_em;
   parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within, priorities_),
                               settings);
   parts_->drawing->set_layer_frames(settings_.layer_colors);
-  const float side = float(std::min(size_.width, size_.height));
   parts_->drawing->set_ghost(
       {settings_.ghost.strength, settings_.ghost.radius * side, settings_.ghost.leader * side});
 }
@@ -476,11 +484,10 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
     const std::vector<glm::vec4> layers = download_layers();
     const std::vector<float> visible =
         label_visibility(layers, size_, layering_.layer_count, frame.labels);
-    const std::vector<float> front =
-        anchor_front_alpha(layers, size_, layering_.layer_count, frame.labels);
+    const std::vector<std::byte> front = runner_->download_buffer(front_alpha_id_);
     for (size_t i = 0; i < frame.labels.size(); ++i) {
       frame.labels[i].visible = visible[i];
-      frame.labels[i].front_alpha = front[i];
+      std::memcpy(&frame.labels[i].front_alpha, front.data() + i * sizeof(float), sizeof(float));
     }
   }
   for (LabelLayout& l : frame.labels) {
@@ -518,26 +525,6 @@ std::vector<float> label_visibility(std::span<const glm::vec4> layers, graph::Ex
       }
     }
     out.push_back(float(seen) / float(size_t(w) * size_t(h)));
-  }
-  return out;
-}
-
-std::vector<float> anchor_front_alpha(std::span<const glm::vec4> layers, graph::Extent size,
-                                      uint32_t layer_count, std::span<const LabelLayout> labels) {
-  const size_t pixels = size_t{size.width} * size.height;
-  std::vector<float> out;
-  for (const LabelLayout& l : labels) {
-    const glm::vec2 a = glm::floor(l.anchor);
-    if (a.x < 0.0f || a.y < 0.0f || a.x >= float(size.width) || a.y >= float(size.height)) {
-      out.push_back(0.0f);
-      continue;
-    }
-    const size_t p = size_t(a.y) * size.width + size_t(a.x);
-    float front = 0.0f;
-    for (uint32_t k = 0; k < std::min(l.layer, layer_count); ++k) {
-      front += (1.0f - front) * layers[k * pixels + p].a;
-    }
-    out.push_back(front);
   }
   return out;
 }

@@ -32,7 +32,7 @@ enum class InsertionOrder {
 // Ghosting (shared/ghost.h): the layers in front of each shown rear label opened around its
 // anchor; sizes are shares of the picture's shorter side.
 struct Ghosting {
-  float strength = 0.0f;  // 0: off, 1: fully open at an anchor
+  float strength = 1.0f;  // 0: off, 1: fully open at an anchor (the default)
   float radius = 0.1f;    // the lens around an anchor
   float leader = 0.0f;    // the lens along a connector (0: none)
 };
@@ -76,8 +76,9 @@ struct LabelLayout {
   bool shown = false;  // placed and legible: visible >= kLegibleShare (placed, when not measured)
   float cost = 0.0f;
   float opacity = 0.0f;  // as drawn: the forces fade it from 0 (hidden) to 1 (fully drawn)
-  // The alpha the layers in front of the label's own composite to at its anchor (what hides the
-  // anchor; ghosting lowers it); NaN where it was not measured, 0 on the front layer.
+  // The alpha the volume's layers in front of the label's own composite to at its anchor (what
+  // hides the anchor; ghosting lowers it; labels drawn over it do not count): labels.front_alpha;
+  // NaN where it was not measured, 0 on the front layer.
   float front_alpha = std::numeric_limits<float>::quiet_NaN();
   // The top-left corner of the placement's box this frame, where the label is heading (its size
   // is box_size); none where the placement did not place it.
@@ -95,11 +96,6 @@ inline constexpr float kHidingAlpha = HIDING_ALPHA;
 // them. Labels not placed get 0.
 std::vector<float> label_visibility(std::span<const glm::vec4> layers, graph::Extent size,
                                     uint32_t layer_count, std::span<const LabelLayout> labels);
-
-// LabelLayout::front_alpha of each label from the same layers: at the pixel of its anchor, 0
-// outside the image.
-std::vector<float> anchor_front_alpha(std::span<const glm::vec4> layers, graph::Extent size,
-                                      uint32_t layer_count, std::span<const LabelLayout> labels);
 
 struct LabelledFrame {
   graph::Extent size;
@@ -291,8 +287,9 @@ class LabelledRenderer {
   RenderStats stats_;
   Placement::Outputs placed_{};
   graph::ResourceId layers_id_ = 0;
-  uint32_t graph_layers_ = 0;  // the layer count the graph was built for
-  bool graph_ghost_ = false;   // the graph has the ghosting pass (LabellingSettings::ghost)
+  graph::ResourceId front_alpha_id_ = 0;  // labels.front_alpha (offline frames only)
+  uint32_t graph_layers_ = 0;             // the layer count the graph was built for
+  bool graph_ghost_ = false;  // the graph has the ghosting pass (LabellingSettings::ghost)
   LabellingSettings settings_;
 };
 

@@ -81,6 +81,7 @@ LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas
                     VK_IMAGE_TYPE_2D,
                     VK_IMAGE_USAGE_SAMPLED_BIT}),
       ghost_pipeline_(ctx, "labels_ghost.comp"),
+      front_alpha_(ctx, "labels_front_alpha.comp"),
       draw_(ctx, "label_draw.comp"),
       composite_(ctx, "label_composite.comp") {
   upload(ctx, atlas_, as_bytes(font.coverage), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
@@ -125,6 +126,19 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
                       pc.dispatch(ghost_pipeline_,
                                   ghost_params(ghost_, pc.viewport, layer_count_, label_count_),
                                   {pc.viewport.width, pc.viewport.height, 1});
+                    },
+                    "labels"});
+  }
+  if (in.front_alpha != 0) {
+    graph.add_pass({"labels.front_alpha",
+                    graph::PassKind::compute,
+                    {{in.layers, Use::storage_read, GHOST_BINDING_LAYERS},
+                     {in.labels, Use::storage_read, GHOST_BINDING_LABELS},
+                     {in.front_alpha, Use::storage_write, GHOST_BINDING_FRONT_ALPHA}},
+                    [this](graph::PassContext& pc) {
+                      pc.dispatch(front_alpha_,
+                                  ghost_params(ghost_, pc.viewport, layer_count_, label_count_),
+                                  {label_count_, 1, 1});
                     },
                     "labels"});
   }
@@ -214,13 +228,37 @@ std::vector<glm::vec4> ghost_reference(std::span<const glm::vec4> layers, graph:
           std::max(open_on[label.layer], gpu::ghost_opening(label, data.placements[i], p, g));
     }
     float behind = 0.0f;
+    float behind_alpha = 0.0f;
     for (int k = int(layer_count) - 1; k >= 0; --k) {
       glm::vec4& c = out[size_t(k) * pixels + q];
-      if (behind > 0.0f) c = to_half_precision(c * gpu::ghost_keep(behind, g));
+      behind_alpha = gpu::ghost_behind_alpha(c.a, behind_alpha);
+      if (behind > 0.0f) c = to_half_precision(c * gpu::ghost_keep(behind, g.strength));
       if (k > 0 && open_on[size_t(k)] > 0.0f) {
-        behind = std::max(behind, open_on[size_t(k)] * gpu::ghost_behind_weight(c.a));
+        behind = std::max(behind, open_on[size_t(k)] * gpu::ghost_behind_weight(behind_alpha));
       }
     }
+  }
+  return out;
+}
+
+std::vector<float> front_alpha_reference(std::span<const glm::vec4> layers, graph::Extent size,
+                                         uint32_t layer_count,
+                                         std::span<const gpu::LabelGpu> labels) {
+  check_layers(layers, size, layer_count);
+  const size_t pixels = size_t{size.width} * size.height;
+  std::vector<float> out;
+  for (const gpu::LabelGpu& l : labels) {
+    const glm::vec2 a = glm::floor(l.anchor);
+    if (a.x < 0.0f || a.y < 0.0f || a.x >= float(size.width) || a.y >= float(size.height)) {
+      out.push_back(0.0f);
+      continue;
+    }
+    const size_t p = size_t(a.y) * size.width + size_t(a.x);
+    float front = 0.0f;
+    for (uint32_t k = 0; k < std::min(l.layer, layer_count); ++k) {
+      front += (1.0f - front) * layers[k * pixels + p].a;
+    }
+    out.push_back(front);
   }
   return out;
 }

@@ -51,6 +51,9 @@ class LabelDrawing {
     graph::ResourceId output;      // a viewport-sized rgba8 image the composite overwrites
     glm::vec3 background{0.0f};
     bool ghost = false;  // with the ghosting pass (its settings: set_ghost)
+    // A float per label, written after the ghosting: the alpha of the layers in front of the
+    // label's own at its anchor (labels_front_alpha.comp); 0: not measured.
+    graph::ResourceId front_alpha = 0;
   };
   // Adds both passes; the font and image atlases are imported with their handles.
   void add_to(graph::Graph& graph, const Inputs& in);
@@ -70,6 +73,7 @@ class LabelDrawing {
   Image atlas_;
   Image images_;
   ComputePipeline ghost_pipeline_;
+  ComputePipeline front_alpha_;
   ComputePipeline draw_;
   ComputePipeline composite_;
   GhostSettings ghost_;
@@ -93,6 +97,12 @@ struct LabelDrawData {
 std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, graph::Extent size,
                                              uint32_t layer_count, const LabelDrawData& data,
                                              const FontAtlas& font, const ImageAtlas& images = {});
+
+// labels.front_alpha on the CPU: for each label, the composited alpha of the layers in front of
+// its own at the pixel of its anchor (0 outside the image).
+std::vector<float> front_alpha_reference(std::span<const glm::vec4> layers, graph::Extent size,
+                                         uint32_t layer_count,
+                                         std::span<const gpu::LabelGpu> labels);
 
 // labels.ghost on the CPU: the layers (shaped as for draw_labels_reference) with ghosting
 // applied, rounded to half precision.

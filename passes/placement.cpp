@@ -66,6 +66,19 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   return p;
 }
 
+gpu::IntegralCostsParams integral_costs_params(const PlacementSettings& s, graph::Extent viewport,
+                                               uint32_t layer_count, uint32_t label_count) {
+  return {viewport.width,
+          viewport.height,
+          layer_count,
+          label_count,
+          s.saliency_weight,
+          s.occlusion_weight,
+          s.single_saliency_weight,
+          s.ghost_strength,
+          s.ghost_radius};
+}
+
 PlacementPlan PlacementPlan::choose(const Context& ctx, uint32_t label_count,
                                     const PlacementLayout& layout) {
   PlacementPlan plan;
@@ -253,10 +266,13 @@ void Placement::add_costs(graph::Graph& graph, const Buffers& b, const Inputs& i
                   {{in.final_image, Use::storage_read, PLACEMENT_BINDING_FINAL},
                    {b.saliency, Use::storage_write, PLACEMENT_BINDING_SALIENCY},
                    {in.layers, Use::storage_read, PLACEMENT_BINDING_LAYERS},
+                   {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
                    {b.costs, Use::storage_write, PLACEMENT_BINDING_COSTS}},
                   [this](graph::PassContext& pc) {
-                    pc.dispatch(integral_costs_, params(pc.viewport, 0),
-                                {pc.viewport.width, pc.viewport.height, 1});
+                    pc.dispatch(
+                        integral_costs_,
+                        integral_costs_params(settings_, pc.viewport, layer_count_, label_count_),
+                        {pc.viewport.width, pc.viewport.height, 1});
                   },
                   "placement"});
   tables_.add_to(graph, b.costs, b.tables, "placement.sat", 2 * in.layer_count);

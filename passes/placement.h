@@ -36,11 +36,15 @@ struct PlacementSettings {
   // A rectangle of the image no box may touch, x0, y0, x1, y1 in pixels (the viewer's panel);
   // empty (x0 >= x1 or y0 >= y1): none. Labels whose boxes fit nowhere else are hidden.
   glm::uvec4 keep_out{0u};
-  bool hard = false;          // forbid constraint violations (labels may end up hidden)
+  bool hard = false;                    // forbid constraint violations (labels may end up hidden)
   float saliency_weight = 0.5f;         // eq. 3.3: how much saliency modulates the occlusion behind
   float occlusion_weight = 0.5f;        // eq. 3.4 (one layer)
   float single_saliency_weight = 0.5f;  // eq. 3.4 (one layer)
-  bool write_constraints = false;       // keep each label's constraint image (tests, debugging)
+  // The ghosting the frame draws (shared/ghost.h): strength 0 to 1, lens radius in pixels. Boxes
+  // in the lenses of the rear labels count as legible where the opened layers let them through.
+  float ghost_strength = 0.0f;
+  float ghost_radius = 0.0f;
+  bool write_constraints = false;  // keep each label's constraint image (tests, debugging)
   // Cost above a label's lowest tile bound that its speculative pass covers (speed only:
   // the positions do not depend on it).
   float bucket_width = 0.0625f;
@@ -57,6 +61,8 @@ inline float margin_pixels(const PlacementSettings& s) {
 
 gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent viewport,
                                       uint32_t layer_count, uint32_t label_count, uint32_t step);
+gpu::IntegralCostsParams integral_costs_params(const PlacementSettings& s, graph::Extent viewport,
+                                               uint32_t layer_count, uint32_t label_count);
 
 // How the placement's dispatches are sized. The label loop's and the tidy-up rounds' sizes are only
 // known on the GPU: an indirect dispatch reads them there; a direct one has enough workgroups for

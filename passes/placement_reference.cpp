@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "passes/summed_area_table.h"
+#include "shared/ghost.h"
 #include "shared/saliency.h"
 
 namespace strata {
@@ -190,14 +191,34 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
   // Integral costs per layer, hidden pixels per layer (after them), and their tables.
   out.costs.resize(pixels * layer_count * 2);
   out.tables.resize(out.costs.size());
+  std::vector<float> open_on(layer_count), kept(layer_count);
   for (size_t p = 0; p < pixels; ++p) {
     float all = 0.0f;
     for (uint32_t l = 0; l < layer_count; ++l) all += layers[l * pixels + p].a;
+    // (the ghosting lenses of the rear labels: ghost_placement_opening)
+    std::fill(open_on.begin(), open_on.end(), 0.0f);
+    if (settings.ghost_strength > 0.0f && settings.ghost_radius > 0.0f) {
+      const glm::vec2 centre(float(p % w) + 0.5f, float(p / w) + 0.5f);
+      for (const gpu::LabelGpu& l : labels) {
+        if (l.layer == 0u || l.layer >= layer_count) continue;
+        open_on[l.layer] = std::max(open_on[l.layer],
+                                    gpu::ghost_placement_opening(l, centre, settings.ghost_radius));
+      }
+    }
+    float behind = 0.0f;
+    float behind_alpha = 0.0f;
+    for (int k = int(layer_count) - 1; k >= 0; --k) {
+      const float a = layers[size_t(k) * pixels + p].a;
+      kept[size_t(k)] = a * gpu::ghost_keep(behind, settings.ghost_strength);
+      behind_alpha = gpu::ghost_behind_alpha(a, behind_alpha);
+      if (k > 0)
+        behind = std::max(behind, open_on[size_t(k)] * gpu::ghost_behind_weight(behind_alpha));
+    }
     float in_front = 0.0f;
-    float composite = 0.0f;  // of the layers in front of layer l
+    float composite = 0.0f;  // of the layers in front of layer l, as the lenses leave them
     for (uint32_t l = 0; l < layer_count; ++l) {
       out.costs[(layer_count + l) * pixels + p] = composite >= HIDING_ALPHA ? 1.0f : 0.0f;
-      composite += (1.0f - composite) * layers[l * pixels + p].a;
+      composite += (1.0f - composite) * kept[l];
       in_front += layers[l * pixels + p].a;
       out.costs[l * pixels + p] = gpu::integral_cost(
           in_front, all - in_front, all, out.saliency[p], layer_count, settings.saliency_weight,

@@ -59,16 +59,17 @@ void main() {
     }
   }
   if (!any) return;
-  // (back to front: the largest opening of the layers behind layer k, each as far as its content
-  // lets it)
+  // (back to front: the largest opening of the labels behind layer k, each as far as what lies
+  // at and behind its layer lets it)
   float behind = 0.0f;
+  float behind_alpha = 0.0f;
   for (int k = int(layer_count) - 1; k >= 0; --k) {
     const ivec3 texel = ivec3(px, k);
-    if (behind > 0.0f) {
-      imageStore(layers, texel, imageLoad(layers, texel) * ghost_keep(behind, params));
-    }
+    const vec4 c = imageLoad(layers, texel);
+    if (behind > 0.0f) imageStore(layers, texel, c * ghost_keep(behind, params.strength));
+    behind_alpha = ghost_behind_alpha(c.a, behind_alpha);
     if (k > 0 && open_on[k] > 0.0f) {
-      behind = max(behind, open_on[k] * ghost_behind_weight(imageLoad(layers, texel).a));
+      behind = max(behind, open_on[k] * ghost_behind_weight(behind_alpha));
     }
   }
 }

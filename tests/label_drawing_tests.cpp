@@ -116,6 +116,7 @@ LabelScene make_scene() {
 struct DrawnLabels {
   std::vector<glm::vec4> layers;
   std::vector<uint8_t> final;
+  std::vector<float> front_alpha;  // labels.front_alpha: per label, after the ghosting
 };
 
 Buffer storage_buffer(Context& ctx, std::span<const std::byte> bytes) {
@@ -159,6 +160,9 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
                                                    .initial_layout = VK_IMAGE_LAYOUT_GENERAL,
                                                    .final_use = graph::Use::transfer_src});
   const auto final_id = g.add_image("final", {VK_FORMAT_R8G8B8A8_UNORM});
+  const size_t label_count = std::max<size_t>(s.labels.size(), 1);
+  const auto front_id = g.add_buffer(
+      "front_alpha", {[label_count](graph::Extent) { return label_count * sizeof(float); }});
   drawing.add_to(g, {.layers = layers_id,
                      .layer_count = s.layer_count,
                      .labels = filled("labels", labels),
@@ -166,7 +170,8 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
                      .glyphs = filled("glyphs", glyphs),
                      .output = final_id,
                      .background = s.background,
-                     .ghost = s.ghost.strength > 0.0f});
+                     .ghost = s.ghost.strength > 0.0f,
+                     .front_alpha = front_id});
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(s.size);
   runner.run_now();
@@ -175,6 +180,9 @@ DrawnLabels draw_on_gpu(Context& ctx, const LabelScene& s) {
   const std::vector<std::byte> final_bytes = runner.download_image(final_id);
   out.final.resize(final_bytes.size());
   std::memcpy(out.final.data(), final_bytes.data(), final_bytes.size());
+  const std::vector<std::byte> front_bytes = runner.download_buffer(front_id);
+  out.front_alpha.resize(s.labels.size());
+  std::memcpy(out.front_alpha.data(), front_bytes.data(), out.front_alpha.size() * sizeof(float));
   const std::vector<std::byte> layer_bytes =
       download(ctx, layers, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   std::vector<uint64_t> halves(layer_bytes.size() / sizeof(uint64_t));
@@ -277,6 +285,15 @@ DrawnLabels draw_matching_the_reference(Context& ctx, const LabelScene& s) {
   const std::vector<uint8_t> final_expected = composite_reference(
       expected, s.size, s.layer_count, s.background, {s.labels, s.placements, s.glyphs});
   CHECK(worst_difference(gpu.final, final_expected) <= 2);
+  // What hides each anchor, read between the ghosting and the drawing.
+  const std::vector<float> front = front_alpha_reference(
+      ghost_reference(s.layers, s.size, s.layer_count, {s.labels, s.placements, s.glyphs}, s.ghost),
+      s.size, s.layer_count, s.labels);
+  REQUIRE(gpu.front_alpha.size() == front.size());
+  for (size_t i = 0; i < front.size(); ++i) {
+    CAPTURE(i);
+    CHECK(gpu.front_alpha[i] == doctest::Approx(front[i]).epsilon(1e-4));
+  }
   return gpu;
 }
 
@@ -718,6 +735,8 @@ TEST_SUITE("gpu") {
       return a;
     };
     const glm::vec2 rear = s.labels[0].anchor, middle = s.labels[1].anchor;
+    CHECK(gpu.front_alpha[0] == doctest::Approx(front_alpha(ghosted, rear, 2)).epsilon(1e-4));
+    CHECK(gpu.front_alpha[0] <= 0.3f);
     CHECK(front_alpha(s.layers, rear, 2) > 0.5f);
     CHECK(front_alpha(ghosted, rear, 2) <= 0.3f);
     CHECK(front_alpha(ghosted, middle, 1) <= 0.3f);

@@ -133,8 +133,8 @@ TEST_SUITE("gpu") {
       const Scene scene = load_scene(std::string(STRATA_SOURCE_DIR "/assets/scenes/") + file);
       LabelledRenderer renderer(ctx, scene, camera_for(scene, "front"), {64, 64}, {});
       const graph::GraphRunner& runner = renderer.runner();
-      CHECK(runner.graph().passes().size() == 21);
-      CHECK(graph::barrier_count(runner.compiled()) == 55);
+      CHECK(runner.graph().passes().size() == 23);  // (with labels.ghost and labels.front_alpha)
+      CHECK(graph::barrier_count(runner.compiled()) == 57);
       const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
       CHECK(loop.name == "placement.labels");
     }
@@ -216,8 +216,8 @@ TEST_SUITE("gpu") {
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
     const graph::Extent size{192, 192};
     const Camera camera = camera_for(scene, "front");
-    LabellingSettings plain, ghosted;
-    ghosted.ghost.strength = 1.0f;
+    LabellingSettings plain, ghosted;  // (ghosting is on by default)
+    plain.ghost.strength = 0.0f;
     LabelledRenderer a(ctx, scene, camera, size, plain), b(ctx, scene, camera, size, ghosted);
     a.run();
     b.run();
@@ -257,6 +257,50 @@ TEST_SUITE("gpu") {
     }
     CHECK(compared > 1000);
     CHECK(changed == 0);
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "a_fading_rear_labels_lens_fades_with_it_frame_by_frame") {
+    // head.json from the front at 128², ghosting on, frames of a 20 fps video at rest: a shown
+    // rear label left out of the placement fades out over 0.3 s, and frame by frame the alpha
+    // in front of its anchor rises as its opacity falls, from open (<= 0.3) to closed, in steps
+    // of about a sixth: no frame pops the lens shut.
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    const Camera camera = camera_for(scene, "front");
+    LabellingSettings settings;
+    settings.ghost.strength = 1.0f;
+    settings.forces.fade_seconds = 0.3f;
+    LabelledRenderer r(ctx, scene, camera, {128, 128}, settings);
+    r.run();
+    const LabelledFrame still = r.result();
+    size_t faded = still.labels.size();
+    for (size_t i = 0; i < still.labels.size() && faded == still.labels.size(); ++i) {
+      const LabelLayout& l = still.labels[i];
+      if (l.placed && l.layer > 0 && l.opacity == 1.0f && l.front_alpha <= 0.3f) faded = i;
+    }
+    REQUIRE(faded < still.labels.size());
+    CAPTURE(still.labels[faded].text);
+    std::vector<uint32_t> others;
+    for (uint32_t i = 0; i < still.labels.size(); ++i)
+      if (i != faded) others.push_back(i);
+    std::vector<float> opacity{1.0f}, front{still.labels[faded].front_alpha};
+    for (int frame = 0; frame < 8 && opacity.back() > 0.0f; ++frame) {
+      r.set_camera(camera);
+      r.set_order(others);
+      r.advance(0.05);
+      const LabelLayout& l = r.result().labels[faded];
+      opacity.push_back(l.opacity);
+      front.push_back(l.front_alpha);
+    }
+    REQUIRE(opacity.back() == 0.0f);
+    CHECK(opacity.size() >= 6);  // (0.3 s in frames of 0.05 s, and the last one at 0)
+    const float rise = front.back() - front.front();
+    REQUIRE(rise > 0.3f);
+    for (size_t k = 1; k < front.size(); ++k) {
+      CAPTURE(k);
+      CHECK(opacity[k] < opacity[k - 1]);
+      CHECK(front[k] > front[k - 1]);
+      CHECK(front[k] - front[k - 1] <= 0.4f * rise);
+    }
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "labels_glide_to_the_new_placement_after_a_camera_move") {

@@ -18,6 +18,7 @@
 #include "gpu_fixture.h"
 #include "labeling/labelled_render.h"
 #include "labeling/layout_metrics.h"
+#include "passes/label_drawing.h"
 #include "passes/label_forces.h"
 #include "passes/placement.h"
 #include "passes/placement_reference.h"
@@ -386,6 +387,53 @@ TEST_SUITE("gpu") {
     CHECK(soft[0].shown == PLACEMENT_SHOWN);
     CHECK(soft[0].cost >= 1000.0f);
     CHECK(place(covered, 0.0f, true)[1].shown == PLACEMENT_SHOWN);
+  }
+
+  // A near-opaque slab over the whole front layer, something to see on the rear layer: hard mode
+  // finds no legible box for the rear label and hides it. With ghosting its lens will open the
+  // slab around its anchor, and the placement counts that: the label is placed in its lens
+  // (GPU == reference, the hidden pixels too), and the layers as the ghosting pass leaves them
+  // show its box. A weak lens (strength 0.3) leaves the slab hiding it.
+  TEST_CASE_FIXTURE(test::GpuTest, "boxes_a_ghosting_lens_opens_count_as_legible") {
+    Inputs in;
+    in.size = {96, 72};
+    const size_t pixels = size_t{in.size.width} * in.size.height;
+    in.final_rgba8.assign(pixels * 4, 90);
+    const float front = glm::unpackHalf1x16(glm::packHalf1x16(0.875f));
+    const float rear = glm::unpackHalf1x16(glm::packHalf1x16(0.625f));
+    in.layers.assign(pixels, glm::vec4(0.3f * front, 0.3f * front, 0.3f * front, front));
+    in.layers.resize(2 * pixels, glm::vec4(0.5f * rear, 0.2f * rear, 0.2f * rear, rear));
+    in.labels = {label({48.0f, 36.0f}, {20.0f, 8.0f}, 1)};
+    in.order = {0};
+    const auto place = [&](float strength) {
+      PlacementSettings settings;
+      settings.weights.integral_costs = 0.0f;
+      settings.hard = true;
+      settings.ghost_strength = strength;
+      settings.ghost_radius = 30.0f;
+      const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
+      const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                     in.labels, in.order, settings, in.size);
+      check_values(gpu.costs, cpu.costs, 1e-3f, false, "integral costs and hidden pixels");
+      check_values(gpu.tables, cpu.tables, 1e-5f, true, "tables");
+      check_placements(gpu, cpu);
+      return gpu.placements;
+    };
+    CHECK(place(0.0f)[0].shown == PLACEMENT_HIDDEN);
+    CHECK(place(0.3f)[0].shown == PLACEMENT_HIDDEN);
+    std::vector<gpu::PlacementGpu> ghosted = place(1.0f);
+    REQUIRE(ghosted[0].shown == PLACEMENT_SHOWN);
+    CHECK(glm::distance(ghosted[0].position, in.labels[0].anchor) < 30.0f);
+    ghosted[0].opacity = 1.0f;  // (as the forces draw a shown label)
+    const std::vector<glm::vec4> opened = ghost_reference(
+        in.layers, in.size, in.layer_count, {.labels = in.labels, .placements = ghosted},
+        {.strength = 1.0f, .radius = 30.0f});
+    LabelLayout l;
+    l.layer = 1;
+    l.box_size = in.labels[0].size;
+    l.box_origin = ghosted[0].position - l.box_size * 0.5f;
+    l.placed = true;
+    CHECK(label_visibility(opened, in.size, in.layer_count, std::vector{l})[0] >= kLegibleShare);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "placement_stages_and_positions_match_the_cpu_reference") {

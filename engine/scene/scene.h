@@ -121,9 +121,10 @@ inline constexpr int kMaxLabels = 4096;
 struct SceneSettings {
   int layer_count = 4;  // 1 to kMaxLayers
   CostWeights weights;
-  // Ghosting: how far the layers in front of a rear label's anchor open (0: off, to 1), and the
-  // lens's radius, a share of the picture's shorter side (kGhostRadiusMin to kGhostRadiusMax).
-  float ghost = 0.0f;
+  // Ghosting: how far the layers in front of a rear label's anchor open (0: off, to 1; on by
+  // default), and the lens's radius, a share of the picture's shorter side (kGhostRadiusMin to
+  // kGhostRadiusMax).
+  float ghost = 1.0f;
   float ghost_radius = 0.1f;
 };
 inline constexpr float kGhostRadiusMin = 0.005f;

@@ -6,18 +6,21 @@
 // A label on layer L opens every layer k < L at p by its lens: 1 within a third of the radius of
 // its anchor, falling smoothly to 0 at the radius (and, with a leader radius, the same around its
 // connector), times the label's opacity (a fading label's lens fades with it), times how much
-// layer L holds at p (ghost_behind_weight). Layer k keeps 1 - strength * (the largest opening at
-// p) of its colour and alpha; nothing changes beyond every lens. Labels are drawn after, so a box
-// is never made harder to read.
+// layer L and the layers behind it hold at p (ghost_behind_weight). Layer k keeps
+// 1 - strength * (the largest opening at p) of its colour and alpha; nothing changes beyond every
+// lens. Labels are drawn after, so a box is never made harder to read. The placement counts the
+// lenses too (ghost_placement_opening): a box the lenses let through is legible.
 #ifndef STRATA_SHARED_GHOST_H
 #define STRATA_SHARED_GHOST_H
 
 #include "label_drawing.h"
 
 #define GHOST_GROUP 16
-#define GHOST_BINDING_LAYERS 0      // rgba16f 2D array, premultiplied, changed in place
-#define GHOST_BINDING_LABELS 1      // LabelGpu[]
-#define GHOST_BINDING_PLACEMENTS 2  // PlacementGpu[]: where the labels are drawn, their opacity
+#define GHOST_BINDING_LAYERS 0       // rgba16f 2D array, premultiplied, changed in place
+#define GHOST_BINDING_LABELS 1       // LabelGpu[]
+#define GHOST_BINDING_PLACEMENTS 2   // PlacementGpu[]: where the labels are drawn, their opacity
+#define GHOST_BINDING_FRONT_ALPHA 3  // float[] per label (labels_front_alpha.comp)
+#define GHOST_FRONT_ALPHA_GROUP 64
 
 STRATA_BEGIN
 
@@ -38,10 +41,16 @@ STRATA_INLINE float ghost_lens(float d, float radius) {
   return radius > 0.0f ? 1.0f - smoothstep(radius / 3.0f, radius, d) : 0.0f;
 }
 
-// How much of an opening a layer's content lets through: the layers in front open only where the
-// label's own layer holds something to see (no hole to the background at an object's edge).
-STRATA_INLINE float ghost_behind_weight(float layer_alpha) {
-  return smoothstep(0.05f, 0.35f, layer_alpha);
+// How much of an opening the content behind lets through, from the composited alpha of the
+// label's own layer and every layer behind it: the layers in front open only where there is
+// something behind them to see (no hole to the background at an object's edge).
+STRATA_INLINE float ghost_behind_weight(float behind_alpha) {
+  return smoothstep(0.05f, 0.35f, behind_alpha);
+}
+
+// The composited alpha of layer k and every layer behind it, from that of the layers behind k.
+STRATA_INLINE float ghost_behind_alpha(float layer_alpha, float behind_alpha) {
+  return layer_alpha + (1.0f - layer_alpha) * behind_alpha;
 }
 
 // How far label `label`, drawn as `drawn`, opens the layers in front of its own at p (0 to 1),
@@ -60,14 +69,32 @@ STRATA_INLINE float ghost_opening(LabelGpu label, PlacementGpu drawn, vec2 p, Gh
   return open * clamp(drawn.opacity, 0.0f, 1.0f);
 }
 
+// The placement's view of a label's lens (the hidden pixels legibility counts,
+// integral_costs.comp): before it places the labels the placement cannot know which will be shown,
+// so every enabled external rear label opens as if shown at full opacity, around its anchor (a
+// connector's lens depends on where the box goes).
+STRATA_INLINE float ghost_placement_opening(LabelGpu label, vec2 p, float radius) {
+  if ((label.flags & LABEL_ENABLED) == 0u || (label.flags & LABEL_INTERNAL) != 0u ||
+      label.layer == 0u) {
+    return 0.0f;
+  }
+  return ghost_lens(length(p - label.anchor), radius);
+}
+
+// Whether no pixel centre in [tile_lo, tile_hi] lies within `radius` of the anchor (with a pixel
+// to spare).
+STRATA_INLINE bool ghost_anchor_far_from_tile(vec2 tile_lo, vec2 tile_hi, vec2 anchor,
+                                              float radius) {
+  float r = radius + 1.0f;
+  return tile_hi.x < anchor.x - r || tile_lo.x > anchor.x + r || tile_hi.y < anchor.y - r ||
+         tile_lo.y > anchor.y + r;
+}
+
 // Whether no pixel centre in [tile_lo, tile_hi] lies within the label's lenses (with a pixel to
 // spare): a workgroup's tile can leave the label out.
 STRATA_INLINE bool ghost_far_from_tile(vec2 tile_lo, vec2 tile_hi, LabelGpu label,
                                        PlacementGpu drawn, GhostParams g) {
-  float r = g.radius + 1.0f;
-  bool near_anchor = !(tile_hi.x < label.anchor.x - r || tile_lo.x > label.anchor.x + r ||
-                       tile_hi.y < label.anchor.y - r || tile_lo.y > label.anchor.y + r);
-  if (near_anchor) return false;
+  if (!ghost_anchor_far_from_tile(tile_lo, tile_hi, label.anchor, g.radius)) return false;
   if (g.leader_radius <= 0.0f) return true;
   vec2 half_size = 0.5f * label.size;
   vec2 end = clamp(label.anchor, drawn.position - half_size, drawn.position + half_size);
@@ -77,8 +104,8 @@ STRATA_INLINE bool ghost_far_from_tile(vec2 tile_lo, vec2 tile_hi, LabelGpu labe
 
 // The share of its colour and alpha a layer keeps where the largest opening of the labels on
 // the layers behind it is `largest_behind`.
-STRATA_INLINE float ghost_keep(float largest_behind, GhostParams g) {
-  return 1.0f - clamp(g.strength, 0.0f, 1.0f) * largest_behind;
+STRATA_INLINE float ghost_keep(float largest_behind, float strength) {
+  return 1.0f - clamp(strength, 0.0f, 1.0f) * largest_behind;
 }
 
 STRATA_END

@@ -36,10 +36,11 @@
 // A packed (cost, pixel) pair no candidate reaches: "not placed".
 #define PLACEMENT_NONE 0xFFFFFFFFFFFFFFFFul
 
-#define PLACEMENT_BINDING_FINAL 0        // rgba8 label-free final image
-#define PLACEMENT_BINDING_SALIENCY 1     // float per pixel
-#define PLACEMENT_BINDING_LAYERS 2       // rgba16f array image, premultiplied
-#define PLACEMENT_BINDING_COSTS 3        // float per pixel per layer (integral costs, eq. 3.3/3.4),
+#define PLACEMENT_BINDING_FINAL 0     // rgba8 label-free final image
+#define PLACEMENT_BINDING_SALIENCY 1  // float per pixel
+#define PLACEMENT_BINDING_LAYERS 2    // rgba16f array image, premultiplied
+#define PLACEMENT_BINDING_COSTS \
+  3                                      // float per pixel per layer (integral costs, eq. 3.3/3.4),
                                          // then per layer 1 where its pixel is hidden, else 0
 #define PLACEMENT_BINDING_TABLES 4       // their summed-area tables, same layout
 #define PLACEMENT_BINDING_LABELS 5       // LabelGpu[]
@@ -139,14 +140,14 @@ struct PlacementParams {
   uint height;
   uint layer_count;
   uint label_count;
-  uint step;               // place_label: the dispatch (main pass of order position step - 1,
-                           // speculative pass of step)
-  uint hard;               // 1: constraint violations and illegible boxes are forbidden (the
-                           // label may end up hidden)
-  uint write_constraints;  // 1: store the constraint bits of every pixel (tests, debugging)
-  float margin;            // pixels added around label boxes in the constraints
-  float saliency_weight;   // eq. 3.3: beta, how much saliency modulates occlusion behind
-  float occlusion_weight;  // eq. 3.4 (one layer): alpha
+  uint step;                     // place_label: the dispatch (main pass of order position step - 1,
+                                 // speculative pass of step)
+  uint hard;                     // 1: constraint violations and illegible boxes are forbidden (the
+                                 // label may end up hidden)
+  uint write_constraints;        // 1: store the constraint bits of every pixel (tests, debugging)
+  float margin;                  // pixels added around label boxes in the constraints
+  float saliency_weight;         // eq. 3.3: beta, how much saliency modulates occlusion behind
+  float occlusion_weight;        // eq. 3.4 (one layer): alpha
   float single_saliency_weight;  // eq. 3.4: beta
   uint phase;                    // placement_bounds.comp: PLACEMENT_PHASE_*
   float bucket_width;            // cost above the label's lowest tile bound that bucket 0 holds
@@ -159,8 +160,22 @@ struct PlacementParams {
   uint tidy_rounds;     // placement_tidy: rounds of the tidy-up at most (0: none)
   uint indirect;        // 1: the tidy-up rounds are indirect dispatches (PlacementPlan)
   float edge;           // pixels a box keeps clear of the image's edges
-  uint keep_out_lo;     // a rectangle no box may touch (the viewer's panel): its corners x | y << 16,
-  uint keep_out_hi;     // [lo, hi) in pixels; lo == hi: none
+  uint keep_out_lo;  // a rectangle no box may touch (the viewer's panel): its corners x | y << 16,
+  uint keep_out_hi;  // [lo, hi) in pixels; lo == hi: none
+};
+
+// placement.integral_costs's own push constants (PlacementParams fills the 128 bytes every device
+// takes): saliency, integral costs and the hidden pixels legibility counts.
+struct IntegralCostsParams {
+  uint width;
+  uint height;
+  uint layer_count;
+  uint label_count;
+  float saliency_weight;
+  float occlusion_weight;
+  float single_saliency_weight;
+  float ghost_strength;  // the frame's ghosting (shared/ghost.h): a pixel its lenses let through
+  float ghost_radius;    // is not hidden (ghost_placement_opening); the lens radius in pixels
 };
 
 // Where a label k's box centre would break a constraint with a placed label j (thesis 4.1.1,
@@ -176,7 +191,9 @@ struct PairRegionsGpu {
 // Where the regions of the label at order position s against the one placed before it at order
 // position t (t < s) are kept: row s holds its s pairs, so n labels need n (n - 1) / 2 of them.
 // (Every pair is written before it is read, by the label loop, once t is final.)
-STRATA_INLINE uint placement_pair_slot(uint s, uint t) { return s * (s - 1u) / 2u + t; }
+STRATA_INLINE uint placement_pair_slot(uint s, uint t) {
+  return s * (s - 1u) / 2u + t;
+}
 STRATA_INLINE uint placement_pair_count(uint labels) {
   return labels > 1u ? labels * (labels - 1u) / 2u : 1u;
 }

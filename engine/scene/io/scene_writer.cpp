@@ -47,7 +47,7 @@ ordered_json settings_json(const SceneSettings& settings) {
                         {"previous_position", shortest_double(w.previous_position)},
                         {"leader_crossing", shortest_double(w.leader_crossing)},
                         {"illegible", shortest_double(w.illegible)}}}};
-  if (settings.ghost > 0.0f) out["ghost"] = shortest_double(settings.ghost);
+  if (settings.ghost != SceneSettings{}.ghost) out["ghost"] = shortest_double(settings.ghost);
   if (settings.ghost_radius != SceneSettings{}.ghost_radius) {
     out["ghost_radius"] = shortest_double(settings.ghost_radius);
   }
