@@ -21,6 +21,8 @@ packages=(
   zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev libjpeg62-turbo-dev
   # videos: H.264 in MP4 through FFmpeg's libraries; ffprobe checks them in the tests
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
+  # the label writer's test validates its markups JSON against 3D Slicer's schema
+  python3-jsonschema
   # window tests without a display
   xvfb xauth xdotool
   # fuzzing (scripts/fuzz.sh): clang and its runtime libraries, libFuzzer among them
