@@ -94,6 +94,7 @@ void add_bench_command(CLI::App& app, DeviceOptions& device);
 void add_info_command(CLI::App& app);
 void add_eval_command(CLI::App& app);
 void add_video_command(CLI::App& app, DeviceOptions& device);
+void add_pick_command(CLI::App& app, DeviceOptions& device);
 // `bench encode` (app/bench_encode.cpp), added to the `bench` command.
 void add_encode_bench(CLI::App* bench);
 

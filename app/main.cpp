@@ -176,6 +176,7 @@ int main(int argc, char** argv) {
   add_info_command(app);
   add_eval_command(app);
   add_video_command(app, device);
+  add_pick_command(app, device);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

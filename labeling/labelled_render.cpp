@@ -19,6 +19,7 @@
 #include "labeling/text_layout.h"
 #include "passes/label_drawing.h"
 #include "passes/label_forces.h"
+#include "passes/picking.h"
 
 namespace strata {
 
@@ -59,10 +60,12 @@ struct LabelledRenderer::Parts {
       : renderer(ctx, scene, settings.render),
         placement(ctx, label_count, settings.placement_layout, placement_pipelines.get()),
         forces(ctx, label_count),
+        picking(ctx),
         target(ctx) {}
   VolumeRenderer renderer;
   Placement placement;
   LabelForces forces;
+  Picking picking;
   std::optional<LabelDrawing> drawing;  // with the font of its size
   HeadlessTarget target;
   Buffer glyphs;
@@ -238,6 +241,7 @@ void LabelledRenderer::build_graph() {
 
   graph::Graph graph;
   const VolumeRenderer::Outputs rendered = p.renderer.add_to(graph);
+  picks_id_ = p.picking.add_to(graph, {.frame = rendered.frame, .depth = rendered.depth});
   graph::ResourceId labels = 0;
   const LabelForces::Outputs moved = beside_ ? add_placement_beside(graph, rendered, labels)
                                              : add_placement_in_frame(graph, rendered, labels);
@@ -358,6 +362,14 @@ void LabelledRenderer::set_camera(const Camera& camera) {
 void LabelledRenderer::advance(double seconds) {
   prepare_frame(seconds);
   run_frame();
+}
+
+void LabelledRenderer::set_picks(std::vector<glm::vec2> pixels) {
+  parts_->picking.set_pixels(std::move(pixels));
+}
+
+std::vector<PickHit> LabelledRenderer::picked() const {
+  return parts_->picking.hits(runner_->download_buffer(picks_id_));
 }
 
 LabelledRenderer::~LabelledRenderer() = default;

@@ -17,6 +17,7 @@
 #include "labeling/layering.h"
 #include "labeling/placement_beside.h"
 #include "passes/label_forces.h"
+#include "passes/picking.h"
 #include "passes/placement.h"
 #include "passes/volume_renderer.h"
 
@@ -242,6 +243,11 @@ class LabelledRenderer {
   // a hidden label counting as much as an anchor-constraint violation.
   double total_cost() const;
 
+  // Picking (passes/picking.h): the frames from now on pick these pixels (at most PICK_MAX),
+  // picked() reads the last frame's points (waits for it).
+  void set_picks(std::vector<glm::vec2> pixels);
+  std::vector<PickHit> picked() const;
+
   // The label-free layer images of the last frame (premultiplied rgba, layer after layer, each
   // size.width x size.height), waited for.
   std::vector<glm::vec4> download_layers() const;
@@ -288,6 +294,7 @@ class LabelledRenderer {
   Placement::Outputs placed_{};
   graph::ResourceId layers_id_ = 0;
   graph::ResourceId front_alpha_id_ = 0;  // labels.front_alpha (offline frames only)
+  graph::ResourceId picks_id_ = 0;        // picking.points
   uint32_t graph_layers_ = 0;             // the layer count the graph was built for
   bool graph_ghost_ = false;  // the graph has the ghosting pass (LabellingSettings::ghost)
   LabellingSettings settings_;

@@ -80,6 +80,30 @@ TEST_SUITE("loaders") {
     CHECK(labels[1].anchor.z == doctest::Approx(100.0f + 0.5f * 1.5f));
   }
 
+  // A point is named by the region of its nearest voxel (spacing and origin applied), with '_'
+  // as ' '; outside the volume, on 0 and on an index without a name: none. The scene's first
+  // atlas that names it wins.
+  TEST_CASE("atlas_region_at_names_the_region_of_the_nearest_voxel") {
+    SceneAtlas atlas{synthetic_atlas({20, 16, 12}, {10, 8, 6}, 4.0f), {}};
+    for (const AtlasRegion& r : kRegions) atlas.names[r.index] = r.name;
+    const auto world = [&](glm::vec3 index) {
+      return glm::vec3(atlas.labels.index_to_world() * glm::vec4(index, 1.0f));
+    };
+    CHECK(atlas_region_at(atlas, world({10.0f, 8.0f, 6.0f})) == "Ball L");
+    CHECK(atlas_region_at(atlas, world({10.4f, 7.6f, 6.3f})) == "Ball L");
+    CHECK(atlas_region_at(atlas, world({1.0f, 2.0f, 3.0f})) == "Box R");
+    CHECK(atlas_region_at(atlas, world({1.0f, 2.0f, 3.6f})).empty());  // (voxel 4: region 0)
+    CHECK(atlas_region_at(atlas, world({-0.6f, 0.0f, 0.0f})).empty());  // outside
+    CHECK(atlas_region_at(atlas, world({19.0f, 15.0f, 12.0f})).empty());
+    atlas.names.erase(7);
+    CHECK(atlas_region_at(atlas, world({1.0f, 2.0f, 3.0f})).empty());
+    Scene scene;
+    scene.atlases = {atlas, atlas};
+    scene.atlases[1].names[7] = "Other_Box";
+    CHECK(atlas_region_at(scene, world({1.0f, 2.0f, 3.0f})) == "Other Box");
+    CHECK(atlas_region_at(scene, world({10.0f, 8.0f, 6.0f})) == "Ball L");
+  }
+
   TEST_CASE("atlas_mask_marks_exactly_the_region_voxels") {
     const Volume v = synthetic_atlas({20, 16, 12}, {10, 8, 6}, 4.0f);
     const Volume mask = atlas_mask(v, kRegions[2]);

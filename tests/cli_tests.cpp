@@ -151,12 +151,39 @@ TEST_SUITE("cli") {
     CHECK(r.output.find("bench view: 12 labels") != std::string::npos);
   }
 
+  // strata pick: the point under a pixel of head.json's front view in LPS and RAS (x and y
+  // negated), the atlas region it lies in, nothing on the background; a pixel outside the image
+  // is a usage error.
+  TEST_CASE("pick_prints_the_point_in_both_systems_and_its_atlas_region") {
+    const auto r = run_strata("pick " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --camera front --size 96 --at 48,40 "
+                              "--at 2,2");
+    REQUIRE(r.exit_code == 0);
+    double l[3] = {}, a[3] = {};
+    char region[64] = {};
+    const size_t at = r.output.find("48,40: LPS ");
+    REQUIRE(at != std::string::npos);
+    REQUIRE(std::sscanf(r.output.c_str() + at,
+                        "48,40: LPS %lf %lf %lf mm, RAS %lf %lf %lf mm, region %63[^\n]", &l[0],
+                        &l[1], &l[2], &a[0], &a[1], &a[2], region) == 7);
+    CHECK(a[0] == doctest::Approx(-l[0]));
+    CHECK(a[1] == doctest::Approx(-l[1]));
+    CHECK(a[2] == doctest::Approx(l[2]));
+    CHECK(l[1] < 0.0);  // (seen from the front: anterior, LPS y negative)
+    CHECK(std::string(region) == "Frontal Sup Medial L");
+    CHECK(r.output.find("2,2: nothing") != std::string::npos);
+    const auto outside =
+        run_strata("pick " STRATA_SOURCE_DIR "/assets/scenes/head.json --size 96 --at 96,3");
+    CHECK(outside.exit_code == 2);
+    CHECK(outside.output.find("--at: 96,3 lies outside the 96x96 image") != std::string::npos);
+  }
+
   TEST_CASE("dump_graph_prints_the_frame_passes_and_barriers") {
     const auto r = run_strata("render " STRATA_SOURCE_DIR
                               "/assets/scenes/head.json --size 48 --dump-graph -o /dev/null");
     CHECK(r.exit_code == 0);
-    CHECK(r.output.find("pass 13 'placement.labels' (compute, placement)") != std::string::npos);
-    CHECK(r.output.find("23 passes, 57 barriers") != std::string::npos);
+    CHECK(r.output.find("pass 15 'placement.labels' (compute, placement)") != std::string::npos);
+    CHECK(r.output.find("25 passes, 59 barriers") != std::string::npos);
   }
 
   // The thesis program's screenshots: one still per named position, named after it.

@@ -133,8 +133,8 @@ TEST_SUITE("gpu") {
       const Scene scene = load_scene(std::string(STRATA_SOURCE_DIR "/assets/scenes/") + file);
       LabelledRenderer renderer(ctx, scene, camera_for(scene, "front"), {64, 64}, {});
       const graph::GraphRunner& runner = renderer.runner();
-      CHECK(runner.graph().passes().size() == 23);  // (with labels.ghost and labels.front_alpha)
-      CHECK(graph::barrier_count(runner.compiled()) == 57);
+      CHECK(runner.graph().passes().size() == 25);  // (with picking, labels.ghost, .front_alpha)
+      CHECK(graph::barrier_count(runner.compiled()) == 59);
       const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
       CHECK(loop.name == "placement.labels");
     }

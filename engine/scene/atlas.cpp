@@ -280,4 +280,28 @@ Mesh atlas_surface(const Volume& labels, const AtlasRegion& region, int smoothin
   return mesh;
 }
 
+std::string atlas_region_at(const SceneAtlas& atlas, glm::vec3 world) {
+  const Volume& v = atlas.labels;
+  const glm::vec4 index = glm::inverse(v.index_to_world()) * glm::vec4(world, 1.0f);
+  const glm::vec3 nearest = glm::round(glm::vec3(index));
+  if (nearest.x < 0.0f || nearest.y < 0.0f || nearest.z < 0.0f || nearest.x >= float(v.dims.x) ||
+      nearest.y >= float(v.dims.y) || nearest.z >= float(v.dims.z)) {
+    return {};
+  }
+  const int region =
+      int(std::lround(v.value(uint32_t(nearest.x), uint32_t(nearest.y), uint32_t(nearest.z))));
+  const auto it = atlas.names.find(region);
+  if (region == 0 || it == atlas.names.end()) return {};
+  std::string name = it->second;
+  std::replace(name.begin(), name.end(), '_', ' ');
+  return name;
+}
+
+std::string atlas_region_at(const Scene& scene, glm::vec3 world) {
+  for (const SceneAtlas& atlas : scene.atlases) {
+    if (std::string name = atlas_region_at(atlas, world); !name.empty()) return name;
+  }
+  return {};
+}
+
 }  // namespace strata

@@ -24,6 +24,12 @@ std::vector<AtlasRegion> load_atlas_names(const std::filesystem::path& path);
 // '_' as ' '; ids are region indices. Regions without voxels are skipped.
 std::vector<Label> atlas_labels(const Volume& labels, const std::vector<AtlasRegion>& regions);
 
+// The region a world point lies in (the label volume's nearest voxel), its name with '_' as ' '
+// ("Thalamus R"); empty outside the volume, on index 0 or an index the names file does not list.
+std::string atlas_region_at(const SceneAtlas& atlas, glm::vec3 world);
+// The first of the scene's atlases that names the point; empty if none does.
+std::string atlas_region_at(const Scene& scene, glm::vec3 world);
+
 // A uint8 volume on the label volume's grid: 255 inside the region, 0 outside.
 Volume atlas_mask(const Volume& labels, const AtlasRegion& region);
 

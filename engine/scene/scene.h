@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -130,6 +131,13 @@ struct SceneSettings {
 inline constexpr float kGhostRadiusMin = 0.005f;
 inline constexpr float kGhostRadiusMax = 0.5f;
 
+// An atlas the scene read: its label volume and every region its names file lists, so that a
+// point can be named by the region it lies in (atlas_region_at in engine/scene/atlas.h).
+struct SceneAtlas {
+  Volume labels;
+  std::map<int, std::string> names;  // region index -> name as in the file ("Thalamus_R")
+};
+
 struct Scene {
   std::filesystem::path source;
   std::vector<Volume> volumes;
@@ -139,6 +147,7 @@ struct Scene {
   Camera camera;
   bool has_camera = false;  // the file gave the camera's view (else complete_scene fits one)
   std::vector<CameraPose> camera_positions;  // named poses ("--camera NAME")
+  std::vector<SceneAtlas> atlases;
   SceneSettings settings;
   std::vector<std::string> warnings;  // e.g. a referenced file that does not exist
   // The strata scene JSON text `source` held when read (empty for other sources): save_scene_json

@@ -131,21 +131,7 @@ vec2 brick_state(uint live, vec3 origin, vec3 direction, float z, float dz) {
   return vec2(exit_z, empty ? 1.0f : 0.0f);
 }
 
-struct Ray {
-  vec3 origin;     // the eye, world space
-  vec3 direction;  // world displacement per unit of eye depth
-};
-
-Ray pixel_ray(vec2 pixel) {
-  vec2 ndc = pixel / vec2(float(frame.width), float(frame.height)) * 2.0f - 1.0f;
-  vec4 far_point = frame.clip_to_view * vec4(ndc, 1.0f, 1.0f);
-  vec3 view_direction = vec3(far_point) / far_point.w;
-  view_direction = view_direction / -view_direction.z;
-  Ray ray;
-  ray.origin = vec3(frame.view_to_world * vec4(0.0f, 0.0f, 0.0f, 1.0f));
-  ray.direction = mat3(frame.view_to_world) * view_direction;
-  return ray;
-}
+Ray pixel_ray(vec2 pixel) { return frame_pixel_ray(frame, pixel); }
 
 float grid_depth(float k, float dz) {
   return frame.near_depth + (k + 0.5f) * dz;

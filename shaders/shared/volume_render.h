@@ -115,6 +115,24 @@ STRATA_INLINE uvec2 resolve_group(uvec2 id, uvec2 groups, uint order) {
   return order == VR_ORDER_ROWS_INTERLEAVED ? uvec2(id.x, resolve_group_row(id.y, groups.y)) : id;
 }
 
+// A pixel's ray: point(z) = origin + direction * z at eye depth z.
+struct Ray {
+  vec3 origin;     // the eye, world space
+  vec3 direction;  // world displacement per unit of eye depth
+};
+
+// The ray through `pixel` (pixel units, centres at +0.5) of frame f.
+STRATA_INLINE Ray frame_pixel_ray(FrameGpu f, vec2 pixel) {
+  vec2 ndc = pixel / vec2(float(f.width), float(f.height)) * 2.0f - 1.0f;
+  vec4 far_point = f.clip_to_view * vec4(ndc, 1.0f, 1.0f);
+  vec3 view_direction = vec3(far_point) / far_point.w;
+  view_direction = view_direction / -view_direction.z;
+  Ray ray;
+  ray.origin = vec3(f.view_to_world * vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  ray.direction = mat3(f.view_to_world) * view_direction;
+  return ray;
+}
+
 // Push constants of one mesh's draw in the HA-Buffer build.
 struct DrawGpu {
   mat4 model;        // model to world

@@ -297,6 +297,13 @@ void SceneReader::atlas(const json& object, const Field& field) {
   const Volume labels = (field / "labels").wrap([&] {
     return load_volume(labels_path, {.limits = limits_}, scene_.warnings);
   });
+  SceneAtlas named{labels, {}};
+  for (const AtlasRegion& r : (field / "names").wrap([&] {
+         return load_atlas_names(resolve(required(object, field, "names"), field / "names"));
+       })) {
+    named.names[r.index] = r.name;
+  }
+  scene_.atlases.push_back(std::move(named));
   // atlas_labels skips regions without voxels, so its result says which regions "limit" counts.
   const std::vector<Label> centroids = atlas_labels(labels, regions);
   int kept = 0;
