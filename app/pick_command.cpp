@@ -7,10 +7,8 @@
 #include <vector>
 
 #include "app/commands.h"
-#include "engine/graph/graph_runner.h"
 #include "engine/scene/atlas.h"
 #include "passes/picking.h"
-#include "passes/volume_renderer.h"
 
 namespace strata::app {
 namespace {
@@ -54,28 +52,12 @@ void pick(DeviceOptions& device, const PickOptions& o) {
   const Camera camera = camera_for(scene, o.camera);
   RenderSettings settings;
   settings.layer_count = o.scene.layer_count(scene);
-  VolumeRenderer renderer(ctx, scene, settings);
-  renderer.set_camera(camera);
-  Picking picking(ctx);
-  picking.set_pixels(pixels);
-  graph::Graph graph;
-  const VolumeRenderer::Outputs out = renderer.add_to(graph);
-  const graph::ResourceId points = picking.add_to(graph, {.frame = out.frame, .depth = out.depth});
-  graph::GraphRunner runner(ctx, std::move(graph));
-  runner.set_viewport(size);
-  renderer.run_until_no_overflow(runner, [](const RenderStats&) {});
-  std::vector<double> gpu_ms;  // the picking passes' time, per run
-  for (uint32_t run = 0; run < o.runs; ++run) {
-    if (run > 0) runner.run_now();
-    double ms = 0.0;
-    for (const graph::PassTiming& t : runner.timings())
-      if (t.group == "picking") ms += t.ms;
-    gpu_ms.push_back(ms);
-  }
+  ScenePick picked = pick_scene(ctx, scene, camera, settings, size, pixels, o.runs);
+  std::vector<double>& gpu_ms = picked.gpu_ms;
   std::sort(gpu_ms.begin(), gpu_ms.end());
   std::fprintf(stderr, "strata: picking %zu pixels took %.4f ms on the GPU (median of %u)\n",
                pixels.size(), gpu_ms[gpu_ms.size() / 2], o.runs);
-  const std::vector<PickHit> hits = picking.hits(runner.download_buffer(points));
+  const std::vector<PickHit>& hits = picked.hits;
   for (size_t i = 0; i < hits.size(); ++i) {
     std::printf("%s: ", o.at[i].c_str());
     if (!hits[i].hit) {

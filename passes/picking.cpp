@@ -6,6 +6,7 @@
 
 #include "engine/core/error.h"
 #include "engine/gpu/resources.h"
+#include "engine/graph/graph_runner.h"
 
 namespace strata {
 
@@ -62,6 +63,31 @@ std::vector<PickHit> Picking::hits(std::span<const std::byte> points) const {
     out.push_back({p.w > 0.5f, glm::vec3(p)});
   }
   return out;
+}
+
+ScenePick pick_scene(Context& ctx, const Scene& scene, const Camera& camera,
+                     const RenderSettings& settings, graph::Extent size,
+                     std::vector<glm::vec2> pixels, uint32_t runs) {
+  VolumeRenderer renderer(ctx, scene, settings);
+  renderer.set_camera(camera);
+  Picking picking(ctx);
+  picking.set_pixels(std::move(pixels));
+  graph::Graph graph;
+  const VolumeRenderer::Outputs out = renderer.add_to(graph);
+  const ResourceId points = picking.add_to(graph, {.frame = out.frame, .depth = out.depth});
+  graph::GraphRunner runner(ctx, std::move(graph));
+  runner.set_viewport(size);
+  renderer.run_until_no_overflow(runner, [](const RenderStats&) {});
+  ScenePick result;
+  for (uint32_t run = 0; run < std::max(runs, 1u); ++run) {
+    if (run > 0) runner.run_now();
+    double ms = 0.0;
+    for (const graph::PassTiming& t : runner.timings())
+      if (t.group == "picking") ms += t.ms;
+    result.gpu_ms.push_back(ms);
+  }
+  result.hits = picking.hits(runner.download_buffer(points));
+  return result;
 }
 
 std::vector<PickHit> pick_reference(const ReferenceImage& image, const gpu::FrameGpu& frame,

@@ -10,6 +10,7 @@
 #include "engine/gpu/shader_library.h"
 #include "engine/graph/render_graph.h"
 #include "passes/volume_render_reference.h"
+#include "passes/volume_renderer.h"
 #include "shared/pick.h"
 
 namespace strata {
@@ -42,6 +43,17 @@ class Picking {
   ComputePipeline pipeline_;
   std::vector<glm::vec2> pixels_;
 };
+
+// The scene rendered at `size` from `camera` (VolumeRenderer with `settings`, the HA-Buffer grown
+// until nothing overflows) with `pixels` picked in the same frame, `runs` times (for timing):
+// the hits, and per run the picking passes' GPU time.
+struct ScenePick {
+  std::vector<PickHit> hits;
+  std::vector<double> gpu_ms;
+};
+ScenePick pick_scene(Context& ctx, const Scene& scene, const Camera& camera,
+                     const RenderSettings& settings, graph::Extent size,
+                     std::vector<glm::vec2> pixels, uint32_t runs = 1);
 
 // Picking on the CPU: the same points from the reference renderer's depth and the frame's data
 // (frame_data for the same camera and size).

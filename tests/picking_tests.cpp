@@ -6,7 +6,6 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "engine/graph/graph_runner.h"
 #include "engine/scene/io/scene_loader.h"
 #include "gpu_fixture.h"
 #include "passes/picking.h"
@@ -25,18 +24,8 @@ struct Picked {
 // reference's picks of the same pixels.
 Picked pick_both(Context& ctx, const Scene& scene, const Camera& camera, graph::Extent size,
                  const std::vector<glm::vec2>& pixels) {
-  VolumeRenderer renderer(ctx, scene, {});
-  renderer.set_camera(camera);
-  Picking picking(ctx);
-  picking.set_pixels(pixels);
-  graph::Graph g;
-  const VolumeRenderer::Outputs out = renderer.add_to(g);
-  const graph::ResourceId points = picking.add_to(g, {.frame = out.frame, .depth = out.depth});
-  graph::GraphRunner runner(ctx, std::move(g));
-  runner.set_viewport(size);
-  runner.run_now();
   Picked r;
-  r.gpu = picking.hits(runner.download_buffer(points));
+  r.gpu = pick_scene(ctx, scene, camera, {}, size, pixels).hits;
   const RenderInputs inputs = prepare_render_inputs(scene, 2048);
   const RenderSettings settings;
   const ReferenceImage image = render_reference(inputs, camera, settings, size);

@@ -187,6 +187,19 @@ void check_placements_across(Context& ctx, const Inputs& in, const ReferencePlac
   }
 }
 
+// The GPU's placement with `settings`, checked against the reference's: integral costs and hidden
+// pixels, their tables, the positions.
+std::vector<gpu::PlacementGpu> place_checked(Context& ctx, const Inputs& in,
+                                             const PlacementSettings& settings) {
+  const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
+  const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
+                                                 in.labels, in.order, settings, in.size);
+  check_values(gpu.costs, cpu.costs, 1e-3f, false, "integral costs and hidden pixels");
+  check_values(gpu.tables, cpu.tables, 1e-5f, true, "tables");
+  check_placements(gpu, cpu);
+  return gpu.placements;
+}
+
 // The placements as a layout, for strata eval's counts.
 FrameMetrics metrics_of(const Inputs& in, const std::vector<gpu::PlacementGpu>& placements) {
   Layout layout{.source = "placement", .width = in.size.width, .height = in.size.height};
@@ -355,13 +368,7 @@ TEST_SUITE("gpu") {
       settings.weights.illegible = illegible;
       settings.hard = hard;
       settings.write_constraints = true;
-      const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
-      const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
-                                                     in.labels, in.order, settings, in.size);
-      check_values(gpu.costs, cpu.costs, 1e-3f, false, "integral costs and hidden pixels");
-      check_values(gpu.tables, cpu.tables, 1e-5f, true, "tables");
-      check_placements(gpu, cpu);
-      return gpu.placements;
+      return place_checked(ctx, in, settings);
     };
     const Inputs in = slab_scene(64.0f);
     // (unaware: the rear label on the slab, next to its anchor)
@@ -411,13 +418,7 @@ TEST_SUITE("gpu") {
       settings.hard = true;
       settings.ghost_strength = strength;
       settings.ghost_radius = 30.0f;
-      const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
-      const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
-                                                     in.labels, in.order, settings, in.size);
-      check_values(gpu.costs, cpu.costs, 1e-3f, false, "integral costs and hidden pixels");
-      check_values(gpu.tables, cpu.tables, 1e-5f, true, "tables");
-      check_placements(gpu, cpu);
-      return gpu.placements;
+      return place_checked(ctx, in, settings);
     };
     CHECK(place(0.0f)[0].shown == PLACEMENT_HIDDEN);
     CHECK(place(0.3f)[0].shown == PLACEMENT_HIDDEN);
