@@ -222,6 +222,27 @@ void Script::run(Viewer& viewer, const ScriptCommand& c) {
       write_text_file(c.word, report.dump() + "\n");
       break;
     }
+    case ScriptOp::place:
+      viewer.place_label({float(n[0]), float(n[1])});
+      break;
+    case ScriptOp::move:
+      viewer.move_label(int(n[0]), {float(n[1]), float(n[2])});
+      break;
+    case ScriptOp::text:
+      viewer.set_label_text(int(n[0]), c.value);
+      break;
+    case ScriptOp::delete_label:
+      viewer.delete_label(int(n[0]));
+      break;
+    case ScriptOp::undo:
+      if (!viewer.undo_labels()) throw Error("nothing to undo");
+      break;
+    case ScriptOp::redo:
+      if (!viewer.redo_labels()) throw Error("nothing to redo");
+      break;
+    case ScriptOp::save_labels:
+      viewer.save_labels(c.word, c.value == "ras" ? LabelAxes::ras : LabelAxes::lps);
+      break;
     case ScriptOp::quit:
       viewer.request_quit();
       break;

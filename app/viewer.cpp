@@ -14,8 +14,10 @@
 #include "engine/core/text_file.h"
 #include "engine/gpu/context.h"
 #include "engine/gpu/vulkan_check.h"
+#include "engine/scene/atlas.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/transfer_function_presets.h"
+#include "engine/scene/value_limits.h"
 #include "labeling/camera_path.h"
 #include "labeling/insertion_order.h"
 
@@ -318,6 +320,16 @@ void Viewer::extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds&
 // --- input -------------------------------------------------------------------------------------
 
 void Viewer::mouse_button(int button, int action, int mods) {
+  if (place_mode_ && button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT)) {
+    if (action != GLFW_PRESS) return;
+    try {
+      place_label(mouse_);
+    } catch (const Error& e) {
+      message_ = e.what();
+      ui_event();
+    }
+    return;
+  }
   if (action == GLFW_PRESS && drag_button_ < 0) {
     drag_button_ = button;
     drag_pan_ = button == GLFW_MOUSE_BUTTON_MIDDLE ||
@@ -347,8 +359,16 @@ void Viewer::scroll(double ticks) {
 }
 
 void Viewer::key(int key, int mods) {
-  (void)mods;
+  if (mods & GLFW_MOD_CONTROL) {
+    if (key == GLFW_KEY_Z && !(mods & GLFW_MOD_SHIFT)) undo_labels();
+    if (key == GLFW_KEY_Y || (key == GLFW_KEY_Z && (mods & GLFW_MOD_SHIFT))) redo_labels();
+    if (key == GLFW_KEY_S) save_labels(default_labels_path());
+    return;
+  }
   switch (key) {
+    case GLFW_KEY_P:
+      set_place_mode(!place_mode_);
+      break;
     case GLFW_KEY_Q:
     case GLFW_KEY_ESCAPE:
       quit_ = true;
@@ -472,6 +492,130 @@ void Viewer::set_label_hidden(int id, bool hidden) {
     return;
   }
   throw Error("the scene has no label " + std::to_string(id));
+}
+
+// --- labels of one's own -------------------------------------------------------------------------
+
+std::optional<glm::vec3> Viewer::pick(glm::vec2 at) {
+  const graph::Extent e = labelled_->size();
+  if (!(at.x >= 0.0f && at.y >= 0.0f && at.x < float(e.width) && at.y < float(e.height))) {
+    throw Error("pixel " + value_limits::shown(at.x) + "," + value_limits::shown(at.y) +
+                " lies outside the " + std::to_string(e.width) + "x" + std::to_string(e.height) +
+                " picture");
+  }
+  labelled_->set_picks({at});
+  frame();
+  output_.wait_idle();
+  const std::vector<PickHit> hits = labelled_->picked();
+  labelled_->set_picks({});
+  if (hits.empty() || !hits[0].hit) return std::nullopt;
+  return hits[0].point;
+}
+
+size_t Viewer::label_index(int id) const {
+  for (size_t i = 0; i < scene_.labels.size(); ++i)
+    if (scene_.labels[i].id == id) return i;
+  throw Error("the scene has no label " + std::to_string(id));
+}
+
+void Viewer::edit_labels(const std::function<void(std::vector<Label>&)>& edit) {
+  std::vector<Label> before = scene_.labels;
+  edit(scene_.labels);
+  undo_.push_back(std::move(before));
+  redo_.clear();
+  labelled_->labels_changed();
+  beside_counted_ = 0;  // (a new placement beside the frames)
+  moving_labels_.clear();
+  if (picked_label_ >= int(scene_.labels.size())) picked_label_ = -1;
+  changed();
+  ui_event();
+}
+
+int Viewer::place_label(glm::vec2 at) {
+  const std::optional<glm::vec3> point = pick(at);
+  if (!point) throw Error("nothing under the pixel to place a label on (background)");
+  Label label;
+  label.id = int(next_label_id(scene_));
+  label.anchor = *point;
+  label.text = atlas_region_at(scene_, *point);
+  if (label.text.empty()) label.text = "Label " + std::to_string(label.id);
+  edit_labels([&](std::vector<Label>& labels) { labels.push_back(label); });
+  picked_label_ = int(scene_.labels.size()) - 1;  // (selected: its text ready to edit)
+  std::snprintf(edit_text_, sizeof edit_text_, "%s", label.text.c_str());
+  message_ = "placed '" + label.text + "' (label " + std::to_string(label.id) + ")";
+  std::printf("view: %s\n", message_.c_str());
+  std::fflush(stdout);
+  return label.id;
+}
+
+void Viewer::set_label_text(int id, const std::string& text) {
+  const size_t i = label_index(id);
+  if (text.empty()) throw Error("a label's text cannot be empty");
+  edit_labels([&](std::vector<Label>& labels) { labels[i].text = text; });
+}
+
+void Viewer::move_label(int id, glm::vec2 at) {
+  const size_t i = label_index(id);
+  const std::optional<glm::vec3> point = pick(at);
+  if (!point) throw Error("nothing under the pixel to move label " + std::to_string(id) + " to");
+  edit_labels([&](std::vector<Label>& labels) { labels[i].anchor = *point; });
+}
+
+void Viewer::delete_label(int id) {
+  const size_t i = label_index(id);
+  edit_labels([&](std::vector<Label>& labels) { labels.erase(labels.begin() + ptrdiff_t(i)); });
+}
+
+bool Viewer::undo_labels() {
+  if (undo_.empty()) return false;
+  redo_.push_back(scene_.labels);
+  scene_.labels = std::move(undo_.back());
+  undo_.pop_back();
+  if (picked_label_ >= int(scene_.labels.size())) picked_label_ = -1;
+  labelled_->labels_changed();
+  beside_counted_ = 0;  // (a new placement beside the frames)
+  changed();
+  return true;
+}
+
+bool Viewer::redo_labels() {
+  if (redo_.empty()) return false;
+  undo_.push_back(scene_.labels);
+  scene_.labels = std::move(redo_.back());
+  redo_.pop_back();
+  if (picked_label_ >= int(scene_.labels.size())) picked_label_ = -1;
+  labelled_->labels_changed();
+  beside_counted_ = 0;  // (a new placement beside the frames)
+  changed();
+  return true;
+}
+
+void Viewer::save_labels(const std::filesystem::path& path, LabelAxes axes) {
+  write_label_file(path, scene_.labels, axes);
+  message_ = "wrote " + std::to_string(scene_.labels.size()) + " labels to " + path.string() +
+             (axes == LabelAxes::lps ? " (LPS)" : " (RAS)");
+  std::printf("view: %s\n", message_.c_str());
+  std::fflush(stdout);
+  ui_event();
+}
+
+std::filesystem::path Viewer::default_labels_path() const {
+  std::filesystem::path path = options_.scene_path;
+  std::string stem = path.filename().string();
+  for (const char* extension : {".json", ".nii.gz", ".nii", ".nrrd", ".mhd", ".mha", ".xml"}) {
+    const std::string e = extension;
+    if (stem.size() > e.size() && stem.compare(stem.size() - e.size(), e.size(), e) == 0) {
+      stem.resize(stem.size() - e.size());
+      break;
+    }
+  }
+  return path.replace_filename(stem + "-labels.mrk.json");
+}
+
+void Viewer::set_place_mode(bool on) {
+  place_mode_ = on;
+  message_ = on ? "place mode: a click places a label (P: off)" : "place mode off";
+  ui_event();
 }
 
 namespace {
@@ -833,8 +977,9 @@ void Viewer::choose_divisor(bool moving) {
 // The placements beside the frames taken up since the last frame: their GPU time and latency.
 void Viewer::count_placements() {
   const PlacementBeside* beside = labelled_->beside();
-  if (!beside || beside->stats().adopted == summary_.placements) return;
-  summary_.placements = beside->stats().adopted;
+  if (!beside || beside->stats().adopted == beside_counted_) return;
+  summary_.placements += beside->stats().adopted - beside_counted_;
+  beside_counted_ = beside->stats().adopted;
   summary_.placement_latency_frames.push_back(beside->stats().latency_frames.back());
   const auto& timings = beside->placement_timings();
   if (!timings.empty())

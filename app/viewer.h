@@ -22,6 +22,7 @@
 #include "engine/core/video_file.h"
 #include "engine/graph/frame_slots.h"
 #include "engine/graph/window_target.h"
+#include "engine/scene/io/label_file_writer.h"
 #include "labeling/camera_control.h"
 #include "labeling/labelled_render.h"
 #include "passes/debug_view.h"
@@ -190,6 +191,24 @@ class Viewer {
   void set_flag(const std::string& name, bool value);
   void set_label_hidden(int id, bool hidden);
   void save_position(const std::string& name);
+
+  // Labels of one's own (docs/viewer.md, "Your own labels"): anchored where the volume rendering
+  // first becomes opaque under a pixel (picking, passes/picking.h), edited, undone, saved as 3D
+  // Slicer markups. place_label: a new label at the point under `at` (framebuffer pixels), named
+  // after the atlas region there, else "Label ID"; returns its id. An Error where the ray meets
+  // only background (move_label too) or no label has the id.
+  int place_label(glm::vec2 at);
+  void set_label_text(int id, const std::string& text);
+  void move_label(int id, glm::vec2 at);  // its anchor to the point under `at`
+  void delete_label(int id);
+  // Every edit above, undone and redone; false when there is nothing to.
+  bool undo_labels();
+  bool redo_labels();
+  // The scene's labels as .mrk.json or .fcsv (by extension), LPS or RAS.
+  void save_labels(const std::filesystem::path& path, LabelAxes axes = LabelAxes::lps);
+  // Place mode (key P, the panel): a left click places a label instead of turning the view.
+  bool place_mode() const { return place_mode_; }
+  void set_place_mode(bool on);
   // The current camera (input scripts, tests), and a jump to another (benchmark paths).
   const Camera& camera() const { return control_.camera(); }
   void set_camera(const Camera& camera) { control_.set_camera(camera); }
@@ -215,6 +234,11 @@ class Viewer {
   };
   void changed();
   void apply_camera();
+  std::optional<glm::vec3> pick(glm::vec2 at);
+  size_t label_index(int id) const;
+  // A label edit: the labels before it kept for undo, the scene's labels changed by `edit`, the
+  // renderer made again for them.
+  void edit_labels(const std::function<void(std::vector<Label>&)>& edit);
   graph::GraphRunner& prepare(uint32_t slot, graph::Extent extent, double seconds);
   void read_slot(uint32_t slot);
   int next_trial();
@@ -271,6 +295,7 @@ class Viewer {
   std::vector<SlotFrame> slots_;
   uint32_t last_slot_ = 0;
   void count_placements();
+  uint64_t beside_counted_ = 0;  // placements of the current PlacementBeside in the summary
   // Interactive rendering: whether the camera moves now, and the divisor for this frame.
   bool camera_moving() const;
   void choose_divisor(bool moving);
@@ -297,11 +322,17 @@ class Viewer {
   char label_filter_[64] = "";
   char position_name_[64] = "";
   std::string message_;
-  int picked_label_ = 0;
+  int picked_label_ = -1;    // the label selected in the panel (its index), -1: none
   int insertion_order_ = 0;  // 0 scene, 1 Apollonius (on rest)
   uint64_t apollonius_serial_ = 0;
   std::deque<float> frame_times_, gpu_times_;
   std::vector<graph::PassTiming> last_timings_;
+
+  // Labels of one's own.
+  bool place_mode_ = false;
+  char edit_text_[256] = "";                          // the panel's text of the selected label
+  std::filesystem::path default_labels_path() const;  // Ctrl+S: SCENE-labels.mrk.json beside it
+  std::vector<std::vector<Label>> undo_, redo_;       // the scene's labels before each edit
 
   // Output.
   std::unique_ptr<VideoFile> video_;

@@ -1,6 +1,7 @@
 // The viewer's Dear ImGui panel: every parameter of the labelling, the forces and the rendering,
 // live; the labels; the camera's positions; timings and statistics; debug views.
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <numeric>
 
@@ -194,7 +195,10 @@ void Viewer::panel_labels() {
       bool shown = !labelled_->label_hidden(i);
       if (ImGui::Checkbox("##shown", &shown)) set_label_hidden(l.id, !shown);
       ImGui::SameLine();
-      if (ImGui::Selectable(l.text.c_str(), picked_label_ == int(i))) picked_label_ = int(i);
+      if (ImGui::Selectable(l.text.c_str(), picked_label_ == int(i))) {
+        picked_label_ = int(i);
+        std::snprintf(edit_text_, sizeof edit_text_, "%s", l.text.c_str());
+      }
       ImGui::PopID();
     }
   }
@@ -202,6 +206,31 @@ void Viewer::panel_labels() {
   if (ImGui::Button("Show all")) {
     for (const Label& l : scene_.labels) set_label_hidden(l.id, false);
   }
+  // Labels of one's own: place mode, the selected label's text, delete, undo, redo, save.
+  bool placing = place_mode_;
+  if (ImGui::Checkbox("Place labels (P)", &placing)) set_place_mode(placing);
+  if (picked_label_ >= 0 && size_t(picked_label_) < scene_.labels.size()) {
+    const int id = scene_.labels[size_t(picked_label_)].id;
+    if (ImGui::InputText("text", edit_text_, sizeof edit_text_,
+                         ImGuiInputTextFlags_EnterReturnsTrue) &&
+        edit_text_[0] != '\0') {
+      set_label_text(id, edit_text_);
+    }
+    if (ImGui::Button("Delete")) {
+      delete_label(id);
+      picked_label_ = -1;
+    }
+    ImGui::SameLine();
+  }
+  ImGui::BeginDisabled(undo_.empty());
+  if (ImGui::Button("Undo")) undo_labels();
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  ImGui::BeginDisabled(redo_.empty());
+  if (ImGui::Button("Redo")) redo_labels();
+  ImGui::EndDisabled();
+  ImGui::SameLine();
+  if (ImGui::Button("Save labels (Ctrl+S)")) save_labels(default_labels_path());
 }
 
 void Viewer::panel_rendering() {
@@ -279,10 +308,11 @@ void Viewer::panel_debug() {
   }
   ImGui::SliderFloat("scale", &debug_choice_->scale, 1e-3f, 100.0f, "%.3g",
                      ImGuiSliderFlags_Logarithmic);
-  debug_choice_->label = uint32_t(std::max(0, picked_label_));
+  const size_t picked =
+      std::min(size_t(std::max(0, picked_label_)), std::max<size_t>(scene_.labels.size(), 1) - 1);
+  debug_choice_->label = uint32_t(picked);
   if (!scene_.labels.empty()) {
-    ImGui::Text("picked label: %s (Labels list)",
-                scene_.labels[size_t(std::max(0, picked_label_))].text.c_str());
+    ImGui::Text("picked label: %s (Labels list)", scene_.labels[picked].text.c_str());
   }
 }
 

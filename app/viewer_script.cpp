@@ -138,15 +138,82 @@ ScriptCommand command(const std::vector<std::string>& w) {
     need(2, "save-position NAME");
     out.op = ScriptOp::save_position;
     out.word = w[1];
+  } else if (c == "place") {
+    need(3, "place X Y");
+    out.op = ScriptOp::place;
+    out.numbers = {number(w[1], 0.0, kScriptMaxCoordinate),
+                   number(w[2], 0.0, kScriptMaxCoordinate)};
+  } else if (c == "move") {
+    need(4, "move LABEL_ID X Y");
+    out.op = ScriptOp::move;
+    out.numbers = {number(w[1], 0.0, kScriptMaxLabelId, true),
+                   number(w[2], 0.0, kScriptMaxCoordinate),
+                   number(w[3], 0.0, kScriptMaxCoordinate)};
+  } else if (c == "text") {
+    need(3, "text LABEL_ID \"TEXT\"");
+    out.op = ScriptOp::text;
+    out.numbers = {number(w[1], 0.0, kScriptMaxLabelId, true)};
+    out.value = w[2];
+    if (out.value.empty()) throw Error("'text' needs a text that is not empty");
+  } else if (c == "delete") {
+    need(2, "delete LABEL_ID");
+    out.op = ScriptOp::delete_label;
+    out.numbers = {number(w[1], 0.0, kScriptMaxLabelId, true)};
+  } else if (c == "undo" || c == "redo") {
+    need(1, c == "undo" ? "undo" : "redo");
+    out.op = c == "undo" ? ScriptOp::undo : ScriptOp::redo;
+  } else if (c == "save") {
+    if (w.size() != 2 && !(w.size() == 3 && (w[2] == "lps" || w[2] == "ras")))
+      throw Error("'save' takes the form: save FILE.mrk.json|FILE.fcsv [lps|ras]");
+    out.op = ScriptOp::save_labels;
+    out.word = w[1];
+    out.value = w.size() == 3 ? w[2] : "lps";
   } else if (c == "quit") {
     need(1, "quit");
     out.op = ScriptOp::quit;
   } else {
     throw Error("no command '" + c +
                 "' (drag, scroll, key, view, preset, set, hide, show, screenshot, capture, layout, "
-                "record, frames, sleep, settle-limit, save-position, report, quit)");
+                "record, frames, sleep, settle-limit, save-position, report, place, move, text, "
+                "delete, undo, redo, save, quit)");
   }
   return out;
+}
+
+// A line's words: split at spaces and tabs, up to a '#' (a comment); "a quoted text" is one word
+// (spaces and '#' kept; \" is a quote, \\ a backslash).
+std::vector<std::string> script_words(const std::string& line) {
+  std::vector<std::string> words;
+  std::string word;
+  bool in_word = false, quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '\\' && i + 1 < line.size() && (line[i + 1] == '"' || line[i + 1] == '\\')) {
+        word += line[++i];
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        word += c;
+      }
+    } else if (c == '#') {
+      break;
+    } else if (c == ' ' || c == '\t' || c == '\r') {
+      if (in_word) words.push_back(std::move(word));
+      word.clear();
+      in_word = false;
+    } else {
+      in_word = true;
+      if (c == '"') {
+        quoted = true;
+      } else {
+        word += c;
+      }
+    }
+  }
+  if (quoted) throw Error("a quoted text has no closing '\"'");
+  if (in_word) words.push_back(std::move(word));
+  return words;
 }
 
 }  // namespace
@@ -156,12 +223,9 @@ std::vector<ScriptCommand> parse_viewer_script(const std::string& text, const st
   std::vector<ScriptCommand> commands;
   std::string line;
   for (size_t n = 1; std::getline(in, line); ++n) {
-    if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    std::istringstream words(line);
-    std::vector<std::string> w;
-    for (std::string word; words >> word;) w.push_back(word);
-    if (w.empty()) continue;
     try {
+      const std::vector<std::string> w = script_words(line);
+      if (w.empty()) continue;
       commands.push_back(command(w));
     } catch (const Error& e) {
       throw Error(file + ":" + std::to_string(n) + ": " + e.what());

@@ -38,6 +38,13 @@ enum class ScriptOp {
   save_position,
   settle_limit,
   report,
+  place,
+  move,
+  text,
+  delete_label,
+  undo,
+  redo,
+  save_labels,
   quit
 };
 
@@ -48,7 +55,7 @@ struct ScriptCommand {
   size_t line = 0;  // in the file, from 1
   ScriptOp op = ScriptOp::quit;
   std::string word;   // drag: the button; key, view, preset: the name; set: the parameter; files
-  std::string value;  // set: the value as written
+  std::string value;  // set: the value as written; text: the text; save: lps or ras
   std::vector<double> numbers;  // drag: x0 y0 x1 y1; scroll, hide, show, frames, sleep, preset
   bool shift = false;           // drag ... shift
 };

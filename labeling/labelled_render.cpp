@@ -62,6 +62,16 @@ struct LabelledRenderer::Parts {
         forces(ctx, label_count),
         picking(ctx),
         target(ctx) {}
+  // (the scene's labels changed: a placement, forces and drawing for them around the volumes
+  // already uploaded)
+  Parts(Context& ctx, VolumeRenderer&& uploaded, const LabellingSettings& settings,
+        uint32_t label_count)
+      : renderer(std::move(uploaded)),
+        placement(ctx, label_count, settings.placement_layout,
+                  Placement::create_pipelines(ctx, label_count)),
+        forces(ctx, label_count),
+        picking(ctx),
+        target(ctx) {}
   VolumeRenderer renderer;
   Placement placement;
   LabelForces forces;
@@ -75,16 +85,50 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
                                    graph::Extent size, const LabellingSettings& settings)
     : ctx_(ctx), scene_(scene), size_(size), camera_(camera), settings_(settings) {
   check_label_text(settings.font_pixels, settings.label_scale);
-  labels_.resize(scene.labels.size());
-  for (const Label& label : scene.labels) priorities_.push_back(label.priority);
-  hidden_.assign(scene.labels.size(), false);
-  for (size_t i = 0; i < scene.labels.size(); ++i) labels_[i].size = scene.labels[i].size;
+  take_scene_labels();
   project_and_layer(camera);
   parts_ = std::make_unique<Parts>(ctx, scene, settings, uint32_t(labels_.size()));
   parts_->renderer.set_camera(camera);
   build_labels();
   set_order(scene_order(uint32_t(labels_.size())));
   build_graph();
+}
+
+// The scene's labels as the next frames see them: sizes and priorities; a label keeps being
+// hidden by hand while its id is in the scene.
+void LabelledRenderer::take_scene_labels() {
+  std::vector<int> hidden_ids;
+  for (size_t i = 0; i < hidden_.size() && i < label_ids_.size(); ++i)
+    if (hidden_[i]) hidden_ids.push_back(label_ids_[i]);
+  labels_.assign(scene_.labels.size(), gpu::LabelGpu{});
+  priorities_.clear();
+  label_ids_.clear();
+  hidden_.clear();
+  for (size_t i = 0; i < scene_.labels.size(); ++i) {
+    const Label& label = scene_.labels[i];
+    labels_[i].size = label.size;
+    priorities_.push_back(label.priority);
+    label_ids_.push_back(label.id);
+    hidden_.push_back(std::find(hidden_ids.begin(), hidden_ids.end(), label.id) !=
+                      hidden_ids.end());
+  }
+}
+
+void LabelledRenderer::labels_changed() {
+  ctx_.wait_idle("the scene's labels changed");
+  const bool beside = beside_ != nullptr;
+  runner_.reset();
+  beside_.reset();
+  take_scene_labels();
+  parts_ = std::make_unique<Parts>(ctx_, std::move(parts_->renderer), settings_,
+                                   uint32_t(labels_.size()));
+  parts_->renderer.set_camera(camera_);
+  project_and_layer(camera_);
+  build_labels();
+  set_order(scene_order(uint32_t(labels_.size())));
+  build_graph();
+  if (frames_in_flight_ > 1) set_frames_in_flight(frames_in_flight_);
+  if (beside) set_placement_beside(true);
 }
 
 void check_label_text(float font_pixels, float label_scale) {

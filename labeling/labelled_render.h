@@ -210,6 +210,10 @@ class LabelledRenderer {
   // with the next set_camera(); the renderer's own settings through renderer().
   LabellingSettings& settings() { return settings_; }
   VolumeRenderer& renderer();
+  // The scene's labels changed (added, removed, moved or given new text: the viewer's own
+  // labels): the placement, forces and drawing are made again for them, the volumes stay
+  // uploaded; every label starts on its new placement. Waits for the frames in flight.
+  void labels_changed();
   // Hides label `index` (of the scene's labels) from the layering, placement and drawing (the
   // anchors are layered again, as by set_camera).
   void set_label_hidden(size_t index, bool hidden);
@@ -286,6 +290,8 @@ class LabelledRenderer {
   Extension extension_;
   uint32_t frames_in_flight_ = 1;
   std::vector<bool> hidden_;
+  std::vector<int> label_ids_;  // the scene's label ids when its labels were last taken
+  void take_scene_labels();
   std::vector<float> priorities_;  // the scene's, per label
   Camera camera_;
   graph::ResourceId labelled_id_ = 0;

@@ -81,6 +81,35 @@ TEST_SUITE("cpu") {
     CHECK(commands[5].op == app::ScriptOp::quit);
   }
 
+  // The label commands: place, move, text (one quoted word with spaces, '#', escaped quotes and
+  // UTF-8), delete, undo, redo, save FILE [lps|ras]; their bad forms are errors with FILE:LINE.
+  TEST_CASE("viewer_script_parser_reads_the_label_commands_and_quoted_text") {
+    const auto c = parse_viewer_script(
+        "place 80 40\nmove 101 90.5 45\ntext 101 \"Thalamus R – Ödem # \\\"rechts\\\"\" # a "
+        "comment\ndelete 103\nundo\nredo\nsave a.mrk.json ras\nsave b.fcsv\n",
+        "demo.txt");
+    REQUIRE(c.size() == 8);
+    CHECK(c[0].op == app::ScriptOp::place);
+    CHECK(c[0].numbers == std::vector<double>{80.0, 40.0});
+    CHECK(c[1].op == app::ScriptOp::move);
+    CHECK(c[1].numbers == std::vector<double>{101.0, 90.5, 45.0});
+    CHECK(c[2].op == app::ScriptOp::text);
+    CHECK(c[2].value == "Thalamus R – Ödem # \"rechts\"");
+    CHECK(c[3].op == app::ScriptOp::delete_label);
+    CHECK(c[4].op == app::ScriptOp::undo);
+    CHECK(c[5].op == app::ScriptOp::redo);
+    CHECK(c[6].op == app::ScriptOp::save_labels);
+    CHECK(c[6].word == "a.mrk.json");
+    CHECK(c[6].value == "ras");
+    CHECK(c[7].value == "lps");
+    CHECK(parse_error("text 3 \"open").find("demo.txt:2: a quoted text has no closing") == 0);
+    CHECK(parse_error("text 3 \"\"").find("demo.txt:2: 'text' needs a text") == 0);
+    CHECK(parse_error("text 3 two words").find("demo.txt:2: 'text' takes the form") == 0);
+    CHECK(parse_error("place -1 4").find("demo.txt:2: '-1' is not a number") == 0);
+    CHECK(parse_error("delete 1.5").find("demo.txt:2: '1.5' is not a whole number") == 0);
+    CHECK(parse_error("save a.mrk.json xyz").find("demo.txt:2: 'save' takes the form") == 0);
+  }
+
   TEST_CASE("viewer_script_parser_refuses_unknown_names_before_anything_runs") {
     CHECK(parse_error("key ctrl").find("demo.txt:2: no key 'ctrl'") == 0);
     CHECK(parse_error("drag wheel 0 0 1 1").find("demo.txt:2: no mouse button 'wheel'") == 0);

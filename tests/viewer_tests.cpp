@@ -12,6 +12,9 @@
 #include <nlohmann/json.hpp>
 
 #include "engine/core/png.h"
+#include "engine/scene/camera.h"
+#include "engine/scene/io/label_file_loader.h"
+#include "engine/scene/io/scene_loader.h"
 #include "gpu_fixture.h"
 #include "test_files.h"
 
@@ -112,6 +115,70 @@ test::CommandResult view(const std::filesystem::path& dir, const std::string& sc
 }  // namespace
 
 TEST_SUITE("window") {
+  // Labels of one's own (issue 36's session): five labels placed on head.json from two views, one
+  // renamed in non-ASCII text, one moved, one deleted and the deletion undone, saved as .mrk.json
+  // in RAS and as .fcsv in LPS. Both files hold the scene's 11 labels and the 5 new ones with the
+  // same points (within 0.01 mm); each new anchor lies on the ray of the pixel it was placed or
+  // moved at (the camera from `report`); `strata render --labels` shows them.
+  TEST_CASE("viewer_places_renames_moves_deletes_undoes_and_saves_labels") {
+    const auto dir = test::fresh_folder("viewer", "own-labels");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto r = view(dir, "view anterior\nplace 80 40\nplace 66 70\nreport " + d("front.json") +
+                                 "\nview left\nplace 80 60\nplace 60 50\nplace 100 70\n"
+                                 "text 101 \"Thalamus R – Ödem \\\"rechts\\\"\"\nmove 102 90 45\n"
+                                 "delete 103\nundo\nreport " +
+                                 d("left.json") + "\nsave " + d("own.mrk.json") + " ras\nsave " +
+                                 d("own.fcsv") + " lps\nquit\n");
+    REQUIRE_MESSAGE(r.exit_code == 0, r.output);
+    const std::vector<Label> ras = load_label_file(d("own.mrk.json"));
+    const std::vector<Label> lps = load_label_file(d("own.fcsv"));
+    REQUIRE(ras.size() == 16);
+    REQUIRE(lps.size() == 16);
+    for (size_t i = 0; i < ras.size(); ++i) {
+      CAPTURE(i);
+      CHECK(ras[i].text == lps[i].text);
+      CHECK(glm::distance(ras[i].anchor, lps[i].anchor) <= 0.01f);
+    }
+    CHECK(ras[11].text == "Thalamus R – Ödem \"rechts\"");
+    // (each placed or moved anchor projects to the centre of its pixel in its view's camera)
+    const Scene scene = load_scene(kScene);
+    const auto camera_of = [&](const char* report) {
+      const auto json = nlohmann::json::parse(test::read_file(dir / report));
+      Camera camera = scene.camera;
+      for (int col = 0; col < 4; ++col)
+        for (int row = 0; row < 4; ++row) camera.view[col][row] = json.at("view")[col * 4 + row];
+      return camera;
+    };
+    const Camera front = camera_of("front.json"), left = camera_of("left.json");
+    const struct {
+      size_t index;
+      const Camera* camera;
+      glm::vec2 pixel;
+    } placed[] = {{11, &front, {80, 40}},
+                  {12, &left, {90, 45}},
+                  {13, &left, {80, 60}},
+                  {14, &left, {60, 50}},
+                  {15, &left, {100, 70}}};
+    for (const auto& p : placed) {
+      CAPTURE(p.index);
+      const ProjectedPoint at = project(*p.camera, ras[p.index].anchor, {kWidth, kHeight});
+      CHECK(at.visible);
+      CHECK(glm::distance(at.pixel, p.pixel + 0.5f) <= 0.05f);
+    }
+    const auto rendered =
+        run_strata("render " + kScene + " --labels " + d("own.mrk.json") + " --size 256 --layout " +
+                   d("render.json") + " -o " + d("render.png"));
+    REQUIRE_MESSAGE(rendered.exit_code == 0, rendered.output);
+    const auto layout = nlohmann::json::parse(test::read_file(dir / "render.json"));
+    for (size_t i = 11; i < ras.size(); ++i) {
+      CAPTURE(ras[i].text);
+      bool drawn = false;
+      for (const auto& l : layout.at("labels"))
+        drawn = drawn || (l.at("text") == ras[i].text && l.at("placed").get<bool>());
+      CHECK(drawn);
+    }
+  }
+
   TEST_CASE("viewer_script_rotates_zooms_pans_jumps_reweights_and_hides") {
     const auto dir = test::fresh_folder("viewer", "script");
     const auto d = [&](const char* name) { return (dir / name).string(); };
