@@ -320,17 +320,39 @@ void Viewer::extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds&
 // --- input -------------------------------------------------------------------------------------
 
 void Viewer::mouse_button(int button, int action, int mods) {
-  if (place_mode_ && button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT)) {
-    if (action != GLFW_PRESS) return;
-    try {
-      place_label(mouse_);
-    } catch (const Error& e) {
-      message_ = e.what();
-      ui_event();
+  const bool left = button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT);
+  try {
+    // Place mode: a press on an anchor drags it (to the point under the release), elsewhere a
+    // press places a label.
+    if (place_mode_ && left && action == GLFW_PRESS && drag_button_ < 0) {
+      anchor_drag_ = label_near(mouse_, true);
+      anchor_drag_from_ = mouse_;
+      if (!anchor_drag_) place_label(mouse_);
+      return;
     }
+    if (left && action == GLFW_RELEASE && anchor_drag_) {
+      const size_t i = *anchor_drag_;
+      anchor_drag_.reset();
+      if (glm::distance(mouse_, anchor_drag_from_) > 2.0f) move_label(scene_.labels[i].id, mouse_);
+      select_label(i);
+      return;
+    }
+    if (place_mode_ && left) return;
+    // Otherwise the camera; a click (no movement) on a label's box or anchor selects it.
+    if (left && action == GLFW_RELEASE && button == drag_button_ &&
+        glm::distance(mouse_, press_at_) <= 2.0f) {
+      std::optional<size_t> i = label_near(mouse_, false);
+      if (!i) i = label_near(mouse_, true);
+      if (i) select_label(*i);
+    }
+  } catch (const Error& e) {
+    message_ = e.what();
+    ui_event();
+    anchor_drag_.reset();
     return;
   }
   if (action == GLFW_PRESS && drag_button_ < 0) {
+    press_at_ = mouse_;
     drag_button_ = button;
     drag_pan_ = button == GLFW_MOUSE_BUTTON_MIDDLE ||
                 (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_SHIFT));
@@ -610,6 +632,39 @@ std::filesystem::path Viewer::default_labels_path() const {
     }
   }
   return path.replace_filename(stem + "-labels.mrk.json");
+}
+
+// The label whose anchor (an enabled label's, within 6 pixels; the nearest) or drawn box (as the
+// last frame read back drew it) holds `at`.
+std::optional<size_t> Viewer::label_near(glm::vec2 at, bool anchor) const {
+  const std::vector<gpu::LabelGpu>& labels = labelled_->labels();
+  const std::span<const gpu::PlacementGpu> drawn = labelled_->drawn();
+  std::optional<size_t> found;
+  float nearest = 6.0f;
+  for (size_t i = 0; i < labels.size(); ++i) {
+    if ((labels[i].flags & LABEL_ENABLED) == 0u) continue;
+    if (anchor) {
+      const float d = glm::distance(at, labels[i].anchor);
+      if (d <= nearest) {
+        nearest = d;
+        found = i;
+      }
+    } else if (i < drawn.size() && drawn[i].shown == PLACEMENT_SHOWN && drawn[i].opacity > 0.0f &&
+               glm::all(
+                   glm::lessThanEqual(glm::abs(at - drawn[i].position), 0.5f * labels[i].size))) {
+      found = i;
+    }
+  }
+  return found;
+}
+
+void Viewer::select_label(size_t index) {
+  if (index >= scene_.labels.size()) return;
+  picked_label_ = int(index);
+  std::snprintf(edit_text_, sizeof edit_text_, "%s", scene_.labels[index].text.c_str());
+  message_ = "selected '" + scene_.labels[index].text + "' (label " +
+             std::to_string(scene_.labels[index].id) + ")";
+  ui_event();
 }
 
 void Viewer::set_place_mode(bool on) {

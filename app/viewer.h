@@ -235,6 +235,8 @@ class Viewer {
   void changed();
   void apply_camera();
   std::optional<glm::vec3> pick(glm::vec2 at);
+  std::optional<size_t> label_near(glm::vec2 at, bool anchor) const;
+  void select_label(size_t index);
   size_t label_index(int id) const;
   // A label edit: the labels before it kept for undo, the scene's labels changed by `edit`, the
   // renderer made again for them.
@@ -330,7 +332,10 @@ class Viewer {
 
   // Labels of one's own.
   bool place_mode_ = false;
-  char edit_text_[256] = "";                          // the panel's text of the selected label
+  std::optional<size_t> anchor_drag_;  // the label whose anchor the left button drags
+  glm::vec2 anchor_drag_from_{0.0f};
+  glm::vec2 press_at_{0.0f};  // where the last button press was (a click selects a label)
+  char edit_text_[256] = "";  // the panel's text of the selected label
   std::filesystem::path default_labels_path() const;  // Ctrl+S: SCENE-labels.mrk.json beside it
   std::vector<std::vector<Label>> undo_, redo_;       // the scene's labels before each edit
 

@@ -116,19 +116,23 @@ test::CommandResult view(const std::filesystem::path& dir, const std::string& sc
 
 TEST_SUITE("window") {
   // Labels of one's own (issue 36's session): five labels placed on head.json from two views, one
-  // renamed in non-ASCII text, one moved, one deleted and the deletion undone, saved as .mrk.json
+  // dragged by its anchor in place mode, one renamed in non-ASCII text, one moved, one deleted
+  // and the deletion undone, saved as .mrk.json
   // in RAS and as .fcsv in LPS. Both files hold the scene's 11 labels and the 5 new ones with the
   // same points (within 0.01 mm); each new anchor lies on the ray of the pixel it was placed or
-  // moved at (the camera from `report`); `strata render --labels` shows them.
+  // moved at (the camera from `report`); `strata render --labels` shows them on the scan.
   TEST_CASE("viewer_places_renames_moves_deletes_undoes_and_saves_labels") {
     const auto dir = test::fresh_folder("viewer", "own-labels");
     const auto d = [&](const char* name) { return (dir / name).string(); };
-    const auto r = view(dir, "view anterior\nplace 80 40\nplace 66 70\nreport " + d("front.json") +
-                                 "\nview left\nplace 80 60\nplace 60 50\nplace 100 70\n"
-                                 "text 101 \"Thalamus R – Ödem \\\"rechts\\\"\"\nmove 102 90 45\n"
-                                 "delete 103\nundo\nreport " +
-                                 d("left.json") + "\nsave " + d("own.mrk.json") + " ras\nsave " +
-                                 d("own.fcsv") + " lps\nquit\n");
+    const auto r = view(
+        dir,
+        "view anterior\nplace 80 40\nplace 66 70\nkey p\ndrag left 80 40 72 34\nkey p\nreport " +
+            d("front.json") +
+            "\nview left\nplace 80 60\nplace 60 50\nplace 100 70\n"
+            "text 101 \"Thalamus R – Ödem \\\"rechts\\\"\"\nmove 102 90 45\n"
+            "delete 103\nundo\nreport " +
+            d("left.json") + "\nsave " + d("own.mrk.json") + " ras\nsave " + d("own.fcsv") +
+            " lps\nquit\n");
     REQUIRE_MESSAGE(r.exit_code == 0, r.output);
     const std::vector<Label> ras = load_label_file(d("own.mrk.json"));
     const std::vector<Label> lps = load_label_file(d("own.fcsv"));
@@ -154,7 +158,7 @@ TEST_SUITE("window") {
       size_t index;
       const Camera* camera;
       glm::vec2 pixel;
-    } placed[] = {{11, &front, {80, 40}},
+    } placed[] = {{11, &front, {72, 34}},
                   {12, &left, {90, 45}},
                   {13, &left, {80, 60}},
                   {14, &left, {60, 50}},
@@ -165,9 +169,9 @@ TEST_SUITE("window") {
       CHECK(at.visible);
       CHECK(glm::distance(at.pixel, p.pixel + 0.5f) <= 0.05f);
     }
-    const auto rendered =
-        run_strata("render " + kScene + " --labels " + d("own.mrk.json") + " --size 256 --layout " +
-                   d("render.json") + " -o " + d("render.png"));
+    const auto rendered = run_strata(
+        "render " STRATA_SOURCE_DIR "/assets/cache/mricron/ch2.nii.gz --labels " +
+        d("own.mrk.json") + " --size 384 --layout " + d("render.json") + " -o " + d("render.png"));
     REQUIRE_MESSAGE(rendered.exit_code == 0, rendered.output);
     const auto layout = nlohmann::json::parse(test::read_file(dir / "render.json"));
     for (size_t i = 11; i < ras.size(); ++i) {
