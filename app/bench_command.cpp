@@ -147,6 +147,7 @@ struct ViewBenchOptions {
   double pace = 0.0;  // frames a second the frames are started at (a display's); 0: at once
   double frame_budget_ms = 0.0;  // the viewer's interactive rendering (`view --frame-budget`)
   float ghost = 1.0f;            // ghosting's strength (0: off), the default lens
+  uint32_t place = 0;  // labels placed at the picture's centre after the runs (their wall time)
 };
 
 // The part of a group's name before its first dot ("placement.sat" is part of "placement"), or
@@ -313,6 +314,25 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   out["frame_budget_ms"] = o.frame_budget_ms;
   out["ghost"] = o.ghost;
   out["largest_divisor"] = frames.after.largest_divisor;
+  if (o.place > 0) {
+    // Labels of one's own: each placed at the centre of a view along the turntable (a pick
+    // frame, waited for, then the placement, forces and drawing made again), wall time.
+    std::vector<double> place_ms;
+    const graph::Extent e = viewer.extent();
+    for (uint32_t k = 0; k < o.place; ++k) {
+      viewer.set_camera(cameras[size_t(k) * cameras.size() / o.place]);
+      viewer.frame(1.0 / fps);
+      const auto start = std::chrono::steady_clock::now();
+      viewer.place_label({0.5f * float(e.width), 0.5f * float(e.height)});
+      place_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
+      viewer.frame(1.0 / fps);
+    }
+    output.wait_idle();
+    std::sort(place_ms.begin(), place_ms.end());
+    out["place_label_ms"] = {{"median", place_ms[place_ms.size() / 2]}, {"max", place_ms.back()}};
+  }
   out["frames_per_second"] = double(cameras.size()) / frames.seconds;
   out["gpu_frame_ms"] = frames.frame_quantiles();
   out["gpu_frame_ms_stamped_per_group"] = groups.frame_quantiles();
@@ -423,6 +443,12 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       ->capture_default_str();
   view_cmd->add_option("--ghost", view->ghost, "ghosting's strength, 0 (off) to 1")
       ->check(finite_range(0.0, 1.0))
+      ->capture_default_str();
+  view_cmd
+      ->add_option("--place", view->place,
+                   "after the runs, place this many labels at the picture's centre (the "
+                   "viewer's place mode) and time each")
+      ->check(whole_range(0, 100))
       ->capture_default_str();
   view_cmd->callback([&device, view] { bench::bench_view(device, *view); });
 

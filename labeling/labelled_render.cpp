@@ -64,13 +64,13 @@ struct LabelledRenderer::Parts {
         target(ctx) {}
   // (the scene's labels changed: a placement, forces and drawing for them around the volumes
   // already uploaded)
-  Parts(Context& ctx, VolumeRenderer&& uploaded, const LabellingSettings& settings,
-        uint32_t label_count)
-      : renderer(std::move(uploaded)),
+  Parts(Context& ctx, Parts& old, const LabellingSettings& settings, uint32_t label_count)
+      : renderer(std::move(old.renderer)),
         placement(ctx, label_count, settings.placement_layout,
-                  Placement::create_pipelines(ctx, label_count)),
-        forces(ctx, label_count),
-        picking(ctx),
+                  old.placement.take_pipelines(label_count)),
+        forces(ctx, label_count, &old.forces),
+        picking(ctx, &old.picking),
+        drawing(std::move(old.drawing)),  // (build_labels makes it again with its pipelines)
         target(ctx) {}
   VolumeRenderer renderer;
   Placement placement;
@@ -120,8 +120,7 @@ void LabelledRenderer::labels_changed() {
   runner_.reset();
   beside_.reset();
   take_scene_labels();
-  parts_ = std::make_unique<Parts>(ctx_, std::move(parts_->renderer), settings_,
-                                   uint32_t(labels_.size()));
+  parts_ = std::make_unique<Parts>(ctx_, *parts_, settings_, uint32_t(labels_.size()));
   parts_->renderer.set_camera(camera_);
   project_and_layer(camera_);
   build_labels();
@@ -157,7 +156,8 @@ void LabelledRenderer::build_labels() {
   p.glyphs = Buffer(ctx_, std::max<size_t>(1, glyphs.size()) * sizeof(gpu::GlyphGpu),
                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
   if (!glyphs.empty()) upload(ctx_, p.glyphs, as_bytes(glyphs));
-  p.drawing.emplace(ctx_, atlas, images.atlas);
+  std::optional<LabelDrawing> old = std::move(p.drawing);
+  p.drawing.emplace(ctx_, atlas, images.atlas, old ? &*old : nullptr);
   p.drawing->set_label_count(uint32_t(labels_.size()));
 }
 

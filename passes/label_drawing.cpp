@@ -71,7 +71,8 @@ struct LabelDrawReference {
 }  // namespace
 }  // namespace gpu
 
-LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas& images)
+LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas& images,
+                           LabelDrawing* from)
     : atlas_(ctx, {VK_FORMAT_R8_UNORM,
                    {font.width, font.height, 1},
                    VK_IMAGE_TYPE_2D,
@@ -80,10 +81,12 @@ LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas
                     {images.width, images.height, 1},
                     VK_IMAGE_TYPE_2D,
                     VK_IMAGE_USAGE_SAMPLED_BIT}),
-      ghost_pipeline_(ctx, "labels_ghost.comp"),
-      front_alpha_(ctx, "labels_front_alpha.comp"),
-      draw_(ctx, "label_draw.comp"),
-      composite_(ctx, "label_composite.comp") {
+      ghost_pipeline_(
+          reuse_or_create(ctx, from ? &from->ghost_pipeline_ : nullptr, "labels_ghost.comp")),
+      front_alpha_(
+          reuse_or_create(ctx, from ? &from->front_alpha_ : nullptr, "labels_front_alpha.comp")),
+      draw_(reuse_or_create(ctx, from ? &from->draw_ : nullptr, "label_draw.comp")),
+      composite_(reuse_or_create(ctx, from ? &from->composite_ : nullptr, "label_composite.comp")) {
   upload(ctx, atlas_, as_bytes(font.coverage), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   upload(ctx, images_, as_bytes(images.texels), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }

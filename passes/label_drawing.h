@@ -40,7 +40,9 @@ gpu::GhostParams ghost_params(const GhostSettings& ghost, graph::Extent size, ui
 class LabelDrawing {
  public:
   // Uploads the font's atlas and the labels' pictures once.
-  LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas& images = {});
+  // (with `pipelines_from`: that one's pipelines, moved out; new labels or a new font)
+  LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas& images = {},
+               LabelDrawing* pipelines_from = nullptr);
 
   struct Inputs {
     graph::ResourceId layers;  // the renderer's rgba16f array image, read and written in place

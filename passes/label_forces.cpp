@@ -64,13 +64,13 @@ gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
   return p;
 }
 
-LabelForces::LabelForces(Context& ctx, uint32_t label_count)
+LabelForces::LabelForces(Context& ctx, uint32_t label_count, LabelForces* from)
     : ctx_(ctx),
       label_count_(label_count),
       params_(forces_params({}, {1024.0f, 14.0f, 1024.0f}, label_count, 0.0)),
-      forces_(ctx, "label_forces.comp"),
-      previous_(ctx, "label_previous.comp"),
-      follow_(ctx, "label_follow.comp"),
+      forces_(reuse_or_create(ctx, from ? &from->forces_ : nullptr, "label_forces.comp")),
+      previous_(reuse_or_create(ctx, from ? &from->previous_ : nullptr, "label_previous.comp")),
+      follow_(reuse_or_create(ctx, from ? &from->follow_ : nullptr, "label_follow.comp")),
       state_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::LabelStateGpu),
              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                  VK_BUFFER_USAGE_TRANSFER_DST_BIT,

@@ -91,7 +91,8 @@ class LabelForces {
     graph::ResourceId drawn;  // PlacementGpu[]: where the labels are drawn
   };
 
-  LabelForces(Context& ctx, uint32_t label_count);
+  // (with `pipelines_from`: that one's pipelines, moved out; the scene's labels changed)
+  LabelForces(Context& ctx, uint32_t label_count, LabelForces* pipelines_from = nullptr);
 
   // The state kept across frames (LabelStateGpu[]), imported into `graph`: before the placement,
   // which reads last frame's drawn positions from it.

@@ -13,7 +13,8 @@ namespace strata {
 using graph::ResourceId;
 using graph::Use;
 
-Picking::Picking(Context& ctx) : pipeline_(ctx, "pick.comp") {}
+Picking::Picking(Context& ctx, Picking* from)
+    : pipeline_(reuse_or_create(ctx, from ? &from->pipeline_ : nullptr, "pick.comp")) {}
 
 void Picking::set_pixels(std::vector<glm::vec2> pixels) {
   if (pixels.size() > PICK_MAX) {

@@ -23,7 +23,8 @@ struct PickHit {
 
 class Picking {
  public:
-  explicit Picking(Context& ctx);
+  // (with `pipeline_from`: that one's pipeline, moved out)
+  explicit Picking(Context& ctx, Picking* pipeline_from = nullptr);
 
   struct Inputs {
     graph::ResourceId frame;  // the renderer's FrameGpu

@@ -102,6 +102,15 @@ std::vector<ComputePipeline> Placement::create_pipelines(Context& ctx, uint32_t 
 Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout)
     : Placement(ctx, label_count, layout, create_pipelines(ctx, label_count)) {}
 
+std::vector<ComputePipeline> Placement::take_pipelines(uint32_t label_count) {
+  if (tidy_states_in_buffer(label_count) != tidy_states_in_buffer(label_count_))
+    return create_pipelines(ctx_, label_count);
+  std::vector<ComputePipeline> out;
+  for (ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &tidy_, &search_})
+    out.push_back(std::move(*p));
+  return out;
+}
+
 Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
                      std::vector<ComputePipeline> pipelines)
     : ctx_(ctx),

@@ -147,6 +147,9 @@ class Placement {
   Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
             std::vector<ComputePipeline> pipelines);
   static std::vector<ComputePipeline> create_pipelines(Context& ctx, uint32_t label_count);
+  // Pipelines for a placement of `label_count` labels: this one's, moved out (it is left without
+  // them), where the count needs the same ones, else new (the scene's labels changed).
+  std::vector<ComputePipeline> take_pipelines(uint32_t label_count);
   const PlacementPlan& plan() const { return plan_; }
 
   // Adds the placement's passes: upload (then in.adjust_labels), costs, bounds, the label loop,

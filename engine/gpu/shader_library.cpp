@@ -253,6 +253,10 @@ std::vector<PipelineStatistic> ComputePipeline::statistics() const {
   return out;
 }
 
+ComputePipeline reuse_or_create(Context& ctx, ComputePipeline* from, std::string_view shader) {
+  return from ? std::move(*from) : ComputePipeline(ctx, shader);
+}
+
 std::vector<ComputePipeline> create_compute_pipelines(Context& ctx,
                                                       std::span<const std::string_view> shaders) {
   std::vector<std::future<ComputePipeline>> pending;

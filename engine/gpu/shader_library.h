@@ -107,6 +107,10 @@ class ComputePipeline : public Pipeline {
   bool captured_ = false;
 };
 
+// `from`'s pipeline moved out (a pass made again keeps its pipelines: compiling them is slow on a
+// CPU device), or, without one, a new pipeline of `shader`.
+ComputePipeline reuse_or_create(Context& ctx, ComputePipeline* from, std::string_view shader);
+
 // The compute pipelines of `shaders`, in that order, created on a thread each: a driver that
 // compiles at creation takes them in parallel (lavapipe compiles at creation; docs/performance.md).
 // The first error is thrown once every creation has ended.
