@@ -259,6 +259,7 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   options.scene_path = o.scene;
   options.optimize_on_idle = false;
   options.keep_frame_spans = true;
+  options.print_actions = false;  // (stdout is the report)
   options.frame_budget_ms = o.frame_budget_ms;
   // (the viewer keeps the placement beside the frames with interactive rendering)
   options.placement_beside = placement_beside(o.placement, ctx) || o.frame_budget_ms > 0.0;

@@ -565,8 +565,10 @@ int Viewer::place_label(glm::vec2 at) {
   picked_label_ = int(scene_.labels.size()) - 1;  // (selected: its text ready to edit)
   std::snprintf(edit_text_, sizeof edit_text_, "%s", label.text.c_str());
   message_ = "placed '" + label.text + "' (label " + std::to_string(label.id) + ")";
-  std::printf("view: %s\n", message_.c_str());
-  std::fflush(stdout);
+  if (options_.print_actions) {
+    std::printf("view: %s\n", message_.c_str());
+    std::fflush(stdout);
+  }
   return label.id;
 }
 

@@ -106,6 +106,8 @@ struct ViewerOptions {
   // placement beside the frames waits until the camera rests; at rest, full resolution again.
   // 0: off.
   double frame_budget_ms = 0.0;
+  // Labels placed are printed ("view: placed ..."); off where stdout holds a report (bench view).
+  bool print_actions = true;
 };
 
 // Totals over a run, printed when the viewer closes and by `strata bench view`.
