@@ -476,7 +476,8 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
   CLI::App* cmd = app.add_subcommand(
       "view",
       "Open the interactive viewer (mouse: left rotate, right/wheel zoom, middle or "
-      "shift+left pan; keys: arrows, r reset, 1-9 positions, F12 screenshot, h panel, q)");
+      "shift+left pan; keys: arrows, r reset, 1-9 positions, F12 screenshot, h panel, p place "
+      "labels, ctrl+z/y undo/redo, ctrl+s save labels, q)");
   auto o = std::make_shared<ViewOptions>();
   cmd->add_option("scene", o->scene.file,
                   "scene file (.json, or .xml of the thesis program), or a volume file or DICOM "
