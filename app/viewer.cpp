@@ -590,11 +590,13 @@ void Viewer::delete_label(int id) {
   edit_labels([&](std::vector<Label>& labels) { labels.erase(labels.begin() + ptrdiff_t(i)); });
 }
 
-bool Viewer::undo_labels() {
-  if (undo_.empty()) return false;
-  redo_.push_back(scene_.labels);
-  scene_.labels = std::move(undo_.back());
-  undo_.pop_back();
+// Undo and redo: the labels on top of `from` come back, the ones they replace go onto `to`.
+bool Viewer::restore_labels(std::vector<std::vector<Label>>& from,
+                            std::vector<std::vector<Label>>& to) {
+  if (from.empty()) return false;
+  to.push_back(scene_.labels);
+  scene_.labels = std::move(from.back());
+  from.pop_back();
   if (picked_label_ >= int(scene_.labels.size())) picked_label_ = -1;
   labelled_->labels_changed();
   beside_counted_ = 0;  // (a new placement beside the frames)
@@ -602,16 +604,12 @@ bool Viewer::undo_labels() {
   return true;
 }
 
+bool Viewer::undo_labels() {
+  return restore_labels(undo_, redo_);
+}
+
 bool Viewer::redo_labels() {
-  if (redo_.empty()) return false;
-  undo_.push_back(scene_.labels);
-  scene_.labels = std::move(redo_.back());
-  redo_.pop_back();
-  if (picked_label_ >= int(scene_.labels.size())) picked_label_ = -1;
-  labelled_->labels_changed();
-  beside_counted_ = 0;  // (a new placement beside the frames)
-  changed();
-  return true;
+  return restore_labels(redo_, undo_);
 }
 
 void Viewer::save_labels(const std::filesystem::path& path, LabelAxes axes) {

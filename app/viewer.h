@@ -243,6 +243,7 @@ class Viewer {
   // A label edit: the labels before it kept for undo, the scene's labels changed by `edit`, the
   // renderer made again for them.
   void edit_labels(const std::function<void(std::vector<Label>&)>& edit);
+  bool restore_labels(std::vector<std::vector<Label>>& from, std::vector<std::vector<Label>>& to);
   graph::GraphRunner& prepare(uint32_t slot, graph::Extent extent, double seconds);
   void read_slot(uint32_t slot);
   int next_trial();
