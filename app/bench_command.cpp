@@ -9,6 +9,7 @@
 #include <random>
 #include <thread>
 
+#include <GLFW/glfw3.h>
 #include <nlohmann/json.hpp>
 
 #include "app/bench_placement.h"
@@ -185,6 +186,60 @@ struct ViewRun {
   }
 };
 
+// Labels of one's own placed as a user does (place mode, a click every fourth frame around the
+// picture's centre, the camera at rest): every frame's wall time from one to the next while
+// placing, against as many frames at rest just before; and the labels placed.
+ordered_json placing_json(Viewer& viewer, ViewerOutput& output, const Scene& scene,
+                          const Camera& camera, uint32_t count, double fps) {
+  const auto intervals = [&](uint32_t frames, bool click) {
+    const graph::Extent e = viewer.extent();
+    const glm::vec2 centre(0.5f * float(e.width), 0.5f * float(e.height));
+    std::vector<double> ms;
+    auto last = std::chrono::steady_clock::now();
+    for (uint32_t f = 0; f < frames; ++f) {
+      if (click && f % 4 == 0) {
+        // (on a spiral around the centre, apart: each click a label of its own)
+        const float k = float(f / 4);
+        const float r =
+            0.3f * float(std::min(e.width, e.height)) * std::sqrt((k + 0.5f) / float(count));
+        viewer.cursor(centre + r * glm::vec2(std::cos(2.4f * k), std::sin(2.4f * k)));
+        viewer.mouse_button(GLFW_MOUSE_BUTTON_LEFT, GLFW_PRESS, 0);
+        viewer.mouse_button(GLFW_MOUSE_BUTTON_LEFT, GLFW_RELEASE, 0);
+      }
+      viewer.frame(1.0 / fps);
+      const auto now = std::chrono::steady_clock::now();
+      ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
+      last = now;
+    }
+    std::sort(ms.begin(), ms.end());
+    return ordered_json{{"median", ms[ms.size() / 2]}, {"max", ms.back()}};
+  };
+  viewer.set_camera(camera);
+  viewer.set_place_mode(true);
+  viewer.runner().set_timestamps_per_pass(true);
+  for (int f = 0; f < 8; ++f) viewer.frame(1.0 / fps);  // (settled into the pace)
+  const size_t before = scene.labels.size();
+  ordered_json out;
+  out["labels_asked"] = count;
+  out["frame_ms_at_rest"] = intervals(4 * count, false);
+  const auto picking_ms = [&] {
+    double ms = 0.0;
+    for (const auto& [pass, sum] : viewer.summary().gpu_ms)
+      if (pass.rfind("picking.", 0) == 0) ms += sum;
+    return ms;
+  };
+  const double picking_before = picking_ms();
+  out["frame_ms_placing"] = intervals(4 * count, true);
+  for (int f = 0; f < 8; ++f) viewer.frame(1.0 / fps);  // (the last picks come back)
+  output.wait_idle();
+  // (every frame's picking passes over the placing frames, per label: the picks' own GPU time,
+  // through the ghosting lenses, and the frames' idle passes)
+  out["picking_gpu_ms_per_label"] = (picking_ms() - picking_before) / double(count);
+  out["labels_placed"] = scene.labels.size() - before;
+  viewer.set_place_mode(false);
+  return out;
+}
+
 // The placement's own figures over a run: placements finished and taken up, their rate, GPU time
 // and latency (frames from the frame that started one to the frame that took it up). In the
 // frame: one a frame, no latency, the placement group's time.
@@ -315,25 +370,8 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   out["frame_budget_ms"] = o.frame_budget_ms;
   out["ghost"] = o.ghost;
   out["largest_divisor"] = frames.after.largest_divisor;
-  if (o.place > 0) {
-    // Labels of one's own: each placed at the centre of a view along the turntable (a pick
-    // frame, waited for, then the placement, forces and drawing made again), wall time.
-    std::vector<double> place_ms;
-    const graph::Extent e = viewer.extent();
-    for (uint32_t k = 0; k < o.place; ++k) {
-      viewer.set_camera(cameras[size_t(k) * cameras.size() / o.place]);
-      viewer.frame(1.0 / fps);
-      const auto start = std::chrono::steady_clock::now();
-      viewer.place_label({0.5f * float(e.width), 0.5f * float(e.height)});
-      place_ms.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-              .count());
-      viewer.frame(1.0 / fps);
-    }
-    output.wait_idle();
-    std::sort(place_ms.begin(), place_ms.end());
-    out["place_label_ms"] = {{"median", place_ms[place_ms.size() / 2]}, {"max", place_ms.back()}};
-  }
+  if (o.place > 0)
+    out["placing"] = placing_json(viewer, output, scene, cameras.front(), o.place, fps);
   out["frames_per_second"] = double(cameras.size()) / frames.seconds;
   out["gpu_frame_ms"] = frames.frame_quantiles();
   out["gpu_frame_ms_stamped_per_group"] = groups.frame_quantiles();
@@ -447,8 +485,8 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       ->capture_default_str();
   view_cmd
       ->add_option("--place", view->place,
-                   "after the runs, place this many labels at the picture's centre (the "
-                   "viewer's place mode) and time each")
+                   "after the runs, place this many labels near the picture's centre (the "
+                   "viewer's place mode, a click every fourth frame) and time the frames")
       ->check(whole_range(0, 100))
       ->capture_default_str();
   view_cmd->callback([&device, view] { bench::bench_view(device, *view); });

@@ -33,6 +33,8 @@ double seconds_between(Clock::time_point a, Clock::time_point b) {
 constexpr double kMaxStep = 0.1;           // a frame's time step at most (slow devices)
 constexpr double kPlotSeconds = 5.0;       // the timing plots' span
 constexpr double kAnimationSeconds = 1.0;  // moves to named positions and anatomical views
+// Label slots beyond the scene's: this many labels of one's own are placed without a new graph.
+constexpr uint32_t kSpareLabelSlots = 64;
 
 bool same_view(const Camera& a, const Camera& b) {
   return a.view == b.view;
@@ -256,6 +258,7 @@ Viewer::Viewer(Context& ctx, Scene& scene, const Camera& camera, const Labelling
   if (size.width == 0 || size.height == 0) size = {64, 64};  // (a minimised window: resized later)
   LabellingSettings labelling = settings;
   labelling.render.interactive = options.frame_budget_ms > 0.0;
+  labelling.spare_label_slots = kSpareLabelSlots;
   labelled_ = std::make_unique<LabelledRenderer>(ctx, scene, camera, size, labelling);
   labelled_->set_extension([this](graph::Graph& graph, const LabelledRenderer::GraphIds& ids) {
     extend_graph(graph, ids);
@@ -283,18 +286,17 @@ void Viewer::extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds&
   ++generation_;
   // (beside the frames, the placement's buffers are not in the frame's graph: no debug view)
   const graph::ResourceId debug_image =
-      !ids.placement_in_frame
-          ? ids.labelled
-          : debug_.add_to(graph, {.saliency = ids.placed.saliency,
-                                  .costs = ids.placed.costs,
-                                  .labels = ids.placed.labels,
-                                  .placements = ids.placed.placements,
-                                  .order = ids.placed.order,
-                                  .layers = ids.rendered.layers,
-                                  .frame = ids.rendered.frame,
-                                  .keys = ids.rendered.keys,
-                                  .layer_count = ids.layer_count,
-                                  .label_count = uint32_t(scene_.labels.size())});
+      !ids.placement_in_frame ? ids.labelled
+                              : debug_.add_to(graph, {.saliency = ids.placed.saliency,
+                                                      .costs = ids.placed.costs,
+                                                      .labels = ids.placed.labels,
+                                                      .placements = ids.placed.placements,
+                                                      .order = ids.placed.order,
+                                                      .layers = ids.rendered.layers,
+                                                      .frame = ids.rendered.frame,
+                                                      .keys = ids.rendered.keys,
+                                                      .layer_count = ids.layer_count,
+                                                      .label_count = ids.label_slots});
   display_id_ = graph.add_image("view.display", {VK_FORMAT_R8G8B8A8_UNORM});
   const graph::ResourceId labelled = ids.labelled, display = display_id_;
   graph.add_pass({"view.copy",
@@ -322,19 +324,23 @@ void Viewer::extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds&
 void Viewer::mouse_button(int button, int action, int mods) {
   const bool left = button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT);
   try {
-    // Place mode: a press on an anchor drags it (to the point under the release), elsewhere a
-    // press places a label.
+    // Place mode: a press on an anchor drags it along the surface under the pointer, elsewhere
+    // a press places a label (both once the frame's pick comes back: no wait).
     if (place_mode_ && left && action == GLFW_PRESS && drag_button_ < 0) {
-      anchor_drag_ = label_near(mouse_, true);
-      anchor_drag_from_ = mouse_;
-      if (!anchor_drag_) place_label(mouse_);
+      anchor_drag_.reset();
+      if (const std::optional<size_t> i = label_near(mouse_, true)) {
+        anchor_drag_ = scene_.labels[*i].id;
+        anchor_drag_from_ = mouse_;
+        drag_undone_ = false;
+        select_label(*i);
+      } else {
+        ask_pick({mouse_, 0, false});
+      }
       return;
     }
     if (left && action == GLFW_RELEASE && anchor_drag_) {
-      const size_t i = *anchor_drag_;
+      if (glm::distance(mouse_, anchor_drag_from_) > 2.0f) ask_pick({mouse_, *anchor_drag_, true});
       anchor_drag_.reset();
-      if (glm::distance(mouse_, anchor_drag_from_) > 2.0f) move_label(scene_.labels[i].id, mouse_);
-      select_label(i);
       return;
     }
     if (place_mode_ && left) return;
@@ -364,6 +370,12 @@ void Viewer::mouse_button(int button, int action, int mods) {
 void Viewer::cursor(glm::vec2 position) {
   const glm::vec2 delta = position - mouse_;
   mouse_ = position;
+  // (an anchor follows the pointer: one pick in flight at a time, the newest position next)
+  if (anchor_drag_ && delta != glm::vec2(0.0f) && glm::distance(mouse_, anchor_drag_from_) > 2.0f &&
+      std::none_of(pending_picks_.begin(), pending_picks_.end(),
+                   [](const PendingPick& p) { return p.drag; })) {
+    ask_pick({mouse_, *anchor_drag_, true});
+  }
   if (drag_button_ < 0 || delta == glm::vec2(0.0f)) return;
   const graph::Extent e = output_.extent();
   const glm::uvec2 viewport{std::max(1u, e.width), std::max(1u, e.height)};
@@ -518,20 +530,56 @@ void Viewer::set_label_hidden(int id, bool hidden) {
 
 // --- labels of one's own -------------------------------------------------------------------------
 
-std::optional<glm::vec3> Viewer::pick(glm::vec2 at) {
+void Viewer::ask_pick(const PendingPick& pick) {
   const graph::Extent e = labelled_->size();
+  const glm::vec2 at = pick.at;
   if (!(at.x >= 0.0f && at.y >= 0.0f && at.x < float(e.width) && at.y < float(e.height))) {
     throw Error("pixel " + value_limits::shown(at.x) + "," + value_limits::shown(at.y) +
                 " lies outside the " + std::to_string(e.width) + "x" + std::to_string(e.height) +
                 " picture");
   }
-  labelled_->set_picks({at});
-  frame();
-  output_.wait_idle();
-  const std::vector<PickHit> hits = labelled_->picked();
-  labelled_->set_picks({});
-  if (hits.empty() || !hits[0].hit) return std::nullopt;
-  return hits[0].point;
+  labelled_->request_pick(at);
+  pending_picks_.push_back(pick);
+}
+
+// The picks come back with their frame's slot: each places or moves its label now. Where the ray
+// met only background, `strict` throws (scripts), else the message says so.
+void Viewer::apply_picks(bool strict) {
+  for (const PickHit& hit : labelled_->take_picks()) {
+    if (pending_picks_.empty()) break;
+    const PendingPick pick = pending_picks_.front();
+    pending_picks_.pop_front();
+    if (!hit.hit) {
+      const std::string what =
+          pick.move_id == 0
+              ? "nothing under the pixel to place a label on (background)"
+              : "nothing under the pixel to move label " + std::to_string(pick.move_id) + " to";
+      if (strict) throw Error(what);
+      if (!pick.drag) message_ = what;  // (a drag over the background: the anchor waits)
+      ui_event();
+      continue;
+    }
+    if (pick.move_id == 0) {
+      add_label(hit.point);
+    } else if (std::any_of(scene_.labels.begin(), scene_.labels.end(),
+                           [&](const Label& l) { return l.id == pick.move_id; })) {
+      // (a drag is one edit to undo: the labels before its first move)
+      const size_t i = label_index(pick.move_id);
+      edit_labels([&](std::vector<Label>& labels) { labels[i].anchor = hit.point; },
+                  !pick.drag || !drag_undone_);
+      drag_undone_ = drag_undone_ || pick.drag;
+    }
+  }
+}
+
+// A pick for a script or a benchmark: asked, then frames until it comes back.
+void Viewer::pick_now(const PendingPick& pick) {
+  ask_pick(pick);
+  for (int frames = 0; !pending_picks_.empty(); ++frames) {
+    if (frames > 16) throw Error("the pick did not come back within 16 frames");
+    frame();
+    apply_picks(true);
+  }
 }
 
 size_t Viewer::label_index(int id) const {
@@ -540,13 +588,14 @@ size_t Viewer::label_index(int id) const {
   throw Error("the scene has no label " + std::to_string(id));
 }
 
-void Viewer::edit_labels(const std::function<void(std::vector<Label>&)>& edit) {
+void Viewer::edit_labels(const std::function<void(std::vector<Label>&)>& edit, bool undoable) {
   std::vector<Label> before = scene_.labels;
   edit(scene_.labels);
-  undo_.push_back(std::move(before));
-  redo_.clear();
+  if (undoable) {
+    undo_.push_back(std::move(before));
+    redo_.clear();
+  }
   labelled_->labels_changed();
-  beside_counted_ = 0;  // (a new placement beside the frames)
   moving_labels_.clear();
   if (picked_label_ >= int(scene_.labels.size())) picked_label_ = -1;
   changed();
@@ -554,12 +603,17 @@ void Viewer::edit_labels(const std::function<void(std::vector<Label>&)>& edit) {
 }
 
 int Viewer::place_label(glm::vec2 at) {
-  const std::optional<glm::vec3> point = pick(at);
-  if (!point) throw Error("nothing under the pixel to place a label on (background)");
+  const size_t labels = scene_.labels.size();
+  pick_now({at, 0, false});
+  if (scene_.labels.size() == labels) throw Error("no label was placed");
+  return scene_.labels.back().id;
+}
+
+void Viewer::add_label(glm::vec3 point) {
   Label label;
   label.id = int(next_label_id(scene_));
-  label.anchor = *point;
-  label.text = atlas_region_at(scene_, *point);
+  label.anchor = point;
+  label.text = atlas_region_at(scene_, point);
   if (label.text.empty()) label.text = "Label " + std::to_string(label.id);
   edit_labels([&](std::vector<Label>& labels) { labels.push_back(label); });
   picked_label_ = int(scene_.labels.size()) - 1;  // (selected: its text ready to edit)
@@ -569,7 +623,6 @@ int Viewer::place_label(glm::vec2 at) {
     std::printf("view: %s\n", message_.c_str());
     std::fflush(stdout);
   }
-  return label.id;
 }
 
 void Viewer::set_label_text(int id, const std::string& text) {
@@ -579,10 +632,8 @@ void Viewer::set_label_text(int id, const std::string& text) {
 }
 
 void Viewer::move_label(int id, glm::vec2 at) {
-  const size_t i = label_index(id);
-  const std::optional<glm::vec3> point = pick(at);
-  if (!point) throw Error("nothing under the pixel to move label " + std::to_string(id) + " to");
-  edit_labels([&](std::vector<Label>& labels) { labels[i].anchor = *point; });
+  label_index(id);  // (an Error when there is no such label)
+  pick_now({at, id, false});
 }
 
 void Viewer::delete_label(int id) {
@@ -599,7 +650,6 @@ bool Viewer::restore_labels(std::vector<std::vector<Label>>& from,
   from.pop_back();
   if (picked_label_ >= int(scene_.labels.size())) picked_label_ = -1;
   labelled_->labels_changed();
-  beside_counted_ = 0;  // (a new placement beside the frames)
   changed();
   return true;
 }
@@ -905,8 +955,9 @@ int Viewer::next_trial() {
 // The results of the frame that last used `slot` (it has finished).
 void Viewer::read_slot(uint32_t slot) {
   const SlotFrame done = slots_[slot];
-  if (done.generation != generation_) return;  // never used, or another graph's
-  labelled_->use_slot(slot);
+  const bool ours = done.generation == generation_;  // (else never used, or another graph's)
+  labelled_->use_slot(slot, ours);
+  if (!ours) return;
   last_timings_ = labelled_->runner().timings(slot);
   double gpu = 0.0;
   for (const graph::PassTiming& t : last_timings_) {
@@ -982,6 +1033,7 @@ graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double 
     changed();
   }
   read_slot(slot);
+  apply_picks(false);
   // Stein & Decoret's order needs the picture: computed once the camera rests (a wait for the
   // frames in flight, once per rest).
   if (insertion_order_ == 1 && settled_ && apollonius_serial_ != serial_ && !control_.animating()) {
@@ -1032,6 +1084,7 @@ void Viewer::choose_divisor(bool moving) {
 // The placements beside the frames taken up since the last frame: their GPU time and latency.
 void Viewer::count_placements() {
   const PlacementBeside* beside = labelled_->beside();
+  if (beside && beside->stats().adopted < beside_counted_) beside_counted_ = 0;  // (a new one)
   if (!beside || beside->stats().adopted == beside_counted_) return;
   summary_.placements += beside->stats().adopted - beside_counted_;
   beside_counted_ = beside->stats().adopted;

@@ -236,13 +236,23 @@ class Viewer {
   };
   void changed();
   void apply_camera();
-  std::optional<glm::vec3> pick(glm::vec2 at);
+  // Picks (LabelledRenderer::request_pick): a pixel whose point places a new label (move_id 0)
+  // or moves label move_id's anchor, as a drag (one undo for all its moves) or not.
+  struct PendingPick {
+    glm::vec2 at{0.0f};
+    int move_id = 0;
+    bool drag = false;
+  };
+  void ask_pick(const PendingPick& pick);
+  void apply_picks(bool strict);
+  void pick_now(const PendingPick& pick);
+  void add_label(glm::vec3 point);
   std::optional<size_t> label_near(glm::vec2 at, bool anchor) const;
   void select_label(size_t index);
   size_t label_index(int id) const;
   // A label edit: the labels before it kept for undo, the scene's labels changed by `edit`, the
   // renderer made again for them.
-  void edit_labels(const std::function<void(std::vector<Label>&)>& edit);
+  void edit_labels(const std::function<void(std::vector<Label>&)>& edit, bool undoable = true);
   bool restore_labels(std::vector<std::vector<Label>>& from, std::vector<std::vector<Label>>& to);
   graph::GraphRunner& prepare(uint32_t slot, graph::Extent extent, double seconds);
   void read_slot(uint32_t slot);
@@ -335,7 +345,9 @@ class Viewer {
 
   // Labels of one's own.
   bool place_mode_ = false;
-  std::optional<size_t> anchor_drag_;  // the label whose anchor the left button drags
+  std::optional<int> anchor_drag_;         // the label (id) whose anchor the left button drags
+  bool drag_undone_ = false;               // the drag's first move is on the undo stack
+  std::deque<PendingPick> pending_picks_;  // asked, in the order asked
   glm::vec2 anchor_drag_from_{0.0f};
   glm::vec2 press_at_{0.0f};  // where the last button press was (a click selects a label)
   char edit_text_[256] = "";  // the panel's text of the selected label

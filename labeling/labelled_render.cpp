@@ -5,6 +5,7 @@
 #include <cstring>
 #include <future>
 #include <optional>
+#include <utility>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
@@ -61,6 +62,7 @@ struct LabelledRenderer::Parts {
         placement(ctx, label_count, settings.placement_layout, placement_pipelines.get()),
         forces(ctx, label_count),
         picking(ctx),
+        pick_points(ctx, PICK_MAX * sizeof(glm::vec4)),
         target(ctx) {}
   // (the scene's labels changed: a placement, forces and drawing for them around the volumes
   // already uploaded)
@@ -70,12 +72,14 @@ struct LabelledRenderer::Parts {
                   old.placement.take_pipelines(label_count)),
         forces(ctx, label_count, &old.forces),
         picking(ctx, &old.picking),
-        drawing(std::move(old.drawing)),  // (build_labels makes it again with its pipelines)
+        pick_points(ctx, PICK_MAX * sizeof(glm::vec4)),
+        drawing(std::move(old.drawing)),  // (build_labels gives it new atlases)
         target(ctx) {}
   VolumeRenderer renderer;
   Placement placement;
   LabelForces forces;
   Picking picking;
+  graph::Readback pick_points;          // the picked points, per frame slot (request_pick)
   std::optional<LabelDrawing> drawing;  // with the font of its size
   HeadlessTarget target;
   Buffer glyphs;
@@ -86,8 +90,9 @@ LabelledRenderer::LabelledRenderer(Context& ctx, const Scene& scene, const Camer
     : ctx_(ctx), scene_(scene), size_(size), camera_(camera), settings_(settings) {
   check_label_text(settings.font_pixels, settings.label_scale);
   take_scene_labels();
+  slots_.reset(label_ids_, settings.spare_label_slots, LABEL_MAX);
   project_and_layer(camera);
-  parts_ = std::make_unique<Parts>(ctx, scene, settings, uint32_t(labels_.size()));
+  parts_ = std::make_unique<Parts>(ctx, scene, settings, slots_.count());
   parts_->renderer.set_camera(camera);
   build_labels();
   set_order(scene_order(uint32_t(labels_.size())));
@@ -115,12 +120,22 @@ void LabelledRenderer::take_scene_labels() {
 }
 
 void LabelledRenderer::labels_changed() {
+  take_scene_labels();
+  if (slots_.assign(label_ids_)) {
+    project_and_layer(camera_);
+    build_labels();
+    set_order(scene_order(uint32_t(labels_.size())));
+    placement_due();
+    if (layering_.layer_count != graph_layers_) build_graph();
+    return;
+  }
   ctx_.wait_idle("the scene's labels changed");
   const bool beside = beside_ != nullptr;
   runner_.reset();
   beside_.reset();
-  take_scene_labels();
-  parts_ = std::make_unique<Parts>(ctx_, *parts_, settings_, uint32_t(labels_.size()));
+  release_retired(true);
+  slots_.reset(label_ids_, settings_.spare_label_slots, LABEL_MAX);
+  parts_ = std::make_unique<Parts>(ctx_, *parts_, settings_, slots_.count());
   parts_->renderer.set_camera(camera_);
   project_and_layer(camera_);
   build_labels();
@@ -139,26 +154,55 @@ void check_label_text(float font_pixels, float label_scale) {
   }
 }
 
-// Boxes from the texts: sizes and glyph ranges stay; anchors and layers follow the camera.
+// Boxes from the texts: sizes and glyph ranges stay; anchors and layers follow the camera. A
+// graph already built is handed the new glyphs, and new atlases where the old ones lack a glyph
+// or picture; what it read before stays until the frames in flight that read it are done.
 void LabelledRenderer::build_labels() {
   const float scale = settings_.label_scale;
-  const Font font(settings_.font_pixels * scale);
+  if (!font_) font_.emplace(settings_.font_pixels * scale);
+  const Font& font = *font_;
   TextStyle style;
   style.max_width = settings_.wrap_width;
   style = style.scaled(scale);
   std::vector<std::string> texts;
   for (const Label& label : scene_.labels) texts.push_back(label.text);
-  const FontAtlas atlas = bake_label_texts(font, texts, style);
-  const LabelImages images = bake_label_images(scene_.labels, scale);
-  const std::vector<gpu::GlyphGpu> glyphs =
-      build_glyph_buffer(font, atlas, texts, labels_, style, images.blocks);
   Parts& p = *parts_;
-  p.glyphs = Buffer(ctx_, std::max<size_t>(1, glyphs.size()) * sizeof(gpu::GlyphGpu),
-                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
-  if (!glyphs.empty()) upload(ctx_, p.glyphs, as_bytes(glyphs));
-  std::optional<LabelDrawing> old = std::move(p.drawing);
-  p.drawing.emplace(ctx_, atlas, images.atlas, old ? &*old : nullptr);
-  p.drawing->set_label_count(uint32_t(labels_.size()));
+  const std::vector<GlyphKey> keys = label_glyph_keys(font, texts, style, &shaped_);
+  const bool glyphs_kept = p.drawing && std::all_of(keys.begin(), keys.end(), [&](GlyphKey k) {
+                             return font_atlas_.glyphs.contains(k);
+                           });
+  if (!glyphs_kept) font_atlas_ = font.bake(keys);
+  LabelImages images = bake_label_images(scene_.labels, scale);
+  const bool images_kept = p.drawing && images.atlas.width == image_atlas_.width &&
+                           images.atlas.height == image_atlas_.height &&
+                           images.atlas.texels == image_atlas_.texels;
+  if (!images_kept) image_atlas_ = std::move(images.atlas);
+  const std::vector<gpu::GlyphGpu> glyphs =
+      build_glyph_buffer(font, font_atlas_, texts, labels_, style, images.blocks, &shaped_);
+  Buffer glyph_buffer(ctx_, std::max<size_t>(1, glyphs.size()) * sizeof(gpu::GlyphGpu),
+                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
+  if (!glyphs.empty()) upload(ctx_, glyph_buffer, as_bytes(glyphs));
+  Retired old{frame_number_ + frames_in_flight_, std::move(p.glyphs), {}};
+  p.glyphs = std::move(glyph_buffer);
+  if (!p.drawing) {
+    p.drawing.emplace(ctx_, font_atlas_, image_atlas_);
+  } else if (!glyphs_kept || !images_kept) {
+    old.images = p.drawing->set_atlases(ctx_, font_atlas_, image_atlas_);
+  }
+  retired_.push_back(std::move(old));
+  p.drawing->set_label_count(slots_.count());
+  if (runner_) {
+    runner_->bind_buffer(glyphs_id_, p.glyphs.handle());
+    p.drawing->bind(*runner_);
+  }
+}
+
+void LabelledRenderer::release_retired(bool all) {
+  std::erase_if(retired_, [&](const Retired& r) { return all || r.until <= frame_number_; });
+}
+
+std::vector<gpu::LabelGpu> LabelledRenderer::slot_labels() const {
+  return slots_.scatter<gpu::LabelGpu>(labels_, gpu::LabelGpu{});
 }
 
 void LabelledRenderer::set_font_pixels(float pixels) {
@@ -176,6 +220,10 @@ void LabelledRenderer::set_label_text(float pixels, float scale) {
   settings_.label_scale = scale;
   for (size_t i = 0; i < labels_.size(); ++i) labels_[i].size = scene_.labels[i].size;
   runner_.reset();
+  release_retired(true);
+  font_.reset();
+  font_atlas_ = {};  // (glyphs of the new size)
+  shaped_.clear();
   build_labels();
   build_graph();
 }
@@ -188,12 +236,12 @@ void LabelledRenderer::set_size(graph::Extent size) {
   if (beside_) beside_->build(layering_.layer_count, size_);
 }
 
-std::span<const gpu::PlacementGpu> LabelledRenderer::placement_results() const {
-  return parts_->placement.results();
+std::vector<gpu::PlacementGpu> LabelledRenderer::placement_results() const {
+  return slots_.gather(parts_->placement.results());
 }
 
-std::span<const gpu::PlacementGpu> LabelledRenderer::drawn() const {
-  return parts_->forces.drawn();
+std::vector<gpu::PlacementGpu> LabelledRenderer::drawn() const {
+  return slots_.gather(parts_->forces.drawn());
 }
 
 size_t LabelledRenderer::placement_order_count() const {
@@ -222,13 +270,25 @@ void LabelledRenderer::set_frames_in_flight(uint32_t frames) {
   parts_->renderer.readback().set_slots(frames);
   if (!beside_) parts_->placement.readback().set_slots(frames);
   parts_->forces.readback().set_slots(frames);
+  parts_->pick_points.set_slots(frames);
+  picks_in_slot_.assign(frames, {});
   use_slot(0);
 }
 
-void LabelledRenderer::use_slot(uint32_t slot) {
+void LabelledRenderer::use_slot(uint32_t slot, bool read) {
+  slot_ = slot;
+  if (extension_) {
+    parts_->pick_points.use_slot(*runner_, slot);
+    if (slot < picks_in_slot_.size() && !picks_in_slot_[slot].empty()) {
+      for (const PickHit& hit : pick_hits(parts_->pick_points.data(), picks_in_slot_[slot].size()))
+        picks_done_.push_back(hit);
+      picks_in_slot_[slot].clear();
+    }
+  }
   parts_->renderer.readback().use_slot(*runner_, slot);
   if (!beside_) parts_->placement.readback().use_slot(*runner_, slot);
   parts_->forces.readback().use_slot(*runner_, slot);
+  if (!read) return;
   stats_ = parts_->renderer.collect(*runner_);
   if (stats_.overflow > 0) placement_due();  // (the next frames show what this one missed)
 }
@@ -239,14 +299,24 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
   ForceSettings forces = settings_.forces;
   if (afresh_) forces.hold_share = forces.hold_cost = 0.0f;
   ++frame_number_;
+  release_retired(false);
   parts_->forces.set_frame(forces, units(), seconds, settings_.placement.hard,
                            parts_->placement.order_count());
   if (beside_) {
     beside_->set_frame_number(frame_number_);
-    beside_->prepare(*runner_, labels_);  // (a placement started now takes this frame's params)
+    beside_->prepare(*runner_,
+                     slot_labels());  // (a placement started now takes this frame's params)
     parts_->forces.set_order_count(beside_->adopted_order_count());
   }
   parts_->forces.set_trial(trial);
+  if (extension_) {
+    // (the frame picks what was asked since the last; PICK_MAX at a time)
+    picks_in_slot_.resize(std::max<size_t>(picks_in_slot_.size(), slot_ + 1));
+    const size_t n = std::min<size_t>(pick_requests_.size(), PICK_MAX);
+    picks_in_slot_[slot_].assign(pick_requests_.begin(), pick_requests_.begin() + ptrdiff_t(n));
+    pick_requests_.erase(pick_requests_.begin(), pick_requests_.begin() + ptrdiff_t(n));
+    parts_->picking.set_pixels(picks_in_slot_[slot_]);
+  }
   afresh_ = false;
   camera_moved_ = false;
   frame_seconds_ = seconds > 0.0 ? std::optional(seconds) : std::nullopt;  // (0 s: a still)
@@ -285,17 +355,21 @@ void LabelledRenderer::build_graph() {
 
   graph::Graph graph;
   const VolumeRenderer::Outputs rendered = p.renderer.add_to(graph);
-  picks_id_ = p.picking.add_to(graph, {.frame = rendered.frame, .depth = rendered.depth});
   graph::ResourceId labels = 0;
   const LabelForces::Outputs moved = beside_ ? add_placement_beside(graph, rendered, labels)
                                              : add_placement_in_frame(graph, rendered, labels);
+  // (picks walk the picture as drawn: through the lenses of the labels and their drawn places)
+  picks_id_ =
+      p.picking.add_to(graph, {.rendered = rendered, .labels = labels, .placements = moved.drawn});
+  if (extension_) add_pick_readback(graph);
   layers_id_ = rendered.layers;
   const graph::ResourceId glyph_buffer =
       graph.import_buffer("labels.glyphs", {.buffer = p.glyphs.handle(), .has_content = true});
+  glyphs_id_ = glyph_buffer;
   const graph::ResourceId labelled = graph.add_image("labels.final", {VK_FORMAT_R8G8B8A8_UNORM});
   labelled_id_ = labelled;
   // (offline frames measure what hides each anchor: LabelLayout::front_alpha)
-  const uint32_t n = std::max(uint32_t(labels_.size()), 1u);
+  const uint32_t n = std::max(slots_.count(), 1u);
   front_alpha_id_ = extension_ ? 0 : graph.add_buffer("labels.front_alpha", {[n](graph::Extent) {
                                                         return VkDeviceSize{n} * sizeof(float);
                                                       }});
@@ -309,12 +383,17 @@ void LabelledRenderer::build_graph() {
                             .ghost = graph_ghost_,
                             .front_alpha = front_alpha_id_});
   if (extension_) {
-    extension_(graph,
-               {labelled, rendered, placed_, moved.drawn, render.layer_count, beside_ == nullptr});
+    extension_(graph, {labelled, rendered, placed_, moved.drawn, render.layer_count, slots_.count(),
+                       beside_ == nullptr});
   } else {
     p.target.add_output(graph, labelled);
   }
   runner_.reset();  // (waits for its frames in flight)
+  // (picks asked in frames of the old graph are asked again)
+  for (auto it = picks_in_slot_.rbegin(); it != picks_in_slot_.rend(); ++it) {
+    pick_requests_.insert(pick_requests_.begin(), it->begin(), it->end());
+    it->clear();
+  }
   runner_ = std::make_unique<graph::GraphRunner>(ctx_, std::move(graph));
   runner_->set_viewport(size_);
   if (!extension_) p.target.bind(*runner_);
@@ -360,8 +439,8 @@ void LabelledRenderer::set_placement_beside(bool beside) {
   runner_.reset();
   beside_.reset();
   if (beside) {
-    beside_ = std::make_unique<PlacementBeside>(ctx_, parts_->placement, parts_->forces,
-                                                uint32_t(labels_.size()));
+    beside_ =
+        std::make_unique<PlacementBeside>(ctx_, parts_->placement, parts_->forces, slots_.count());
   } else {
     parts_->placement.readback().set_slots(frames_in_flight_);
   }
@@ -384,11 +463,14 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
   if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
   // While the camera moves, kept-apart labels keep room to slide along the image's edge.
   if (moving && camera_moved_ && settings_.forces.keep_apart) settings.edge_em = settings.margin_em;
-  parts_->placement.set_frame(labels_, insertion_order(labels_, layering_, within, priorities_),
-                              settings);
+  parts_->placement.set_frame(
+      slot_labels(), slots_.to_slots(insertion_order(labels_, layering_, within, priorities_)),
+      settings, slots_.used());
   parts_->drawing->set_layer_frames(settings_.layer_colors);
-  parts_->drawing->set_ghost(
-      {settings_.ghost.strength, settings_.ghost.radius * side, settings_.ghost.leader * side});
+  const GhostSettings ghost{settings_.ghost.strength, settings_.ghost.radius * side,
+                            settings_.ghost.leader * side};
+  parts_->drawing->set_ghost(ghost);
+  parts_->picking.set_ghost(ghost);  // (a pick sees through the lenses drawn)
 }
 
 void LabelledRenderer::set_camera(const Camera& camera) {
@@ -416,6 +498,34 @@ std::vector<PickHit> LabelledRenderer::picked() const {
   return parts_->picking.hits(runner_->download_buffer(picks_id_));
 }
 
+void LabelledRenderer::add_pick_readback(graph::Graph& graph) {
+  const graph::ResourceId readback = parts_->pick_points.import(graph, "picking.readback");
+  const graph::ResourceId points = picks_id_;
+  graph.add_pass({"picking.readback",
+                  graph::PassKind::transfer,
+                  {{points, graph::Use::transfer_src}, {readback, graph::Use::transfer_dst}},
+                  [this, points, readback](graph::PassContext& pc) {
+                    if (parts_->picking.pixels().empty()) return;
+                    const VkBufferCopy region{0, 0, parts_->pick_points.size()};
+                    vkCmdCopyBuffer(pc.cmd, pc.buffer(points), pc.buffer(readback), 1, &region);
+                  },
+                  "picking"});
+}
+
+void LabelledRenderer::request_pick(glm::vec2 pixel) {
+  pick_requests_.push_back(pixel);
+}
+
+std::vector<PickHit> LabelledRenderer::take_picks() {
+  return std::exchange(picks_done_, {});
+}
+
+size_t LabelledRenderer::picks_pending() const {
+  size_t n = pick_requests_.size();
+  for (const auto& slot : picks_in_slot_) n += slot.size();
+  return n;
+}
+
 LabelledRenderer::~LabelledRenderer() = default;
 
 std::vector<PipelineReport> LabelledRenderer::placement_pipelines() const {
@@ -424,6 +534,7 @@ std::vector<PipelineReport> LabelledRenderer::placement_pipelines() const {
 
 void LabelledRenderer::run_frame() {
   if (beside_) throw Error("a still needs the placement in the frame (set_placement_beside)");
+  release_retired(true);  // (run_now: no frame is in flight)
   stats_ = parts_->renderer.run_until_no_overflow(*runner_);
 }
 
@@ -445,7 +556,7 @@ std::vector<uint32_t> LabelledRenderer::apollonius_layers_order() {
 
 double LabelledRenderer::total_cost() const {
   double total = 0.0;
-  const auto results = parts_->placement.results();
+  const std::vector<gpu::PlacementGpu> results = placement_results();
   for (size_t i = 0; i < labels_.size(); ++i) {
     if ((labels_[i].flags & LABEL_ENABLED) == 0u) continue;
     total += results[i].shown == PLACEMENT_SHOWN
@@ -516,8 +627,8 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
     const auto pixels = parts_->target.pixels();
     frame.image.assign(pixels.begin(), pixels.end());
   }
-  const auto results = parts_->placement.results();
-  const auto drawn = parts_->forces.drawn();
+  const std::vector<gpu::PlacementGpu> results = placement_results();
+  const std::vector<gpu::PlacementGpu> drawn = this->drawn();
   for (size_t i = 0; i < labels_.size(); ++i) {
     LabelLayout l;
     l.id = scene_.labels[i].id;
@@ -543,7 +654,8 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
     const std::vector<std::byte> front = runner_->download_buffer(front_alpha_id_);
     for (size_t i = 0; i < frame.labels.size(); ++i) {
       frame.labels[i].visible = visible[i];
-      std::memcpy(&frame.labels[i].front_alpha, front.data() + i * sizeof(float), sizeof(float));
+      std::memcpy(&frame.labels[i].front_alpha, front.data() + slots_.of(i) * sizeof(float),
+                  sizeof(float));
     }
   }
   for (LabelLayout& l : frame.labels) {

@@ -14,8 +14,10 @@
 
 #include "engine/core/font.h"
 #include "engine/scene/scene.h"
+#include "labeling/label_slots.h"
 #include "labeling/layering.h"
 #include "labeling/placement_beside.h"
+#include "labeling/text_layout.h"
 #include "passes/label_forces.h"
 #include "passes/picking.h"
 #include "passes/placement.h"
@@ -54,6 +56,9 @@ struct LabellingSettings {
   float wrap_width = 240.0f;
   bool layer_colors = false;  // label borders in their layer's colour (the thesis's depth cue)
   Ghosting ghost;
+  // Label slots kept free beyond the scene's labels (labeling/label_slots.h): labels added later
+  // (labels_changed) fill them without new buffers or a new graph; the viewer keeps some.
+  uint32_t spare_label_slots = 0;
   uint64_t seed = 1;      // k-means++
   RenderSettings render;  // its layer_count and splits come from the layering
 };
@@ -131,6 +136,7 @@ class LabelledRenderer {
     Placement::Outputs placed;
     graph::ResourceId drawn;  // PlacementGpu[]: where the labels are drawn
     uint32_t layer_count = 1;
+    uint32_t label_slots = 1;  // the per-label buffers' length (LabelSlots::count)
     // The placement is in the frame's graph (`placed` is valid), not beside it.
     bool placement_in_frame = true;
   };
@@ -170,8 +176,9 @@ class LabelledRenderer {
   void set_frames_in_flight(uint32_t frames);
   // Frame slot `slot` is free (its last frame finished): the results read from now on are that
   // frame's (a frame or two old), the next frame writes its own into the slot. Reads the
-  // renderer's counters (and grows its table when it overflowed).
-  void use_slot(uint32_t slot);
+  // renderer's counters (and grows its table when it overflowed); with `read` false (the slot's
+  // last frame was another graph's) only the slot is chosen.
+  void use_slot(uint32_t slot, bool read = true);
   // Sets the next frame up, `seconds` after the last, without running it (the caller records
   // runner() into its own command buffer). A trial frame places the labels (in the order given
   // to set_trial_order) but leaves the forces' state as it was (optimisation on idle).
@@ -211,8 +218,11 @@ class LabelledRenderer {
   LabellingSettings& settings() { return settings_; }
   VolumeRenderer& renderer();
   // The scene's labels changed (added, removed, moved or given new text: the viewer's own
-  // labels): the placement, forces and drawing are made again for them, the volumes stay
-  // uploaded; every label starts on its new placement. Waits for the frames in flight.
+  // labels). Where they fit the label slots, the next frame takes them without waiting: new
+  // glyphs are bound into the graph, the labels kept keep where they are drawn, a new one
+  // appears on its placement. Else the placement, forces and drawing are made again for them
+  // around the uploaded volumes (a wait for the frames in flight, a new graph) and every label
+  // starts on its new placement.
   void labels_changed();
   // Hides label `index` (of the scene's labels) from the layering, placement and drawing (the
   // anchors are layered again, as by set_camera).
@@ -227,8 +237,10 @@ class LabelledRenderer {
   const RenderStats& stats() const { return stats_; }
   graph::ResourceId labelled_image() const { return labelled_id_; }
   // The last completed frame's (of the current slot) placements and drawn positions, per label.
-  std::span<const gpu::PlacementGpu> placement_results() const;
-  std::span<const gpu::PlacementGpu> drawn() const;
+  std::vector<gpu::PlacementGpu> placement_results() const;
+  std::vector<gpu::PlacementGpu> drawn() const;
+  // The per-label buffers' slots (labeling/label_slots.h): the graph was built for count().
+  const LabelSlots& label_slots() const { return slots_; }
   // Stein & Decoret's order inside each layer, from the last frame's layers (downloads them:
   // nothing may be in flight).
   std::vector<uint32_t> apollonius_layers_order();
@@ -251,6 +263,12 @@ class LabelledRenderer {
   // picked() reads the last frame's points (waits for it).
   void set_picks(std::vector<glm::vec2> pixels);
   std::vector<PickHit> picked() const;
+  // Picks without waiting (the viewer's clicks; frames with an extension): the pixels asked go
+  // into the next frame prepared and their points come back with that frame's slot (use_slot);
+  // take_picks() hands over those come back since, in the order asked.
+  void request_pick(glm::vec2 pixel);
+  std::vector<PickHit> take_picks();
+  size_t picks_pending() const;
 
   // The label-free layer images of the last frame (premultiplied rgba, layer after layer, each
   // size.width x size.height), waited for.
@@ -266,7 +284,24 @@ class LabelledRenderer {
   std::unique_ptr<Parts> parts_;
   std::unique_ptr<graph::GraphRunner> runner_;
   std::unique_ptr<PlacementBeside> beside_;
+  LabelSlots slots_;
   uint64_t frame_number_ = 0;
+  // The labels as the GPU's buffers hold them: each in its slot, disabled ones in the others.
+  std::vector<gpu::LabelGpu> slot_labels() const;
+  // Glyphs and atlases replaced while frames in flight may still read them: kept until
+  // frame `until` is prepared.
+  struct Retired {
+    uint64_t until = 0;
+    Buffer glyphs;
+    std::vector<Image> images;
+  };
+  std::vector<Retired> retired_;
+  void release_retired(bool all);
+  std::optional<Font> font_;  // the label font at settings_.font_pixels * label_scale
+  FontAtlas font_atlas_;      // the glyphs the drawing has (kept while they cover the texts)
+  ImageAtlas image_atlas_;    // the labels' pictures the drawing has
+  ShapedTexts shaped_;        // the label texts shaped so far (font_ and the style)
+  graph::ResourceId glyphs_id_ = 0;
   void run_frame();
   // The frame's placement and forces: in the frame's graph, or beside it.
   LabelForces::Outputs add_placement_in_frame(graph::Graph& graph,
@@ -277,6 +312,7 @@ class LabelledRenderer {
                                             graph::ResourceId& labels);
   void project_and_layer(const Camera& camera);
   void build_graph();
+  void add_pick_readback(graph::Graph& graph);
   void set_placement_frame(bool moving, const std::vector<uint32_t>& within);
   std::vector<uint32_t> within_;  // the order inside each layer set_order() was last given
   std::vector<uint32_t> trial_within_;
@@ -301,8 +337,13 @@ class LabelledRenderer {
   graph::ResourceId layers_id_ = 0;
   graph::ResourceId front_alpha_id_ = 0;  // labels.front_alpha (offline frames only)
   graph::ResourceId picks_id_ = 0;        // picking.points
-  uint32_t graph_layers_ = 0;             // the layer count the graph was built for
-  bool graph_ghost_ = false;  // the graph has the ghosting pass (LabellingSettings::ghost)
+  std::vector<glm::vec2> pick_requests_;  // asked, in no frame yet
+  // Per frame slot: the pixels its frame picks (request_pick), and the points come back.
+  std::vector<std::vector<glm::vec2>> picks_in_slot_;
+  std::vector<PickHit> picks_done_;
+  uint32_t slot_ = 0;          // the frame slot use_slot() chose last
+  uint32_t graph_layers_ = 0;  // the layer count the graph was built for
+  bool graph_ghost_ = false;   // the graph has the ghosting pass (LabellingSettings::ghost)
   LabellingSettings settings_;
 };
 

@@ -48,15 +48,29 @@ std::vector<ShapedLine> shape_label_text(const Font& font, std::string_view text
   return lines;
 }
 
-FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,
-                           const TextStyle& style) {
+const std::vector<ShapedLine>& ShapedTexts::lines(const Font& font, const std::string& text,
+                                                  const TextStyle& style) {
+  auto it = lines_.find(text);
+  if (it == lines_.end()) it = lines_.emplace(text, shape_label_text(font, text, style)).first;
+  return it->second;
+}
+
+std::vector<GlyphKey> label_glyph_keys(const Font& font, std::span<const std::string> texts,
+                                       const TextStyle& style, ShapedTexts* shaped) {
   std::vector<GlyphKey> keys;
   for (const std::string& text : texts) {
-    for (const ShapedLine& line : shape_label_text(font, text, style)) {
+    const std::vector<ShapedLine> own =
+        shaped ? std::vector<ShapedLine>{} : shape_label_text(font, text, style);
+    for (const ShapedLine& line : shaped ? shaped->lines(font, text, style) : own) {
       for (const ShapedGlyph& g : line.glyphs) keys.push_back(g.key);
     }
   }
-  return font.bake(keys);
+  return keys;
+}
+
+FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,
+                           const TextStyle& style) {
+  return font.bake(label_glyph_keys(font, texts, style));
 }
 
 std::vector<std::string> missing_glyph_warnings(const Font& font, std::span<const Label> labels) {
@@ -118,8 +132,11 @@ LabelImages bake_label_images(std::span<const Label> labels, float scale) {
 
 LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std::string_view text,
                                   const TextStyle& style, glm::vec2 min_size,
-                                  const std::optional<LabelImageBlock>& image) {
-  const std::vector<ShapedLine> lines = shape_label_text(font, text, style);
+                                  const std::optional<LabelImageBlock>& image,
+                                  const std::vector<ShapedLine>* shaped_lines) {
+  const std::vector<ShapedLine> own =
+      shaped_lines ? std::vector<ShapedLine>{} : shape_label_text(font, text, style);
+  const std::vector<ShapedLine>& lines = shaped_lines ? *shaped_lines : own;
   float widest = 0.0f;
   for (const ShapedLine& line : lines) widest = std::max(widest, line.advance);
   const float spacing = std::round(font.line_spacing());
@@ -170,7 +187,7 @@ LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std:
 std::vector<gpu::GlyphGpu> build_glyph_buffer(
     const Font& font, const FontAtlas& atlas, std::span<const std::string> texts,
     std::span<gpu::LabelGpu> labels, const TextStyle& style,
-    std::span<const std::optional<LabelImageBlock>> images) {
+    std::span<const std::optional<LabelImageBlock>> images, ShapedTexts* shaped) {
   if (texts.size() != labels.size() || (!images.empty() && images.size() != labels.size())) {
     throw Error("labels: " + std::to_string(texts.size()) + " texts and " +
                 std::to_string(images.size()) + " images for " + std::to_string(labels.size()) +
@@ -179,8 +196,9 @@ std::vector<gpu::GlyphGpu> build_glyph_buffer(
   std::vector<gpu::GlyphGpu> glyphs;
   for (size_t i = 0; i < texts.size(); ++i) {
     gpu::LabelGpu& label = labels[i];
-    const LabelTextLayout layout = layout_label_text(font, atlas, texts[i], style, label.size,
-                                                     images.empty() ? std::nullopt : images[i]);
+    const LabelTextLayout layout = layout_label_text(
+        font, atlas, texts[i], style, label.size, images.empty() ? std::nullopt : images[i],
+        shaped ? &shaped->lines(font, texts[i], style) : nullptr);
     label.size = layout.size;
     label.glyph_first = static_cast<uint32_t>(glyphs.size());
     label.glyph_count = static_cast<uint32_t>(layout.glyphs.size());

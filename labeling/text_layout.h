@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -64,6 +65,23 @@ std::vector<ShapedLine> shape_label_text(const Font& font, std::string_view text
 // character itself.
 std::vector<std::string> missing_glyph_warnings(const Font& font, std::span<const Label> labels);
 
+// Shaped lines by text for one font and style, each text shaped once: the viewer's label edits
+// shape only the texts they bring. clear() when the font or style changes.
+class ShapedTexts {
+ public:
+  const std::vector<ShapedLine>& lines(const Font& font, const std::string& text,
+                                       const TextStyle& style);
+  void clear() { lines_.clear(); }
+
+ private:
+  std::unordered_map<std::string, std::vector<ShapedLine>> lines_;
+};
+
+// The glyphs `texts` are drawn with (shaped as shape_label_text shapes them; by `shaped` where
+// given).
+std::vector<GlyphKey> label_glyph_keys(const Font& font, std::span<const std::string> texts,
+                                       const TextStyle& style = {}, ShapedTexts* shaped = nullptr);
+
 // The atlas with every glyph of `texts`.
 FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,
                            const TextStyle& style = {});
@@ -72,9 +90,11 @@ FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,
 // centred in the box. The box is at least `min_size` (zero: from the text alone), so a label's
 // given size is kept. With an image, the box holds it (padding around it, centred across the
 // box) above or left of the text, and the text is centred in the rest.
+// `lines`: the text shaped already (shape_label_text's), where given.
 LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std::string_view text,
                                   const TextStyle& style = {}, glm::vec2 min_size = glm::vec2(0),
-                                  const std::optional<LabelImageBlock>& image = std::nullopt);
+                                  const std::optional<LabelImageBlock>& image = std::nullopt,
+                                  const std::vector<ShapedLine>* lines = nullptr);
 
 // The glyph buffer for labels[i] showing texts[i] (and images[i], when images is not empty):
 // every label's glyphs one after the other, then its picture's quad. Sets each label's
@@ -83,6 +103,6 @@ LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std:
 std::vector<gpu::GlyphGpu> build_glyph_buffer(
     const Font& font, const FontAtlas& atlas, std::span<const std::string> texts,
     std::span<gpu::LabelGpu> labels, const TextStyle& style = {},
-    std::span<const std::optional<LabelImageBlock>> images = {});
+    std::span<const std::optional<LabelImageBlock>> images = {}, ShapedTexts* shaped = nullptr);
 
 }  // namespace strata

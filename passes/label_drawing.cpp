@@ -71,24 +71,45 @@ struct LabelDrawReference {
 }  // namespace
 }  // namespace gpu
 
+namespace {
+
+Image atlas_image(Context& ctx, VkFormat format, uint32_t width, uint32_t height,
+                  std::span<const std::byte> texels) {
+  Image image(ctx, {format, {width, height, 1}, VK_IMAGE_TYPE_2D, VK_IMAGE_USAGE_SAMPLED_BIT});
+  upload(ctx, image, texels, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  return image;
+}
+
+}  // namespace
+
 LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas& images,
                            LabelDrawing* from)
-    : atlas_(ctx, {VK_FORMAT_R8_UNORM,
-                   {font.width, font.height, 1},
-                   VK_IMAGE_TYPE_2D,
-                   VK_IMAGE_USAGE_SAMPLED_BIT}),
-      images_(ctx, {VK_FORMAT_R8G8B8A8_UNORM,
-                    {images.width, images.height, 1},
-                    VK_IMAGE_TYPE_2D,
-                    VK_IMAGE_USAGE_SAMPLED_BIT}),
-      ghost_pipeline_(
+    : ghost_pipeline_(
           reuse_or_create(ctx, from ? &from->ghost_pipeline_ : nullptr, "labels_ghost.comp")),
       front_alpha_(
           reuse_or_create(ctx, from ? &from->front_alpha_ : nullptr, "labels_front_alpha.comp")),
       draw_(reuse_or_create(ctx, from ? &from->draw_ : nullptr, "label_draw.comp")),
       composite_(reuse_or_create(ctx, from ? &from->composite_ : nullptr, "label_composite.comp")) {
-  upload(ctx, atlas_, as_bytes(font.coverage), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  upload(ctx, images_, as_bytes(images.texels), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  set_atlases(ctx, font, images);
+}
+
+std::vector<Image> LabelDrawing::set_atlases(Context& ctx, const FontAtlas& font,
+                                             const ImageAtlas& images) {
+  std::vector<Image> old;
+  if (atlas_) old.push_back(std::move(*atlas_));
+  if (images_) old.push_back(std::move(*images_));
+  atlas_.emplace(
+      atlas_image(ctx, VK_FORMAT_R8_UNORM, font.width, font.height, as_bytes(font.coverage)));
+  images_.emplace(atlas_image(ctx, VK_FORMAT_R8G8B8A8_UNORM, images.width, images.height,
+                              as_bytes(images.texels)));
+  return old;
+}
+
+void LabelDrawing::bind(graph::GraphRunner& runner) const {
+  if (atlas_id_ != 0) {
+    runner.bind_image(atlas_id_, atlas_->handle(), atlas_->view(), VK_FORMAT_R8_UNORM);
+    runner.bind_image(images_id_, images_->handle(), images_->view(), VK_FORMAT_R8G8B8A8_UNORM);
+  }
 }
 
 gpu::LabelDrawParams LabelDrawing::params(graph::Extent viewport) const {
@@ -107,17 +128,19 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
   layer_count_ = in.layer_count;
   background_ = in.background;
   const ResourceId atlas = graph.import_image(
-      "labels.font_atlas", {.image = atlas_.handle(),
-                            .view = atlas_.view(),
+      "labels.font_atlas", {.image = atlas_->handle(),
+                            .view = atlas_->view(),
                             .format = VK_FORMAT_R8_UNORM,
                             .has_content = true,
                             .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
   const ResourceId images = graph.import_image(
-      "labels.image_atlas", {.image = images_.handle(),
-                             .view = images_.view(),
+      "labels.image_atlas", {.image = images_->handle(),
+                             .view = images_->view(),
                              .format = VK_FORMAT_R8G8B8A8_UNORM,
                              .has_content = true,
                              .initial_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  atlas_id_ = atlas;
+  images_id_ = images;
   if (in.ghost) {
     graph.add_pass({"labels.ghost",
                     graph::PassKind::compute,
@@ -220,25 +243,22 @@ std::vector<glm::vec4> ghost_reference(std::span<const glm::vec4> layers, graph:
   const gpu::GhostParams g = ghost_params(ghost, size, layer_count, uint32_t(count));
   std::vector<glm::vec4> out(layers.begin(), layers.end());
   if (ghost.strength <= 0.0f) return out;
-  std::vector<float> open_on(layer_count);
   for (size_t q = 0; q < pixels; ++q) {
     const glm::vec2 p(float(q % size.width) + 0.5f, float(q / size.width) + 0.5f);
-    std::fill(open_on.begin(), open_on.end(), 0.0f);
+    float open_on[VR_MAX_LAYERS] = {};
+    float alpha[VR_MAX_LAYERS] = {};
     for (size_t i = 0; i < count; ++i) {
       const gpu::LabelGpu& label = data.labels[i];
-      if (label.layer >= layer_count) continue;
+      if (label.layer >= std::min(layer_count, uint32_t(VR_MAX_LAYERS))) continue;
       open_on[label.layer] =
           std::max(open_on[label.layer], gpu::ghost_opening(label, data.placements[i], p, g));
     }
-    float behind = 0.0f;
-    float behind_alpha = 0.0f;
-    for (int k = int(layer_count) - 1; k >= 0; --k) {
+    for (uint32_t k = 0; k < std::min(layer_count, uint32_t(VR_MAX_LAYERS)); ++k)
+      alpha[k] = out[size_t(k) * pixels + q].a;
+    const gpu::GhostKeeps keeps = gpu::ghost_keeps(open_on, alpha, layer_count, g.strength);
+    for (uint32_t k = 0; k < std::min(layer_count, uint32_t(VR_MAX_LAYERS)); ++k) {
       glm::vec4& c = out[size_t(k) * pixels + q];
-      behind_alpha = gpu::ghost_behind_alpha(c.a, behind_alpha);
-      if (behind > 0.0f) c = to_half_precision(c * gpu::ghost_keep(behind, g.strength));
-      if (k > 0 && open_on[size_t(k)] > 0.0f) {
-        behind = std::max(behind, open_on[size_t(k)] * gpu::ghost_behind_weight(behind_alpha));
-      }
+      if (keeps.layer[k] < 1.0f) c = to_half_precision(c * keeps.layer[k]);
     }
   }
   return out;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -60,6 +61,12 @@ class LabelDrawing {
   // Adds both passes; the font and image atlases are imported with their handles.
   void add_to(graph::Graph& graph, const Inputs& in);
 
+  // New font and image atlases (new label texts): uploaded into new images, which bind() hands
+  // to a graph built before; the old images are returned, for the caller to keep until the
+  // frames in flight that read them have finished.
+  std::vector<Image> set_atlases(Context& ctx, const FontAtlas& font, const ImageAtlas& images);
+  void bind(graph::GraphRunner& runner) const;
+
   // How many labels of the labels buffer to draw (read when the graph is recorded); the shader
   // never reads past the end of the labels or placements buffer either way.
   void set_label_count(uint32_t count) { label_count_ = count; }
@@ -72,8 +79,9 @@ class LabelDrawing {
  private:
   gpu::LabelDrawParams params(graph::Extent viewport) const;
 
-  Image atlas_;
-  Image images_;
+  std::optional<Image> atlas_;
+  std::optional<Image> images_;
+  graph::ResourceId atlas_id_ = 0, images_id_ = 0;  // as imported into the graph last built
   ComputePipeline ghost_pipeline_;
   ComputePipeline front_alpha_;
   ComputePipeline draw_;

@@ -30,34 +30,63 @@ ResourceId Picking::add_to(graph::Graph& graph, const Inputs& in) {
   };
   const ResourceId pixels = graph.add_buffer("picking.pixels", fixed(PICK_MAX * sizeof(glm::vec2)));
   const ResourceId points = graph.add_buffer("picking.points", fixed(PICK_MAX * sizeof(glm::vec4)));
-  graph.add_pass({"picking.upload",
-                  graph::PassKind::transfer,
-                  {{pixels, Use::transfer_dst}},
-                  [this, pixels](graph::PassContext& pc) {
+  // (no labels: empty stand-ins for the shader's label bindings, cleared, never read)
+  labels_ = in.labels != 0 && in.placements != 0;
+  const ResourceId labels =
+      labels_ ? in.labels : graph.add_buffer("picking.no_labels", fixed(sizeof(gpu::LabelGpu)));
+  const ResourceId placements =
+      labels_ ? in.placements
+              : graph.add_buffer("picking.no_placements", fixed(sizeof(gpu::PlacementGpu)));
+  std::vector<graph::ResourceUse> uploads{{pixels, Use::transfer_dst}};
+  if (!labels_) {
+    uploads.push_back({labels, Use::transfer_dst});
+    uploads.push_back({placements, Use::transfer_dst});
+  }
+  graph.add_pass({"picking.upload", graph::PassKind::transfer, uploads,
+                  [this, pixels, labels, placements](graph::PassContext& pc) {
+                    if (!labels_) {
+                      vkCmdFillBuffer(pc.cmd, pc.buffer(labels), 0, VK_WHOLE_SIZE, 0);
+                      vkCmdFillBuffer(pc.cmd, pc.buffer(placements), 0, VK_WHOLE_SIZE, 0);
+                    }
                     if (pixels_.empty()) return;
                     record_update(pc.cmd, pc.buffer(pixels), 0, as_bytes(pixels_));
                   },
                   "picking"});
+  const VolumeRenderer::Outputs& r = in.rendered;
+  const uint32_t label_count = labels_ ? in.label_count : 0u;
   graph.add_pass({"picking.points",
                   graph::PassKind::compute,
-                  {{in.frame, Use::uniform, PICK_BINDING_FRAME},
-                   {in.depth, Use::storage_read, PICK_BINDING_DEPTH},
+                  {{r.frame, Use::uniform, VR_BINDING_FRAME},
+                   {r.volumes, Use::uniform, VR_BINDING_VOLUMES},
+                   {r.keys, Use::storage_read, VR_BINDING_KEYS},
+                   {r.payload, Use::storage_read, VR_BINDING_PAYLOAD},
+                   {r.atlas, Use::sampled, VR_BINDING_ATLAS},
+                   {r.transfer, Use::storage_read, VR_BINDING_TRANSFER},
+                   {r.occupancy, Use::storage_read, VR_BINDING_OCCUPANCY},
+                   {r.depth, Use::storage_read, PICK_BINDING_DEPTH},
+                   {r.layers, Use::storage_read, PICK_BINDING_LAYERS},
+                   {labels, Use::storage_read, PICK_BINDING_LABELS},
+                   {placements, Use::storage_read, PICK_BINDING_PLACEMENTS},
                    {pixels, Use::storage_read, PICK_BINDING_PIXELS},
                    {points, Use::storage_write, PICK_BINDING_POINTS}},
-                  [this](graph::PassContext& pc) {
+                  [this, label_count](graph::PassContext& pc) {
                     if (pixels_.empty()) return;
                     const auto count = static_cast<uint32_t>(pixels_.size());
-                    pc.dispatch(pipeline_,
-                                gpu::PickParams{count, pc.viewport.width, pc.viewport.height, 0u},
-                                {count, 1, 1});
+                    const gpu::PickParams params{
+                        count, 0u, 0u, 0u, ghost_params(ghost_, pc.viewport, 0u, label_count)};
+                    pc.dispatch(pipeline_, params, {count, 1, 1});
                   },
                   "picking"});
   return points;
 }
 
 std::vector<PickHit> Picking::hits(std::span<const std::byte> points) const {
+  return pick_hits(points, pixels_.size());
+}
+
+std::vector<PickHit> pick_hits(std::span<const std::byte> points, size_t count) {
   std::vector<PickHit> out;
-  for (size_t i = 0; i < pixels_.size(); ++i) {
+  for (size_t i = 0; i < count; ++i) {
     glm::vec4 p(0.0f);
     if ((i + 1) * sizeof p <= points.size())
       std::memcpy(&p, points.data() + i * sizeof p, sizeof p);
@@ -66,16 +95,41 @@ std::vector<PickHit> Picking::hits(std::span<const std::byte> points) const {
   return out;
 }
 
+namespace {
+
+// A device-local buffer holding `data` (at least one element's worth), imported into `graph`.
+template <typename T>
+ResourceId import_filled(Context& ctx, graph::Graph& graph, const char* name,
+                         std::span<const T> data, std::vector<Buffer>& keep) {
+  const std::vector<T> bytes =
+      data.empty() ? std::vector<T>(1) : std::vector<T>(data.begin(), data.end());
+  keep.emplace_back(ctx, bytes.size() * sizeof(T), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                    MemoryKind::device_local);
+  upload(ctx, keep.back(), as_bytes(bytes));
+  return graph.import_buffer(name, {.buffer = keep.back().handle(), .has_content = true});
+}
+
+}  // namespace
+
 ScenePick pick_scene(Context& ctx, const Scene& scene, const Camera& camera,
                      const RenderSettings& settings, graph::Extent size,
-                     std::vector<glm::vec2> pixels, uint32_t runs) {
+                     std::vector<glm::vec2> pixels, uint32_t runs, const PickLabels& labels) {
   VolumeRenderer renderer(ctx, scene, settings);
   renderer.set_camera(camera);
   Picking picking(ctx);
   picking.set_pixels(std::move(pixels));
+  picking.set_ghost(labels.ghost);
   graph::Graph graph;
   const VolumeRenderer::Outputs out = renderer.add_to(graph);
-  const ResourceId points = picking.add_to(graph, {.frame = out.frame, .depth = out.depth});
+  Picking::Inputs in{.rendered = out};
+  std::vector<Buffer> label_buffers;
+  label_buffers.reserve(2);
+  if (!labels.labels.empty() && !labels.placements.empty()) {
+    in.labels = import_filled(ctx, graph, "pick.labels", labels.labels, label_buffers);
+    in.placements = import_filled(ctx, graph, "pick.placements", labels.placements, label_buffers);
+    in.label_count = uint32_t(std::min(labels.labels.size(), labels.placements.size()));
+  }
+  const ResourceId points = picking.add_to(graph, in);
   graph::GraphRunner runner(ctx, std::move(graph));
   runner.set_viewport(size);
   renderer.run_until_no_overflow(runner, [](const RenderStats&) {});
@@ -91,13 +145,40 @@ ScenePick pick_scene(Context& ctx, const Scene& scene, const Camera& camera,
   return result;
 }
 
-std::vector<PickHit> pick_reference(const ReferenceImage& image, const gpu::FrameGpu& frame,
-                                    std::span<const glm::vec2> pixels) {
+std::vector<PickHit> pick_reference(const RenderInputs& inputs, const gpu::FrameGpu& frame,
+                                    graph::Extent size, std::span<const glm::vec2> pixels,
+                                    const PickLabels& labels) {
+  const size_t label_count =
+      std::min({labels.labels.size(), labels.placements.size(), size_t{LABEL_MAX}});
+  const gpu::GhostParams g = ghost_params(labels.ghost, size, 0u, uint32_t(label_count));
+  const uint32_t layer_count = std::min(frame.layer_count, uint32_t{VR_MAX_LAYERS});
   std::vector<PickHit> out;
   for (const glm::vec2 pixel : pixels) {
-    const glm::ivec2 t = gpu::pick_texel(pixel, image.size.width, image.size.height);
-    const float depth = image.depth[size_t(t.y) * image.size.width + size_t(t.x)];
-    const glm::vec4 p = gpu::pick_point(frame, t, depth, image.size.width, image.size.height);
+    const glm::ivec2 t = gpu::pick_texel(pixel, size.width, size.height);
+    const glm::ivec2 cast = gpu::pick_cast_pixel(frame, t, size.width, size.height);
+    const glm::vec2 centre = glm::vec2(cast) + 0.5f;
+    ReferencePixel walked = walk_reference_pixel(inputs, frame, centre);
+    // (as pick.comp: the labels' openings at the pixel, then the keeps from the layers' alphas)
+    float open_on[VR_MAX_LAYERS] = {};
+    bool any = false;
+    for (size_t i = 0; i < label_count && g.strength > 0.0f; ++i) {
+      const gpu::LabelGpu& label = labels.labels[i];
+      if (label.layer >= layer_count) continue;
+      const float open = gpu::ghost_opening(label, labels.placements[i], glm::vec2(t) + 0.5f, g);
+      open_on[label.layer] = std::max(open_on[label.layer], open);
+      any = any || open > 0.0f;
+    }
+    if (any) {
+      float alpha[VR_MAX_LAYERS] = {};
+      for (uint32_t l = 0; l < layer_count; ++l)
+        alpha[l] = gpu::pick_stored_alpha(walked.layers[l].a);
+      const gpu::GhostKeeps keeps = gpu::ghost_keeps(open_on, alpha, layer_count, g.strength);
+      if (std::any_of(std::begin(keeps.layer), std::end(keeps.layer),
+                      [](float k) { return k < 1.0f; })) {
+        walked = walk_reference_pixel(inputs, frame, centre, keeps.layer);
+      }
+    }
+    const glm::vec4 p = gpu::pick_point(frame, cast, walked.depth);
     out.push_back({p.w > 0.5f, glm::vec3(p)});
   }
   return out;

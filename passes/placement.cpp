@@ -136,7 +136,7 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
 }
 
 gpu::PlacementParams Placement::params(graph::Extent viewport, uint32_t step) const {
-  gpu::PlacementParams p = placement_params(settings_, viewport, layer_count_, label_count_, step);
+  gpu::PlacementParams p = placement_params(settings_, viewport, layer_count_, frame_count(), step);
   p.order_count = static_cast<uint32_t>(order_.size());
   // place_label dispatch `step`: the main pass of position step - 1, the speculative one of step
   p.label = step > 0 && step <= order_.size() ? order_[step - 1] : 0;
@@ -154,11 +154,12 @@ uint32_t Placement::classify_tiles(graph::Extent viewport) const {
 }
 
 void Placement::set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_t> order,
-                          const PlacementSettings& settings) {
+                          const PlacementSettings& settings, std::optional<uint32_t> active) {
   if (labels.size() != label_count_ || order.size() > label_count_) {
     throw Error("placement: set_frame got " + std::to_string(labels.size()) + " labels and " +
                 std::to_string(order.size()) + " in the order for " + std::to_string(label_count_));
   }
+  active_ = std::min(active.value_or(label_count_), label_count_);
   labels_ = std::move(labels);
   order_ = std::move(order);
   settings_ = settings;
@@ -280,7 +281,7 @@ void Placement::add_costs(graph::Graph& graph, const Buffers& b, const Inputs& i
                   [this](graph::PassContext& pc) {
                     pc.dispatch(
                         integral_costs_,
-                        integral_costs_params(settings_, pc.viewport, layer_count_, label_count_),
+                        integral_costs_params(settings_, pc.viewport, layer_count_, frame_count()),
                         {pc.viewport.width, pc.viewport.height, 1});
                   },
                   "placement"});
@@ -414,11 +415,11 @@ void Placement::add_tidy(graph::Graph& graph, const Buffers& b) {
                   [this, b](graph::PassContext& pc) {
                     gpu::PlacementParams p = params(pc.viewport, 0);
                     p.phase = TIDY_PHASE_START;
-                    pc.dispatch(tidy_, p, {std::max(label_count_, p.tidy_rounds + 1), 1, 1});
+                    pc.dispatch(tidy_, p, {std::max(frame_count(), p.tidy_rounds + 1), 1, 1});
                     record_tidy_rounds(pc, p, b);
                     pc.barrier();
                     p.phase = TIDY_PHASE_OUTPUT;
-                    pc.dispatch(tidy_, p, {label_count_, 1, 1});
+                    pc.dispatch(tidy_, p, {frame_count(), 1, 1});
                   },
                   "placement"});
   graph.add_pass({"placement.readback",
@@ -454,7 +455,8 @@ void Placement::record_tidy_rounds(graph::PassContext& pc, gpu::PlacementParams 
       const ComputePipeline& pipeline = p.phase == TIDY_PHASE_SEARCH ? search_ : tidy_;
       const VkDeviceSize offset =
           (VkDeviceSize{round} * TIDY_ROUND_STEPS + k) * 3 * sizeof(uint32_t);
-      dispatch(pc, pipeline, p, b.tidy_args, offset, gpu::tidy_phase_groups(p.phase, label_count_));
+      dispatch(pc, pipeline, p, b.tidy_args, offset,
+               gpu::tidy_phase_groups(p.phase, frame_count()));
     }
     const bool block_ends = (round + 1) % kTidyBlockRounds == 0 || round + 1 == p.tidy_rounds;
     if (conditional && block_ends) pc.end_conditional();

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -157,9 +158,10 @@ class Placement {
   Outputs add_to(graph::Graph& graph, const Inputs& in);
 
   // This frame's labels (label_count of them; disabled ones are skipped) and insertion order
-  // (indices of the enabled labels). Read when the frame is recorded.
+  // (indices of the enabled labels). Read when the frame is recorded. Labels from `active` on
+  // are all disabled (spare label slots): the placement's work leaves them out.
   void set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_t> order,
-                 const PlacementSettings& settings);
+                 const PlacementSettings& settings, std::optional<uint32_t> active = {});
 
   // Labels in this frame's insertion order.
   uint32_t order_count() const { return uint32_t(order_.size()); }
@@ -200,6 +202,8 @@ class Placement {
 
   Context& ctx_;
   uint32_t label_count_;
+  uint32_t active_ = 0;
+  uint32_t frame_count() const { return active_; }
   PlacementLayout layout_;
   PlacementPlan plan_;
   uint32_t layer_count_ = 1;

@@ -12,7 +12,9 @@ namespace {
 using glm::ivec3;  // the software sampler's voxel coordinates, by their GLSL name like the rest
 
 // One pixel's work on the CPU. The shared resolve is included inside this struct, so its
-// functions see `frame` and the sampling functions below as members.
+// functions see `frame` and the sampling functions below as members. It is compiled with the
+// layer keep hook (picking walks the picture as ghosting draws it): with every layer kept whole,
+// the resolve's own walk.
 struct Reference {
   FrameGpu frame;
   const RenderInputs& in;
@@ -59,8 +61,15 @@ struct Reference {
   size_t stride = 0;
   void emit_layer(uint l, vec4 colour) const { layers[l * stride] = colour; }
 
+  // The share of each layer the walk keeps (VR_RESOLVE_LAYER_KEEP).
+  float layer_keeps[VR_MAX_LAYERS] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+  float layer_keep(uint l) const { return layer_keeps[l]; }
+
+#define VR_RESOLVE_LAYER_KEEP
 #include "shared/resolve_walk.h"
+#undef VR_RESOLVE_LAYER_KEEP
 };
+static_assert(VR_MAX_LAYERS == 8, "layer_keeps' initialiser");
 
 struct Fragment {
   float depth;
@@ -108,8 +117,37 @@ std::vector<Fragment> mesh_fragments(const RenderInputs& in, const FrameGpu& fra
   return out;
 }
 
+// The mesh fragments along the ray through `pixel`, in the walk's arrays (the first
+// VR_MAX_MESH_FRAGMENTS, as the GPU's resolve keeps); returns how many.
+uint32_t walk_fragments(const Reference& ref, vec2 pixel, float (&depths)[VR_MAX_FRAGMENTS],
+                        uvec2 (&payloads)[VR_MAX_FRAGMENTS]) {
+  const Ray ray = frame_pixel_ray(ref.frame, pixel);
+  const std::vector<Fragment> found = mesh_fragments(ref.in, ref.frame, ray.origin, ray.direction);
+  const uint32_t count = uint32_t(std::min<size_t>(found.size(), VR_MAX_MESH_FRAGMENTS));
+  for (uint32_t i = 0; i < count; ++i) {
+    depths[i] = found[i].depth;
+    payloads[i] = found[i].payload;
+  }
+  return count;
+}
+
 }  // namespace
 }  // namespace gpu
+
+ReferencePixel walk_reference_pixel(const RenderInputs& inputs, const gpu::FrameGpu& frame,
+                                    glm::vec2 pixel, std::span<const float> keep) {
+  gpu::Reference ref{frame, inputs, corrected_transfer(inputs, frame.step)};
+  for (size_t l = 0; l < keep.size() && l < VR_MAX_LAYERS; ++l) ref.layer_keeps[l] = keep[l];
+  ReferencePixel out;
+  out.layers.assign(frame.layer_count, glm::vec4(0.0f));
+  ref.layers = out.layers.data();
+  ref.stride = 1;
+  float depths[VR_MAX_FRAGMENTS];
+  glm::uvec2 payloads[VR_MAX_FRAGMENTS];
+  const uint32_t count = gpu::walk_fragments(ref, pixel, depths, payloads);
+  out.depth = ref.resolve_pixel(pixel, count, depths, payloads).depth;
+  return out;
+}
 
 ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera,
                                 const RenderSettings& settings, graph::Extent size) {
@@ -125,16 +163,9 @@ ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera
   for (uint32_t y = 0; y < size.height; ++y) {
     for (uint32_t x = 0; x < size.width; ++x) {
       const glm::vec2 centre(float(x) + 0.5f, float(y) + 0.5f);
-      const auto ray = ref.pixel_ray(centre);
-      const std::vector<gpu::Fragment> found =
-          gpu::mesh_fragments(inputs, ref.frame, ray.origin, ray.direction);
       float depths[VR_MAX_FRAGMENTS];
       glm::uvec2 payloads[VR_MAX_FRAGMENTS];
-      const uint32_t count = uint32_t(std::min<size_t>(found.size(), VR_MAX_MESH_FRAGMENTS));
-      for (uint32_t i = 0; i < count; ++i) {
-        depths[i] = found[i].depth;
-        payloads[i] = found[i].payload;
-      }
+      const uint32_t count = gpu::walk_fragments(ref, centre, depths, payloads);
       const size_t p = size_t{y} * size.width + x;
       ref.layers = &image.layers[p];
       ref.stride = pixels;

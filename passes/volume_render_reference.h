@@ -3,6 +3,7 @@
 // software trilinear sampling of the same atlas and transfer table. Small images only: tests.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "passes/volume_renderer.h"
@@ -21,5 +22,16 @@ struct ReferenceImage {
 
 ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera,
                                 const RenderSettings& settings, graph::Extent size);
+
+// One pixel's walk (the frame's pixel units, centres at +0.5), keeping keep[l] of each layer l
+// (ghosting: shared/ghost.h; layers past keep's end are kept whole): the layers as walked, whole,
+// and the eye depth where the picture drawn with those keeps first reaches depth_alpha (0:
+// nowhere). Every layer whole: the depth of render_reference.
+struct ReferencePixel {
+  std::vector<glm::vec4> layers;  // frame.layer_count, premultiplied
+  float depth = 0.0f;
+};
+ReferencePixel walk_reference_pixel(const RenderInputs& inputs, const gpu::FrameGpu& frame,
+                                    glm::vec2 pixel, std::span<const float> keep = {});
 
 }  // namespace strata

@@ -455,6 +455,11 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
   ids_.vertices = uploaded("render.vertices", vertices_);
   ids_.indices = uploaded("render.indices", indices_);
   ids_.readback = counters_readback_.import(graph, "render.counters_readback");
+  out.payload = payload;
+  out.volumes = ids_.volumes;
+  out.atlas = ids_.atlas;
+  out.transfer = transfer;
+  out.occupancy = ids_.occupancy;
 
   graph.add_pass({"render.clear",
                   graph::PassKind::transfer,

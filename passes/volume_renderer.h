@@ -116,7 +116,10 @@ class VolumeRenderer {
     graph::ResourceId final;   // rgba8, layers over the background
     graph::ResourceId depth;   // r32f eye depth, 0 where nothing is opaque enough
     graph::ResourceId frame;   // FrameGpu (uniform): camera, layers, the HA-Buffer's size
-    graph::ResourceId keys;    // the HA-Buffer: uint64_t per slot (debug views)
+    graph::ResourceId keys;    // the HA-Buffer: uint64_t per slot (debug views, picking)
+    // What the resolve reads besides (picking walks rays again): the HA-Buffer's payloads, the
+    // volumes' records (uniform), the atlas (sampled), the transfer table and the occupancy.
+    graph::ResourceId payload, volumes, atlas, transfer, occupancy;
   };
 
   // Uploads the scene once: volumes into the atlas, transfer functions into their table, the

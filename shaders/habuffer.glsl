@@ -1,4 +1,5 @@
-// The HA-Buffer in storage buffers, shared by its build and its resolve.
+// The HA-Buffer in storage buffers, shared by its build, its resolve and the pick (the counters
+// are the build's and the resolve's own).
 // A key is 64 bits: eye depth (float bits, positive so they order like the floats) in the high
 // word, then the age (probe number, 8 bits) and the pixel index (24 bits). Slot of (pixel, age):
 // pixel + age * golden ratio, modulo the table: age 1 keeps neighbouring pixels in neighbouring
@@ -10,7 +11,6 @@
 
 layout(binding = VR_BINDING_KEYS, std430) buffer Keys { uint64_t keys[]; };
 layout(binding = VR_BINDING_PAYLOAD, std430) buffer Payload { uvec2 payload[]; };
-layout(binding = VR_BINDING_COUNTERS, std430) buffer Counters { uint counters[VR_COUNTER_COUNT]; };
 
 uint habuffer_slot(uint pixel, uint age, uint table_size) {
   return (pixel + age * 0x9E3779B1u) % table_size;

@@ -6,6 +6,7 @@
 // Thin: every fragment of every mesh goes into the hash table; nothing is drawn.
 layout(early_fragment_tests) in;
 layout(binding = VR_BINDING_FRAME) uniform Frame { FrameGpu frame; };
+layout(binding = VR_BINDING_COUNTERS, std430) buffer Counters { uint counters[VR_COUNTER_COUNT]; };
 layout(push_constant) uniform Push { DrawGpu draw; };
 
 layout(location = 0) in vec3 view_position;

@@ -1,38 +1,22 @@
-// The resolve (shared/resolve_walk.h): per pixel, the HA-Buffer's fragments gathered and sorted,
-// the volumes' boxes added, the walk, the layers and the final image. Included by
-// habuffer_resolve.comp (any scene) and, with VR_RESOLVE_ONE_VOLUME, by
-// habuffer_resolve_one_volume.comp: a scene of one volume and no meshes, whose walk the compiler
-// then specialises (fewer registers, a faster resolve: docs/performance.md). The volumes' records
-// are a uniform block, read as constants.
+// The resolve (shared/resolve_walk.h): per pixel, the HA-Buffer's fragments gathered and sorted
+// (resolve_scene.glsl, with the scene's bindings), the volumes' boxes added, the walk, the layers
+// and the final image. Included by habuffer_resolve.comp (any scene) and, with
+// VR_RESOLVE_ONE_VOLUME, by habuffer_resolve_one_volume.comp: a scene of one volume and no meshes,
+// whose walk the compiler then specialises (fewer registers, a faster resolve:
+// docs/performance.md). The volumes' records are a uniform block, read as constants.
 #ifdef VR_RESOLVE_ONE_VOLUME
 #define VR_RESOLVE_MESHES false
 #else
 #define VR_RESOLVE_MESHES (frame.mesh_count > 0u)
 #endif
 #include "shared/volume_shading.h"
-#include "habuffer.glsl"
+#include "resolve_scene.glsl"
 
 layout(local_size_x = VR_RESOLVE_GROUP, local_size_y = VR_RESOLVE_GROUP) in;
-layout(binding = VR_BINDING_FRAME) uniform Frame { FrameGpu frame; };
-// (a uniform block: GPUs read its fields as constants instead of holding them in registers)
-layout(binding = VR_BINDING_VOLUMES) uniform Volumes { VolumeGpu volumes[VR_MAX_VOLUMES]; };
-layout(binding = VR_BINDING_ATLAS) uniform sampler3D atlas;
-layout(binding = VR_BINDING_TRANSFER, std430) readonly buffer Transfer { vec4 transfer_table[]; };
-layout(binding = VR_BINDING_OCCUPANCY, std430) readonly buffer Occupancy { uint occupancy[]; };
+layout(binding = VR_BINDING_COUNTERS, std430) buffer Counters { uint counters[VR_COUNTER_COUNT]; };
 layout(binding = VR_BINDING_LAYERS, rgba16f) writeonly uniform image2DArray layers;
 layout(binding = VR_BINDING_FINAL, rgba8) writeonly uniform image2D final_image;
 layout(binding = VR_BINDING_DEPTH, r32f) writeonly uniform image2D depth_image;
-
-VolumeGpu volume_info(uint v) { return volumes[v]; }
-vec4 volume_sample(uint v, vec3 tc) {
-  return texture(atlas, volumes[v].atlas_offset.xyz + tc * volumes[v].atlas_scale.xyz);
-}
-vec4 table_entry(uint v, int i) { return transfer_table[v * VR_TF_SIZE + uint(i)]; }
-bool brick_empty(uint v, vec3 tc) {
-  const uvec3 b = min(uvec3(tc / (volumes[v].texel.xyz * float(VR_BRICK))), volumes[v].bricks.xyz - 1u);
-  const uvec4 g = volumes[v].bricks;
-  return occupancy[g.w + (b.z * g.y + b.y) * g.x + b.x] == 0u;
-}
 
 // The pixel's layers go to the images as the walk leaves them; the final image composites them.
 ivec2 pixel_coord;
@@ -51,30 +35,7 @@ void main() {
   uint count = 0u, dropped = 0u;
   float depths[VR_MAX_FRAGMENTS];
   uvec2 payloads[VR_MAX_FRAGMENTS];
-  if (inside && VR_RESOLVE_MESHES) {
-    // Gather this pixel's mesh fragments along its probe sequence up to the first empty slot,
-    // then sort them by depth.
-    const uint pixel = px.y * frame.width + px.x;
-    for (uint age = 1u; age <= VR_MAX_AGE; ++age) {
-      const uint slot = habuffer_slot(pixel, age, frame.table_size);
-      const uint64_t key = keys[slot];
-      if (key == uint64_t(0)) break;
-      if (uint(key & 0xFFFFFFul) != pixel || uint((key >> 24) & 0xFFul) != age) continue;
-      if (count == VR_MAX_MESH_FRAGMENTS) {
-        ++dropped;
-        continue;
-      }
-      const float d = uintBitsToFloat(uint(key >> 32));
-      const uvec2 p = payload[slot];
-      uint j = count++;
-      for (; j > 0u && depths[j - 1u] > d; --j) {
-        depths[j] = depths[j - 1u];
-        payloads[j] = payloads[j - 1u];
-      }
-      depths[j] = d;
-      payloads[j] = p;
-    }
-  }
+  if (inside && VR_RESOLVE_MESHES) count = gather_fragments(px, depths, payloads, dropped);
   PixelResult r;
   pixel_coord = ivec2(px);
   if (inside) r = resolve_pixel(vec2(px) + 0.5, count, depths, payloads);

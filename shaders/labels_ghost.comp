@@ -1,7 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "shared/ghost.h"
-#include "shared/volume_render.h"  // VR_MAX_LAYERS
 
 // Ghosting (shared/ghost.h): each layer in front of a shown rear label made more transparent
 // around the label's anchor (and connector), in place, before the labels are drawn.
@@ -59,17 +58,14 @@ void main() {
     }
   }
   if (!any) return;
-  // (back to front: the largest opening of the labels behind layer k, each as far as what lies
-  // at and behind its layer lets it)
-  float behind = 0.0f;
-  float behind_alpha = 0.0f;
-  for (int k = int(layer_count) - 1; k >= 0; --k) {
-    const ivec3 texel = ivec3(px, k);
-    const vec4 c = imageLoad(layers, texel);
-    if (behind > 0.0f) imageStore(layers, texel, c * ghost_keep(behind, params.strength));
-    behind_alpha = ghost_behind_alpha(c.a, behind_alpha);
-    if (k > 0 && open_on[k] > 0.0f) {
-      behind = max(behind, open_on[k] * ghost_behind_weight(behind_alpha));
-    }
+  vec4 colour[VR_MAX_LAYERS];
+  float alpha[VR_MAX_LAYERS];
+  for (uint k = 0u; k < VR_MAX_LAYERS; ++k) {
+    colour[k] = k < layer_count ? imageLoad(layers, ivec3(px, k)) : vec4(0.0);
+    alpha[k] = colour[k].a;
+  }
+  const GhostKeeps keeps = ghost_keeps(open_on, alpha, layer_count, params.strength);
+  for (uint k = 0u; k < layer_count; ++k) {
+    if (keeps.layer[k] < 1.0) imageStore(layers, ivec3(px, k), colour[k] * keeps.layer[k]);
   }
 }

@@ -182,7 +182,7 @@ TEST_SUITE("cli") {
     const auto r = run_strata("render " STRATA_SOURCE_DIR
                               "/assets/scenes/head.json --size 48 --dump-graph -o /dev/null");
     CHECK(r.exit_code == 0);
-    CHECK(r.output.find("pass 15 'placement.labels' (compute, placement)") != std::string::npos);
+    CHECK(r.output.find("pass 13 'placement.labels' (compute, placement)") != std::string::npos);
     CHECK(r.output.find("25 passes, 59 barriers") != std::string::npos);
   }
 

@@ -72,6 +72,29 @@ TEST_SUITE("cpu") {
     CHECK(insertion_order(labels, layering, within, priorities) ==
           std::vector<uint32_t>{2, 0, 1, 3});
   }
+
+  // A label keeps its slot by id; a new one takes the next never used; an edit that does not fit,
+  // or two labels with one id, changes nothing.
+  TEST_CASE("label_slots_keep_each_ids_slot_and_refuse_what_does_not_fit") {
+    LabelSlots slots;
+    slots.reset(std::vector<int>{7, 3, 9}, 2, LABEL_MAX);
+    CHECK(slots.count() == 5);
+    CHECK(slots.to_slots(std::vector<uint32_t>{2, 0}) == std::vector<uint32_t>{2, 0});
+    REQUIRE(slots.assign(std::vector<int>{7, 9, 11}));  // 3 deleted, 11 added
+    CHECK(std::vector<uint32_t>(slots.slots().begin(), slots.slots().end()) ==
+          std::vector<uint32_t>{0, 2, 3});
+    REQUIRE(slots.assign(std::vector<int>{7, 3, 9, 11}));  // 3 back (an undo): its own slot
+    CHECK(std::vector<uint32_t>(slots.slots().begin(), slots.slots().end()) ==
+          std::vector<uint32_t>{0, 1, 2, 3});
+    CHECK_FALSE(slots.assign(std::vector<int>{7, 3, 9, 11, 12, 13}));  // one slot left, two new
+    CHECK_FALSE(slots.assign(std::vector<int>{7, 7}));
+    CHECK(slots.of(3) == 3);  // (unchanged by the refusals)
+    const std::vector<int> per_label = {70, 30, 90, 110};
+    CHECK(slots.scatter<int>(per_label, -1) == std::vector<int>{70, 30, 90, 110, -1});
+    CHECK(slots.gather<int>(std::vector<int>{0, 1, 2, 3, 4}) == std::vector<int>{0, 1, 2, 3});
+    slots.reset(std::vector<int>(5000, 1), 64, LABEL_MAX);  // (past the limit: as many as asked)
+    CHECK(slots.count() == 5000);
+  }
 }
 
 TEST_SUITE("gpu") {
@@ -301,6 +324,68 @@ TEST_SUITE("gpu") {
       CHECK(front[k] > front[k - 1]);
       CHECK(front[k] - front[k - 1] <= 0.4f * rise);
     }
+  }
+
+  // The viewer's own labels: an edit that fits the spare slots keeps the graph (no wait, no new
+  // resources) and gives the layout and picture a renderer without spare slots gives after the
+  // same edits (the label side made again each time); one that does not fit makes the label side
+  // again with more slots.
+  TEST_CASE_FIXTURE(test::GpuTest, "label_edits_in_spare_slots_keep_the_graph_and_the_result") {
+    const Scene loaded = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    Scene scene = loaded;
+    const graph::Extent size{128, 128};
+    const Camera camera = camera_for(scene, "front");
+    LabellingSettings settings;
+    settings.spare_label_slots = 4;
+    LabelledRenderer renderer(ctx, scene, camera, size, settings);
+    LabelledRenderer rebuilt(ctx, scene, camera, size, {});
+    renderer.run();
+    const graph::GraphRunner* runner = &renderer.runner();
+    const uint64_t allocation = runner->allocation();
+    const auto same_as_rebuilt = [&](const char* edit) {
+      CAPTURE(edit);
+      renderer.labels_changed();
+      rebuilt.labels_changed();
+      renderer.run();
+      rebuilt.run();
+      CHECK(&renderer.runner() == runner);
+      CHECK(renderer.runner().allocation() == allocation);
+      const LabelledFrame kept = renderer.result();
+      const LabelledFrame afresh = rebuilt.result();
+      REQUIRE(kept.labels.size() == scene.labels.size());
+      REQUIRE(afresh.labels.size() == scene.labels.size());
+      size_t placed = 0;
+      for (size_t i = 0; i < kept.labels.size(); ++i) {
+        CAPTURE(kept.labels[i].text);
+        CHECK(kept.labels[i].id == scene.labels[i].id);
+        CHECK(kept.labels[i].placed == afresh.labels[i].placed);
+        CHECK(kept.labels[i].box_size == afresh.labels[i].box_size);
+        CHECK(kept.labels[i].box_origin == afresh.labels[i].box_origin);
+        placed += kept.labels[i].placed ? 1 : 0;
+      }
+      CHECK(placed >= 4);  // (at 128 px not all fit)
+      test::check_close(kept.image, afresh.image, size, std::string("edit ") + edit);
+    };
+    Label added = scene.labels[3];
+    added.id = 500;
+    added.text = "Added – ödem";
+    added.anchor += glm::vec3(0.0f, 0.0f, 12.0f);
+    scene.labels.push_back(added);
+    same_as_rebuilt("added");
+    scene.labels.erase(scene.labels.begin() + 1);
+    same_as_rebuilt("deleted");
+    scene.labels[0].text = "A longer name for the first label";
+    same_as_rebuilt("renamed");
+    scene.labels.insert(scene.labels.begin() + 1, loaded.labels[1]);  // (an undo)
+    same_as_rebuilt("brought back");
+    for (int id = 600; id < 606; ++id) {  // more than the spare slots
+      added.id = id;
+      scene.labels.push_back(added);
+    }
+    renderer.labels_changed();
+    CHECK(renderer.label_slots().count() >= scene.labels.size() + settings.spare_label_slots);
+    renderer.run();
+    CHECK(renderer.result().labels.size() == scene.labels.size());
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "labels_glide_to_the_new_placement_after_a_camera_move") {

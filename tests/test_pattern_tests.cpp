@@ -118,6 +118,16 @@ TEST_SUITE("gpu") {
     runner.set_timestamps_per_pass(true);
     runner.run_now();
     CHECK(runner.timings().size() == runner.graph().passes().size());
+    // A change of the stamping applies to the frames recorded after it: the last frame is read
+    // as it was stamped (its slot's stamps, not stamps never written).
+    runner.set_timestamps_per_frame();
+    CHECK(runner.timings().size() == runner.graph().passes().size());
+    runner.run_now();
+    REQUIRE(runner.timings().size() == 1);
+    CHECK(runner.timings()[0].name == "frame");
+    runner.set_timestamps_per_pass(true);
+    CHECK(runner.timings().size() == 1);
+    runner.run_now();
     const std::vector<uint8_t> expected = test_pattern_reference(40, 30, 3);
     CHECK(compare_images(target.pixels(), expected, {40, 30}, 2, "group-stamps") <= 2);
   }

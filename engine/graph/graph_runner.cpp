@@ -187,6 +187,7 @@ void GraphRunner::set_frames_in_flight(uint32_t frames) {
   if (!queries_.empty()) ctx_.wait_idle("the frames in flight (their query pools are replaced)");
   for (VkQueryPool pool : queries_) vkDestroyQueryPool(ctx_.device(), pool, nullptr);
   queries_.assign(frames, VK_NULL_HANDLE);
+  slot_stamps_.assign(frames, stamps_);
   VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
   info.queryType = VK_QUERY_TYPE_TIMESTAMP;
   info.queryCount = static_cast<uint32_t>(2 * std::max<size_t>(1, graph_.passes().size()));
@@ -339,21 +340,21 @@ void GraphRunner::check_bound() const {
   }
 }
 
-bool GraphRunner::stamps_begin(uint32_t p) const {
+bool GraphRunner::stamps_begin(uint32_t p, Stamps stamps) const {
   const auto& passes = graph_.passes();
-  if (frame_stamps_) return p == 0;
-  return per_pass_stamps_ || p == 0 || passes[p - 1].group != passes[p].group;
+  if (stamps == Stamps::frame) return p == 0;
+  return stamps == Stamps::pass || p == 0 || passes[p - 1].group != passes[p].group;
 }
 
-bool GraphRunner::stamps_end(uint32_t p) const {
+bool GraphRunner::stamps_end(uint32_t p, Stamps stamps) const {
   const auto& passes = graph_.passes();
-  if (frame_stamps_) return p + 1 == passes.size();
-  return per_pass_stamps_ || p + 1 == passes.size() || passes[p + 1].group != passes[p].group;
+  if (stamps == Stamps::frame) return p + 1 == passes.size();
+  return stamps == Stamps::pass || p + 1 == passes.size() || passes[p + 1].group != passes[p].group;
 }
 
 void GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
   emit(cmd, compiled_.pass_barriers[p]);
-  if (stamps_begin(p)) {
+  if (stamps_begin(p, slot_stamps_[slot_])) {
     vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_[slot_], 2 * p);
   }
   PassContext pc;
@@ -371,7 +372,7 @@ void GraphRunner::record_pass(VkCommandBuffer cmd, uint32_t p) {
     pc.end_conditional();  // (the command buffer still ends cleanly)
     throw GraphError("pass '" + graph_.passes()[p].name + "' leaves a conditional block open");
   }
-  if (stamps_end(p)) {
+  if (stamps_end(p, slot_stamps_[slot_])) {
     vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries_[slot_], 2 * p + 1);
   }
 }
@@ -392,6 +393,7 @@ void GraphRunner::record_passes(VkCommandBuffer cmd, PassId first, PassId end, u
                 " of " + std::to_string(passes));
   }
   slot_ = slot;
+  if (first == 0) slot_stamps_[slot_] = stamps_;
   if (first == 0 && frames_in_flight() > 1) {
     // Frames share the transient resources and follow each other on the queue: everything the
     // earlier frames did is done and visible before this one starts (compile() orders the passes
@@ -428,15 +430,16 @@ std::vector<PassTiming> GraphRunner::timings(uint32_t slot) const {
                                     sizeof(uint64_t),
                                     VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   };
-  if (per_pass_stamps_ && !passes.empty()) {
+  const Stamps mode = slot_stamps_.at(slot);
+  if (mode == Stamps::pass && !passes.empty()) {
     STRATA_VK(vkGetQueryPoolResults(ctx_.device(), pool, 0, static_cast<uint32_t>(stamps.size()),
                                     stamps.size() * sizeof(uint64_t), stamps.data(),
                                     sizeof(uint64_t),
                                     VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   } else {
     for (uint32_t p = 0; p < passes.size(); ++p) {
-      if (stamps_begin(p)) read(2 * p);
-      if (stamps_end(p)) read(2 * p + 1);
+      if (stamps_begin(p, mode)) read(2 * p);
+      if (stamps_end(p, mode)) read(2 * p + 1);
     }
   }
   std::vector<PassTiming> out;
@@ -446,15 +449,15 @@ std::vector<PassTiming> GraphRunner::timings(uint32_t slot) const {
   };
   uint32_t group_first = 0;
   for (uint32_t p = 0; p < passes.size(); ++p) {
-    if (per_pass_stamps_) {
+    if (mode == Stamps::pass) {
       const double begin = since_start(2 * p), end = since_start(2 * p + 1);
       out.push_back({passes[p].name, passes[p].group, end - begin, begin, end});
       continue;
     }
-    if (stamps_begin(p)) group_first = p;
-    if (stamps_end(p)) {
+    if (stamps_begin(p, mode)) group_first = p;
+    if (stamps_end(p, mode)) {
       const double begin = since_start(2 * group_first), end = since_start(2 * p + 1);
-      const std::string name = frame_stamps_ ? "frame" : passes[p].group;
+      const std::string name = mode == Stamps::frame ? "frame" : passes[p].group;
       out.push_back({name, name, end - begin, begin, end});
     }
   }

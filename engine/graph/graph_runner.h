@@ -161,15 +161,11 @@ class GraphRunner {
 
   // Timestamps around every pass (the default), or only where a group of passes begins and
   // ends: a group's time without the cost of stamping each of its passes (benchmarks).
-  void set_timestamps_per_pass(bool per_pass) {
-    per_pass_stamps_ = per_pass;
-    frame_stamps_ = false;
-  }
+  // Each frame slot is read as its last frame was stamped, so the stamping may change while
+  // frames are in flight.
+  void set_timestamps_per_pass(bool per_pass) { stamps_ = per_pass ? Stamps::pass : Stamps::group; }
   // Only where the frame begins and ends: one entry, "frame" (the least disturbed whole time).
-  void set_timestamps_per_frame() {
-    per_pass_stamps_ = false;
-    frame_stamps_ = true;
-  }
+  void set_timestamps_per_frame() { stamps_ = Stamps::frame; }
   // GPU time of each pass of the last completed run; with group stamps only, one entry per
   // group (named after it) instead. With frames in flight: of the last completed frame of `slot`.
   std::vector<PassTiming> timings(uint32_t slot = 0) const;
@@ -192,13 +188,15 @@ class GraphRunner {
   void check_bound() const;
   void record_pass(VkCommandBuffer cmd, uint32_t pass);
   void put_in_layout(const Image& image, VkImageLayout layout);
-  // Whether pass p stamps its begin / its end (every pass, or a group's first / last).
-  bool stamps_begin(uint32_t pass) const;
-  bool stamps_end(uint32_t pass) const;
+  enum class Stamps { pass, group, frame };
+  // Whether pass p stamps its begin / its end (every pass, a group's first / last, or the
+  // frame's).
+  bool stamps_begin(uint32_t pass, Stamps stamps) const;
+  bool stamps_end(uint32_t pass, Stamps stamps) const;
 
   Context& ctx_;
-  bool per_pass_stamps_ = true;
-  bool frame_stamps_ = false;
+  Stamps stamps_ = Stamps::pass;
+  std::vector<Stamps> slot_stamps_;  // how each slot's last frame was stamped
   Graph graph_;
   CompiledGraph compiled_;
   Extent viewport_{};

@@ -38,6 +38,7 @@ using glm::max;
 using glm::min;
 using glm::mix;
 using glm::normalize;
+using glm::packHalf2x16;
 using glm::packUnorm4x8;
 using glm::pow;
 using glm::sin;
@@ -45,6 +46,7 @@ using glm::smoothstep;
 using glm::sqrt;
 using glm::transpose;
 using glm::uintBitsToFloat;
+using glm::unpackHalf2x16;
 using glm::unpackUnorm4x8;
 }  // namespace strata::gpu
 

@@ -9,11 +9,13 @@
 // layer L and the layers behind it hold at p (ghost_behind_weight). Layer k keeps
 // 1 - strength * (the largest opening at p) of its colour and alpha; nothing changes beyond every
 // lens. Labels are drawn after, so a box is never made harder to read. The placement counts the
-// lenses too (ghost_placement_opening): a box the lenses let through is legible.
+// lenses too (ghost_placement_opening): a box the lenses let through is legible. Picking
+// (shared/pick.h) walks the picture as drawn, with the same shares kept (ghost_keeps).
 #ifndef STRATA_SHARED_GHOST_H
 #define STRATA_SHARED_GHOST_H
 
 #include "label_drawing.h"
+#include "volume_render.h"  // VR_MAX_LAYERS
 
 #define GHOST_GROUP 16
 #define GHOST_BINDING_LAYERS 0       // rgba16f 2D array, premultiplied, changed in place
@@ -106,6 +108,30 @@ STRATA_INLINE bool ghost_far_from_tile(vec2 tile_lo, vec2 tile_hi, LabelGpu labe
 // the layers behind it is `largest_behind`.
 STRATA_INLINE float ghost_keep(float largest_behind, float strength) {
   return 1.0f - clamp(strength, 0.0f, 1.0f) * largest_behind;
+}
+
+// The share each of a pixel's layers keeps (layer[k]; 1 past layer_count), from the largest
+// opening of the labels on each layer (open_on) and the layers' own alphas at the pixel. Back to
+// front: layer k opens by the largest opening of the labels behind it, each as far as what lies
+// at and behind its own layer lets it.
+struct GhostKeeps {
+  float layer[VR_MAX_LAYERS];
+};
+
+STRATA_INLINE GhostKeeps ghost_keeps(float open_on[VR_MAX_LAYERS], float alpha[VR_MAX_LAYERS],
+                                     uint layer_count, float strength) {
+  GhostKeeps keeps;
+  for (uint k = 0u; k < uint(VR_MAX_LAYERS); ++k) keeps.layer[k] = 1.0f;
+  float behind = 0.0f;
+  float behind_alpha = 0.0f;
+  for (int k = int(min(layer_count, uint(VR_MAX_LAYERS))) - 1; k >= 0; --k) {
+    if (behind > 0.0f) keeps.layer[k] = ghost_keep(behind, strength);
+    behind_alpha = ghost_behind_alpha(alpha[k], behind_alpha);
+    if (k > 0 && open_on[k] > 0.0f) {
+      behind = max(behind, open_on[k] * ghost_behind_weight(behind_alpha));
+    }
+  }
+  return keeps;
 }
 
 STRATA_END

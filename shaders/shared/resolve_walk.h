@@ -12,6 +12,14 @@
 // and the pixel's mesh fragments sorted front to back: their eye depths and payloads. The
 // volumes' boxes are added here, by a ray-box test.
 //
+// With VR_RESOLVE_LAYER_KEEP defined the includer also provides
+//   float layer_keep(uint l)               the share of layer l's colour and alpha the picture
+//                                          keeps (ghosting: shared/ghost.h; 1 without)
+// and the depth follows the drawn picture instead of the walk's own sum: with A_l(z) layer l's
+// alpha up to z, the picture's alpha at z in layer l is 1 - T * (1 - keep_l * A_l(z)), T the
+// product of (1 - keep_j * A_j) over the layers j in front (their whole alphas). While every
+// layer so far is kept whole that is the walk's own sum, so the depth is exactly the resolve's.
+//
 // The ray is parametrised by eye depth z: point(z) = origin + direction * z. Samples lie on one
 // grid for the whole ray (near + (k + 0.5) * dz), so segments between fragments join seamlessly.
 
@@ -33,9 +41,27 @@ struct PixelResult {
 uint shaded_samples = 0u;
 uint atlas_fetches = 0u;
 
+#ifdef VR_RESOLVE_LAYER_KEEP
+float drawn_front_clear = 1.0f;  // T: what the drawn layers the ray has left let through
+bool drawn_front_whole = true;   // every layer the ray has left is drawn as walked
+
+// The drawn picture's alpha in layer l, whose own alpha so far is layer_alpha (total: the walk's
+// sum of every layer).
+float drawn_alpha(float total, float layer_alpha, uint l) {
+  float keep = layer_keep(l);
+  if (drawn_front_whole && keep >= 1.0f) return total;
+  return 1.0f - drawn_front_clear * (1.0f - keep * layer_alpha);
+}
+#endif
+
 // The ray leaves layer `from` (its colour `acc`) for layer `to`: those in between stay empty.
 void close_layers(uint from, uint to, vec4 acc) {
   emit_layer(from, acc);
+#ifdef VR_RESOLVE_LAYER_KEEP
+  float keep = layer_keep(from);
+  drawn_front_clear *= 1.0f - keep * acc.a;
+  drawn_front_whole = drawn_front_whole && (keep >= 1.0f || acc.a <= 0.0f);
+#endif
   for (uint l = from + 1u; l < to; ++l) emit_layer(l, vec4(0.0f));
 }
 
@@ -166,6 +192,10 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   r.samples = 0u;
   shaded_samples = 0u;
   atlas_fetches = 0u;
+#ifdef VR_RESOLVE_LAYER_KEEP
+  drawn_front_clear = 1.0f;
+  drawn_front_whole = true;
+#endif
 
   Ray ray = pixel_ray(pixel);
   vec3 origin = ray.origin;
@@ -245,9 +275,15 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
                           : sample_volumes(live, origin + direction * zs, to_eye);
       r.samples += 1u;
       acc = over(acc, c);
+#ifdef VR_RESOLVE_LAYER_KEEP
+      total = total + (1.0f - total) * c.a;
+      // (the first z: the drawn alpha may step back by a rounding where a layer stops being whole)
+      if (r.depth <= 0.0f && drawn_alpha(total, acc.a, layer) >= frame.depth_alpha) r.depth = zs;
+#else
       float before = total;
       total = total + (1.0f - total) * c.a;
       if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = zs;
+#endif
       k += 1.0f;
     }
     if (i == count) break;
@@ -263,9 +299,16 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
         acc = vec4(0.0f);
       }
       acc = over(acc, c);
+#ifdef VR_RESOLVE_LAYER_KEEP
+      total = total + (1.0f - total) * c.a;
+      if (r.depth <= 0.0f && drawn_alpha(total, acc.a, layer) >= frame.depth_alpha) {
+        r.depth = z_end;
+      }
+#else
       float before = total;
       total = total + (1.0f - total) * c.a;
       if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = z_end;
+#endif
     } else {
       uint bit = 1u << (p.y & 255u);
       live = ((p.y >> 10u) & 1u) != 0u ? (live | bit) : (live & ~bit);
