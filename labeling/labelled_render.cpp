@@ -190,7 +190,7 @@ void LabelledRenderer::build_labels() {
     old.images = p.drawing->set_atlases(ctx_, font_atlas_, image_atlas_);
   }
   retired_.push_back(std::move(old));
-  p.drawing->set_label_count(slots_.count());
+  p.drawing->set_label_count(slots_.used());
   if (runner_) {
     runner_->bind_buffer(glyphs_id_, p.glyphs.handle());
     p.drawing->bind(*runner_);
@@ -466,6 +466,7 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
   parts_->placement.set_frame(
       slot_labels(), slots_.to_slots(insertion_order(labels_, layering_, within, priorities_)),
       settings, slots_.used());
+  parts_->forces.set_active(slots_.used());
   parts_->drawing->set_layer_frames(settings_.layer_colors);
   const GhostSettings ghost{settings_.ghost.strength, settings_.ghost.radius * side,
                             settings_.ghost.leader * side};

@@ -67,6 +67,7 @@ gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
 LabelForces::LabelForces(Context& ctx, uint32_t label_count, LabelForces* from)
     : ctx_(ctx),
       label_count_(label_count),
+      active_(label_count),
       params_(forces_params({}, {1024.0f, 14.0f, 1024.0f}, label_count, 0.0)),
       forces_(reuse_or_create(ctx, from ? &from->forces_ : nullptr, "label_forces.comp")),
       previous_(reuse_or_create(ctx, from ? &from->previous_ : nullptr, "label_previous.comp")),
@@ -86,7 +87,7 @@ void LabelForces::reset() {
 
 void LabelForces::set_frame(const ForceSettings& settings, LabelUnits units, double seconds,
                             bool hard, uint32_t order_count) {
-  params_ = forces_params(settings, units, label_count_, seconds, hard, order_count);
+  params_ = forces_params(settings, units, active_, seconds, hard, order_count);
 }
 
 std::vector<gpu::LabelStateGpu> LabelForces::state() const {
@@ -110,7 +111,7 @@ void LabelForces::add_previous(graph::Graph& graph, graph::ResourceId labels,
                   {{labels, Use::storage_read_write, FORCES_BINDING_LABELS},
                    {state, Use::storage_read, FORCES_BINDING_STATE}},
                   [this](graph::PassContext& pc) {
-                    pc.dispatch(previous_, params_, {label_count_, 1, 1});
+                    pc.dispatch(previous_, params_, {active_, 1, 1});
                   },
                   "placement"});  // (timed with the placement it feeds)
 }
@@ -161,7 +162,7 @@ graph::ResourceId LabelForces::add_follow(graph::Graph& graph, graph::ResourceId
                    {targets, Use::storage_read, FORCES_BINDING_TARGETS},
                    {followed, Use::storage_write, FORCES_BINDING_FOLLOWED}},
                   [this](graph::PassContext& pc) {
-                    pc.dispatch(follow_, params_, {label_count_, 1, 1});
+                    pc.dispatch(follow_, params_, {active_, 1, 1});
                   },
                   "labels"});
   return followed;

@@ -112,6 +112,9 @@ class LabelForces {
   // repeatable).
   void set_frame(const ForceSettings& settings, LabelUnits units, double seconds, bool hard = false,
                  uint32_t order_count = 0);
+  // Labels from `count` on are all disabled (spare label slots): the next frames set (set_frame)
+  // leave them out.
+  void set_active(uint32_t count) { active_ = std::min(count, label_count_); }
   // The frame's count of labels in the insertion order the forces read (a placement's older than
   // the frame: labeling/placement_beside.h).
   void set_order_count(uint32_t count) { params_.order_count = std::min(count, label_count_); }
@@ -131,6 +134,7 @@ class LabelForces {
  private:
   Context& ctx_;
   uint32_t label_count_;
+  uint32_t active_;  // labels the frames move (set_active)
   gpu::ForcesParams params_{};
   ComputePipeline forces_, previous_, follow_;
   Buffer state_;

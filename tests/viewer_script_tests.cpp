@@ -146,7 +146,9 @@ TEST_SUITE("window") {
       CHECK(r.exit_code == 1);
       CHECK(r.output.find("strata: error: " + script.string() + ":2: " + message) !=
             std::string::npos);
-      CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(60));
+      // (a bound against waiting for ever, not a speed target: far above the run's own time on a
+      // loaded 2-core machine)
+      CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(180));
     }
   }
 
@@ -170,7 +172,9 @@ TEST_SUITE("window") {
                         ":3: the view did not settle within 8 s (--settle-limit, "
                         "settle-limit); still busy: ") != std::string::npos);
     CHECK(r.output.find("moving or fading (") != std::string::npos);
-    CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(60));
+    // (a bound against waiting for ever, not a speed target: far above the run's own time on a
+    // loaded 2-core machine)
+    CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(180));
   }
 }
 
