@@ -543,8 +543,8 @@ void Viewer::ask_pick(const PendingPick& pick) {
 }
 
 // The picks come back with their frame's slot: each places or moves its label now. Where the ray
-// met only background, `strict` throws (scripts), else the message says so.
-void Viewer::apply_picks(bool strict) {
+// met only background the message says so (and pick_now throws it).
+void Viewer::apply_picks() {
   for (const PickHit& hit : labelled_->take_picks()) {
     if (pending_picks_.empty()) break;
     const PendingPick pick = pending_picks_.front();
@@ -554,7 +554,7 @@ void Viewer::apply_picks(bool strict) {
           pick.move_id == 0
               ? "nothing under the pixel to place a label on (background)"
               : "nothing under the pixel to move label " + std::to_string(pick.move_id) + " to";
-      if (strict) throw Error(what);
+      missed_pick_ = what;
       if (!pick.drag) message_ = what;  // (a drag over the background: the anchor waits)
       ui_event();
       continue;
@@ -575,11 +575,12 @@ void Viewer::apply_picks(bool strict) {
 // A pick for a script or a benchmark: asked, then frames until it comes back.
 void Viewer::pick_now(const PendingPick& pick) {
   ask_pick(pick);
+  missed_pick_.reset();
   for (int frames = 0; !pending_picks_.empty(); ++frames) {
     if (frames > 16) throw Error("the pick did not come back within 16 frames");
     frame();
-    apply_picks(true);
   }
+  if (missed_pick_) throw Error(*missed_pick_);
 }
 
 size_t Viewer::label_index(int id) const {
@@ -1033,7 +1034,7 @@ graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double 
     changed();
   }
   read_slot(slot);
-  apply_picks(false);
+  apply_picks();
   // Stein & Decoret's order needs the picture: computed once the camera rests (a wait for the
   // frames in flight, once per rest).
   if (insertion_order_ == 1 && settled_ && apollonius_serial_ != serial_ && !control_.animating()) {

@@ -244,7 +244,7 @@ class Viewer {
     bool drag = false;
   };
   void ask_pick(const PendingPick& pick);
-  void apply_picks(bool strict);
+  void apply_picks();
   void pick_now(const PendingPick& pick);
   void add_label(glm::vec3 point);
   std::optional<size_t> label_near(glm::vec2 at, bool anchor) const;
@@ -345,9 +345,10 @@ class Viewer {
 
   // Labels of one's own.
   bool place_mode_ = false;
-  std::optional<int> anchor_drag_;         // the label (id) whose anchor the left button drags
-  bool drag_undone_ = false;               // the drag's first move is on the undo stack
-  std::deque<PendingPick> pending_picks_;  // asked, in the order asked
+  std::optional<int> anchor_drag_;          // the label (id) whose anchor the left button drags
+  bool drag_undone_ = false;                // the drag's first move is on the undo stack
+  std::deque<PendingPick> pending_picks_;   // asked, in the order asked
+  std::optional<std::string> missed_pick_;  // the last pick that met only background
   glm::vec2 anchor_drag_from_{0.0f};
   glm::vec2 press_at_{0.0f};  // where the last button press was (a click selects a label)
   char edit_text_[256] = "";  // the panel's text of the selected label

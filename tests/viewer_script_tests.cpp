@@ -133,6 +133,8 @@ TEST_SUITE("window") {
          "parameter weights.label_shadow: -5 is not a number in [0, 1e+09]"},
         {"set forces.fade nan", "parameter forces.fade: 'nan' is not a number"},
         {"set render.step 1e-9", "parameter render.step: 1e-09 is below"},
+        {"place 0 0", "nothing under the pixel to place a label on (background)"},
+        {"move 3 0 0", "nothing under the pixel to move label 3 to"},
     };
     for (const auto& [line, message] : cases) {
       CAPTURE(line);
