@@ -491,14 +491,6 @@ void LabelledRenderer::advance(double seconds) {
   run_frame();
 }
 
-void LabelledRenderer::set_picks(std::vector<glm::vec2> pixels) {
-  parts_->picking.set_pixels(std::move(pixels));
-}
-
-std::vector<PickHit> LabelledRenderer::picked() const {
-  return parts_->picking.hits(runner_->download_buffer(picks_id_));
-}
-
 void LabelledRenderer::add_pick_readback(graph::Graph& graph) {
   const graph::ResourceId readback = parts_->pick_points.import(graph, "picking.readback");
   const graph::ResourceId points = picks_id_;

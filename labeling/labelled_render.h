@@ -259,13 +259,9 @@ class LabelledRenderer {
   // a hidden label counting as much as an anchor-constraint violation.
   double total_cost() const;
 
-  // Picking (passes/picking.h): the frames from now on pick these pixels (at most PICK_MAX),
-  // picked() reads the last frame's points (waits for it).
-  void set_picks(std::vector<glm::vec2> pixels);
-  std::vector<PickHit> picked() const;
-  // Picks without waiting (the viewer's clicks; frames with an extension): the pixels asked go
-  // into the next frame prepared and their points come back with that frame's slot (use_slot);
-  // take_picks() hands over those come back since, in the order asked.
+  // Picking (passes/picking.h) without waiting (the viewer's clicks; frames with an extension): the
+  // pixels asked go into the next frame prepared and their points come back with that frame's slot
+  // (use_slot); take_picks() hands over those come back since, in the order asked.
   void request_pick(glm::vec2 pixel);
   std::vector<PickHit> take_picks();
   size_t picks_pending() const;
