@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <numeric>
 #include <random>
 #include <thread>
 
@@ -211,8 +212,10 @@ ordered_json placing_json(Viewer& viewer, ViewerOutput& output, const Scene& sce
       ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
       last = now;
     }
+    // (the mean too: with frames in flight a long interval is often followed by a short one)
+    const double mean = std::accumulate(ms.begin(), ms.end(), 0.0) / double(ms.size());
     std::sort(ms.begin(), ms.end());
-    return ordered_json{{"median", ms[ms.size() / 2]}, {"max", ms.back()}};
+    return ordered_json{{"median", ms[ms.size() / 2]}, {"mean", mean}, {"max", ms.back()}};
   };
   viewer.set_camera(camera);
   viewer.set_place_mode(true);

@@ -131,7 +131,7 @@ void LabelledRenderer::labels_changed() {
   }
   ctx_.wait_idle("the scene's labels changed");
   const bool beside = beside_ != nullptr;
-  runner_.reset();
+  drop_runner();
   beside_.reset();
   release_retired(true);
   slots_.reset(label_ids_, settings_.spare_label_slots, LABEL_MAX);
@@ -143,6 +143,15 @@ void LabelledRenderer::labels_changed() {
   build_graph();
   if (frames_in_flight_ > 1) set_frames_in_flight(frames_in_flight_);
   if (beside) set_placement_beside(true);
+}
+
+// The graph goes (once its frames in flight are done); the copies its next frame would have
+// made are made now.
+void LabelledRenderer::drop_runner() {
+  if (!runner_) return;
+  const Uploads uploads = runner_->take_uploads();
+  runner_.reset();
+  if (!uploads.empty()) ctx_.run_now([&](VkCommandBuffer cmd) { uploads.record(cmd); });
 }
 
 void check_label_text(float font_pixels, float label_scale) {
@@ -181,15 +190,24 @@ void LabelledRenderer::build_labels() {
       build_glyph_buffer(font, font_atlas_, texts, labels_, style, images.blocks, &shaped_);
   Buffer glyph_buffer(ctx_, std::max<size_t>(1, glyphs.size()) * sizeof(gpu::GlyphGpu),
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryKind::device_local);
-  if (!glyphs.empty()) upload(ctx_, glyph_buffer, as_bytes(glyphs));
-  Retired old{frame_number_ + frames_in_flight_, std::move(p.glyphs), {}};
+  // (a built graph's next frame copies what is new before its passes: no wait here; what is
+  // replaced is kept one frame more than the frames in flight, for a copy recorded into the next)
+  Uploads uploads;
+  Uploads* in_frame = runner_ ? &uploads : nullptr;
+  if (in_frame) {
+    uploads.add(ctx_, glyph_buffer, as_bytes(glyphs));
+  } else if (!glyphs.empty()) {
+    upload(ctx_, glyph_buffer, as_bytes(glyphs));
+  }
+  Retired old{frame_number_ + frames_in_flight_ + 1, std::move(p.glyphs), {}};
   p.glyphs = std::move(glyph_buffer);
   if (!p.drawing) {
     p.drawing.emplace(ctx_, font_atlas_, image_atlas_);
   } else if (!glyphs_kept || !images_kept) {
-    old.images = p.drawing->set_atlases(ctx_, font_atlas_, image_atlas_);
+    old.images = p.drawing->set_atlases(ctx_, font_atlas_, image_atlas_, in_frame);
   }
   retired_.push_back(std::move(old));
+  if (in_frame) runner_->upload_in_next_frame(std::move(uploads));
   p.drawing->set_label_count(slots_.used());
   if (runner_) {
     runner_->bind_buffer(glyphs_id_, p.glyphs.handle());
@@ -219,7 +237,7 @@ void LabelledRenderer::set_label_text(float pixels, float scale) {
   settings_.font_pixels = pixels;
   settings_.label_scale = scale;
   for (size_t i = 0; i < labels_.size(); ++i) labels_[i].size = scene_.labels[i].size;
-  runner_.reset();
+  drop_runner();
   release_retired(true);
   font_.reset();
   font_atlas_ = {};  // (glyphs of the new size)
@@ -388,6 +406,8 @@ void LabelledRenderer::build_graph() {
   } else {
     p.target.add_output(graph, labelled);
   }
+  // (what the old graph's next frame would have copied, the new one copies)
+  Uploads uploads = runner_ ? runner_->take_uploads() : Uploads{};
   runner_.reset();  // (waits for its frames in flight)
   // (picks asked in frames of the old graph are asked again)
   for (auto it = picks_in_slot_.rbegin(); it != picks_in_slot_.rend(); ++it) {
@@ -398,6 +418,7 @@ void LabelledRenderer::build_graph() {
   runner_->set_viewport(size_);
   if (!extension_) p.target.bind(*runner_);
   if (frames_in_flight_ > 1) runner_->set_frames_in_flight(frames_in_flight_);
+  runner_->upload_in_next_frame(std::move(uploads));
   if (beside_) beside_->build(render.layer_count, size_);
 }
 
@@ -436,7 +457,7 @@ LabelForces::Outputs LabelledRenderer::add_placement_beside(graph::Graph& graph,
 void LabelledRenderer::set_placement_beside(bool beside) {
   if (beside == placement_beside()) return;
   ctx_.wait_idle("the placement moving beside the frames or back");
-  runner_.reset();
+  drop_runner();
   beside_.reset();
   if (beside) {
     beside_ =

@@ -317,6 +317,7 @@ class LabelledRenderer {
   // rest lets the labels settle where a still would put them).
   bool camera_moved_ = false;
   std::optional<double> frame_seconds_;  // of the last frame set up; none: a still
+  void drop_runner();
   void build_labels();  // glyphs and box sizes from the texts at settings_.font_pixels
   void set_label_text(float pixels, float scale);
   Extension extension_;

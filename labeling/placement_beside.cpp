@@ -5,7 +5,9 @@
 #include "engine/core/error.h"
 #include "engine/gpu/context.h"
 #include "engine/gpu/resources.h"
+#include "engine/gpu/shader_library.h"
 #include "engine/gpu/vulkan_check.h"
+#include "shared/placement_snapshot.h"
 
 namespace strata {
 
@@ -39,17 +41,25 @@ void copy_buffer(const graph::PassContext& pc, graph::ResourceId from, graph::Re
   vkCmdCopyBuffer(pc.cmd, pc.buffer(from), pc.buffer(to), 1, &region);
 }
 
-void copy_image(const graph::PassContext& pc, graph::ResourceId from, graph::ResourceId to,
-                uint32_t layers) {
-  VkImageCopy region{};
-  region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, layers};
-  region.dstSubresource = region.srcSubresource;
-  region.extent = {pc.viewport.width, pc.viewport.height, 1};
-  vkCmdCopyImage(pc.cmd, pc.image(from), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.image(to),
-                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-}
-
 }  // namespace
+
+void add_snapshot_pass(graph::Graph& graph, const ComputePipeline& pipeline,
+                       const SnapshotImages& images, std::function<uint32_t()> layers_now) {
+  graph.add_pass(
+      {"placement.snapshot",
+       graph::PassKind::compute,
+       {{images.final_image, Use::storage_read, SNAPSHOT_BINDING_FINAL},
+        {images.layers, Use::storage_read, SNAPSHOT_BINDING_LAYERS},
+        {images.final_copy, Use::storage_write, SNAPSHOT_BINDING_FINAL_COPY},
+        {images.layers_copy, Use::storage_write, SNAPSHOT_BINDING_LAYERS_COPY}},
+       [&pipeline, layers_now = std::move(layers_now)](graph::PassContext& pc) {
+         const uint32_t layers = layers_now();
+         if (layers == 0) return;
+         const gpu::SnapshotParams params{{pc.viewport.width, pc.viewport.height}, layers, 0u};
+         pc.dispatch(pipeline, params, {pc.viewport.width, pc.viewport.height, 1});
+       },
+       "placement"});
+}
 
 PlacementBeside::PlacementBeside(Context& ctx, Placement& placement, LabelForces& forces,
                                  uint32_t label_count)
@@ -57,6 +67,7 @@ PlacementBeside::PlacementBeside(Context& ctx, Placement& placement, LabelForces
       placement_(placement),
       forces_(forces),
       label_count_(std::max(label_count, 1u)),
+      snapshot_(ctx, "placement_snapshot.comp"),
       published_targets_(zeroed_buffer(ctx, label_count_ * sizeof(gpu::PlacementGpu))),
       published_labels_(zeroed_buffer(ctx, label_count_ * sizeof(gpu::LabelGpu))),
       published_order_(zeroed_buffer(ctx, label_count_ * sizeof(uint32_t))),
@@ -83,7 +94,7 @@ void PlacementBeside::build(uint32_t layer_count, graph::Extent size) {
   layer_count_ = layer_count;
   placement_.readback().set_slots(2);
   for (Snapshot& s : snapshots_) {
-    const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT;
     s.final = Image(ctx_, {.format = VK_FORMAT_R8G8B8A8_UNORM,
                            .extent = {size.width, size.height, 1},
                            .usage = usage,
@@ -103,7 +114,7 @@ void PlacementBeside::build(uint32_t layer_count, graph::Extent size) {
     // at every stage)
     return graph.import_image(name, {.format = format,
                                      .has_content = true,
-                                     .initial_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                     .initial_layout = VK_IMAGE_LAYOUT_GENERAL,
                                      .initial_stage = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT});
   };
   const graph::ResourceId final_image = snapshot_image("beside.final", VK_FORMAT_R8G8B8A8_UNORM);
@@ -155,18 +166,8 @@ PlacementBeside::FrameIds PlacementBeside::add_to_frame(graph::Graph& graph,
   frame_snapshot_ids_[0] = final_image;
   frame_snapshot_ids_[1] = layers;
   const VkDeviceSize n = label_count_;
-  graph.add_pass({"placement.snapshot",
-                  graph::PassKind::transfer,
-                  {{rendered.final, Use::transfer_src},
-                   {rendered.layers, Use::transfer_src},
-                   {final_image, Use::transfer_dst},
-                   {layers, Use::transfer_dst}},
-                  [=, this](graph::PassContext& pc) {
-                    if (!start_now_) return;
-                    copy_image(pc, rendered.final, final_image, 1);
-                    copy_image(pc, rendered.layers, layers, layer_count_);
-                  },
-                  "placement"});
+  add_snapshot_pass(graph, snapshot_, {rendered.final, rendered.layers, final_image, layers},
+                    [this] { return start_now_ ? layer_count_ : 0u; });
   const auto imported = [&graph](const char* name, const Buffer& buffer) {
     return graph.import_buffer(name, {.buffer = buffer.handle(), .has_content = true});
   };

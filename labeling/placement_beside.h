@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -23,6 +24,17 @@
 #include "passes/volume_renderer.h"
 
 namespace strata {
+
+// The images a placement beside the frames reads, and the frame's that it copies them from.
+struct SnapshotImages {
+  graph::ResourceId final_image, layers;  // the frame's picture (rgba8) and layers (rgba16f)
+  graph::ResourceId final_copy, layers_copy;
+};
+
+// The pass that copies the frame's picture and the first layers_now() of its layers, every texel
+// as it is (placement_snapshot.comp), when the frame is recorded; 0: no copy in this frame.
+void add_snapshot_pass(graph::Graph& graph, const ComputePipeline& pipeline,
+                       const SnapshotImages& images, std::function<uint32_t()> layers_now);
 
 class PlacementBeside {
  public:
@@ -90,6 +102,7 @@ class PlacementBeside {
   Placement& placement_;
   LabelForces& forces_;
   uint32_t label_count_;
+  ComputePipeline snapshot_;  // the frame's copy for the placement it starts
   std::array<Snapshot, 2> snapshots_;
   Buffer published_targets_, published_labels_, published_order_;
   Buffer adopted_targets_, adopted_labels_, adopted_order_;

@@ -74,9 +74,13 @@ struct LabelDrawReference {
 namespace {
 
 Image atlas_image(Context& ctx, VkFormat format, uint32_t width, uint32_t height,
-                  std::span<const std::byte> texels) {
+                  std::span<const std::byte> texels, Uploads* uploads) {
   Image image(ctx, {format, {width, height, 1}, VK_IMAGE_TYPE_2D, VK_IMAGE_USAGE_SAMPLED_BIT});
-  upload(ctx, image, texels, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  if (uploads) {
+    uploads->add(ctx, image, texels, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  } else {
+    upload(ctx, image, texels, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  }
   return image;
 }
 
@@ -94,14 +98,14 @@ LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas
 }
 
 std::vector<Image> LabelDrawing::set_atlases(Context& ctx, const FontAtlas& font,
-                                             const ImageAtlas& images) {
+                                             const ImageAtlas& images, Uploads* uploads) {
   std::vector<Image> old;
   if (atlas_) old.push_back(std::move(*atlas_));
   if (images_) old.push_back(std::move(*images_));
-  atlas_.emplace(
-      atlas_image(ctx, VK_FORMAT_R8_UNORM, font.width, font.height, as_bytes(font.coverage)));
+  atlas_.emplace(atlas_image(ctx, VK_FORMAT_R8_UNORM, font.width, font.height,
+                             as_bytes(font.coverage), uploads));
   images_.emplace(atlas_image(ctx, VK_FORMAT_R8G8B8A8_UNORM, images.width, images.height,
-                              as_bytes(images.texels)));
+                              as_bytes(images.texels), uploads));
   return old;
 }
 

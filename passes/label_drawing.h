@@ -62,9 +62,11 @@ class LabelDrawing {
   void add_to(graph::Graph& graph, const Inputs& in);
 
   // New font and image atlases (new label texts): uploaded into new images, which bind() hands
-  // to a graph built before; the old images are returned, for the caller to keep until the
-  // frames in flight that read them have finished.
-  std::vector<Image> set_atlases(Context& ctx, const FontAtlas& font, const ImageAtlas& images);
+  // to a graph built before (the copies waited for, or added to `uploads`: a frame's); the old
+  // images are returned, for the caller to keep until the frames in flight that read them have
+  // finished.
+  std::vector<Image> set_atlases(Context& ctx, const FontAtlas& font, const ImageAtlas& images,
+                                 Uploads* uploads = nullptr);
   void bind(graph::GraphRunner& runner) const;
 
   // How many labels of the labels buffer to draw (read when the graph is recorded); the shader

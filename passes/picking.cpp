@@ -175,7 +175,10 @@ std::vector<PickHit> pick_reference(const RenderInputs& inputs, const gpu::Frame
       const gpu::GhostKeeps keeps = gpu::ghost_keeps(open_on, alpha, layer_count, g.strength);
       if (std::any_of(std::begin(keeps.layer), std::end(keeps.layer),
                       [](float k) { return k < 1.0f; })) {
-        walked = walk_reference_pixel(inputs, frame, centre, keeps.layer);
+        const gpu::PickStart start = gpu::pick_start(keeps, alpha, layer_count, frame.depth_alpha);
+        walked.depth = 0.0f;
+        if (start.layer < layer_count)
+          walked = walk_reference_pixel(inputs, frame, centre, keeps.layer, &start);
       }
     }
     const glm::vec4 p = gpu::pick_point(frame, cast, walked.depth);

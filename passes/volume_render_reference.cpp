@@ -64,6 +64,11 @@ struct Reference {
   // The share of each layer the walk keeps (VR_RESOLVE_LAYER_KEEP).
   float layer_keeps[VR_MAX_LAYERS] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
   float layer_keep(uint l) const { return layer_keeps[l]; }
+  PickStart start{0u, 1.0f};  // where the walk starts (a pick's: pick_start)
+  bool stops_at_depth = false;
+  uint walk_start_layer() const { return start.layer; }
+  float walk_start_clear() const { return start.clear; }
+  bool walk_stops_at_depth() const { return stops_at_depth; }
 
 #define VR_RESOLVE_LAYER_KEEP
 #include "shared/resolve_walk.h"
@@ -135,9 +140,14 @@ uint32_t walk_fragments(const Reference& ref, vec2 pixel, float (&depths)[VR_MAX
 }  // namespace gpu
 
 ReferencePixel walk_reference_pixel(const RenderInputs& inputs, const gpu::FrameGpu& frame,
-                                    glm::vec2 pixel, std::span<const float> keep) {
+                                    glm::vec2 pixel, std::span<const float> keep,
+                                    const gpu::PickStart* pick) {
   gpu::Reference ref{frame, inputs, corrected_transfer(inputs, frame.step)};
   for (size_t l = 0; l < keep.size() && l < VR_MAX_LAYERS; ++l) ref.layer_keeps[l] = keep[l];
+  if (pick) {
+    ref.start = *pick;
+    ref.stops_at_depth = true;
+  }
   ReferencePixel out;
   out.layers.assign(frame.layer_count, glm::vec4(0.0f));
   ref.layers = out.layers.data();

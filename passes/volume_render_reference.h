@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "passes/volume_renderer.h"
+#include "shared/pick.h"
 
 namespace strata {
 
@@ -26,12 +27,14 @@ ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera
 // One pixel's walk (the frame's pixel units, centres at +0.5), keeping keep[l] of each layer l
 // (ghosting: shared/ghost.h; layers past keep's end are kept whole): the layers as walked, whole,
 // and the eye depth where the picture drawn with those keeps first reaches depth_alpha (0:
-// nowhere). Every layer whole: the depth of render_reference.
+// nowhere). Every layer whole: the depth of render_reference. With `pick` the walk is a pick's: it
+// starts at pick->layer (pick_start) and ends at the depth, so the layers are not whole.
 struct ReferencePixel {
   std::vector<glm::vec4> layers;  // frame.layer_count, premultiplied
   float depth = 0.0f;
 };
 ReferencePixel walk_reference_pixel(const RenderInputs& inputs, const gpu::FrameGpu& frame,
-                                    glm::vec2 pixel, std::span<const float> keep = {});
+                                    glm::vec2 pixel, std::span<const float> keep = {},
+                                    const gpu::PickStart* pick = nullptr);
 
 }  // namespace strata

@@ -5,7 +5,7 @@
 #include "resolve_scene.glsl"
 
 // Picking (shared/pick.h): each asked pixel's ray walked as the picture is drawn, one invocation
-// a pixel.
+// a pixel, from the first layer that can reach depth_alpha to the depth.
 layout(local_size_x = PICK_GROUP) in;
 layout(binding = PICK_BINDING_PIXELS, std430) readonly buffer Pixels { vec2 pixels[]; };
 layout(binding = PICK_BINDING_POINTS, std430) writeonly buffer Points { vec4 points[]; };
@@ -22,6 +22,10 @@ float layer_alpha[VR_MAX_LAYERS];
 float layer_keeps[VR_MAX_LAYERS];
 void emit_layer(uint l, vec4 colour) {}
 float layer_keep(uint l) { return layer_keeps[l]; }
+PickStart start;  // (pick_start: the layers in front cannot reach depth_alpha)
+uint walk_start_layer() { return start.layer; }
+float walk_start_clear() { return start.clear; }
+bool walk_stops_at_depth() { return true; }
 #define VR_RESOLVE_LAYER_KEEP
 #include "shared/resolve_walk.h"
 
@@ -58,6 +62,11 @@ void main() {
   }
   const GhostKeeps keeps = ghost_keeps(open_on, layer_alpha, layer_count, params.ghost.strength);
   for (uint l = 0u; l < VR_MAX_LAYERS; ++l) layer_keeps[l] = keeps.layer[l];
+  start = pick_start(keeps, layer_alpha, layer_count, frame.depth_alpha);
+  if (start.layer >= layer_count) {
+    points[i] = vec4(0.0f);
+    return;
+  }
   uint count = 0u, dropped = 0u;
   float depths[VR_MAX_FRAGMENTS];
   uvec2 payloads[VR_MAX_FRAGMENTS];

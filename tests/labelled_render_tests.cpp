@@ -2,6 +2,7 @@
 // screen, readable, and no two label boxes overlap.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -12,6 +13,7 @@
 #include "engine/scene/io/scene_loader.h"
 #include "gpu_fixture.h"
 #include "labeling/labelled_render.h"
+#include "labeling/placement_beside.h"
 
 namespace strata {
 
@@ -386,6 +388,36 @@ TEST_SUITE("gpu") {
     CHECK(renderer.label_slots().count() >= scene.labels.size() + settings.spare_label_slots);
     renderer.run();
     CHECK(renderer.result().labels.size() == scene.labels.size());
+  }
+
+  // The placement beside the frames reads a copy of the frame that starts it: the copy must be
+  // the frame's picture and layers exactly, at a size that is no multiple of the pass's groups.
+  TEST_CASE_FIXTURE(test::GpuTest, "a_placements_snapshot_is_the_frames_picture_and_layers") {
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    RenderSettings settings;
+    settings.layer_count = 3;
+    VolumeRenderer renderer(ctx, scene, settings);
+    renderer.set_camera(camera_for(scene, "oblique"));
+    graph::Graph graph;
+    const VolumeRenderer::Outputs out = renderer.add_to(graph);
+    const graph::ResourceId final_copy = graph.add_image("copy.final", {});
+    const graph::ResourceId layers_copy =
+        graph.add_image("copy.layers", {VK_FORMAT_R16G16B16A16_SFLOAT, {}, 3, true});
+    const ComputePipeline pipeline(ctx, "placement_snapshot.comp");
+    const uint32_t copied = 3;
+    add_snapshot_pass(graph, pipeline, {out.final, out.layers, final_copy, layers_copy},
+                      [&copied] { return copied; });
+    graph::GraphRunner runner(ctx, std::move(graph));
+    runner.set_viewport({100, 75});
+    renderer.run_until_no_overflow(runner);
+    const std::vector<std::byte> final_image = runner.download_image(out.final);
+    const std::vector<std::byte> layers = runner.download_image(out.layers);
+    REQUIRE(layers.size() == size_t{100} * 75 * 3 * 8);
+    const size_t covered = size_t(std::count_if(final_image.begin(), final_image.end(),
+                                                [](std::byte b) { return b != std::byte{0}; }));
+    CHECK(covered > final_image.size() / 4);  // (the head, not an empty picture)
+    CHECK(runner.download_image(final_copy) == final_image);
+    CHECK(runner.download_image(layers_copy) == layers);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "labels_glide_to_the_new_placement_after_a_camera_move") {

@@ -58,17 +58,22 @@ VkDeviceSize image_bytes(const ImageDesc& d) {
          texel_size(d.format);
 }
 
-// Makes a copy's writes visible to the host that reads the staging buffer after the fence.
-void copy_to_host_barrier(VkCommandBuffer cmd) {
-  VkMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-  to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-  to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-  to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-  to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+// Makes the copies' writes so far visible to `stage`'s `access`.
+void copied_barrier(VkCommandBuffer cmd, VkPipelineStageFlags2 stage, VkAccessFlags2 access) {
+  VkMemoryBarrier2 copied{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+  copied.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+  copied.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  copied.dstStageMask = stage;
+  copied.dstAccessMask = access;
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.memoryBarrierCount = 1;
-  dep.pMemoryBarriers = &to_host;
+  dep.pMemoryBarriers = &copied;
   vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+// Makes a copy's writes visible to the host that reads the staging buffer after the fence.
+void copy_to_host_barrier(VkCommandBuffer cmd) {
+  copied_barrier(cmd, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
 }
 
 }  // namespace
@@ -256,21 +261,10 @@ uint32_t texel_size(VkFormat format) {
   }
 }
 
-void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data) {
-  if (data.size() > dst.size()) throw Error("upload: data larger than the buffer");
-  if (data.empty()) return;
-  Buffer staging(ctx, data.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::host_upload);
-  std::memcpy(staging.mapped(), data.data(), data.size());
-  ctx.run_now([&](VkCommandBuffer cmd) {
-    const VkBufferCopy region{0, 0, data.size()};
-    vkCmdCopyBuffer(cmd, staging.handle(), dst.handle(), 1, &region);
-  });
-}
-
 namespace {
 
-void transition(VkCommandBuffer cmd, const Image& image, VkImageLayout from, VkImageLayout to,
-                VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+void transition(VkCommandBuffer cmd, VkImage image, const ImageDesc& desc, VkImageLayout from,
+                VkImageLayout to, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                 VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) {
   VkImageMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
   barrier.srcStageMask = src_stage;
@@ -280,40 +274,79 @@ void transition(VkCommandBuffer cmd, const Image& image, VkImageLayout from, VkI
   barrier.oldLayout = from;
   barrier.newLayout = to;
   barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  barrier.image = image.handle();
-  barrier.subresourceRange = {aspect_of(image.desc().format), 0, 1, 0, image.desc().layers};
+  barrier.image = image;
+  barrier.subresourceRange = {aspect_of(desc.format), 0, 1, 0, desc.layers};
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.imageMemoryBarrierCount = 1;
   dep.pImageMemoryBarriers = &barrier;
   vkCmdPipelineBarrier2(cmd, &dep);
 }
 
+Buffer staged(Context& ctx, std::span<const std::byte> data) {
+  Buffer staging(ctx, data.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::host_upload);
+  std::memcpy(staging.mapped(), data.data(), data.size());
+  return staging;
+}
+
 }  // namespace
 
-void upload(Context& ctx, const Image& dst, std::span<const std::byte> data,
-            VkImageLayout final_layout) {
+void Uploads::add(Context& ctx, const Buffer& dst, std::span<const std::byte> data) {
+  if (data.size() > dst.size()) throw Error("upload: data larger than the buffer");
+  if (data.empty()) return;
+  items_.push_back({staged(ctx, data), dst.handle()});
+}
+
+void Uploads::add(Context& ctx, const Image& dst, std::span<const std::byte> data,
+                  VkImageLayout final_layout) {
   const VkDeviceSize size = image_bytes(dst.desc());
   if (data.size() != size) {
     throw Error("upload: " + std::to_string(data.size()) + " bytes for an image of " +
                 std::to_string(size));
   }
-  Buffer staging(ctx, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryKind::host_upload);
-  std::memcpy(staging.mapped(), data.data(), size);
-  ctx.run_now([&](VkCommandBuffer cmd) {
-    // Setup code outside any graph: the image is new, so it starts undefined and is then handed
-    // to every later stage (the graph imports it with content in `final_layout`).
-    transition(cmd, dst, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-               VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT,
-               VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  items_.push_back({staged(ctx, data), VK_NULL_HANDLE, dst.handle(), dst.desc(), final_layout});
+}
+
+void Uploads::append(Uploads&& later) {
+  for (Item& item : later.items_) items_.push_back(std::move(item));
+  later.items_.clear();
+}
+
+void Uploads::record(VkCommandBuffer cmd) const {
+  if (items_.empty()) return;
+  for (const Item& item : items_) {
+    if (item.buffer != VK_NULL_HANDLE) {
+      const VkBufferCopy region{0, 0, item.staging.size()};
+      vkCmdCopyBuffer(cmd, item.staging.handle(), item.buffer, 1, &region);
+      continue;
+    }
+    // (a new image: it starts undefined, and is handed to every later stage in final_layout)
+    transition(cmd, item.image, item.desc, VK_IMAGE_LAYOUT_UNDEFINED,
+               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+               VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
     VkBufferImageCopy region{};
-    region.imageSubresource = {aspect_of(dst.desc().format), 0, 0, dst.desc().layers};
-    region.imageExtent = dst.desc().extent;
-    vkCmdCopyBufferToImage(cmd, staging.handle(), dst.handle(),
+    region.imageSubresource = {aspect_of(item.desc.format), 0, 0, item.desc.layers};
+    region.imageExtent = item.desc.extent;
+    vkCmdCopyBufferToImage(cmd, item.staging.handle(), item.image,
                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-    transition(cmd, dst, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, final_layout,
+    transition(cmd, item.image, item.desc, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, item.final_layout,
                VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
-  });
+  }
+  copied_barrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+}
+
+void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data) {
+  Uploads uploads;
+  uploads.add(ctx, dst, data);
+  if (!uploads.empty()) ctx.run_now([&](VkCommandBuffer cmd) { uploads.record(cmd); });
+}
+
+void upload(Context& ctx, const Image& dst, std::span<const std::byte> data,
+            VkImageLayout final_layout) {
+  // (setup code outside any graph: the graph imports the image with content in final_layout)
+  Uploads uploads;
+  uploads.add(ctx, dst, data, final_layout);
+  ctx.run_now([&](VkCommandBuffer cmd) { uploads.record(cmd); });
 }
 
 std::vector<std::byte> download(Context& ctx, const Buffer& src) {

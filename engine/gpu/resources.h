@@ -1,6 +1,7 @@
 // Buffers and images with their own memory, moved not copied, freed with their owner.
 // Device-local resources are filled through a staging buffer (upload) and read back through one
-// (download); both wait on the GPU and are meant for setup and tests, never inside a frame.
+// (download); both wait on the GPU and are meant for setup and tests, never inside a frame (a
+// frame takes its uploads as Uploads, recorded into it).
 // Each allocation is checked against the device's limits first (an Error naming the limit and
 // the bytes, not a driver failure) and counted in the Context (`Context::memory_use()`).
 #pragma once
@@ -86,6 +87,34 @@ uint32_t texel_size(VkFormat format);
 // the 65536 bytes it takes at once).
 void record_update(VkCommandBuffer cmd, VkBuffer buffer, VkDeviceSize offset,
                    std::span<const std::byte> data);
+
+// Copies for a command buffer someone else submits (a frame: GraphRunner::upload_in_next_frame)
+// instead of a submission and a wait of their own. The data are staged when added; record()
+// copies them and makes them visible to every later command. The staging memory lives as long as
+// the Uploads, which must outlive the recorded commands' run; the destinations too.
+class Uploads {
+ public:
+  // Into a buffer at offset 0.
+  void add(Context& ctx, const Buffer& dst, std::span<const std::byte> data);
+  // A whole image (2D or 3D, tightly packed texels; new: its contents are dropped), left in
+  // `final_layout`.
+  void add(Context& ctx, const Image& dst, std::span<const std::byte> data,
+           VkImageLayout final_layout);
+  bool empty() const { return items_.empty(); }
+  // Moves what `later` holds to the end of these.
+  void append(Uploads&& later);
+  void record(VkCommandBuffer cmd) const;
+
+ private:
+  struct Item {
+    Buffer staging;
+    VkBuffer buffer = VK_NULL_HANDLE;  // or an image
+    VkImage image = VK_NULL_HANDLE;
+    ImageDesc desc{};
+    VkImageLayout final_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  };
+  std::vector<Item> items_;
+};
 
 // Copies `data` into a device-local buffer at offset 0 and waits.
 void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data);

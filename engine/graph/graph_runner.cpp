@@ -407,6 +407,11 @@ void GraphRunner::record_passes(VkCommandBuffer cmd, PassId first, PassId end, u
     dep.pMemoryBarriers = &all;
     vkCmdPipelineBarrier2(cmd, &dep);
   }
+  if (first == 0) {
+    slot_uploads_.resize(queries_.size());
+    slot_uploads_[slot_] = take_uploads();  // (the slot's last frame has run)
+    slot_uploads_[slot_].record(cmd);
+  }
   if (first < end) vkCmdResetQueryPool(cmd, queries_[slot_], 2 * first, 2 * (end - first));
   for (PassId p = first; p < end; ++p) record_pass(cmd, p);
   if (end == passes) emit(cmd, compiled_.final_barriers);

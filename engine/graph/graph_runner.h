@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -134,6 +135,14 @@ class GraphRunner {
   void bind_buffer(ResourceId id, VkBuffer buffer);
   void bind_image(ResourceId id, VkImage image, VkImageView view, VkFormat format);
 
+  // Copies recorded at the start of the next frame (record, record_passes from pass 0, run_now)
+  // before its first pass, visible to all of them: new contents for imported buffers and images
+  // (a label edit's glyphs and atlases) without a wait on the host. Their staging memory is kept
+  // until that frame slot is recorded again, or the runner goes.
+  void upload_in_next_frame(Uploads&& uploads) { pending_uploads_.append(std::move(uploads)); }
+  // The uploads no frame has recorded yet, for the runner that replaces this one.
+  Uploads take_uploads() { return std::exchange(pending_uploads_, {}); }
+
   // Frames recorded before the earlier ones finished (the viewer keeps two in flight): each
   // frame slot has its own timestamps, and a frame first waits on the queue for everything the
   // frames before it did. Waits for the device when it changes.
@@ -206,6 +215,8 @@ class GraphRunner {
   uint32_t slot_ = 0;                 // the slot being recorded
   uint64_t allocation_ = 0;
   FrameSubmission submission_;
+  Uploads pending_uploads_;
+  std::vector<Uploads> slot_uploads_;  // per frame slot, what its last frame copied
   VkSampler linear_sampler_ = VK_NULL_HANDLE;
   PFN_vkCmdBeginConditionalRenderingEXT begin_conditional_ = nullptr;  // with the extension only
   PFN_vkCmdEndConditionalRenderingEXT end_conditional_ = nullptr;

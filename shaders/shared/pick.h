@@ -3,7 +3,7 @@
 // lens the pixel's ray is walked again as the resolve walks it (shared/resolve_walk.h: the same
 // transfer functions, meshes and empty-space skipping), with each layer kept as far as ghosting
 // (shared/ghost.h) keeps it there, to the first eye depth where the drawn alpha reaches
-// depth_alpha; the keeps come from the labels' openings on each layer at the pixel and the
+// depth_alpha, from the first layer whose drawn alpha can reach it (pick_start); the keeps come from the labels' openings on each layer at the pixel and the
 // layers' alphas there, as labels.ghost reads them from the layers image (ghost_keeps). Written
 // once for GLSL and C++: the GPU pass (pick.comp) and its CPU reference (pick_reference in
 // passes/picking.cpp, which takes the layers' alphas from its own walk: the same values in a frame
@@ -54,6 +54,32 @@ STRATA_INLINE ivec2 pick_cast_pixel(FrameGpu f, ivec2 t, uint width, uint height
 // A layer's alpha as the rgba16f layers image holds it, which is what labels.ghost reads.
 STRATA_INLINE float pick_stored_alpha(float alpha) {
   return unpackHalf2x16(packHalf2x16(vec2(alpha, 0.0f))).x;
+}
+
+// Where a walk with ghosting's keeps starts (resolve_walk.h, VR_RESOLVE_LAYER_KEEP): the first
+// layer whose drawn alpha at its end, from the layers' stored alphas, comes within PICK_START_MARGIN
+// of depth_alpha (layer_count: none does, nothing to walk), and what the drawn layers in front of
+// it let through. The layers in front cannot reach depth_alpha, so the walk need not sample them.
+#define PICK_START_MARGIN 0.004f  // beyond rgba16f's rounding of the layers' alphas, summed
+struct PickStart {
+  uint layer;
+  float clear;
+};
+
+STRATA_INLINE PickStart pick_start(GhostKeeps keeps, float alpha[VR_MAX_LAYERS], uint layer_count,
+                                   float depth_alpha) {
+  PickStart s;
+  s.layer = layer_count;
+  s.clear = 1.0f;
+  for (uint l = 0u; l < layer_count; ++l) {
+    float after = s.clear * (1.0f - keeps.layer[l] * alpha[l]);
+    if (1.0f - after >= depth_alpha - PICK_START_MARGIN) {
+      s.layer = l;
+      return s;
+    }
+    s.clear = after;
+  }
+  return s;
 }
 
 // The world point of a pick at eye depth `depth` on the ray through the centre of the cast

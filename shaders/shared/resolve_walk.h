@@ -15,6 +15,11 @@
 // With VR_RESOLVE_LAYER_KEEP defined the includer also provides
 //   float layer_keep(uint l)               the share of layer l's colour and alpha the picture
 //                                          keeps (ghosting: shared/ghost.h; 1 without)
+//   uint walk_start_layer()                the first layer the walk samples (below layer_count);
+//                                          those in front are not walked nor emitted
+//   float walk_start_clear()               what the drawn layers in front of it let through
+//   bool walk_stops_at_depth()             the walk ends at the depth (a pick needs no more; the
+//                                          layers from there on are then not whole)
 // and the depth follows the drawn picture instead of the walk's own sum: with A_l(z) layer l's
 // alpha up to z, the picture's alpha at z in layer l is 1 - T * (1 - keep_l * A_l(z)), T the
 // product of (1 - keep_j * A_j) over the layers j in front (their whole alphas). While every
@@ -193,9 +198,17 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   shaded_samples = 0u;
   atlas_fetches = 0u;
 #ifdef VR_RESOLVE_LAYER_KEEP
-  drawn_front_clear = 1.0f;
-  drawn_front_whole = true;
+  const uint start_layer = walk_start_layer();
+  drawn_front_clear = start_layer > 0u ? walk_start_clear() : 1.0f;
+  drawn_front_whole = start_layer == 0u;
+  const bool stops = walk_stops_at_depth();
+#else
+  const uint start_layer = 0u;
+  const bool stops = false;
 #endif
+  // (samples and mesh fragments in front of the start layer are not walked)
+  const float start_z =
+      start_layer > 0u ? split_depth(frame.splits, start_layer - 1u) : frame.near_depth;
 
   Ray ray = pixel_ray(pixel);
   vec3 origin = ray.origin;
@@ -238,12 +251,14 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
   // Depth only grows along the ray, so layers are visited in order: the current layer's colour
   // stays in registers and is emitted when the ray moves on (no array of layers: a dynamically
   // indexed one would live in slow local memory on GPUs).
-  uint layer = 0u;
-  float next_split = frame.layer_count > 1u ? split_depth(frame.splits, 0u) : 3.4e38f;
+  uint layer = start_layer;
+  float next_split =
+      start_layer + 1u < frame.layer_count ? split_depth(frame.splits, start_layer) : 3.4e38f;
   vec4 acc = vec4(0.0f);
   for (uint i = 0u; i <= count; ++i) {
+    if (stops && r.depth > 0.0f) break;
     float z_end = i < count ? depths[i] : frame.far_depth;
-    float k = grid_index_at_or_after(z, dz);
+    float k = grid_index_at_or_after(max(z, start_z), dz);
     while (live != 0u && grid_depth(k, dz) < z_end) {
       float zs = grid_depth(k, dz);
       uint l = zs >= next_split ? layer_of(zs) : layer;
@@ -278,7 +293,10 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
 #ifdef VR_RESOLVE_LAYER_KEEP
       total = total + (1.0f - total) * c.a;
       // (the first z: the drawn alpha may step back by a rounding where a layer stops being whole)
-      if (r.depth <= 0.0f && drawn_alpha(total, acc.a, layer) >= frame.depth_alpha) r.depth = zs;
+      if (r.depth <= 0.0f && drawn_alpha(total, acc.a, layer) >= frame.depth_alpha) {
+        r.depth = zs;
+        if (stops) break;
+      }
 #else
       float before = total;
       total = total + (1.0f - total) * c.a;
@@ -289,7 +307,7 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
     if (i == count) break;
     uvec2 p = payloads[i];
     uint kind = (p.y >> 8u) & 3u;
-    if (kind == VR_KIND_MESH) {
+    if (kind == VR_KIND_MESH && z_end >= start_z) {
       vec4 c = unpackUnorm4x8(p.x);
       uint l = z_end >= next_split ? layer_of(z_end) : layer;
       if (l != layer) {
@@ -309,7 +327,7 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
       total = total + (1.0f - total) * c.a;
       if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = z_end;
 #endif
-    } else {
+    } else if (kind != VR_KIND_MESH) {
       uint bit = 1u << (p.y & 255u);
       live = ((p.y >> 10u) & 1u) != 0u ? (live | bit) : (live & ~bit);
       checked_until = -1.0f;
