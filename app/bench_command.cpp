@@ -97,7 +97,7 @@ void bench_render(DeviceOptions& device, const RenderBenchOptions& o, uint32_t r
                   double(o.step), double(finest / 16.0f));
     throw UsageError(text);
   }
-  renderer.set_camera(camera_for(scene, o.camera));
+  renderer.set_camera(option_camera(scene, o.camera));
   graph::Graph graph;
   renderer.add_to(graph);
   graph::GraphRunner runner(ctx, std::move(graph));

@@ -265,7 +265,7 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
   const std::string scene_file = find_data_file(o.scene);
   const graph::Extent size = parse_size(o.size, "--size");
   Scene scene = load_scene_reporting(scene_file);
-  const Camera camera = camera_for(scene, o.camera);
+  const Camera camera = option_camera(scene, o.camera);
   std::vector<std::vector<Label>> labels;
   for (const uint32_t count : counts) {
     labels.push_back(resized_labels(scene.labels, count, scene_file));

@@ -24,6 +24,10 @@ class UsageError : public Error {
   using Error::Error;
 };
 
+// The scene's camera position an option names (--camera): an unknown name is a usage error that
+// names the option and the scene's positions.
+Camera option_camera(const Scene& scene, const std::string& name, const char* option = "--camera");
+
 // Numeric options: the text must be a finite number in [lo, hi] ((lo, hi] with open_low); NaN,
 // infinities, words and values outside are usage errors (exit 2) that name the option and the
 // range: "--seconds: nan is not a number in (0, 3600]". The text is checked before CLI11 converts

@@ -1,17 +1,22 @@
-// `strata info FILE`: what a scene, volume, mesh or transfer-function file holds, as plain text.
+// `strata info FILE`: what a scene, volume, mesh, transfer-function or label file holds, as plain
+// text.
 // Needs no device, so it also checks scene files on machines without Vulkan.
 #include <algorithm>
+#include <cctype>
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "app/commands.h"
 #include "engine/core/font.h"
+#include "engine/scene/io/label_file_loader.h"
 #include "engine/scene/io/mesh_loader.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
 #include "engine/scene/io/volume_loader.h"
+#include "engine/scene/scene_bounds.h"
 
 namespace strata::app {
 
@@ -142,6 +147,56 @@ std::string describe(const Scene& scene, bool whole_scene) {
   return out;
 }
 
+bool is_label_file(const fs::path& path) {
+  std::string name = path.filename().string();
+  std::transform(name.begin(), name.end(), name.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return name.ends_with(".mrk.json") || name.ends_with(".fcsv") || name.ends_with(".csv");
+}
+
+// A label file: how many points, the coordinate system they were written in, their bounds (LPS,
+// strata's world, and RAS) and, given a scene, which anchors lie outside all of its volumes.
+std::string describe_label_file(const LabelFile& file, const Scene* scene) {
+  std::string systems;
+  for (const std::string& s : file.coordinate_systems) systems += (systems.empty() ? "" : ", ") + s;
+  std::string out = format("labels: %zu, written in %s\n", file.labels.size(), systems.c_str());
+  Bounds bounds;
+  for (const Label& l : file.labels) bounds.add(l.anchor);
+  const glm::vec3 ras_lo(-bounds.hi.x, -bounds.hi.y, bounds.lo.z);
+  const glm::vec3 ras_hi(-bounds.lo.x, -bounds.lo.y, bounds.hi.z);
+  out += "  bounds: LPS " + vec(bounds.lo) + " .. " + vec(bounds.hi) + " mm, RAS " + vec(ras_lo) +
+         " .. " + vec(ras_hi) + " mm\n";
+  std::vector<const Label*> outside;
+  for (const Label& l : scene ? file.labels : std::vector<Label>{}) {
+    const bool inside =
+        std::any_of(scene->volumes.begin(), scene->volumes.end(), [&](const Volume& v) {
+          // (the box of the voxel centres, in the volume's own index space: oblique volumes too)
+          const glm::vec3 i =
+              glm::vec3(glm::inverse(v.index_to_world()) * glm::vec4(l.anchor, 1.0f));
+          const glm::vec3 top = glm::vec3(v.dims) - 1.0f;
+          constexpr float slack = 1e-3f;
+          return glm::all(glm::greaterThanEqual(i, glm::vec3(-slack))) &&
+                 glm::all(glm::lessThanEqual(i, top + slack));
+        });
+    if (!inside) outside.push_back(&l);
+  }
+  if (!scene) {
+    out += "  inside a scene's volumes: not checked (--scene SCENE)\n";
+  } else {
+    out += format("  inside the volumes of %s: %zu of %zu\n", scene->source.string().c_str(),
+                  file.labels.size() - outside.size(), file.labels.size());
+    for (const Label* l : outside) {
+      out += format("    outside: %4d  \"%s\" at LPS ", l->id, printable_text(l->text).c_str()) +
+             vec(l->anchor) + "\n";
+    }
+  }
+  for (const Label& l : file.labels) {
+    out += format("  %4d  %-24s LPS ", l.id, ("\"" + printable_text(l.text) + "\"").c_str()) +
+           vec(l.anchor) + "\n";
+  }
+  return out;
+}
+
 bool is_scene_file(const fs::path& path) {
   return !is_volume_path(path) && !is_transfer_function_file(path) &&
          (path.extension() == ".json" || path.extension() == ".xml");
@@ -167,11 +222,25 @@ Scene load_single_file(const fs::path& path) {
 
 void add_info_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
-      "info", "Describe a scene (.json, thesis .xml), volume, mesh or transfer-function file");
+      "info",
+      "Describe a scene (.json, thesis .xml), volume, mesh, transfer-function or label file");
   auto file = std::make_shared<std::string>();
   cmd->add_option("FILE", *file, "the file to describe")->required();
-  cmd->callback([file] {
+  auto scene_file = std::make_shared<std::string>();
+  cmd->add_option("--scene", *scene_file,
+                  "for a label file (.mrk.json, .fcsv, .csv): check its anchors against this "
+                  "scene's volumes");
+  cmd->callback([file, scene_file] {
     const fs::path path(*file);
+    if (is_label_file(path)) {
+      const LabelFile labels = read_label_file(path);
+      std::optional<Scene> scene;
+      if (!scene_file->empty()) scene = load_scene(*scene_file);
+      std::printf("%s\n%s", file->c_str(),
+                  describe_label_file(labels, scene ? &*scene : nullptr).c_str());
+      return;
+    }
+    if (!scene_file->empty()) throw UsageError("--scene goes with a label file only");
     const bool whole_scene = is_scene_file(path);
     const Scene scene = whole_scene ? load_scene(path) : load_single_file(path);
     std::printf("%s\n%s", file->c_str(), describe(scene, whole_scene).c_str());

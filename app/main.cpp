@@ -8,6 +8,7 @@
 #include "engine/core/error.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/transfer_function_presets.h"
+#include "labeling/camera_path.h"
 #include "labeling/labelled_render.h"
 #include "labeling/text_layout.h"
 #include "passes/volume_renderer.h"
@@ -58,6 +59,14 @@ Scene load_scene_reporting(const std::string& path) {
   return load_scene_reporting(SceneInput{.file = path});
 }
 
+Camera option_camera(const Scene& scene, const std::string& name, const char* option) {
+  try {
+    return camera_position(scene, name);
+  } catch (const Error& e) {
+    throw UsageError(std::string(option) + ": " + e.what());
+  }
+}
+
 uint32_t SceneInput::layer_count(const Scene& scene) const {
   return layers > 0 ? layers : uint32_t(scene.settings.layer_count);  // (the loader checked it)
 }
@@ -68,7 +77,14 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
     presets += std::string(presets.empty() ? "" : ", ") + p.name;
   cmd->add_option("--preset", in.preset,
                   "transfer-function preset for every volume: " + presets +
-                      " (default: the volume's own, else chosen from its values)");
+                      " (default: the volume's own, else chosen from its values)")
+      ->check(CLI::Validator(
+          [presets](std::string& input) -> std::string {
+            for (const TransferFunctionPreset& p : transfer_function_presets())
+              if (input == p.name) return {};
+            return "'" + input + "' is not a preset (" + presets + ")";
+          },
+          "PRESET"));
   cmd->add_option("--labels", in.labels,
                   "labels from a file: 3D Slicer markups (.mrk.json, .fcsv) or CSV "
                   "(docs/scene-format.md)");

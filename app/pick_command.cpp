@@ -49,7 +49,7 @@ void pick(DeviceOptions& device, const PickOptions& o) {
   Context ctx(device.context());
   check_image_size(ctx, size, "--size");
   const Scene scene = load_scene_reporting(o.scene, ctx);
-  const Camera camera = camera_for(scene, o.camera);
+  const Camera camera = option_camera(scene, o.camera);
   RenderSettings settings;
   settings.layer_count = o.scene.layer_count(scene);
   ScenePick picked = pick_scene(ctx, scene, camera, settings, size, pixels, o.runs);

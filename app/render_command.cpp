@@ -88,7 +88,7 @@ std::string named_for(const std::string& path, const std::string& position) {
 std::vector<Still> stills(const Scene& scene, const RenderOptions& o) {
   const std::vector<std::string> names = split_camera_list(o.camera);
   if (names.size() == 1)
-    return {{camera_position(scene, o.camera), o.output, o.layout, o.dump_layers}};
+    return {{option_camera(scene, o.camera), o.output, o.layout, o.dump_layers}};
   std::vector<Still> out;
   for (size_t i = 0; i < names.size(); ++i) {
     if (names[i].empty()) {
@@ -96,7 +96,7 @@ std::vector<Still> stills(const Scene& scene, const RenderOptions& o) {
     }
     std::string layers = o.dump_layers;
     while (layers.size() > 1 && layers.back() == '/') layers.pop_back();
-    out.push_back({camera_position(scene, names[i]), named_for(o.output, names[i]),
+    out.push_back({option_camera(scene, names[i]), named_for(o.output, names[i]),
                    named_for(o.layout, names[i]), layers.empty() ? "" : layers + "-" + names[i]});
   }
   return out;

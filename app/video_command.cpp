@@ -56,7 +56,7 @@ CameraPath camera_path(const Scene& scene, const VideoOptions& o) {
   if (o.orbit == 0.0)
     throw UsageError("video: give a camera path (--path) or a turntable (--orbit)");
   const double seconds = o.seconds > 0.0 ? o.seconds : std::abs(o.orbit) / 30.0;
-  return orbit_path(scene, camera_for(scene, o.camera), o.orbit, seconds);
+  return orbit_path(scene, option_camera(scene, o.camera), o.orbit, seconds);
 }
 
 // -o: NAME.mp4, or a folder for PNG frames (no extension, or one that exists). Anything else

@@ -364,7 +364,7 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   context.presentation = true;
   Context ctx(context);
   Scene scene = load_scene_reporting(o.scene, ctx);  // volumes checked against the device
-  const Camera camera = camera_for(scene, o.camera);
+  const Camera camera = option_camera(scene, o.camera);
   const std::string title = "strata - " + std::filesystem::path(o.scene.file).filename().string();
   Window window(size, o.size, title);
   float scale_x = 1.0f, scale_y = 1.0f;

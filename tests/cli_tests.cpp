@@ -211,7 +211,7 @@ TEST_SUITE("cli") {
                               "/assets/scenes/head.json --size 32 "
                               "--camera front,back -o " +
                               dir + "/head.png");
-    CHECK(r.exit_code == 1);
+    CHECK(r.exit_code == 2);  // (a bad option value)
     CHECK(r.output.find("strata: error: ") != std::string::npos);
     CHECK(r.output.find("no camera position named 'back'") != std::string::npos);
     CHECK(std::filesystem::is_empty(dir));  // names are checked before anything renders
@@ -385,6 +385,37 @@ TEST_SUITE("cli") {
     CHECK(r.output.find("Cerebelum 6 R") != std::string::npos);
     CHECK(r.output.find("front") != std::string::npos);
     CHECK(r.output.find("oblique") != std::string::npos);
+  }
+
+  // Label files: the count, the system they were written in, their bounds in both systems and,
+  // with --scene, the anchors outside every volume of the scene.
+  TEST_CASE("info_describes_label_files_and_checks_them_against_a_scene") {
+    for (const char* name : {"landmarks_ras.mrk.json", "landmarks_lps.fcsv",
+                             "landmarks_slicer4_ras.fcsv", "landmarks_ras.csv"}) {
+      CAPTURE(name);
+      const auto r =
+          run_strata(std::string("info ") + STRATA_SOURCE_DIR "/tests/data/labels/" + name);
+      CHECK(r.exit_code == 0);
+      const bool ras = std::string(name).find("ras") != std::string::npos;
+      CHECK(r.output.find(std::string("labels: 3, written in ") + (ras ? "RAS" : "LPS")) !=
+            std::string::npos);
+      CHECK(r.output.find("bounds: LPS (-20.5, -40, -12.5) .. (15.125, 25.75, 30) mm, RAS "
+                          "(-15.125, -25.75, -12.5) .. (20.5, 40, 30) mm") != std::string::npos);
+      CHECK(r.output.find("not checked (--scene SCENE)") != std::string::npos);
+    }
+    const auto folder = test::fresh_folder("cli", "info_labels");
+    const std::string csv = test::write_file(
+        folder / "marks.csv", "text,r,a,s\ninside,0,10,20\nbeyond the head,0,400,0\n");
+    const auto r =
+        run_strata("info " + csv + " --scene " STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    CHECK(r.exit_code == 0);
+    CHECK(r.output.find("inside the volumes of ") != std::string::npos);
+    CHECK(r.output.find(": 1 of 2") != std::string::npos);
+    CHECK(r.output.find("outside:    1  \"beyond the head\" at LPS (0, -400, 0)") !=
+          std::string::npos);
+    const auto usage = run_strata(std::string("info ") +
+                                  STRATA_SOURCE_DIR "/assets/scenes/head.json --scene " + csv);
+    CHECK(usage.exit_code == 2);
   }
 
   TEST_CASE("info_imports_a_thesis_scene_and_warns_about_its_missing_volume") {

@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+#include <tuple>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "engine/scene/fitted_camera.h"
 #include "engine/scene/io/scene_loader.h"
@@ -123,6 +126,27 @@ TEST_SUITE("loaders") {
           "mr-head, mr-brain)");
   }
 
+  // A preset for the other modality maps the values to nothing (or everything): it warns.
+  TEST_CASE("a_preset_for_the_other_modality_warns") {
+    strata::Volume mr = ct_block();
+    mr.value_range = {0.0f, 255.0f};
+    for (const auto& [volume, preset, warns] :
+         {std::tuple{ct_block(), "ct-bone", false}, std::tuple{ct_block(), "mr-head", true},
+          std::tuple{mr, "ct-bone", true}, std::tuple{mr, "mr-brain", false}}) {
+      CAPTURE(preset);
+      strata::Scene scene;
+      scene.volumes.push_back(volume);
+      strata::complete_scene(scene, preset);
+      REQUIRE(scene.transfer_functions.size() == 1);
+      CHECK(scene.transfer_functions[0].name == preset);
+      const bool warned =
+          std::any_of(scene.warnings.begin(), scene.warnings.end(), [&](const std::string& w) {
+            return w.find(std::string("preset ") + preset + " is for") != std::string::npos;
+          });
+      CHECK(warned == warns);
+    }
+  }
+
   TEST_CASE("a_volume_opens_as_a_scene_with_a_preset_a_fitted_camera_and_named_views") {
     const fs::path ch2 = cache / "mricron/ch2.nii.gz";
     REQUIRE_MESSAGE(fs::exists(ch2), "run scripts/fetch-data.sh");
@@ -150,15 +174,66 @@ TEST_SUITE("loaders") {
     CHECK(chosen.labels[0].text == "Ventricule latéral");
   }
 
+  // Every scene knows the six anatomical views, fitted to its content with its own lens, and
+  // the camera's planes hold the content from each of them.
+  TEST_CASE("every_demo_scene_has_the_six_anatomical_views_besides_its_own") {
+    for (const std::string name : {"head", "head-100", "head-surfaces", "head-images"}) {
+      CAPTURE(name);
+      const strata::Scene scene =
+          strata::load_scene(fs::path(STRATA_SOURCE_DIR "/assets/scenes") / (name + ".json"));
+      CHECK(strata::camera_for(scene, "front").view != strata::camera_for(scene, "anterior").view);
+      for (size_t v = 0; v < strata::kAnatomicalViewNames.size(); ++v) {
+        const std::string view = strata::kAnatomicalViewNames[v];
+        CAPTURE(view);
+        const strata::Camera camera = strata::camera_for(scene, view);
+        // (the scenes' own "left" wins)
+        const bool fitted = camera.view == strata::fitted_view(scene, strata::AnatomicalView(v),
+                                                               scene.camera.fov_y_degrees);
+        CHECK(fitted == (view != "left"));
+        // (the content's box between the planes)
+        const strata::Bounds bounds = strata::scene_bounds(scene);
+        for (int corner = 0; corner < 8; ++corner) {
+          const glm::vec3 p((corner & 1) ? bounds.hi.x : bounds.lo.x,
+                            (corner & 2) ? bounds.hi.y : bounds.lo.y,
+                            (corner & 4) ? bounds.hi.z : bounds.lo.z);
+          const float depth = -(camera.view * glm::vec4(p, 1.0f)).z;
+          CHECK(depth > camera.near_plane);
+          CHECK(depth < camera.far_plane);
+        }
+      }
+      // Its own names come first, as in the file (the keys 1 to 9 follow them); saved, the
+      // scene's file keeps its own positions only.
+      CHECK(scene.camera_positions.front().name == "front");
+      const fs::path saved = output_folder("anatomical") / (name + ".json");
+      strata::save_scene_json(saved, scene);
+      const strata::Scene back = strata::load_scene(saved);
+      CHECK(back.camera_positions.size() == scene.camera_positions.size());
+      CHECK(strata::test::read_file(saved).find("\"anterior\"") == std::string::npos);
+    }
+  }
+
   TEST_CASE("a_scene_with_a_camera_keeps_it_and_its_labels_may_come_from_a_label_file") {
     const fs::path folder = output_folder("label_file");
     const fs::path scene_path =
         write_file(folder / "s.json", R"({"strata_scene": 1, "labels": ")" STRATA_TEST_DATA
                                       R"(/labels/landmarks_lps.fcsv",
-          "camera": {"eye": [0, -500, 0], "target": [0, 0, 0], "up": [0, 0, 1]}})");
+          "camera": {"eye": [0, -500, 0], "target": [0, 0, 0], "up": [0, 0, 1],
+                     "positions": [{"name": "left", "eye": [9, 0, 0], "target": [0, 0, 0],
+                                    "up": [0, 0, 1]}]}})");
     const strata::Scene scene = strata::load_scene(scene_path);
     CHECK(scene.has_camera);
-    CHECK(scene.camera_positions.empty());  // no fitted views added
+    CHECK(scene.camera.view ==
+          glm::lookAt(glm::vec3(0, -500, 0), glm::vec3(0), glm::vec3(0, 0, 1)));
+    // The six anatomical views besides its own positions; its own "left" wins.
+    REQUIRE(scene.camera_positions.size() == 6);
+    CHECK(scene.camera_positions[0].name == "left");
+    CHECK(scene.camera_positions[0].view ==
+          glm::lookAt(glm::vec3(9, 0, 0), glm::vec3(0), glm::vec3(0, 0, 1)));
+    for (const char* name : {"anterior", "posterior", "right", "superior", "inferior"}) {
+      CAPTURE(name);
+      CHECK(std::count_if(scene.camera_positions.begin(), scene.camera_positions.end(),
+                          [&](const strata::CameraPose& p) { return p.name == name; }) == 1);
+    }
     REQUIRE(scene.labels.size() == 3);
     CHECK(scene.labels[0].id == 0);
     CHECK(scene.labels[2].id == 2);

@@ -82,8 +82,10 @@ TEST_SUITE("loaders") {
     CHECK(camera.fov_y_degrees == doctest::Approx(45.0).epsilon(1e-6));
     CHECK(camera.near_plane == doctest::Approx(-1.434267998 / (-1.513750076 - 1.0)));
     CHECK(camera.far_plane == doctest::Approx(-1.434267998 / (-1.513750076 + 1.0)));
-    REQUIRE(scene.camera_positions.size() == 6);
+    // Its own six, then the six anatomical views every scene has.
+    REQUIRE(scene.camera_positions.size() == 12);
     for (size_t i = 0; i < 6; ++i) CHECK(scene.camera_positions[i].name == "S" + std::to_string(i));
+    CHECK(scene.camera_positions[6].name == "anterior");
     const glm::mat4& s5 = scene.camera_positions[5].view;
     CHECK(s5[0][0] == float(-9.615108371e-01));
     CHECK(s5[3][0] == float(1.172330454e-01));   // r0c3
@@ -113,8 +115,8 @@ TEST_SUITE("loaders") {
       const char* first_text;
     };
     for (const Expected& e :
-         {Expected{"jet-engine.xml", "assets/models/jet_engine1.dae", 10, 6, "Fan"},
-          Expected{"sponza.xml", "assets/models/crytek-sponza/sponza.obj", 10, 5, nullptr}}) {
+         {Expected{"jet-engine.xml", "assets/models/jet_engine1.dae", 10, 6 + 6, "Fan"},
+          Expected{"sponza.xml", "assets/models/crytek-sponza/sponza.obj", 10, 5 + 6, nullptr}}) {
       CAPTURE(e.file);
       const fs::path path = voly_scenes / e.file;
       const strata::Scene scene = strata::load_scene(path);
@@ -238,7 +240,7 @@ TEST_SUITE("loaders") {
     CHECK(scene.camera.near_plane == 0.5f);
     CHECK(scene.camera.far_plane == 50.0f);
     CHECK(scene.camera.view[3] == glm::vec4(0.0f, 0.0f, -10.0f, 1.0f));
-    REQUIRE(scene.camera_positions.size() == 2);
+    REQUIRE(scene.camera_positions.size() == 2 + 6);  // (and the six anatomical views)
     CHECK(scene.camera_positions[0].name == "side");
     const glm::vec4 side_eye = glm::inverse(scene.camera_positions[0].view)[3];
     CHECK(side_eye.x == doctest::Approx(10.0));
@@ -501,7 +503,7 @@ TEST_SUITE("loaders") {
     CHECK(back.camera.fov_y_degrees == scene.camera.fov_y_degrees);
     CHECK(back.camera.near_plane == scene.camera.near_plane);
     CHECK(back.camera.far_plane == scene.camera.far_plane);
-    REQUIRE(back.camera_positions.size() == 6);
+    REQUIRE(back.camera_positions.size() == 6 + 6);
     CHECK(back.camera_positions[5].name == "S5");
     CHECK(back.camera_positions[5].view == scene.camera_positions[5].view);
     REQUIRE(back.meshes.size() == 1);

@@ -85,21 +85,33 @@ glm::mat4 fitted_view(const Scene& scene, AnatomicalView view, float fov_y_degre
   return glm::mat4(glm::lookAt(centre + side.eye_direction * distance, centre, side.up));
 }
 
+AnatomicalPositions anatomical_positions(const Scene& scene, float fov_y_degrees) {
+  AnatomicalPositions out;
+  const Bounds bounds = content_bounds(scene);
+  const double radius = 0.5 * glm::length(glm::dvec3(bounds.hi - bounds.lo));
+  const double half_fov = glm::radians(double(fov_y_degrees)) / 2.0;
+  double nearest = std::numeric_limits<double>::max(), farthest = 0.0;
+  for (size_t v = 0; v < kAnatomicalViewNames.size(); ++v) {
+    const double d = fitting_distance(bounds, side_of(AnatomicalView(v)), half_fov);
+    nearest = std::min(nearest, d);
+    farthest = std::max(farthest, d);
+    out.positions.push_back(
+        {kAnatomicalViewNames[v], fitted_view(scene, AnatomicalView(v), fov_y_degrees)});
+  }
+  out.nearest = float(nearest - radius);
+  out.farthest = float(farthest + radius);
+  return out;
+}
+
 FittedCamera fitted_camera(const Scene& scene) {
   FittedCamera fitted;
   Camera& camera = fitted.camera;
   camera.fov_y_degrees = 30.0f;  // a long lens: little perspective distortion of anatomy
   const Bounds bounds = content_bounds(scene);
   const double radius = 0.5 * glm::length(glm::dvec3(bounds.hi - bounds.lo));
-  const double half_fov = glm::radians(double(camera.fov_y_degrees)) / 2.0;
-  double nearest = std::numeric_limits<double>::max(), farthest = 0.0;
-  for (size_t v = 0; v < kAnatomicalViewNames.size(); ++v) {
-    const double d = fitting_distance(bounds, side_of(AnatomicalView(v)), half_fov);
-    nearest = std::min(nearest, d);
-    farthest = std::max(farthest, d);
-    fitted.positions.push_back(
-        {kAnatomicalViewNames[v], fitted_view(scene, AnatomicalView(v), camera.fov_y_degrees)});
-  }
+  AnatomicalPositions views = anatomical_positions(scene, camera.fov_y_degrees);
+  fitted.positions = std::move(views.positions);
+  const double nearest = double(views.nearest) + radius, farthest = double(views.farthest) - radius;
   // Room to zoom in to the centre and out to four times the distance (the viewer's wheel).
   camera.near_plane = float(std::max(0.01 * nearest, 0.1 * (nearest - radius)));
   camera.far_plane = float(4.0 * farthest + radius);

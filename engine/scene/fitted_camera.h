@@ -36,6 +36,14 @@ ViewSide side_of(AnatomicalView view);
 // square (fov_y of `lens` both ways, 5% margin); near and far from `lens`.
 glm::mat4 fitted_view(const Scene& scene, AnatomicalView view, float fov_y_degrees);
 
+// The six views as named positions (kAnatomicalViewNames) for a lens of `fov_y_degrees`, and
+// the near and far planes that hold the content from all of them.
+struct AnatomicalPositions {
+  std::vector<CameraPose> positions;
+  float nearest = 0.0f, farthest = 0.0f;  // eye depths of the content's nearest and farthest point
+};
+AnatomicalPositions anatomical_positions(const Scene& scene, float fov_y_degrees);
+
 // A lens and a view for a scene without a camera: anterior, or for flat content (one slice)
 // the view facing it; near and far planes holding the content from all six views with room to
 // zoom out; and the six views as named positions.

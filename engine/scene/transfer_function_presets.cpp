@@ -161,6 +161,12 @@ TransferFunction make_transfer_function_preset(std::string_view name, const Volu
   return tf;
 }
 
+bool preset_is_ct(std::string_view name) {
+  for (const TransferFunctionPreset& p : transfer_function_presets())
+    if (name == p.name) return p.ct;
+  return false;
+}
+
 PresetChoice choose_transfer_function_preset(const Volume& volume) {
   char range[96];
   std::snprintf(range, sizeof range, "values %g to %g", volume.value_range.x, volume.value_range.y);

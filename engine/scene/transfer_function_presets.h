@@ -31,4 +31,7 @@ struct PresetChoice {
 };
 PresetChoice choose_transfer_function_preset(const Volume& volume);
 
+// Whether the preset named `name` is one for CT (false for an MR preset or no preset).
+bool preset_is_ct(std::string_view name);
+
 }  // namespace strata

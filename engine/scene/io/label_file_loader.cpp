@@ -109,10 +109,14 @@ glm::vec3 to_world(const glm::dvec3& position, Axes axes) {
 struct ReadLabels {
   std::vector<Label> labels;
   std::vector<std::string> places;
+  std::vector<std::string> systems;  // the coordinate systems the points were written in
 
-  void add(Label label, std::string place) {
+  void add(Label label, std::string place, Axes axes) {
     labels.push_back(std::move(label));
     places.push_back(std::move(place));
+    const std::string system = axes == Axes::ras ? "RAS" : "LPS";
+    if (std::find(systems.begin(), systems.end(), system) == systems.end())
+      systems.push_back(system);
   }
 };
 
@@ -332,7 +336,7 @@ ReadLabels read_fcsv(const fs::path& path, const std::string& text) {
     if (const auto problem = anchor_problem(label)) line.fail(*problem);
     if (layout.label) label.text = text_field(row.fields[*layout.label], "label", line);
     if (label.text.empty()) label.text = fallback_text(base_name(path), index);
-    labels.add(std::move(label), "line " + std::to_string(row.line));
+    labels.add(std::move(label), "line " + std::to_string(row.line), *axes);
   }
   return labels;
 }
@@ -412,7 +416,7 @@ ReadLabels read_csv(const fs::path& path, const std::string& text) {
     if (const auto problem = anchor_problem(label)) line.fail(*problem);
     label.text = text_field(row.fields[layout.text], names[layout.text], line);
     if (label.text.empty()) label.text = fallback_text(base_name(path), i - 1);
-    labels.add(std::move(label), "line " + std::to_string(row.line));
+    labels.add(std::move(label), "line " + std::to_string(row.line), layout.system);
   }
   return labels;
 }
@@ -522,7 +526,7 @@ void read_markup(const json& markup, const Field& field, const std::string& file
     const json* text = optional(point, "label");
     if (text) label.text = string(*text, point_field / "label");
     if (label.text.empty()) label.text = fallback_text(list_name, i);
-    labels.add(std::move(label), point_field.path);
+    labels.add(std::move(label), point_field.path, axes);
   }
 }
 
@@ -543,6 +547,10 @@ ReadLabels read_markups(const fs::path& path) {
 }  // namespace
 
 std::vector<Label> load_label_file(const fs::path& path, int64_t first_id) {
+  return read_label_file(path, first_id).labels;
+}
+
+LabelFile read_label_file(const fs::path& path, int64_t first_id) {
   const std::string name = lowercase(path.filename().string());
   ReadLabels labels;
   std::string none = "no points";
@@ -570,7 +578,7 @@ std::vector<Label> load_label_file(const fs::path& path, int64_t first_id) {
                   ", after the labels before it)");
     labels.labels[i].id = int(id);
   }
-  return std::move(labels.labels);
+  return {std::move(labels.labels), std::move(labels.systems)};
 }
 
 }  // namespace strata

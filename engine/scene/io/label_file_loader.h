@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "engine/scene/scene.h"
@@ -18,5 +19,13 @@ namespace strata {
 // line>: <reason>".
 // An id past 2147483647 is an error naming the label's line or entry.
 std::vector<Label> load_label_file(const std::filesystem::path& path, int64_t first_id = 0);
+
+// The same, with the coordinate systems the file's points were written in ("LPS", "RAS"; in the
+// order first met: a markups file may hold lists in both).
+struct LabelFile {
+  std::vector<Label> labels;
+  std::vector<std::string> coordinate_systems;
+};
+LabelFile read_label_file(const std::filesystem::path& path, int64_t first_id = 0);
 
 }  // namespace strata

@@ -607,21 +607,38 @@ void complete_scene(Scene& scene, const std::string& preset) {
     }
     if (preset.empty() && volume.transfer_function >= 0) continue;
     std::string name = preset;
+    const PresetChoice choice = choose_transfer_function_preset(volume);
     if (name.empty()) {
-      const PresetChoice choice = choose_transfer_function_preset(volume);
       name = choice.name;
       scene.warnings.push_back("volume '" + volume.name + "' has no transfer function; preset " +
                                name + " (" + choice.reason + "; --preset NAME to choose)");
+    } else if (preset_is_ct(name) != preset_is_ct(choice.name)) {
+      // (a preset for the other modality maps the values to nothing or to everything)
+      scene.warnings.push_back("volume '" + volume.name + "': preset " + name + " is for " +
+                               (preset_is_ct(name) ? "CT" : "MR") + ", but " + choice.reason +
+                               "; it may show nothing (" + choice.name + " would suit it)");
     }
     scene.transfer_functions.push_back(make_transfer_function_preset(name, volume));
     volume.transfer_function = int(scene.transfer_functions.size()) - 1;
   }
   check_content_bounds(scene);
-  if (scene.has_camera) return;
-  FittedCamera fitted = fitted_camera(scene);
-  check_fitted_camera(scene, fitted.camera);
-  scene.camera = fitted.camera;
-  for (CameraPose& pose : fitted.positions) {
+  // Every scene has the six anatomical views as named positions besides its own (an own
+  // position of the same name wins), fitted to its content with its lens.
+  std::vector<CameraPose> views;
+  if (scene.has_camera) {
+    const AnatomicalPositions fitted = anatomical_positions(scene, scene.camera.fov_y_degrees);
+    views = fitted.positions;
+    // (the planes hold the content from those views too)
+    if (fitted.nearest > 0.0f)
+      scene.camera.near_plane = std::min(scene.camera.near_plane, fitted.nearest);
+    scene.camera.far_plane = std::max(scene.camera.far_plane, fitted.farthest);
+  } else {
+    FittedCamera fitted = fitted_camera(scene);
+    check_fitted_camera(scene, fitted.camera);
+    scene.camera = fitted.camera;
+    views = std::move(fitted.positions);
+  }
+  for (CameraPose& pose : views) {
     const bool taken = std::any_of(scene.camera_positions.begin(), scene.camera_positions.end(),
                                    [&](const CameraPose& p) { return p.name == pose.name; });
     if (!taken) scene.camera_positions.push_back(std::move(pose));

@@ -114,11 +114,12 @@ void write_positions(ordered_json& root, const Scene& scene) {
   ordered_json read =
       camera && camera->contains("positions") ? (*camera)["positions"] : ordered_json::array();
   std::vector<bool> used(read.size(), false);
-  // The positions complete_scene appends for a file without a camera: the loader appends them
-  // again, so those at the end of the list are not written (ones before a saved position are,
-  // to keep the order that the keys 1 to 9 follow).
+  // The anatomical views complete_scene appends: the loader appends them again, so those at the
+  // end of the list are not written (ones before a saved position are, to keep the order that
+  // the keys 1 to 9 follow).
   const std::vector<CameraPose> fitted =
-      scene.has_camera ? std::vector<CameraPose>{} : fitted_camera(scene).positions;
+      scene.has_camera ? anatomical_positions(scene, scene.camera.fov_y_degrees).positions
+                       : fitted_camera(scene).positions;
   const auto is_fitted = [&](const CameraPose& pose) {
     return std::any_of(fitted.begin(), fitted.end(), [&](const CameraPose& p) {
       return p.name == pose.name && p.view == pose.view;
