@@ -49,6 +49,7 @@ struct SceneInput {
   std::string preset;   // --preset: every volume's transfer function
   std::string labels;   // --labels: a label file (.mrk.json, .fcsv, .csv) added
   int frame = -1;       // --frame: a 4-D volume's frame (-1: the first, with a warning)
+  std::string series;   // --series: a DICOM folder's series (SeriesNumber or UID)
   uint32_t layers = 0;  // --layers: 0 keeps the scene's settings.layers
   // The depth layers asked for: --layers, else the scene's.
   uint32_t layer_count(const Scene& scene) const;

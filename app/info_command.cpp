@@ -241,6 +241,25 @@ void add_info_command(CLI::App& app) {
       return;
     }
     if (!scene_file->empty()) throw UsageError("--scene goes with a label file only");
+    std::error_code error;
+    if (fs::is_directory(path, error)) {
+      // A DICOM folder: every series in it, then the volume a load opens by default.
+      const std::vector<DicomSeries> all = list_dicom_series_isolated(path);
+      std::string listed = format("series: %zu\n", all.size());
+      for (const DicomSeries& s : all) {
+        listed += format("  %s  %s  %s %ux%ux%u, %s", s.number.empty() ? "-" : s.number.c_str(),
+                         s.uid.empty() ? "(no SeriesInstanceUID)" : s.uid.c_str(),
+                         s.modality.empty() ? "?" : s.modality.c_str(), s.columns, s.rows, s.images,
+                         s.orientation.c_str());
+        if (s.time_points > 1) listed += format(", %u time points", s.time_points);
+        listed += s.description.empty() ? "\n" : "  \"" + printable_text(s.description) + "\"\n";
+      }
+      const Scene scene = load_single_file(path);
+      std::printf("%s\n%s%s", file->c_str(), listed.c_str(), describe(scene, false).c_str());
+      for (const std::string& w : scene.warnings)
+        std::fprintf(stderr, "strata: warning: %s\n", w.c_str());
+      return;
+    }
     const bool whole_scene = is_scene_file(path);
     const Scene scene = whole_scene ? load_scene(path) : load_single_file(path);
     std::printf("%s\n%s", file->c_str(), describe(scene, whole_scene).c_str());

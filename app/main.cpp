@@ -35,6 +35,7 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
   options.preset = in.preset;
   options.labels = in.labels;
   if (in.frame >= 0) options.frame = in.frame;
+  options.series = in.series;
   Scene scene = load_scene(in.file, options);
   if (!scene.labels.empty()) {  // (characters no font draws: the size does not matter)
     for (std::string& w : missing_glyph_warnings(Font(16.0f), scene.labels))
@@ -90,6 +91,10 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
                   "(docs/scene-format.md)");
   cmd->add_option("--frame", in.frame, "a 4-D volume's frame, from 0 (default: the first)")
       ->check(whole_range(0, 1e6));
+  cmd->add_option("--series", in.series,
+                  "a DICOM folder holding several series: the one with this SeriesNumber or "
+                  "SeriesInstanceUID (default: the largest 3-D image series; strata info FOLDER "
+                  "lists them)");
   cmd->add_option("--layers", in.layers,
                   "depth layers, 1 to " + std::to_string(kMaxLayers) +
                       " (default: the scene's settings.layers, else 4)")

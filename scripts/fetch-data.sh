@@ -9,7 +9,8 @@
 #                    CT_small.dcm (one 128x128 CT slice), MR_small.dcm and MR_small_implicit.dcm
 #                    (one MR slice, explicit and implicit VR little endian)
 #   python3-nibabel: philips_mprage.dcm (an enhanced multi-frame MR: 176 frames of 256x256 in one
-#                    file; its pixels are zeros) and example4d.nii.gz (4-D NIfTI, 2 frames)
+#                    file; its pixels are zeros), example4d.nii.gz (4-D NIfTI, 2 frames) and
+#                    nicom's 0.dcm (a Siemens diffusion mosaic: slices tiled in one image)
 #   assimp-testmodels: invalid/OutOfMemory.off (309 bytes whose header claims 3.5 million vertices:
 #                    Assimp runs for minutes and takes gigabytes; the parser limits' test)
 set -euo pipefail
@@ -39,6 +40,7 @@ nibabel=usr/lib/python3/dist-packages/nibabel
 files+=(
   "python3-nibabel $nibabel/nicom/tests/data/philips_mprage.dcm.gz dicom/philips_mprage.dcm 00058b3a5141b839493c21393c317e1cfe12ca912be8edf2f856ad3ea69fb6e3"
   "python3-nibabel $nibabel/tests/data/example4d.nii.gz nibabel/example4d.nii.gz 42097dfbab9d2a036b41ae5c97a359591cf2cf5c3f8dc6ca6455c0b8a7f22696"
+  "python3-nibabel $nibabel/nicom/tests/data/0.dcm dicom/siemens_mosaic.dcm 7045df97f3f8300f3af2f5ef4006b77b8c3c1181b5668d5f9a4783d2375c6dbb"
 )
 files+=(
   "assimp-testmodels usr/share/assimp/models/invalid/OutOfMemory.off assimp/OutOfMemory.off 4e337750dcd6b28e6c68392126a93d5756ef0f0d4f7d69c3c1c6ec413aefef7d"

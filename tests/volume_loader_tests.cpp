@@ -705,6 +705,81 @@ TEST_SUITE("loaders") {
     CHECK_LOAD_ERROR(wide, "2392: BitsAllocated = 32: only 8 and 16 are supported");
   }
 
+  // A folder as an archive exports it: the five CT slices of one series and an MR slice of
+  // another. Listed both; opened by default the largest 3-D one with a warning naming the other,
+  // either by its SeriesNumber or UID, and the choice kept when the scene is saved.
+  TEST_CASE("dicom_folder_with_two_series_lists_both_and_opens_either") {
+    const fs::path folder = copy_ct5n("dicom_two_series", {"2062", "2392", "2693", "3023", "3353"});
+    fs::copy_file(cache / "dicom/MR_small.dcm", folder / "MR_small.dcm");
+    const std::vector<strata::DicomSeries> series = strata::list_dicom_series_isolated(folder);
+    REQUIRE(series.size() == 2);
+    CHECK(series[0].number == "5");
+    CHECK(series[0].modality == "CT");
+    CHECK(series[0].images == 5);
+    CHECK(series[0].orientation == "axial");
+    CHECK(series[0].description == "SmartScore - Gated 0.5 sec");
+    CHECK(series[1].number == "1");
+    CHECK(series[1].modality == "MR");
+    CHECK(series[1].columns == 64);
+    CHECK(series[1].images == 1);
+    CHECK(series[0].uid != series[1].uid);
+
+    std::vector<std::string> warnings;
+    const Volume chosen = strata::load_volume(folder, {}, warnings);
+    CHECK(chosen.dims == glm::uvec3(16, 16, 5));
+    CHECK(chosen.voxels == strata::load_volume(ct5n).voxels);
+    CHECK(chosen.series == series[0].uid);
+    REQUIRE(!warnings.empty());
+    CHECK(warnings[0] == folder.string() +
+                             ": holds 2 series; opened series 5 'SmartScore - Gated 0.5 sec' "
+                             "(CT, 16x16x5), the largest 3-D image; the others: series 1 (MR, "
+                             "64x64x1). --series NUMBER or UID (or the scene's \"series\") opens "
+                             "another; strata info " +
+                             folder.string() + " lists them");
+    const Volume mr = strata::load_volume(cache / "dicom/MR_small.dcm", {}, warnings);
+    for (const std::string& wanted : {std::string("1"), series[1].uid}) {
+      CAPTURE(wanted);
+      warnings.clear();
+      const Volume v = strata::load_volume(folder, {.series = wanted}, warnings);
+      CHECK(v.voxels == mr.voxels);
+      CHECK(v.index_to_patient() == mr.index_to_patient());
+      CHECK(v.series == series[1].uid);
+      for (const std::string& w : warnings) CHECK(w.find("holds 2 series") == std::string::npos);
+    }
+    const auto error_with = [](const fs::path& path, const std::string& wanted) {
+      std::vector<std::string> ignored;
+      return strata::test::error_of(
+          [&] { strata::load_volume(path, {.series = wanted}, ignored); });
+    };
+    CHECK(error_with(folder, "9") ==
+          folder.string() +
+              ": no series '9' (SeriesNumber or SeriesInstanceUID); the folder holds: series 5 "
+              "'SmartScore - Gated 0.5 sec' (CT, 16x16x5); series 1 (MR, 64x64x1)");
+    CHECK(error_with(cache / "dicom/MR_small.dcm", "1").find("is chosen in a DICOM folder only") !=
+          std::string::npos);
+
+    // Saved, the scene of the folder opens the same series again.
+    const strata::Scene scene = strata::load_scene(folder, {.series = "1"});
+    const fs::path saved = output_folder("dicom_two_series_scene") / "scene.json";
+    strata::save_scene_json(saved, scene);
+    const strata::Scene back = strata::load_scene(saved);
+    REQUIRE(back.volumes.size() == 1);
+    CHECK(back.volumes[0].voxels == mr.voxels);
+  }
+
+  // A Siemens mosaic tiles its slices into one image: refused, never shown as one slice.
+  TEST_CASE("dicom_siemens_mosaic_is_refused_with_the_way_out") {
+    const fs::path mosaic = cache / "dicom/siemens_mosaic.dcm";
+    REQUIRE_MESSAGE(fs::exists(mosaic), "run scripts/fetch-data.sh");
+    std::vector<std::string> warnings;
+    const std::string error =
+        strata::test::error_of([&] { strata::load_volume(mosaic, {}, warnings); });
+    CHECK(error.starts_with(mosaic.string() +
+                            ": a Siemens mosaic (ImageType ORIGINAL\\PRIMARY\\"
+                            "DIFFUSION\\NONE\\ND\\MOSAIC): its slices are tiles"));
+    CHECK(error.find("dcm2niix") != std::string::npos);
+  }
+
   TEST_CASE("dicom_rescale_gives_float32_when_fractional_and_applies_per_slice") {
     const fs::path half = output_folder("dicom_half_slope");
     const fs::path per_slice = output_folder("dicom_per_slice_slope");
@@ -978,9 +1053,17 @@ TEST_SUITE("loaders") {
     write_file(folder / "notes.dcm", "not DICOM\n");
     CHECK_LOAD_ERROR(folder / "notes.dcm", "not a DICOM file");
 
+    // (the made-up enhanced file has no SeriesInstanceUID: a series of its own beside 2062's)
     const fs::path mixed = copy_ct5n("dicom_enhanced_and_slices", {"2062"});
     write_file(mixed / "enhanced.dcm", enhanced_ct({shuffled_ct5n()}));
-    CHECK_LOAD_ERROR(mixed, "holds the multi-frame file enhanced.dcm and other images");
+    std::vector<std::string> warnings;
+    CHECK(strata::load_volume(mixed, {}, warnings).dims == glm::uvec3(16, 16, 5));
+    REQUIRE(!warnings.empty());
+    CHECK(warnings[0].find("holds 2 series") != std::string::npos);
+    const fs::path two = output_folder("dicom_two_multi_frame_files");
+    write_file(two / "enhanced.dcm", enhanced_ct({shuffled_ct5n()}));
+    write_file(two / "other.dcm", enhanced_ct({shuffled_ct5n()}));
+    CHECK_LOAD_ERROR(two, "holds the multi-frame file enhanced.dcm and other images of its series");
   }
 
   // ---- 2-D images: one voxel thick, with a warning

@@ -35,6 +35,9 @@ struct Volume {
   std::vector<std::byte> voxels;  // i fastest, then j, then k; rescale slope/intercept applied
   glm::vec2 value_range{0.0f};    // min and max voxel value (transfer functions normalise by it)
   int transfer_function = -1;     // index into Scene::transfer_functions, -1 for none
+  // The SeriesInstanceUID it was read from, where its DICOM folder holds several series (the
+  // scene writer keeps it, so the same series opens again).
+  std::string series;
 
   size_t voxel_count() const { return size_t{dims.x} * dims.y * dims.z; }
   size_t byte_size() const { return voxels.size(); }

@@ -49,8 +49,10 @@ struct Slice {
   int bits_allocated = 0, bits_stored = 0, high_bit = 0;
   bool is_signed = false;
   Rescale rescale;
-  std::string series, syntax;  // SeriesInstanceUID, TransferSyntaxUID
-  std::string stack, time;     // StackID and TemporalPositionIndex of enhanced files' frames
+  std::string series, syntax;                        // SeriesInstanceUID, TransferSyntaxUID
+  std::string series_number, description, modality;  // SeriesNumber, SeriesDescription, Modality
+  std::string time_position;                         // TemporalPositionIdentifier
+  std::string stack, time;  // StackID and TemporalPositionIndex of enhanced files' frames
   double thickness = 0.0;
   double along_normal = 0.0;  // the position projected onto the slice normal
   bool placed = true;         // false: no ImagePositionPatient (a secondary capture, a 2-D image)
@@ -409,6 +411,18 @@ std::vector<Slice> read_file_slices(const fs::path& file) {
   Slice common{.file = file};
   read_pixel_format(e, common);
   common.series = e.text(0x0020, 0x000e);
+  common.series_number = e.text(0x0020, 0x0011);
+  common.description = e.text(0x0008, 0x103e);
+  common.modality = e.text(0x0008, 0x0060);
+  common.time_position = e.text(0x0020, 0x0100);
+  // A Siemens mosaic tiles a whole stack of slices into one image; read as one slice it would
+  // show as a grid of stripes.
+  const std::string image_type = e.text(0x0008, 0x0008);
+  if (image_type.find("MOSAIC") != std::string::npos)
+    fail(file, concat("a Siemens mosaic (ImageType ", printable(image_type, 80),
+                      "): its slices are tiles of one image, which strata does not unpack; "
+                      "convert the series to NIfTI first (dcm2niix, in Debian's dcm2niix "
+                      "package) and open that"));
   const char* syntax = reader.GetFile().GetHeader().GetDataSetTransferSyntax().GetString();
   common.syntax = syntax ? syntax : "";
   std::vector<Slice> slices = read_frames(reader.GetFile(), e, common);
@@ -452,18 +466,9 @@ std::vector<Slice> read_folder(const fs::path& folder) {
   if (error) fail(folder, concat("cannot list the folder: ", error.message()));
   std::sort(files.begin(), files.end());
   std::vector<Slice> slices;
-  size_t images = 0;
-  std::string multi_frame;  // the name of a multi-frame file among them
   for (const fs::path& file : files) {
     if (file.filename().string().front() != '.') check_not_a_damaged_slice(file);
     std::vector<Slice> more = read_file_slices(file);
-    if (more.empty()) continue;
-    ++images;
-    if (more.front().frames_in_file > 1) multi_frame = file.filename().string();
-    if (!multi_frame.empty() && images > 1)
-      fail(folder, concat("holds the multi-frame file ", multi_frame,
-                          " and other images: strata reads a folder of single-frame slices or "
-                          "one multi-frame file"));
     slices.insert(slices.end(), more.begin(), more.end());
   }
   if (slices.empty())
@@ -471,6 +476,126 @@ std::vector<Slice> read_folder(const fs::path& folder) {
                                : concat("no DICOM files (none of its ", files.size(),
                                         " files is a DICOM image)"));
   return slices;
+}
+
+// A folder's slices by series (SeriesInstanceUID; files without one together), in the order
+// their first files sort. Within a series: single-frame slices or one multi-frame file.
+std::vector<std::vector<Slice>> by_series(const fs::path& folder, std::vector<Slice> slices) {
+  std::vector<std::vector<Slice>> groups;
+  for (Slice& s : slices) {
+    auto group = std::find_if(groups.begin(), groups.end(), [&](const std::vector<Slice>& g) {
+      return g.front().series == s.series;
+    });
+    if (group == groups.end()) {
+      groups.emplace_back();
+      group = groups.end() - 1;
+    }
+    group->push_back(std::move(s));
+  }
+  for (const std::vector<Slice>& g : groups) {
+    const auto multi =
+        std::find_if(g.begin(), g.end(), [](const Slice& s) { return s.frames_in_file > 1; });
+    if (multi == g.end()) continue;
+    const auto other =
+        std::find_if(g.begin(), g.end(), [&](const Slice& s) { return s.file != multi->file; });
+    if (other != g.end())
+      fail(folder, concat("holds the multi-frame file ", multi->file.filename().string(),
+                          " and other images of its series: strata reads a series of "
+                          "single-frame slices or one multi-frame file"));
+  }
+  return groups;
+}
+
+// The plane of the slices, from their normal: the patient axis it is nearest (within 10
+// degrees), else oblique.
+std::string orientation_name(const Slice& s) {
+  const glm::dvec3 n = glm::cross(s.row_cosine, s.column_cosine);
+  if (glm::length(n) < 0.5) return "unknown";
+  const glm::dvec3 a = glm::abs(glm::normalize(n));
+  const double cos10 = std::cos(10.0 * 3.14159265358979 / 180.0);
+  if (a.z >= cos10) return "axial";
+  if (a.x >= cos10) return "sagittal";
+  if (a.y >= cos10) return "coronal";
+  return "oblique";
+}
+
+DicomSeries describe_series(const std::vector<Slice>& g) {
+  const Slice& first = g.front();
+  DicomSeries out;
+  out.uid = first.series;
+  out.number = first.series_number;
+  out.description = first.description;
+  out.modality = first.modality;
+  out.columns = first.columns;
+  out.rows = first.rows;
+  out.images = uint32_t(g.size());
+  std::vector<std::string> times;
+  for (const Slice& s : g) {
+    const std::string& t = s.time.empty() ? s.time_position : s.time;
+    if (std::find(times.begin(), times.end(), t) == times.end()) times.push_back(t);
+  }
+  out.time_points = uint32_t(times.size());
+  out.orientation = first.placed ? orientation_name(first) : "unplaced";
+  return out;
+}
+
+// "series 3 'T1 MPRAGE' (MR, 256x256x176)", or by its UID where it has no number.
+std::string series_name(const DicomSeries& s) {
+  std::string name = s.number.empty()
+                         ? "series " + (s.uid.empty() ? std::string("(no UID)") : s.uid)
+                         : "series " + s.number;
+  if (!s.description.empty()) name += " '" + printable(s.description, 64) + "'";
+  return concat(name, " (", s.modality.empty() ? "?" : s.modality, ", ", s.columns, "x", s.rows,
+                "x", s.images, ")");
+}
+
+// The series a load opens: the one `wanted` names (its SeriesNumber or SeriesInstanceUID), else
+// the only one, else the largest 3-D image series (most voxels among those of more than one
+// slice), with a warning naming the others and how to choose.
+size_t choose_series(const fs::path& folder, const std::vector<std::vector<Slice>>& groups,
+                     const std::string& wanted, std::vector<std::string>& warnings) {
+  std::vector<DicomSeries> all;
+  for (const auto& g : groups) all.push_back(describe_series(g));
+  std::string listed;
+  for (const DicomSeries& s : all) listed += (listed.empty() ? "" : "; ") + series_name(s);
+  if (!wanted.empty()) {
+    std::vector<size_t> matches;
+    for (size_t i = 0; i < all.size(); ++i)
+      if (all[i].uid == wanted || all[i].number == wanted) matches.push_back(i);
+    if (matches.empty())
+      fail(folder, concat("no series '", printable(wanted, 80),
+                          "' (SeriesNumber or "
+                          "SeriesInstanceUID); the folder holds: ",
+                          listed));
+    if (matches.size() > 1)
+      fail(folder, concat("SeriesNumber ", wanted, " names ", matches.size(),
+                          " series: give the SeriesInstanceUID (strata info ", folder.string(),
+                          " lists them)"));
+    return matches.front();
+  }
+  if (all.size() == 1) return 0;
+  const auto voxels = [](const DicomSeries& s) {
+    return uint64_t{s.columns} * s.rows * s.images * (s.images > 1 ? 1u : 0u);
+  };
+  size_t best = 0;
+  for (size_t i = 1; i < all.size(); ++i) {
+    const bool more = voxels(all[i]) > voxels(all[best]) ||
+                      (voxels(all[best]) == 0 &&
+                       all[i].images * uint64_t{all[i].columns} * all[i].rows >
+                           all[best].images * uint64_t{all[best].columns} * all[best].rows);
+    if (more) best = i;
+  }
+  std::string others;
+  for (size_t i = 0; i < all.size(); ++i)
+    if (i != best) others += (others.empty() ? "" : "; ") + series_name(all[i]);
+  warnings.push_back(
+      concat(folder.string(), ": holds ", all.size(), " series; opened ", series_name(all[best]),
+             voxels(all[best]) > 0 ? ", the largest 3-D image" : ", the largest image",
+             "; the others: ", others,
+             ". --series NUMBER or UID (or the scene's \"series\") opens another; "
+             "strata info ",
+             folder.string(), " lists them"));
+  return best;
 }
 
 // Sorts along the normal and returns the uniform distance between slices.
@@ -744,13 +869,27 @@ Volume load_dicom_series(const std::filesystem::path& folder, const VolumeReadOp
   if (!fs::is_directory(folder, error)) fail(folder, "not a folder (a DICOM series is a folder)");
   choose_frame(folder, 1, options, warnings);
   quiet_gdcm();
-  std::vector<Slice> slices = read_folder(folder);
+  std::vector<std::vector<Slice>> groups = by_series(folder, read_folder(folder));
+  std::vector<Slice> slices =
+      std::move(groups[choose_series(folder, groups, options.series, warnings)]);
+  const std::string series = groups.size() > 1 ? slices.front().series : std::string();
   // A folder holding one multi-frame file: errors about its frames name the file.
   const fs::path where = slices.front().frames_in_file > 1 ? slices.front().file : folder;
   Volume volume = assemble(where, std::move(slices), options.limits, warnings);
   volume.name = volume_name(folder);
   volume.source = folder;
+  volume.series = series;
   return volume;
+}
+
+std::vector<DicomSeries> list_dicom_series(const std::filesystem::path& folder) {
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) fail(folder, "not a folder (a DICOM series is a folder)");
+  quiet_gdcm();
+  std::vector<DicomSeries> out;
+  for (const std::vector<Slice>& g : by_series(folder, read_folder(folder)))
+    out.push_back(describe_series(g));
+  return out;
 }
 
 Volume load_dicom_file(const std::filesystem::path& path, const VolumeReadOptions& options,

@@ -47,7 +47,7 @@ constexpr uint64_t kGiB = uint64_t{1} << 30;
 // The result crosses the process boundary field by field (mesh_fields, volume_fields): a field
 // added to Mesh or Volume must be added there too, or it is silently lost for meshes and DICOM.
 static_assert(sizeof(Mesh) == 224, "Mesh changed: update mesh_fields (isolated_read.cpp)");
-static_assert(sizeof(Volume) == 256, "Volume changed: update volume_fields (isolated_read.cpp)");
+static_assert(sizeof(Volume) == 288, "Volume changed: update volume_fields (isolated_read.cpp)");
 
 template <class T>
 constexpr bool is_vector = false;
@@ -494,6 +494,7 @@ void volume_fields(Io& io, V& volume) {
   io.field(volume.voxels);
   io.field(volume.value_range);
   io.field(volume.transfer_function);
+  io.field(volume.series);
 }
 
 }  // namespace
@@ -528,6 +529,25 @@ std::vector<Mesh> read_meshes_isolated(const std::filesystem::path& file, std::s
         for (Mesh& mesh : meshes) mesh_fields(child, mesh);
       });
   return meshes;
+}
+
+std::vector<std::string> read_texts_isolated(
+    const std::filesystem::path& file, std::string_view parser, const ParserLimits& limits,
+    const std::function<std::vector<std::string>()>& read) {
+  std::vector<std::string> texts;
+  run_isolated(
+      file, parser, limits,
+      [&](Writer& w) {
+        const std::vector<std::string> result = read();
+        w.outcome(Outcome::value);
+        w.pod(uint64_t{result.size()});
+        for (const std::string& text : result) w.text(text);
+      },
+      [&](Child& child) {
+        texts.resize(child.pod<uint64_t>());
+        for (std::string& text : texts) text = child.text();
+      });
+  return texts;
 }
 
 Volume read_volume_isolated(const std::filesystem::path& file, std::string_view parser,

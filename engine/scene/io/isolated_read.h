@@ -37,4 +37,9 @@ Volume read_volume_isolated(const std::filesystem::path& file, std::string_view 
                             const ParserLimits& limits, std::vector<std::string>& warnings,
                             const std::function<Volume(std::vector<std::string>&)>& read);
 
+// The same for texts (a DICOM folder's series, each as its fields).
+std::vector<std::string> read_texts_isolated(const std::filesystem::path& file,
+                                             std::string_view parser, const ParserLimits& limits,
+                                             const std::function<std::vector<std::string>()>& read);
+
 }  // namespace strata

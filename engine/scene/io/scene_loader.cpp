@@ -195,12 +195,16 @@ int SceneReader::transfer_function(const json& value, const Field& field) {
 
 // Every field is checked before the (slow) file is read, so a typo is reported at once.
 void SceneReader::volume(const json& object, const Field& field) {
-  check_keys(object, field, {"name", "file", "frame", "transfer_function", "transform"});
+  check_keys(object, field, {"name", "file", "frame", "series", "transfer_function", "transform"});
   const std::filesystem::path path = resolve(required(object, field, "file"), field / "file");
   VolumeReadOptions options{.limits = limits_};
   if (const json* frame = optional(object, "frame")) {
     options.frame = integer(*frame, field / "frame");
     if (*options.frame < 0) (field / "frame").fail("expected an integer >= 0");
+  }
+  if (const json* series = optional(object, "series")) {
+    options.series = string(*series, field / "series");
+    if (options.series.empty()) (field / "series").fail("expected a SeriesNumber or UID");
   }
   const json* name = optional(object, "name");
   const std::string volume_name = name ? string(*name, field / "name") : base_name(path);
@@ -512,6 +516,10 @@ Scene load_scene_json(const std::filesystem::path& path, const VolumeLimits& lim
 Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& options) {
   const std::string extension = path.extension().string();
   Scene scene;
+  if (!options.series.empty() && !is_volume_path(path))
+    throw Error(path.string() +
+                ": --series chooses the series of a DICOM folder opened directly; "
+                "a scene file names it in its volume's \"series\"");
   if (extension == ".json") {
     scene = load_scene_json(path, options.limits);
   } else if (extension == ".xml") {
@@ -545,7 +553,8 @@ int64_t next_label_id(const Scene& scene) {
 Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOptions& options) {
   Scene scene;
   scene.source = path;
-  const VolumeReadOptions read{.frame = options.frame, .limits = options.limits};
+  const VolumeReadOptions read{
+      .frame = options.frame, .series = options.series, .limits = options.limits};
   scene.volumes.push_back(load_volume(path, read, scene.warnings));
   Volume& volume = scene.volumes.back();
   if (volume.name.empty()) volume.name = base_name(path.lexically_normal());

@@ -19,6 +19,7 @@ struct SceneOpenOptions {
   std::string preset;            // every volume's transfer function: this preset
   std::filesystem::path labels;  // labels from this file (load_label_file) added
   std::optional<int> frame;      // a 4-D volume opened directly: this frame
+  std::string series;            // a DICOM folder opened directly: this series (number or UID)
   VolumeLimits limits;           // every volume read, checked from its header (volume_loader.h)
 };
 

@@ -171,6 +171,7 @@ ordered_json from_model(const std::filesystem::path& path, const Scene& scene) {
       entry["transfer_function"] =
           tf.source.empty() ? transfer_function_to_json(tf) : ordered_json(relative(tf.source));
     }
+    if (!volume.series.empty()) entry["series"] = volume.series;
     if (volume.transform != glm::mat4(1.0f)) entry["transform"] = matrix_json(volume.transform);
     volumes.push_back(std::move(entry));
   }

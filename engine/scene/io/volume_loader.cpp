@@ -81,6 +81,34 @@ void check_voxel_values(const std::filesystem::path& path, Volume& volume,
 
 constexpr std::string_view kDicomReader = "the DICOM reader (GDCM)";
 
+}  // namespace
+
+std::vector<DicomSeries> list_dicom_series_isolated(const std::filesystem::path& folder,
+                                                    const ParserLimits& limits) {
+  // (each series as its nine fields, in the order of DicomSeries)
+  constexpr size_t kFields = 9;
+  const std::vector<std::string> texts = read_texts_isolated(folder, kDicomReader, limits, [&] {
+    std::vector<std::string> out;
+    for (const DicomSeries& s : list_dicom_series(folder)) {
+      for (const std::string& field :
+           {s.uid, s.number, s.description, s.modality, std::to_string(s.columns),
+            std::to_string(s.rows), std::to_string(s.images), std::to_string(s.time_points),
+            s.orientation})
+        out.push_back(field);
+    }
+    return out;
+  });
+  std::vector<DicomSeries> series;
+  for (size_t i = 0; i + kFields <= texts.size(); i += kFields) {
+    const auto number = [&](size_t k) { return uint32_t(std::stoul(texts[i + k])); };
+    series.push_back({texts[i], texts[i + 1], texts[i + 2], texts[i + 3], number(4), number(5),
+                      number(6), number(7), texts[i + 8]});
+  }
+  return series;
+}
+
+namespace {
+
 Volume read_by_extension(const std::filesystem::path& path, const VolumeReadOptions& options,
                          std::vector<std::string>& warnings) {
   std::error_code error;
@@ -117,6 +145,9 @@ bool is_volume_path(const std::filesystem::path& path) {
 
 Volume load_volume(const std::filesystem::path& path, const VolumeReadOptions& options,
                    std::vector<std::string>& warnings) {
+  if (!options.series.empty() && format_of(path) != Format::dicom_folder)
+    volume_io::fail(path, "a series (" + options.series +
+                              ") is chosen in a DICOM folder only; this is not one");
   Volume volume = read_by_extension(path, options, warnings);
   // Every format, DICOM too: its reader names the fields it read, this names what they gave.
   volume_io::check_plausible_geometry(path, "origin", "spacing", volume);

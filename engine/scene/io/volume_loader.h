@@ -36,6 +36,9 @@ struct VolumeLimits {
 
 struct VolumeReadOptions {
   std::optional<int> frame;  // 4-D images: which frame (default 0)
+  // A DICOM folder holding several series: the one with this SeriesNumber or SeriesInstanceUID
+  // (default: the largest 3-D image series, with a warning naming the others).
+  std::string series;
   VolumeLimits limits;
   ParserLimits parser;  // DICOM: GDCM's child process (isolated_read.h)
 };
@@ -58,6 +61,24 @@ Volume load_nrrd(const std::filesystem::path& path, const VolumeReadOptions& opt
                  std::vector<std::string>& warnings);
 Volume load_dicom_series(const std::filesystem::path& folder, const VolumeReadOptions& options,
                          std::vector<std::string>& warnings);
+// One series of a DICOM folder, as its first slice describes it.
+struct DicomSeries {
+  std::string uid;          // SeriesInstanceUID ("" where the files give none)
+  std::string number;       // SeriesNumber as written ("" where none)
+  std::string description;  // SeriesDescription
+  std::string modality;     // CT, MR, ...
+  uint32_t columns = 0, rows = 0;
+  uint32_t images = 0;       // slices (frames of a multi-frame file)
+  uint32_t time_points = 1;  // distinct temporal positions among them
+  std::string orientation;   // axial, sagittal, coronal, oblique (or unplaced: no position)
+};
+// Every series of a DICOM folder, in the order of their first files (GDCM in this process: run
+// it through list_dicom_series_isolated).
+std::vector<DicomSeries> list_dicom_series(const std::filesystem::path& folder);
+// The same in a child process (isolated_read.h).
+std::vector<DicomSeries> list_dicom_series_isolated(const std::filesystem::path& folder,
+                                                    const ParserLimits& limits = {});
+
 Volume load_dicom_file(const std::filesystem::path& path, const VolumeReadOptions& options,
                        std::vector<std::string>& warnings);
 
