@@ -34,8 +34,9 @@ Timings measure(graph::GraphRunner& runner, uint32_t warmup, uint32_t runs,
                 const std::function<void()>& after_run = {});
 // A GPU that idled while the host set a benchmark up runs its first frames slowly: with three
 // warm-up frames the first count measured in a process read its loop several times too slow
-// (docs/performance.md); warming up for this long made that rare. (The labels' state carries over from frame to frame, so how many frames
-// ran changes how many tidy-up rounds the measured frames run.)
+// (docs/performance.md); warming up for this long made that rare. (The labels' state carries over
+// from frame to frame, so how many frames ran changes how many tidy-up rounds the measured frames
+// run.)
 inline constexpr double kWarmupSeconds = 0.5;
 
 // Milliseconds rounded to whole nanoseconds, the finest a GPU timestamp resolves: further digits

@@ -24,6 +24,9 @@ class UsageError : public Error {
   using Error::Error;
 };
 
+// --window's "CENTER,WIDTH" (the volume's values; a usage error otherwise).
+glm::vec2 parse_window(const std::string& text);
+
 // The scene's camera position an option names (--camera): an unknown name is a usage error that
 // names the option and the scene's positions.
 Camera option_camera(const Scene& scene, const std::string& name, const char* option = "--camera");
@@ -50,6 +53,7 @@ struct SceneInput {
   std::string labels;   // --labels: a label file (.mrk.json, .fcsv, .csv) added
   int frame = -1;       // --frame: a 4-D volume's frame (-1: the first, with a warning)
   std::string series;   // --series: a DICOM folder's series (SeriesNumber or UID)
+  std::string window;   // --window CENTER,WIDTH: a grey ramp in the volumes' values
   uint32_t layers = 0;  // --layers: 0 keeps the scene's settings.layers
   // The depth layers asked for: --layers, else the scene's.
   uint32_t layer_count(const Scene& scene) const;

@@ -1,3 +1,4 @@
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -36,6 +37,10 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
   options.labels = in.labels;
   if (in.frame >= 0) options.frame = in.frame;
   options.series = in.series;
+  if (!in.window.empty()) {
+    if (!in.preset.empty()) throw UsageError("give --preset or --window, not both");
+    options.window = parse_window(in.window);
+  }
   Scene scene = load_scene(in.file, options);
   if (!scene.labels.empty()) {  // (characters no font draws: the size does not matter)
     for (std::string& w : missing_glyph_warnings(Font(16.0f), scene.labels))
@@ -58,6 +63,17 @@ Scene load_scene_reporting(const SceneInput& in, const Context& ctx) {
 
 Scene load_scene_reporting(const std::string& path) {
   return load_scene_reporting(SceneInput{.file = path});
+}
+
+glm::vec2 parse_window(const std::string& text) {
+  float center = 0.0f, width = 0.0f;
+  char comma = 0, extra = 0;
+  const int n = std::sscanf(text.c_str(), "%f%c%f%c", &center, &comma, &width, &extra);
+  if (n != 3 || comma != ',' || !(std::abs(center) <= 1e9f) || !(width > 0.0f && width <= 1e9f))
+    throw UsageError("--window: '" + text +
+                     "' is not CENTER,WIDTH (the volume's values, e.g. 40,80 for brain or "
+                     "400,1800 for bone in HU; width > 0)");
+  return {center, width};
 }
 
 Camera option_camera(const Scene& scene, const std::string& name, const char* option) {
@@ -91,6 +107,9 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
                   "(docs/scene-format.md)");
   cmd->add_option("--frame", in.frame, "a 4-D volume's frame, from 0 (default: the first)")
       ->check(whole_range(0, 1e6));
+  cmd->add_option("--window", in.window,
+                  "CENTER,WIDTH: every volume shown as a grey ramp over these values (Hounsfield "
+                  "units for CT: 40,80 brain, 400,1800 bone), in place of its transfer function");
   cmd->add_option("--series", in.series,
                   "a DICOM folder holding several series: the one with this SeriesNumber or "
                   "SeriesInstanceUID (default: the largest 3-D image series; strata info FOLDER "

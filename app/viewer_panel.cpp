@@ -246,8 +246,17 @@ void Viewer::panel_rendering() {
       }
       ImGui::EndCombo();
     }
-    bool edited = ImGui::SliderFloat("level", &look.level, 0.0f, 1.0f, "%.3f");
-    edited |= ImGui::SliderFloat("window", &look.window, 0.01f, 2.0f, "%.3f");
+    // Level and window in the volume's own values (Hounsfield units for CT), as radiology sets
+    // them; the look keeps them as shares of the value range.
+    const glm::vec2 range = scene_.volumes[v].value_range;
+    const float span = std::max(range.y - range.x, 1e-6f);
+    float level = range.x + look.level * span, window = look.window * span;
+    bool edited = ImGui::SliderFloat("level", &level, range.x, range.y, "%.5g");
+    edited |= ImGui::SliderFloat("window", &window, 0.01f * span, 2.0f * span, "%.5g");
+    if (edited) {
+      look.level = (level - range.x) / span;
+      look.window = std::max(window / span, 0.01f);
+    }
     edited |= ImGui::SliderFloat("opacity", &look.opacity, 0.0f, 4.0f, "%.2f");
     if (ImGui::Button("Reset")) {
       look = {};

@@ -147,6 +147,50 @@ TEST_SUITE("loaders") {
     }
   }
 
+  // A volume's window and a transfer function in HU are made 0..1 of its value range; HU on a
+  // volume whose values are not Hounsfield units warns.
+  TEST_CASE("windows_and_functions_in_the_volumes_values_map_to_its_range") {
+    const fs::path folder = output_folder("values");
+    const std::string ct5n = (cache / "dicom/CT5N").string();
+    const strata::Scene windowed = strata::load_scene(write_file(
+        folder / "w.json",
+        R"({"strata_scene": 1, "volumes": [{"file": ")" + ct5n + R"(", "window": [-400, 800]}]})"));
+    const strata::Volume& v = windowed.volumes[0];
+    REQUIRE(v.value_range == glm::vec2(-888.0f, 85.0f));
+    const strata::TransferFunction& tf = windowed.transfer_functions[size_t(v.transfer_function)];
+    CHECK(tf.name == "window -400/800");
+    CHECK(tf.units.empty());
+    const auto at = [&](float value) { return tf.sample((value + 888.0f) / 973.0f); };
+    CHECK(at(-800.0f) == glm::vec4(0.0f));
+    CHECK(at(-400.0f).a == doctest::Approx(0.5f).epsilon(1e-4));
+    CHECK(at(0.0f).a == doctest::Approx(0.5f + 400.0f / 800.0f).epsilon(1e-4));
+    CHECK(error_of([&] {
+            strata::load_scene(write_file(folder / "both.json",
+                                          R"({"strata_scene": 1, "volumes": [{"file": ")" + ct5n +
+                                              R"(", "window": [40, 80], "transfer_function": {
+              "stops": [{"position": 0, "color": [1, 1, 1, 1]}]}}]})"));
+          }).find("volumes[0].window: give a transfer_function or a window, not both") !=
+          std::string::npos);
+
+    strata::Scene mr;
+    strata::Volume volume = ct_block();
+    volume.value_range = {0.0f, 255.0f};
+    mr.volumes.push_back(volume);
+    strata::TransferFunction hu;
+    hu.name = "bone";
+    hu.units = "HU";
+    hu.stops = {{300.0f, glm::vec4(0.0f)}, {1000.0f, glm::vec4(1.0f)}};
+    mr.transfer_functions.push_back(hu);
+    mr.volumes[0].transfer_function = 0;
+    strata::complete_scene(mr);
+    CHECK(mr.transfer_functions.size() == 2);
+    CHECK(mr.volumes[0].transfer_function == 1);
+    CHECK(std::any_of(mr.warnings.begin(), mr.warnings.end(), [](const std::string& w) {
+      return w.find("transfer function bone is in Hounsfield units, but values 0 to 255") !=
+             std::string::npos;
+    }));
+  }
+
   TEST_CASE("a_volume_opens_as_a_scene_with_a_preset_a_fitted_camera_and_named_views") {
     const fs::path ch2 = cache / "mricron/ch2.nii.gz";
     REQUIRE_MESSAGE(fs::exists(ch2), "run scripts/fetch-data.sh");

@@ -340,8 +340,8 @@ TEST_SUITE("loaders") {
               "camera, settings)");
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "trasform": []}]})") ==
           prefix +
-              "volumes[0]: unknown key 'trasform' (expected name, file, frame, transfer_function, "
-              "transform)");
+              "volumes[0]: unknown key 'trasform' (expected name, file, frame, series, "
+              "transfer_function, window, transform)");
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "transform": [1, 2, 3]}]})") ==
           prefix + "volumes[0].transform: expected 16 numbers");
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": 3}]})") ==

@@ -89,6 +89,20 @@ TEST_SUITE("loaders") {
       for (int c = 0; c < 4; ++c) CHECK(back.stops[i].color[c] == tf.stops[i].color[c]);
     }
     CHECK(strata::is_transfer_function_file(path));
+    CHECK(back.units.empty());
+    // In the volume's values (HU): positions beyond 0..1 and the units kept.
+    strata::TransferFunction hu = tf;
+    hu.units = "HU";
+    hu.stops[0].position = -1000.0f;
+    hu.stops[1].position = -500.0f;
+    hu.stops[2].position = 40.0f;
+    hu.stops[3].position = 1800.0f;
+    strata::write_transfer_function_json(output_folder() / "hu.json", hu);
+    const strata::TransferFunction hu_back =
+        strata::load_transfer_function(output_folder() / "hu.json");
+    CHECK(hu_back.units == "HU");
+    CHECK(hu_back.stops[1].position == -500.0f);
+    CHECK(hu_back.stops[3].position == 1800.0f);
     // Floats are written with the fewest digits that read back the same.
     std::ifstream in(path);
     const std::string text{std::istreambuf_iterator<char>(in), {}};
@@ -175,7 +189,17 @@ TEST_SUITE("loaders") {
               "version.json: strata_transfer_function: version 2 is not supported (this strata "
               "reads version 1)");
     CHECK(load_text("key.json", R"({"strata_transfer_function": 1, "stop": []})") ==
-          folder + "key.json: unknown key 'stop' (expected strata_transfer_function, name, stops)");
+          folder +
+              "key.json: unknown key 'stop' (expected strata_transfer_function, name, units, "
+              "stops)");
+    CHECK(
+        load_text("units.json", R"({"strata_transfer_function": 1, "units": "mm", "stops": []})") ==
+        folder +
+            "units.json: units: expected \"HU\" or \"raw\" (positions in the volume's values) or "
+            "\"range\" (0..1 of its value range, the default)");
+    CHECK(load_text("hu.json", R"({"strata_transfer_function": 1, "units": "HU",
+            "stops": [{"position": "a", "color": [1, 1, 1, 1]}]})") ==
+          folder + "hu.json: stops[0].position: expected a value of the volume (|v| <= 1e9)");
     CHECK(
         load_text(
             "color.json",

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
+#include <optional>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -18,6 +20,7 @@
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
 #include "engine/scene/io/scene_loader.h"
+#include "engine/scene/transfer_function_presets.h"
 #include "gpu_fixture.h"
 #include "passes/volume_render_reference.h"
 #include "passes/volume_renderer.h"
@@ -237,6 +240,72 @@ TEST_SUITE("gpu") {
     }
     CHECK(worst < 4e-3f);                  // (half floats)
     CHECK(upscaled.final != plain.final);  // fewer rays: not the same picture
+  }
+
+  // Transfer functions in the volume's values: the same CT with two value ranges (one voxel of
+  // padding at -3000 HU, as scanners write outside the field of view) looks the same through a
+  // window or a function in HU, and not through one written for 0..1 of the first one's range.
+  TEST_CASE_FIXTURE(test::GpuTest, "windows_and_hounsfield_functions_look_alike_on_two_ranges") {
+    std::vector<std::string> warnings;
+    const Volume a = load_volume(
+        std::filesystem::path(STRATA_SOURCE_DIR) / "assets/cache/dicom/CT5N", {}, warnings);
+    REQUIRE(a.type == VoxelType::int16);
+    // The padding replaces the lowest voxel (air already, below every window here).
+    size_t lowest = 0;
+    for (size_t i = 0; i < a.voxel_count(); ++i) {
+      int16_t v, w;
+      std::memcpy(&v, a.voxels.data() + 2 * i, 2);
+      std::memcpy(&w, a.voxels.data() + 2 * lowest, 2);
+      if (v < w) lowest = i;
+    }
+    Volume b = a;
+    const int16_t padding = -3000;
+    std::memcpy(b.voxels.data() + 2 * lowest, &padding, 2);
+    b.value_range.x = -3000.0f;
+    TransferFunction hu;
+    hu.name = "bone and tissue";
+    hu.units = "HU";
+    hu.stops = {{-500.0f, glm::vec4(0.0f)},
+                {-50.0f, glm::vec4(0.9f, 0.6f, 0.5f, 0.3f)},
+                {1300.0f, glm::vec4(1.0f)}};
+    Scene first;
+    first.volumes.push_back(a);
+    complete_scene(first);
+    const Camera camera = first.camera;  // (the same for both: the same box)
+    const graph::Extent size{48, 48};
+    const auto picture = [&](const Volume& v, const TransferFunction* tf,
+                             std::optional<glm::vec2> window) {
+      Scene scene;
+      scene.volumes.push_back(v);
+      if (tf) {
+        scene.transfer_functions.push_back(*tf);
+        scene.volumes[0].transfer_function = 0;
+      }
+      complete_scene(scene, "", window);
+      return render_gpu(ctx, scene, camera, {}, size).final;
+    };
+    // The share of pixels that differ by more than 3 of 255 in a channel.
+    const auto differing = [&](const std::vector<uint8_t>& x, const std::vector<uint8_t>& y) {
+      size_t count = 0, shown = 0;
+      for (size_t p = 0; p < x.size(); p += 4) {
+        bool differs = false;
+        for (size_t c = 0; c < 4; ++c)
+          differs = differs || std::abs(int(x[p + c]) - int(y[p + c])) > 3;
+        count += differs ? 1 : 0;
+        shown += x[p + 3] > 0 ? 1 : 0;
+      }
+      CHECK(shown > x.size() / 4 / 4);  // (something to compare)
+      return double(count) / double(x.size() / 4);
+    };
+    const double window = differing(picture(a, nullptr, glm::vec2(400.0f, 1800.0f)),
+                                    picture(b, nullptr, glm::vec2(400.0f, 1800.0f)));
+    const double in_hu = differing(picture(a, &hu, {}), picture(b, &hu, {}));
+    const TransferFunction range = in_value_range(hu, a);  // 0..1 of a's range, as files were
+    const double in_range = differing(picture(a, &range, {}), picture(b, &range, {}));
+    MESSAGE("pixels differing: window ", window, ", HU ", in_hu, ", 0..1 of the range ", in_range);
+    CHECK(window <= 0.02);
+    CHECK(in_hu <= 0.02);
+    CHECK(in_range >= 0.2);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "one_volume_matches_the_reference") {

@@ -53,12 +53,16 @@ struct Volume {
 // Piecewise-linear RGBA over intensity normalised to [0, 1] by the volume's value range.
 struct TransferFunction {
   struct Stop {
-    float position = 0.0f;  // 0..1
+    float position = 0.0f;  // 0..1 of the volume's value range (or in `units`)
     glm::vec4 color{0.0f};  // straight (not premultiplied) RGBA, 0..1
   };
   std::string name;
   std::filesystem::path source;
   std::vector<Stop> stops;  // sorted by position
+  // "": positions are 0..1 of the volume's value range; "HU" or "raw": they are the volume's own
+  // values (Hounsfield units for CT, after the file's rescale), the same on any scan.
+  // complete_scene makes each volume a 0..1 copy for its range (in_value_range).
+  std::string units;
   // Colour at t in [0, 1]: clamped to the first and last stop outside them.
   glm::vec4 sample(float t) const;
 };

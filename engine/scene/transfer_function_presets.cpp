@@ -142,14 +142,23 @@ TransferFunction make_transfer_function_preset(std::string_view name, const Volu
   if (!found)
     throw Error("no transfer-function preset '" + std::string(name) + "' (" + names + ")");
 
-  // The preset's values as the volume's normalised [0, 1] (its value range), cut to that range:
-  // a stop at each end with the colour there, the stops strictly inside kept.
   const float scale = found->preset.ct ? 1.0f : bright_level(volume);
-  std::vector<ValueStop> stops = found->stops;
-  for (ValueStop& s : stops) s.value *= scale;
+  TransferFunction in_values;
+  in_values.name = found->preset.name;
+  in_values.units = "raw";
+  for (const ValueStop& s : found->stops) in_values.stops.push_back({s.value * scale, s.color});
+  return in_value_range(in_values, volume);
+}
+
+// The values as the volume's normalised [0, 1] (its value range), cut to that range: a stop at
+// each end with the colour there, the stops strictly inside kept.
+TransferFunction in_value_range(const TransferFunction& in_values, const Volume& volume) {
+  std::vector<ValueStop> stops;
+  for (const TransferFunction::Stop& s : in_values.stops) stops.push_back({s.position, s.color});
   const float lo = volume.value_range.x, hi = volume.value_range.y;
   TransferFunction tf;
-  tf.name = found->preset.name;
+  tf.name = in_values.name;
+  tf.source = in_values.source;
   tf.stops.push_back({0.0f, color_at(stops, lo)});
   if (hi > lo) {
     for (const ValueStop& s : stops) {
@@ -158,6 +167,16 @@ TransferFunction make_transfer_function_preset(std::string_view name, const Volu
     }
   }
   tf.stops.push_back({1.0f, color_at(stops, hi)});
+  return tf;
+}
+
+TransferFunction window_transfer_function(float center, float width) {
+  TransferFunction tf;
+  char name[64];
+  std::snprintf(name, sizeof name, "window %g/%g", center, width);
+  tf.name = name;
+  tf.units = "raw";
+  tf.stops = {{center - 0.5f * width, glm::vec4(0.0f)}, {center + 0.5f * width, glm::vec4(1.0f)}};
   return tf;
 }
 

@@ -31,6 +31,15 @@ struct PresetChoice {
 };
 PresetChoice choose_transfer_function_preset(const Volume& volume);
 
+// A transfer function whose positions are the volume's own values (units "HU" or "raw") made one
+// of 0..1 of `volume`'s value range, which the renderer takes.
+TransferFunction in_value_range(const TransferFunction& in_values, const Volume& volume);
+
+// Window and level as radiology sets them, in the volume's values (HU for CT: brain 40/80, bone
+// 400/1800): a grey ramp over [center - width / 2, center + width / 2], transparent black below
+// it, opaque white above (units "raw").
+TransferFunction window_transfer_function(float center, float width);
+
 // Whether the preset named `name` is one for CT (false for an MR preset or no preset).
 bool preset_is_ct(std::string_view name);
 

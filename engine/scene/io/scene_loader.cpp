@@ -195,7 +195,8 @@ int SceneReader::transfer_function(const json& value, const Field& field) {
 
 // Every field is checked before the (slow) file is read, so a typo is reported at once.
 void SceneReader::volume(const json& object, const Field& field) {
-  check_keys(object, field, {"name", "file", "frame", "series", "transfer_function", "transform"});
+  check_keys(object, field,
+             {"name", "file", "frame", "series", "transfer_function", "window", "transform"});
   const std::filesystem::path path = resolve(required(object, field, "file"), field / "file");
   VolumeReadOptions options{.limits = limits_};
   if (const json* frame = optional(object, "frame")) {
@@ -211,7 +212,15 @@ void SceneReader::volume(const json& object, const Field& field) {
   const json* transform = optional(object, "transform");
   const glm::mat4 placement = transform ? matrix(*transform, field / "transform") : glm::mat4(1.0f);
   const json* tf = optional(object, "transfer_function");
-  const int tf_index = tf ? transfer_function(*tf, field / "transfer_function") : -1;
+  int tf_index = tf ? transfer_function(*tf, field / "transfer_function") : -1;
+  if (const json* window = optional(object, "window")) {
+    if (tf) (field / "window").fail("give a transfer_function or a window, not both");
+    const std::vector<float> v = numbers(*window, field / "window", 2);
+    if (!(std::abs(v[0]) <= 1e9f && v[1] > 0.0f && v[1] <= 1e9f))
+      (field / "window").fail("expected [center, width] in the volume's values, width > 0");
+    scene_.transfer_functions.push_back(window_transfer_function(v[0], v[1]));
+    tf_index = int(scene_.transfer_functions.size()) - 1;
+  }
   Volume volume =
       (field / "file").wrap([&] { return load_volume(path, options, scene_.warnings); });
   volume.name = volume_name;
@@ -540,7 +549,7 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
   if (scene.labels.size() > size_t(kMaxLabels))
     throw Error(path.string() + ": " + std::to_string(scene.labels.size()) +
                 " labels; strata places at most " + std::to_string(kMaxLabels) + " in a scene");
-  complete_scene(scene, options.preset);
+  complete_scene(scene, options.preset, options.window);
   return scene;
 }
 
@@ -607,14 +616,31 @@ void check_fitted_camera(const Scene& scene, const Camera& camera) {
 
 }  // namespace
 
-void complete_scene(Scene& scene, const std::string& preset) {
+void complete_scene(Scene& scene, const std::string& preset, std::optional<glm::vec2> window) {
   for (Volume& volume : scene.volumes) {
     if (!(volume.value_range.y > volume.value_range.x)) {
       scene.warnings.push_back("volume '" + volume.name + "' holds the one value " +
                                json(volume.value_range.x).dump() +
                                " everywhere: no transfer function can show it");
     }
-    if (preset.empty() && volume.transfer_function >= 0) continue;
+    if (window) {
+      scene.transfer_functions.push_back(
+          in_value_range(window_transfer_function(window->x, window->y), volume));
+      volume.transfer_function = int(scene.transfer_functions.size()) - 1;
+      continue;
+    }
+    if (preset.empty() && volume.transfer_function >= 0) {
+      // A function in the volume's own values: made one of its value range (each volume its own).
+      const TransferFunction tf = scene.transfer_functions[size_t(volume.transfer_function)];
+      if (tf.units.empty()) continue;
+      const PresetChoice suits = choose_transfer_function_preset(volume);
+      if (tf.units == "HU" && !preset_is_ct(suits.name))
+        scene.warnings.push_back("volume '" + volume.name + "': transfer function " + tf.name +
+                                 " is in Hounsfield units, but " + suits.reason);
+      scene.transfer_functions.push_back(in_value_range(tf, volume));
+      volume.transfer_function = int(scene.transfer_functions.size()) - 1;
+      continue;
+    }
     std::string name = preset;
     const PresetChoice choice = choose_transfer_function_preset(volume);
     if (name.empty()) {

@@ -16,11 +16,12 @@ namespace strata {
 
 // What the command line adds to a scene (--preset, --labels, --frame).
 struct SceneOpenOptions {
-  std::string preset;            // every volume's transfer function: this preset
-  std::filesystem::path labels;  // labels from this file (load_label_file) added
-  std::optional<int> frame;      // a 4-D volume opened directly: this frame
-  std::string series;            // a DICOM folder opened directly: this series (number or UID)
-  VolumeLimits limits;           // every volume read, checked from its header (volume_loader.h)
+  std::string preset;               // every volume's transfer function: this preset
+  std::filesystem::path labels;     // labels from this file (load_label_file) added
+  std::optional<int> frame;         // a 4-D volume opened directly: this frame
+  std::string series;               // a DICOM folder opened directly: this series (number or UID)
+  std::optional<glm::vec2> window;  // every volume: a grey ramp at (center, width), its values
+  VolumeLimits limits;              // every volume read, checked from its header (volume_loader.h)
 };
 
 // A scene file, .json (strata) or .xml (thesis import), or a volume file or DICOM folder opened
@@ -34,7 +35,11 @@ Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOption
 // function gets the preset that suits its data (transfer_function_presets.h) and a warning
 // saying which; `preset`, when given, replaces every volume's. A scene without a camera gets the
 // fitted one and the six anatomical views as named positions (fitted_camera.h).
-void complete_scene(Scene& scene, const std::string& preset = "");
+// `window` (center, width in the volume's values), when given, replaces every volume's
+// transfer function with that grey ramp (window_transfer_function). A transfer function in the
+// volume's values (units HU or raw) is made one of its value range here.
+void complete_scene(Scene& scene, const std::string& preset = "",
+                    std::optional<glm::vec2> window = {});
 
 // One more than the highest label id (0 for none): where added labels' ids start.
 // (int64_t: one past a label with id 2147483647 is no int.)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -40,7 +41,7 @@ float unit_number(const json& value, const std::string& file, const std::string&
 }
 
 TransferFunction::Stop stop_from_json(const json& stop, const std::string& file,
-                                      const std::string& field) {
+                                      const std::string& field, bool in_values) {
   if (!stop.is_object())
     fail(file, field, "expected an object {\"position\": ..., \"color\": ...}");
   for (const auto& [key, value] : stop.items()) {
@@ -51,7 +52,15 @@ TransferFunction::Stop stop_from_json(const json& stop, const std::string& file,
   if (!stop.contains("position")) fail(file, field, "missing key 'position'");
   if (!stop.contains("color")) fail(file, field, "missing key 'color'");
   TransferFunction::Stop result;
-  result.position = unit_number(stop["position"], file, child(field, "position"));
+  if (in_values) {
+    const json& position = stop["position"];
+    const double v = position.is_number() ? position.get<double>() : NAN;
+    if (!(std::abs(v) <= 1e9))
+      fail(file, child(field, "position"), "expected a value of the volume (|v| <= 1e9)");
+    result.position = static_cast<float>(v);
+  } else {
+    result.position = unit_number(stop["position"], file, child(field, "position"));
+  }
   const json& color = stop["color"];
   const std::string color_field = child(field, "color");
   if (!color.is_array() || color.size() != 4) {
@@ -110,9 +119,9 @@ TransferFunction transfer_function_from_json(const json& object, const std::stri
                                              const std::string& field) {
   if (!object.is_object()) fail(file, field, "expected a transfer-function object");
   for (const auto& [key, value] : object.items()) {
-    if (key != "strata_transfer_function" && key != "name" && key != "stops") {
+    if (key != "strata_transfer_function" && key != "name" && key != "units" && key != "stops") {
       fail(file, field,
-           "unknown key '" + key + "' (expected strata_transfer_function, name, stops)");
+           "unknown key '" + key + "' (expected strata_transfer_function, name, units, stops)");
     }
   }
   if (object.contains("strata_transfer_function") && object["strata_transfer_function"] != 1) {
@@ -125,12 +134,20 @@ TransferFunction transfer_function_from_json(const json& object, const std::stri
     if (!object["name"].is_string()) fail(file, child(field, "name"), "expected a string");
     tf.name = object["name"].get<std::string>();
   }
+  if (object.contains("units")) {
+    const json& units = object["units"];
+    if (!units.is_string() || (units != "HU" && units != "raw" && units != "range"))
+      fail(file, child(field, "units"),
+           "expected \"HU\" or \"raw\" (positions in the volume's values) or \"range\" (0..1 of "
+           "its value range, the default)");
+    if (units != "range") tf.units = units.get<std::string>();
+  }
   const std::string stops_field = child(field, "stops");
   if (!object.contains("stops")) fail(file, field, "missing key 'stops'");
   const json& stops = object["stops"];
   if (!stops.is_array() || stops.empty()) fail(file, stops_field, "expected a non-empty array");
   for (size_t i = 0; i < stops.size(); ++i) {
-    tf.stops.push_back(stop_from_json(stops[i], file, element(stops_field, i)));
+    tf.stops.push_back(stop_from_json(stops[i], file, element(stops_field, i), !tf.units.empty()));
     // Sorted stops are part of the format: an unsorted file is most likely a typo.
     if (i > 0 && tf.stops[i].position < tf.stops[i - 1].position) {
       fail(file, child(element(stops_field, i), "position"),
@@ -147,7 +164,10 @@ nlohmann::ordered_json transfer_function_to_json(const TransferFunction& tf) {
     for (int c = 0; c < 4; ++c) color.push_back(shortest_double(stop.color[c]));
     stops.push_back({{"position", shortest_double(stop.position)}, {"color", color}});
   }
-  return {{"strata_transfer_function", 1}, {"name", tf.name}, {"stops", stops}};
+  nlohmann::ordered_json out = {{"strata_transfer_function", 1}, {"name", tf.name}};
+  if (!tf.units.empty()) out["units"] = tf.units;
+  out["stops"] = stops;
+  return out;
 }
 
 TransferFunction load_transfer_function_json(const std::filesystem::path& path) {
