@@ -24,6 +24,9 @@ class UsageError : public Error {
   using Error::Error;
 };
 
+// COUNT numbers separated by commas for `option` (a usage error naming `form` otherwise).
+std::vector<float> parse_numbers(const std::string& text, size_t count, const char* option,
+                                 const char* form);
 // --window's "CENTER,WIDTH" (the volume's values; a usage error otherwise).
 glm::vec2 parse_window(const std::string& text);
 
@@ -54,6 +57,8 @@ struct SceneInput {
   int frame = -1;       // --frame: a 4-D volume's frame (-1: the first, with a warning)
   std::string series;   // --series: a DICOM folder's series (SeriesNumber or UID)
   std::string window;   // --window CENTER,WIDTH: a grey ramp in the volumes' values
+  std::string crop;                // --crop X0,Y0,Z0,X1,Y1,Z1 (world, mm)
+  std::vector<std::string> clip;   // --clip PX,PY,PZ,NX,NY,NZ, up to six
   uint32_t layers = 0;  // --layers: 0 keeps the scene's settings.layers
   // The depth layers asked for: --layers, else the scene's.
   uint32_t layer_count(const Scene& scene) const;

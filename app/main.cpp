@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -37,6 +38,21 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
   options.labels = in.labels;
   if (in.frame >= 0) options.frame = in.frame;
   options.series = in.series;
+  if (!in.crop.empty()) {
+    const std::vector<float> v = parse_numbers(in.crop, 6, "--crop", "X0,Y0,Z0,X1,Y1,Z1");
+    const glm::vec3 lo(v[0], v[1], v[2]), hi(v[3], v[4], v[5]);
+    if (!glm::all(glm::lessThan(lo, hi)))
+      throw UsageError("--crop: '" + in.crop + "': each low corner value must be below the high");
+    options.cut = crop_planes(lo, hi);
+  }
+  if (in.clip.size() > 6) throw UsageError("--clip: at most six planes");
+  for (const std::string& text : in.clip) {
+    const std::vector<float> v = parse_numbers(text, 6, "--clip", "PX,PY,PZ,NX,NY,NZ");
+    const glm::vec3 normal(v[3], v[4], v[5]);
+    if (!(glm::length(normal) > 1e-6f))
+      throw UsageError("--clip: '" + text + "': the normal (NX,NY,NZ) must not be zero");
+    options.cut.push_back(clip_plane(glm::vec3(v[0], v[1], v[2]), normal));
+  }
   if (!in.window.empty()) {
     if (!in.preset.empty()) throw UsageError("give --preset or --window, not both");
     options.window = parse_window(in.window);
@@ -63,6 +79,26 @@ Scene load_scene_reporting(const SceneInput& in, const Context& ctx) {
 
 Scene load_scene_reporting(const std::string& path) {
   return load_scene_reporting(SceneInput{.file = path});
+}
+
+std::vector<float> parse_numbers(const std::string& text, size_t count, const char* option,
+                                 const char* form) {
+  std::vector<float> out;
+  size_t start = 0;
+  for (;;) {
+    const size_t comma = text.find(',', start);
+    const std::string part = text.substr(start, comma == std::string::npos ? comma : comma - start);
+    char* end = nullptr;
+    const float v = std::strtof(part.c_str(), &end);
+    if (part.empty() || end != part.c_str() + part.size() || !(std::abs(v) <= 1e9f)) break;
+    out.push_back(v);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (out.size() != count || std::count(text.begin(), text.end(), ',') != std::ptrdiff_t(count - 1))
+    throw UsageError(std::string(option) + ": '" + text + "' is not " + form +
+                     " (world coordinates in mm, LPS)");
+  return out;
 }
 
 glm::vec2 parse_window(const std::string& text) {
@@ -110,6 +146,11 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
   cmd->add_option("--window", in.window,
                   "CENTER,WIDTH: every volume shown as a grey ramp over these values (Hounsfield "
                   "units for CT: 40,80 brain, 400,1800 bone), in place of its transfer function");
+  cmd->add_option("--crop", in.crop,
+                  "X0,Y0,Z0,X1,Y1,Z1: show only this box of every volume (world mm, LPS)");
+  cmd->add_option("--clip", in.clip,
+                  "PX,PY,PZ,NX,NY,NZ: cut every volume at the plane through P, keeping the side "
+                  "N points to (world mm, LPS); up to six");
   cmd->add_option("--series", in.series,
                   "a DICOM folder holding several series: the one with this SeriesNumber or "
                   "SeriesInstanceUID (default: the largest 3-D image series; strata info FOLDER "

@@ -344,10 +344,13 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
 // first frame warm-started from the last one's planes and with hysteresis.
 void LabelledRenderer::project_and_layer(const Camera& camera) {
   const std::vector<ProjectedPoint> anchors = project_anchors(scene_, camera, size_);
+  // (a label whose anchor a cut-away removes is hidden with what it names)
+  std::vector<bool> shown(anchors.size());
+  for (size_t i = 0; i < anchors.size(); ++i)
+    shown[i] = anchors[i].visible && !hidden_[i] && !anchor_cut_away(scene_, scene_.labels[i].anchor);
   std::vector<float> depths;
-  for (size_t i = 0; i < anchors.size(); ++i) {
-    depths.push_back(anchors[i].visible && !hidden_[i] ? anchors[i].eye_depth : std::nanf(""));
-  }
+  for (size_t i = 0; i < anchors.size(); ++i)
+    depths.push_back(shown[i] ? anchors[i].eye_depth : std::nanf(""));
   layering_ = follow_layering(layering_, depths, settings_.layer_count, camera.near_plane,
                               camera.far_plane, settings_.hysteresis, settings_.seed);
   for (size_t i = 0; i < labels_.size(); ++i) {
@@ -356,7 +359,7 @@ void LabelledRenderer::project_and_layer(const Camera& camera) {
     l.previous = anchors[i].pixel;  // (the GPU's forces state replaces it once drawn)
     l.anchor_depth = anchors[i].eye_depth;
     l.layer = layering_.label_layer[i];
-    l.flags = (anchors[i].visible && !hidden_[i] ? LABEL_ENABLED : 0u) |
+    l.flags = (shown[i] ? LABEL_ENABLED : 0u) |
               (settings_.internal ? LABEL_INTERNAL : 0u);
   }
 }

@@ -49,6 +49,13 @@ struct Reference {
 
   vec4 table_entry(uint v, int i) const { return table[size_t(v) * VR_TF_SIZE + size_t(i)]; }
 
+  bool volume_cut(uint v, vec3 tc) const {
+    const VolumeGpu& vol = in.volumes[v];
+    for (uint i = 0; i < vol.cut_count.x; ++i)
+      if (dot(vec3(vol.cut[i]), tc) + vol.cut[i].w < 0.0f) return true;
+    return false;
+  }
+
   bool brick_empty(uint v, vec3 tc) const {
     const VolumeGpu& vol = in.volumes[v];
     const uvec3 bricks(vol.bricks);

@@ -21,6 +21,7 @@ using graph::ResourceId;
 using graph::Use;
 
 static_assert(VR_MAX_LAYERS == kMaxLayers, "the scene side's layer limit is the renderer's");
+static_assert(VR_MAX_CUT_PLANES == kMaxCutPlanes, "the scene side's cut-away limit");
 
 namespace {
 
@@ -215,6 +216,16 @@ RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimens
     const float spacing = finest_world_spacing(to_world, v.dims);
     info.atlas_scale = glm::vec4(glm::vec3(v.dims) / atlas_size, spacing);
     info.texel = glm::vec4(1.0f / glm::vec3(v.dims), 0.0f);
+    // (world planes to texture space: n . (A tc + b) + d = (A^T n) . tc + n . b + d)
+    if (v.cut.size() > VR_MAX_CUT_PLANES)
+      throw Error("volume '" + v.name + "': " + std::to_string(v.cut.size()) +
+                  " cut-away planes, at most " + std::to_string(VR_MAX_CUT_PLANES));
+    for (size_t c = 0; c < v.cut.size(); ++c) {
+      const glm::vec3 n(v.cut[c]);
+      info.cut[c] = glm::vec4(glm::transpose(glm::mat3(to_world)) * n,
+                              glm::dot(n, glm::vec3(to_world[3])) + v.cut[c].w);
+    }
+    info.cut_count = glm::uvec4(uint32_t(v.cut.size()), 0u, 0u, 0u);
     const glm::uvec3 bricks = (v.dims + uint32_t(VR_BRICK - 1)) / uint32_t(VR_BRICK);
     info.bricks = glm::uvec4(bricks, first_brick);
     brick_ranges(t, v.dims, bricks, in.brick_ranges);

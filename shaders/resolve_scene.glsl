@@ -16,6 +16,11 @@ vec4 volume_sample(uint v, vec3 tc) {
   return texture(atlas, volumes[v].atlas_offset.xyz + tc * volumes[v].atlas_scale.xyz);
 }
 vec4 table_entry(uint v, int i) { return transfer_table[v * VR_TF_SIZE + uint(i)]; }
+bool volume_cut(uint v, vec3 tc) {
+  for (uint i = 0u; i < volumes[v].cut_count.x; ++i)
+    if (dot(volumes[v].cut[i].xyz, tc) + volumes[v].cut[i].w < 0.0f) return true;
+  return false;
+}
 bool brick_empty(uint v, vec3 tc) {
   const uvec3 b = min(uvec3(tc / (volumes[v].texel.xyz * float(VR_BRICK))), volumes[v].bricks.xyz - 1u);
   const uvec4 g = volumes[v].bricks;

@@ -347,6 +347,33 @@ TEST_SUITE("gpu") {
     CHECK(with_mesh.stats.fragments > 0);
   }
 
+  // Cut-aways: a crop box and a plane, GPU = reference; where the front volume is cut away the
+  // picture shows what lies behind it, exactly as without it.
+  TEST_CASE_FIXTURE(test::GpuTest, "cut_away_volumes_match_the_reference_and_show_what_is_behind") {
+    Scene cut;
+    add_volume(cut, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.6f, 0.3f}));
+    cut.volumes[0].cut = crop_planes(glm::vec3(-20.0f, -6.0f, -20.0f), glm::vec3(20.0f));
+    cut.volumes[0].cut.push_back(clip_plane(glm::vec3(0.0f), glm::vec3(-1.0f, 0.0f, 1.0f)));
+    check_against_reference(ctx, cut, camera_at({12.0f, 9.0f, 32.0f}), "cut-away");
+
+    Scene behind;  // a ball 20 behind another, seen through it
+    add_volume(behind, ball({24, 24, 24}, glm::vec3(-12.0f, -12.0f, -32.0f), 11.0f),
+               ramp({0.3f, 0.6f, 1.0f}));
+    Scene both = behind;
+    add_volume(both, ball({24, 24, 24}, glm::vec3(-12.0f, -12.0f, 8.0f), 11.0f),
+               ramp({1.0f, 0.6f, 0.3f}));
+    const Camera camera = camera_at({0.0f, 0.0f, 90.0f});
+    const graph::Extent size{48, 48};
+    const std::vector<uint8_t> alone = render_gpu(ctx, behind, camera, {}, size).final;
+    CHECK(render_gpu(ctx, both, camera, {}, size).final != alone);
+    both.volumes[1].cut = {clip_plane(glm::vec3(0.0f, 0.0f, 2.0f), glm::vec3(0.0f, 0.0f, -1.0f))};
+    CHECK(render_gpu(ctx, both, camera, {}, size).final == alone);
+    // (a label anchored in the cut-away ball is cut away with it; one in the kept ball is not)
+    CHECK(anchor_cut_away(both, glm::vec3(0.0f, 0.0f, 20.0f)));
+    CHECK(!anchor_cut_away(both, glm::vec3(0.0f, 0.0f, -20.0f)));
+    CHECK(!anchor_cut_away(both, glm::vec3(0.0f, 0.0f, 60.0f)));  // (in no volume)
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "two_overlapping_volumes_match_the_reference") {
     Scene scene;
     add_volume(scene, ball({24, 24, 24}, glm::vec3(-16.0f, -12.0f, -12.0f), 11.0f),

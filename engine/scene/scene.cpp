@@ -95,6 +95,41 @@ glm::vec4 TransferFunction::sample(float t) const {
   return span > 0.0f ? glm::mix(a.color, b.color, (t - a.position) / span) : b.color;
 }
 
+std::vector<glm::vec4> crop_planes(glm::vec3 lo, glm::vec3 hi) {
+  std::vector<glm::vec4> planes;
+  for (int axis = 0; axis < 3; ++axis) {
+    glm::vec3 n(0.0f);
+    n[axis] = 1.0f;
+    planes.push_back(glm::vec4(n, -lo[axis]));   // p >= lo
+    planes.push_back(glm::vec4(-n, hi[axis]));   // p <= hi
+  }
+  return planes;
+}
+
+glm::vec4 clip_plane(glm::vec3 point, glm::vec3 normal) {
+  const glm::vec3 n = glm::normalize(normal);
+  return glm::vec4(n, -glm::dot(n, point));
+}
+
+bool cut_away(const Volume& volume, glm::vec3 p) {
+  for (const glm::vec4& plane : volume.cut)
+    if (glm::dot(glm::vec3(plane), p) + plane.w < 0.0f) return true;
+  return false;
+}
+
+bool anchor_cut_away(const Scene& scene, glm::vec3 anchor) {
+  bool cut = false;
+  for (const Volume& v : scene.volumes) {
+    const glm::vec3 i = glm::vec3(glm::inverse(v.index_to_world()) * glm::vec4(anchor, 1.0f));
+    const bool inside = glm::all(glm::greaterThanEqual(i, glm::vec3(-0.5f))) &&
+                        glm::all(glm::lessThanEqual(i, glm::vec3(v.dims) - 0.5f));
+    if (!inside) continue;
+    if (!cut_away(v, anchor)) return false;
+    cut = true;
+  }
+  return cut;
+}
+
 Camera camera_for(const Scene& scene, const std::string& name) {
   Camera camera = scene.camera;
   if (name.empty()) return camera;

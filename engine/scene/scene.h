@@ -35,6 +35,10 @@ struct Volume {
   std::vector<std::byte> voxels;  // i fastest, then j, then k; rescale slope/intercept applied
   glm::vec2 value_range{0.0f};    // min and max voxel value (transfer functions normalise by it)
   int transfer_function = -1;     // index into Scene::transfer_functions, -1 for none
+  // Cut-aways: planes in world space (xyz the normal, w the offset); a point p of the volume is
+  // shown where dot(xyz, p) + w >= 0 for every plane. A crop box is six of them
+  // (crop_planes); at most kMaxCutPlanes.
+  std::vector<glm::vec4> cut;
   // The SeriesInstanceUID it was read from, where its DICOM folder holds several series (the
   // scene writer keeps it, so the same series opens again).
   std::string series;
@@ -49,6 +53,15 @@ struct Volume {
   // The value of voxel (i, j, k) as float, whatever the type.
   float value(uint32_t i, uint32_t j, uint32_t k) const;
 };
+
+inline constexpr size_t kMaxCutPlanes = 12;  // VR_MAX_CUT_PLANES
+
+// The six planes that keep the box [lo, hi] (world space).
+std::vector<glm::vec4> crop_planes(glm::vec3 lo, glm::vec3 hi);
+// The plane through `point` that keeps the side `normal` points to.
+glm::vec4 clip_plane(glm::vec3 point, glm::vec3 normal);
+// Whether a volume's cut-aways remove world point p (false for a volume without any).
+bool cut_away(const Volume& volume, glm::vec3 p);
 
 // Piecewise-linear RGBA over intensity normalised to [0, 1] by the volume's value range.
 struct TransferFunction {
@@ -165,5 +178,9 @@ struct Scene {
 
 // The scene's camera, or its named position `name` (an Error listing the names if there is none).
 Camera camera_for(const Scene& scene, const std::string& name);
+
+// Whether the volumes around a label's anchor all cut it away: some volume's box (its voxel
+// centres') holds it and cuts it, none that holds it keeps it.
+bool anchor_cut_away(const Scene& scene, glm::vec3 anchor);
 
 }  // namespace strata

@@ -7,6 +7,7 @@
 //   vec4 table_entry(uint v, int i)        transfer table entry i of volume v, its alpha
 //                                          corrected for the frame's step (corrected_transfer)
 //   bool brick_empty(uint v, vec3 tc)      transfer function is transparent in tc's brick
+//   bool volume_cut(uint v, vec3 tc)       volume v's cut-aways remove tc (VolumeGpu::cut)
 //   void emit_layer(uint l, vec4 colour)   the pixel's layer l (premultiplied), called for every
 //                                          layer in order, once
 // and the pixel's mesh fragments sorted front to back: their eye depths and payloads. The
@@ -97,7 +98,7 @@ bool inside_unit_box(vec3 tc) {
 // its transfer function is transparent). The table's alpha is already corrected for the step:
 // the per-sample power this would take otherwise cost the resolve a fifth of its time.
 vec4 sample_volume(uint v, VolumeGpu vol, vec3 tc, vec3 to_eye) {
-  if (!inside_unit_box(tc)) return vec4(0.0f);
+  if (!inside_unit_box(tc) || volume_cut(v, tc)) return vec4(0.0f);
   vec4 s = volume_sample(v, tc);
   atlas_fetches += 1u;
   vec4 c = transfer(v, s.w);

@@ -8,6 +8,7 @@
 #include "common.h"
 
 #define VR_MAX_VOLUMES 8
+#define VR_MAX_CUT_PLANES 12  // per volume: a crop box's six and six clipping planes
 #define VR_MAX_LAYERS 8
 #define VR_MAX_MESH_FRAGMENTS 16  // per pixel in the resolve; more are counted, not drawn
 #define VR_MAX_FRAGMENTS (VR_MAX_MESH_FRAGMENTS + 2 * VR_MAX_VOLUMES)  // with the boxes' faces
@@ -57,6 +58,10 @@ struct VolumeGpu {
                      // (transfer-function alpha is per this distance: opacity correction)
   vec4 texel;        // xyz: 1 / dims (central differences, texture units); w: unused
   uvec4 bricks;      // xyz: brick grid size; w: first brick's index in the occupancy buffer
+  // Cut-aways (Volume::cut) in texture space: a sample at tc is shown where
+  // dot(xyz, tc) + w >= 0 for the first cut_count.x planes.
+  vec4 cut[VR_MAX_CUT_PLANES];
+  uvec4 cut_count;
 };
 
 struct FrameGpu {

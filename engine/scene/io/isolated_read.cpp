@@ -47,7 +47,7 @@ constexpr uint64_t kGiB = uint64_t{1} << 30;
 // The result crosses the process boundary field by field (mesh_fields, volume_fields): a field
 // added to Mesh or Volume must be added there too, or it is silently lost for meshes and DICOM.
 static_assert(sizeof(Mesh) == 224, "Mesh changed: update mesh_fields (isolated_read.cpp)");
-static_assert(sizeof(Volume) == 288, "Volume changed: update volume_fields (isolated_read.cpp)");
+static_assert(sizeof(Volume) == 312, "Volume changed: update volume_fields (isolated_read.cpp)");
 
 template <class T>
 constexpr bool is_vector = false;
@@ -495,6 +495,7 @@ void volume_fields(Io& io, V& volume) {
   io.field(volume.value_range);
   io.field(volume.transfer_function);
   io.field(volume.series);
+  io.field(volume.cut);
 }
 
 }  // namespace

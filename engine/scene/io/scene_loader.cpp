@@ -193,10 +193,41 @@ int SceneReader::transfer_function(const json& value, const Field& field) {
   return index;
 }
 
+// A volume's cut-aways: "crop" [x0, y0, z0, x1, y1, z1] (world, lo < hi) and "clip", planes
+// {"point": [x, y, z], "normal": [x, y, z]} that keep the side the normal points to.
+std::vector<glm::vec4> cut_planes(const json& object, const Field& field) {
+  std::vector<glm::vec4> planes;
+  if (const json* crop = optional(object, "crop")) {
+    const std::vector<float> v = numbers(*crop, field / "crop", 6);
+    const glm::vec3 lo(v[0], v[1], v[2]), hi(v[3], v[4], v[5]);
+    if (!glm::all(glm::lessThan(lo, hi)))
+      (field / "crop").fail("expected [x0, y0, z0, x1, y1, z1] with x0 < x1, y0 < y1, z0 < z1");
+    planes = crop_planes(lo, hi);
+  }
+  if (const json* clip = optional(object, "clip")) {
+    const Field clips = field / "clip";
+    if (!clip->is_array()) clips.fail("expected an array of planes {\"point\", \"normal\"}");
+    for (size_t i = 0; i < clip->size(); ++i) {
+      const Field plane = clips[i];
+      if (!(*clip)[i].is_object()) plane.fail("expected {\"point\": [x, y, z], \"normal\": [x, y, z]}");
+      check_keys((*clip)[i], plane, {"point", "normal"});
+      const glm::vec3 point = vec3(required((*clip)[i], plane, "point"), plane / "point");
+      const glm::vec3 normal = vec3(required((*clip)[i], plane, "normal"), plane / "normal");
+      if (!(glm::length(normal) > 1e-6f)) (plane / "normal").fail("expected a non-zero normal");
+      planes.push_back(clip_plane(point, normal));
+    }
+  }
+  if (planes.size() > kMaxCutPlanes)
+    field.fail(std::to_string(planes.size()) + " cut-away planes (a crop box is six): at most " +
+               std::to_string(kMaxCutPlanes));
+  return planes;
+}
+
 // Every field is checked before the (slow) file is read, so a typo is reported at once.
 void SceneReader::volume(const json& object, const Field& field) {
   check_keys(object, field,
-             {"name", "file", "frame", "series", "transfer_function", "window", "transform"});
+             {"name", "file", "frame", "series", "transfer_function", "window", "crop", "clip",
+              "transform"});
   const std::filesystem::path path = resolve(required(object, field, "file"), field / "file");
   VolumeReadOptions options{.limits = limits_};
   if (const json* frame = optional(object, "frame")) {
@@ -221,8 +252,10 @@ void SceneReader::volume(const json& object, const Field& field) {
     scene_.transfer_functions.push_back(window_transfer_function(v[0], v[1]));
     tf_index = int(scene_.transfer_functions.size()) - 1;
   }
+  const std::vector<glm::vec4> cut = cut_planes(object, field);
   Volume volume =
       (field / "file").wrap([&] { return load_volume(path, options, scene_.warnings); });
+  volume.cut = cut;
   volume.name = volume_name;
   volume.transform = placement;
   volume.transfer_function = tf_index;
@@ -549,6 +582,13 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
   if (scene.labels.size() > size_t(kMaxLabels))
     throw Error(path.string() + ": " + std::to_string(scene.labels.size()) +
                 " labels; strata places at most " + std::to_string(kMaxLabels) + " in a scene");
+  for (Volume& volume : scene.volumes) {
+    volume.cut.insert(volume.cut.end(), options.cut.begin(), options.cut.end());
+    if (volume.cut.size() > kMaxCutPlanes)
+      throw Error(path.string() + ": volume '" + volume.name + "' with --crop and --clip has " +
+                  std::to_string(volume.cut.size()) + " cut-away planes, at most " +
+                  std::to_string(kMaxCutPlanes));
+  }
   complete_scene(scene, options.preset, options.window);
   return scene;
 }

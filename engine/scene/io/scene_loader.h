@@ -21,6 +21,7 @@ struct SceneOpenOptions {
   std::optional<int> frame;         // a 4-D volume opened directly: this frame
   std::string series;               // a DICOM folder opened directly: this series (number or UID)
   std::optional<glm::vec2> window;  // every volume: a grey ramp at (center, width), its values
+  std::vector<glm::vec4> cut;       // every volume: these cut-away planes added (Volume::cut)
   VolumeLimits limits;              // every volume read, checked from its header (volume_loader.h)
 };
 
