@@ -243,6 +243,14 @@ void Script::run(Viewer& viewer, const ScriptCommand& c) {
     case ScriptOp::save_labels:
       viewer.save_labels(c.word, c.value == "ras" ? LabelAxes::ras : LabelAxes::lps);
       break;
+    case ScriptOp::crop:
+      if (n.empty()) {
+        viewer.set_crop(std::nullopt);
+      } else {
+        viewer.set_crop(std::array<glm::vec3, 2>{glm::vec3(float(n[0]), float(n[1]), float(n[2])),
+                                                 glm::vec3(float(n[3]), float(n[4]), float(n[5]))});
+      }
+      break;
     case ScriptOp::quit:
       viewer.request_quit();
       break;

@@ -269,6 +269,28 @@ Viewer::Viewer(Context& ctx, Scene& scene, const Camera& camera, const Labelling
                                                      : TransferFunction{});
   }
   looks_.resize(scene.volumes.size());
+  for (const Volume& v : scene.volumes) scene_cuts_.push_back(v.cut);
+}
+
+void Viewer::set_crop(std::optional<std::array<glm::vec3, 2>> box) {
+  if (box && !glm::all(glm::lessThan((*box)[0], (*box)[1])))
+    throw Error("crop box: each low corner value must be below the high one");
+  crop_ = box;
+  output_.wait_idle();  // (the volumes' records are rewritten)
+  for (size_t v = 0; v < scene_.volumes.size(); ++v) {
+    std::vector<glm::vec4> cut = scene_cuts_[v];
+    if (box) {
+      const std::vector<glm::vec4> planes = crop_planes((*box)[0], (*box)[1]);
+      cut.insert(cut.end(), planes.begin(), planes.end());
+    }
+    if (cut.size() > kMaxCutPlanes)
+      throw Error("volume '" + scene_.volumes[v].name + "': the crop box and its " +
+                  std::to_string(scene_cuts_[v].size()) + " planes are more than " +
+                  std::to_string(kMaxCutPlanes));
+    scene_.volumes[v].cut = std::move(cut);
+    labelled_->renderer().set_cut(uint32_t(v), scene_.volumes[v]);
+  }
+  settings_changed(true);  // (labels whose anchors are cut away hide)
 }
 
 Viewer::~Viewer() {
@@ -1128,6 +1150,7 @@ void Viewer::draw_frame(std::optional<double> step) {
   ui_.begin_frame(extent, seconds);
   panel_ = glm::uvec4(0u);
   if (options_.show_panel) build_panel();
+  draw_crop_box();
   ui_.end_frame();
   if (panel_ != labelled_->settings().placement.keep_out) {
     labelled_->settings().placement.keep_out = panel_;  // (the panel moved, or was shown or hidden)

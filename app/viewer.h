@@ -6,6 +6,7 @@
 // nothing to do (camera still, labels settled, no input) the viewer asks for no frames.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <deque>
 #include <filesystem>
@@ -200,6 +201,10 @@ class Viewer {
   // after the atlas region there, else "Label ID"; returns its id. An Error where the ray meets
   // only background (move_label too) or no label has the id.
   int place_label(glm::vec2 at);
+  // Every volume's crop box (world mm, LPS), besides the cut-aways of its scene; none: only those.
+  // The panel's Crop section drags its faces; the box is drawn over the picture while it is on.
+  void set_crop(std::optional<std::array<glm::vec3, 2>> box);
+  const std::optional<std::array<glm::vec3, 2>>& crop() const { return crop_; }
   void set_label_text(int id, const std::string& text);
   void move_label(int id, glm::vec2 at);  // its anchor to the point under `at`
   void delete_label(int id);
@@ -334,6 +339,10 @@ class Viewer {
     float level = 0.5f, window = 1.0f, opacity = 1.0f;
   };
   std::vector<VolumeLook> looks_;
+  std::vector<std::vector<glm::vec4>> scene_cuts_;  // each volume's cut-aways from the scene
+  std::optional<std::array<glm::vec3, 2>> crop_;
+  void panel_crop();
+  void draw_crop_box();
   char label_filter_[64] = "";
   char position_name_[64] = "";
   std::string message_;

@@ -138,6 +138,19 @@ ScriptCommand command(const std::vector<std::string>& w) {
     need(2, "save-position NAME");
     out.op = ScriptOp::save_position;
     out.word = w[1];
+  } else if (c == "crop") {
+    // (every volume's crop box in world mm, LPS; "crop off" removes it)
+    if (w.size() == 2 && w[1] == "off") {
+      out.op = ScriptOp::crop;
+    } else {
+      need(7, "crop X0 Y0 Z0 X1 Y1 Z1 | crop off");
+      out.op = ScriptOp::crop;
+      for (size_t i = 1; i < 7; ++i)
+        out.numbers.push_back(number(w[i], -kScriptMaxWorld, kScriptMaxWorld));
+      for (size_t a = 0; a < 3; ++a)
+        if (!(out.numbers[a] < out.numbers[a + 3]))
+          throw Error("'crop': each low corner value must be below the high one");
+    }
   } else if (c == "place") {
     need(3, "place X Y");
     out.op = ScriptOp::place;

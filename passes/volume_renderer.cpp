@@ -32,6 +32,23 @@ namespace {
 constexpr VkFormat kAtlasFormat = VK_FORMAT_R16G16B16A16_SNORM;
 constexpr float kSnorm = 32767.0f;
 
+glm::mat4 texture_to_world(const Volume& v);
+
+// Volume v's cut-away planes (world) in its texture space, where the walk tests them:
+// n . (A tc + b) + d = (A^T n) . tc + n . b + d.
+void set_cut_planes(const Volume& v, const std::vector<glm::vec4>& planes, gpu::VolumeGpu& info) {
+  if (planes.size() > VR_MAX_CUT_PLANES)
+    throw Error("volume '" + v.name + "': " + std::to_string(planes.size()) +
+                " cut-away planes, at most " + std::to_string(VR_MAX_CUT_PLANES));
+  const glm::mat4 to_world = texture_to_world(v);
+  info.cut_count = glm::uvec4(uint32_t(planes.size()), 0u, 0u, 0u);
+  for (size_t c = 0; c < planes.size(); ++c) {
+    const glm::vec3 n(planes[c]);
+    info.cut[c] = glm::vec4(glm::transpose(glm::mat3(to_world)) * n,
+                            glm::dot(n, glm::vec3(to_world[3])) + planes[c].w);
+  }
+}
+
 glm::mat4 texture_to_world(const Volume& v) {
   const glm::mat4 voxel_from_texture = glm::translate(glm::mat4(1.0f), glm::vec3(-0.5f)) *
                                        glm::scale(glm::mat4(1.0f), glm::vec3(v.dims));
@@ -216,16 +233,7 @@ RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimens
     const float spacing = finest_world_spacing(to_world, v.dims);
     info.atlas_scale = glm::vec4(glm::vec3(v.dims) / atlas_size, spacing);
     info.texel = glm::vec4(1.0f / glm::vec3(v.dims), 0.0f);
-    // (world planes to texture space: n . (A tc + b) + d = (A^T n) . tc + n . b + d)
-    if (v.cut.size() > VR_MAX_CUT_PLANES)
-      throw Error("volume '" + v.name + "': " + std::to_string(v.cut.size()) +
-                  " cut-away planes, at most " + std::to_string(VR_MAX_CUT_PLANES));
-    for (size_t c = 0; c < v.cut.size(); ++c) {
-      const glm::vec3 n(v.cut[c]);
-      info.cut[c] = glm::vec4(glm::transpose(glm::mat3(to_world)) * n,
-                              glm::dot(n, glm::vec3(to_world[3])) + v.cut[c].w);
-    }
-    info.cut_count = glm::uvec4(uint32_t(v.cut.size()), 0u, 0u, 0u);
+    set_cut_planes(v, v.cut, info);
     const glm::uvec3 bricks = (v.dims + uint32_t(VR_BRICK - 1)) / uint32_t(VR_BRICK);
     info.bricks = glm::uvec4(bricks, first_brick);
     brick_ranges(t, v.dims, bricks, in.brick_ranges);
@@ -403,6 +411,14 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
 void VolumeRenderer::upload_transfer() {
   ++transfer_version_;
   if (!inputs_.occupancy.empty()) upload(ctx_, occupancy_, as_bytes(inputs_.occupancy));
+}
+
+void VolumeRenderer::set_cut(uint32_t volume, const Volume& v) {
+  set_cut_planes(v, v.cut, inputs_.volumes.at(volume));
+  std::vector<gpu::VolumeGpu> volume_data = inputs_.volumes;
+  volume_data.resize(VR_MAX_VOLUMES);
+  upload(ctx_, volumes_, as_bytes(volume_data));
+  ++transfer_version_;  // (an interactive frame casts its rays again)
 }
 
 void VolumeRenderer::set_transfer_function(uint32_t volume, const TransferFunction& tf) {

@@ -110,6 +110,18 @@ TEST_SUITE("cpu") {
     CHECK(parse_error("save a.mrk.json xyz").find("demo.txt:2: 'save' takes the form") == 0);
   }
 
+  TEST_CASE("viewer_script_parser_reads_the_crop_box") {
+    const auto c = parse_viewer_script("crop -100 -120 -60 100 120 40.5\ncrop off\n", "demo.txt");
+    REQUIRE(c.size() == 2);
+    CHECK(c[0].op == app::ScriptOp::crop);
+    CHECK(c[0].numbers == std::vector<double>{-100, -120, -60, 100, 120, 40.5});
+    CHECK(c[1].op == app::ScriptOp::crop);
+    CHECK(c[1].numbers.empty());
+    CHECK(parse_error("crop 0 0 0 1 1").find("demo.txt:2: 'crop' takes the form") == 0);
+    CHECK(parse_error("crop 0 0 5 1 1 4").find("demo.txt:2: 'crop': each low corner") == 0);
+    CHECK(parse_error("crop 0 0 0 1 1 nan").find("demo.txt:2: 'nan' is not a number") == 0);
+  }
+
   TEST_CASE("viewer_script_parser_refuses_unknown_names_before_anything_runs") {
     CHECK(parse_error("key ctrl").find("demo.txt:2: no key 'ctrl'") == 0);
     CHECK(parse_error("drag wheel 0 0 1 1").find("demo.txt:2: no mouse button 'wheel'") == 0);

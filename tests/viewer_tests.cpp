@@ -3,6 +3,7 @@
 // test sends real X events with xdotool.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -121,6 +122,56 @@ TEST_SUITE("window") {
   // in RAS and as .fcsv in LPS. Both files hold the scene's 11 labels and the 5 new ones with the
   // same points (within 0.01 mm); each new anchor lies on the ray of the pixel it was placed or
   // moved at (the camera from `report`); `strata render --labels` shows them on the scan.
+  // The crop box from a script: the picture shows the head cut below z = 40 (from the front, its
+  // top rows empty), the box's edges are drawn over the window's picture, labels anchored in
+  // the cut part hide, and `crop off` brings the whole head back.
+  TEST_CASE("viewer_crop_box_cuts_the_picture_is_drawn_and_hides_cut_labels") {
+    const auto dir = test::fresh_folder("viewer", "crop");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto r =
+        view(dir, "view anterior\nlayout " + d("whole.json") + "\nscreenshot " + d("whole.png") +
+                      "\ncrop -100 -120 -60 100 120 10\nlayout " + d("cut.json") + "\nscreenshot " +
+                      d("cut.png") + "\ncapture " + d("cut-window.png") +
+                      "\ncrop off\nscreenshot " + d("again.png") + "\nquit\n");
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    const Rgba8Image whole = read_png(d("whole.png")), cut = read_png(d("cut.png"));
+    CHECK(changed_pixels(whole, cut) > 1000);
+    CHECK(changed_pixels(cut, read_png(d("again.png"))) > 1000);  // (the whole head again)
+    // (the box's edges: the orange of draw_crop_box, in the window's picture only)
+    const auto orange = [](const Rgba8Image& image) {
+      size_t n = 0;
+      for (size_t p = 0; p + 3 < image.pixels.size(); p += 4)
+        n += image.pixels[p] > 200 && image.pixels[p + 1] > 150 && image.pixels[p + 1] < 230 &&
+             image.pixels[p + 2] < 120;
+      return n;
+    };
+    CHECK(orange(read_png(d("cut-window.png"))) > 100);
+    CHECK(orange(cut) < orange(read_png(d("cut-window.png"))) / 4);
+    // Labels anchored above z = 10 are cut away with the head there.
+    const Scene scene = load_scene(kScene);
+    const auto shown = [&](const char* name) {
+      const nlohmann::json layout = nlohmann::json::parse(test::read_file(d(name)));
+      std::vector<int> ids;
+      for (const auto& l : layout.at("labels"))
+        if (l.at("shown").get<bool>()) ids.push_back(l.at("id").get<int>());
+      return ids;
+    };
+    for (const int id : shown("cut.json")) {
+      for (const Label& l : scene.labels)
+        if (l.id == id) CHECK(l.anchor.z <= 10.0f);
+    }
+    // (and one shown before, anchored above the cut, is hidden: the check above is not empty)
+    const std::vector<int> now = shown("cut.json");
+    size_t hidden_above = 0;
+    for (const int id : shown("whole.json")) {
+      for (const Label& l : scene.labels)
+        if (l.id == id && l.anchor.z > 10.0f && std::find(now.begin(), now.end(), id) == now.end())
+          ++hidden_above;
+    }
+    CHECK(hidden_above > 0);
+  }
+
   TEST_CASE("viewer_places_renames_moves_deletes_undoes_and_saves_labels") {
     const auto dir = test::fresh_folder("viewer", "own-labels");
     const auto d = [&](const char* name) { return (dir / name).string(); };
