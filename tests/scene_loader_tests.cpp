@@ -341,7 +341,15 @@ TEST_SUITE("loaders") {
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "trasform": []}]})") ==
           prefix +
               "volumes[0]: unknown key 'trasform' (expected name, file, frame, series, "
-              "transfer_function, window, transform)");
+              "transfer_function, window, crop, clip, transform)");
+    CHECK(
+        load(
+            R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "crop": [0, 0, 5, 1, 1, 4]}]})") ==
+        prefix +
+            "volumes[0].crop: expected [x0, y0, z0, x1, y1, z1] with x0 < x1, y0 < y1, z0 < z1");
+    CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii",
+            "clip": [{"point": [0, 0, 0], "normal": [0, 0, 0]}]}]})") ==
+          prefix + "volumes[0].clip[0].normal: expected a non-zero normal");
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "transform": [1, 2, 3]}]})") ==
           prefix + "volumes[0].transform: expected 16 numbers");
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": 3}]})") ==
