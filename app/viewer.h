@@ -341,6 +341,9 @@ class Viewer {
   std::vector<VolumeLook> looks_;
   std::vector<std::vector<glm::vec4>> scene_cuts_;  // each volume's cut-aways from the scene
   std::optional<std::array<glm::vec3, 2>> crop_;
+  // The panel's box while a face is dragged: drawn at once, applied when the button is let go
+  // (each change waits for the frames in flight).
+  std::optional<std::optional<std::array<glm::vec3, 2>>> crop_dragged_;
   void panel_crop();
   void draw_crop_box();
   char label_filter_[64] = "";

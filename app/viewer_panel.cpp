@@ -238,8 +238,9 @@ void Viewer::panel_labels() {
 // The crop box: on or off, its faces dragged per axis (world mm, LPS), within the content's box.
 void Viewer::panel_crop() {
   const Bounds content = scene_bounds(scene_);
-  bool on = crop_.has_value();
-  std::array<glm::vec3, 2> box = crop_ ? *crop_ : std::array<glm::vec3, 2>{content.lo, content.hi};
+  const std::optional<std::array<glm::vec3, 2>> shown = crop_dragged_ ? *crop_dragged_ : crop_;
+  bool on = shown.has_value();
+  std::array<glm::vec3, 2> box = shown ? *shown : std::array<glm::vec3, 2>{content.lo, content.hi};
   bool edited = ImGui::Checkbox("crop box", &on);
   if (on) {
     const char* names[3] = {"x (L)", "y (P)", "z (S)"};
@@ -250,15 +251,21 @@ void Viewer::panel_crop() {
       box[1][a] = std::max(box[1][a], box[0][a] + step);
     }
   }
-  if (edited) set_crop(on ? std::optional(box) : std::nullopt);
+  if (edited) crop_dragged_ = on ? std::optional(box) : std::nullopt;
+  if (crop_dragged_ && !ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+    const std::optional<std::array<glm::vec3, 2>> applied = *crop_dragged_;
+    crop_dragged_.reset();
+    set_crop(applied);
+  }
 }
 
 // The crop box's twelve edges over the picture, while it is on.
 void Viewer::draw_crop_box() {
-  if (!crop_) return;
+  const std::optional<std::array<glm::vec3, 2>> shown = crop_dragged_ ? *crop_dragged_ : crop_;
+  if (!shown) return;
   const graph::Extent e = labelled_->size();
   const Camera camera = control_.camera();
-  const std::array<glm::vec3, 2>& b = *crop_;
+  const std::array<glm::vec3, 2>& b = *shown;
   ImDrawList* draw = ImGui::GetBackgroundDrawList();
   const ImU32 colour = IM_COL32(255, 200, 60, 220);
   for (int c = 0; c < 8; ++c) {
