@@ -48,22 +48,32 @@ struct DeviceOptions {
   ContextOptions context() const;
 };
 
+// Every option of `app` and its subcommands that takes a value refuses an empty one ("--layout
+// ''"): a usage error naming the option, not a default taken silently.
+void refuse_empty_values(CLI::App& app);
+// With no scene (render and view draw a test pattern) only `pattern_options` apply; with a scene
+// the pattern's own (--blur) do not: any other option given is a usage error naming it.
+void check_options_apply(const CLI::App* cmd, bool has_scene,
+                         std::initializer_list<const char*> pattern_options,
+                         std::initializer_list<const char*> pattern_only);
+
 // The scene a command works on: a scene file, or a volume file or DICOM folder opened as one
 // (docs/scene-format.md), and what the command line adds or overrides.
 struct SceneInput {
   std::string file;
-  std::string preset;   // --preset: every volume's transfer function
-  std::string labels;   // --labels: a label file (.mrk.json, .fcsv, .csv) added
-  int frame = -1;       // --frame: a 4-D volume's frame (-1: the first, with a warning)
-  std::string series;   // --series: a DICOM folder's series (SeriesNumber or UID)
-  std::string window;   // --window CENTER,WIDTH: a grey ramp in the volumes' values
-  std::string crop;                // --crop X0,Y0,Z0,X1,Y1,Z1 (world, mm)
-  std::vector<std::string> clip;   // --clip PX,PY,PZ,NX,NY,NZ, up to six
-  uint32_t layers = 0;  // --layers: 0 keeps the scene's settings.layers
+  std::string preset;             // --preset: every volume's transfer function
+  std::string labels;             // --labels: a label file (.mrk.json, .fcsv, .csv) added
+  int frame = -1;                 // --frame: a 4-D volume's frame (-1: the first, with a warning)
+  std::string series;             // --series: a DICOM folder's series (SeriesNumber or UID)
+  std::string window;             // --window CENTER,WIDTH: a grey ramp in the volumes' values
+  std::string crop;               // --crop X0,Y0,Z0,X1,Y1,Z1 (world, mm)
+  std::vector<std::string> clip;  // --clip PX,PY,PZ,NX,NY,NZ, up to six
+  uint32_t layers = 0;            // --layers: 0 keeps the scene's settings.layers
   // The depth layers asked for: --layers, else the scene's.
   uint32_t layer_count(const Scene& scene) const;
 };
-// --preset, --labels, --frame and --layers (the positional FILE is the command's own).
+// --preset, --labels, --frame, --window, --crop, --clip, --series and --layers (the positional
+// FILE is the command's own).
 void add_scene_input_options(CLI::App* cmd, SceneInput& in);
 
 // Loads the scene (load_scene with the input's options) and prints its warnings (missing data

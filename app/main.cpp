@@ -9,6 +9,7 @@
 #include "app/commands.h"
 #include "engine/core/error.h"
 #include "engine/scene/io/scene_loader.h"
+#include "engine/scene/io/volume_loader.h"
 #include "engine/scene/transfer_function_presets.h"
 #include "labeling/camera_path.h"
 #include "labeling/labelled_render.h"
@@ -38,6 +39,15 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
   options.labels = in.labels;
   if (in.frame >= 0) options.frame = in.frame;
   options.series = in.series;
+  // A scene file names its volumes' series and frames itself.
+  if (!in.series.empty() && !is_volume_path(in.file))
+    throw UsageError("--series: " + in.file +
+                     " is a scene file; --series chooses the series of a DICOM folder opened "
+                     "directly (a scene file names it in its volume's \"series\")");
+  if (in.frame >= 0 && !is_volume_path(in.file))
+    throw UsageError("--frame: " + in.file +
+                     " is a scene file; --frame chooses the frame of a 4-D volume opened directly "
+                     "(a scene file names it in its volume's \"frame\")");
   if (!in.crop.empty()) {
     const std::vector<float> v = parse_numbers(in.crop, 6, "--crop", "X0,Y0,Z0,X1,Y1,Z1");
     const glm::vec3 lo(v[0], v[1], v[2]), hi(v[3], v[4], v[5]);
@@ -120,6 +130,32 @@ Camera option_camera(const Scene& scene, const std::string& name, const char* op
   }
 }
 
+void refuse_empty_values(CLI::App& app) {
+  const CLI::Validator not_empty(
+      [](std::string& input) { return input.empty() ? std::string("an empty value") : ""; }, "");
+  for (CLI::Option* option : app.get_options()) {
+    if (option->get_type_size() != 0) option->check(not_empty);
+  }
+  for (CLI::App* sub : app.get_subcommands({})) refuse_empty_values(*sub);
+}
+
+void check_options_apply(const CLI::App* cmd, bool has_scene,
+                         std::initializer_list<const char*> pattern_options,
+                         std::initializer_list<const char*> pattern_only) {
+  const auto named = [](std::initializer_list<const char*> names, const CLI::Option* option) {
+    return std::any_of(names.begin(), names.end(),
+                       [&](const char* name) { return option->check_name(name); });
+  };
+  for (const CLI::Option* option : cmd->get_options()) {
+    if (option->count() == 0 || !option->nonpositional()) continue;
+    if (has_scene && named(pattern_only, option))
+      throw UsageError(option->get_name() + ": applies to the test pattern only (no scene)");
+    if (!has_scene && !named(pattern_options, option) && !named(pattern_only, option))
+      throw UsageError(option->get_name() +
+                       ": needs a scene (with none given the test pattern is drawn)");
+  }
+}
+
 uint32_t SceneInput::layer_count(const Scene& scene) const {
   return layers > 0 ? layers : uint32_t(scene.settings.layer_count);  // (the loader checked it)
 }
@@ -150,7 +186,8 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
                   "X0,Y0,Z0,X1,Y1,Z1: show only this box of every volume (world mm, LPS)");
   cmd->add_option("--clip", in.clip,
                   "PX,PY,PZ,NX,NY,NZ: cut every volume at the plane through P, keeping the side "
-                  "N points to (world mm, LPS); up to six");
+                  "N points to (world mm, LPS); up to six")
+      ->allow_extra_args(false);  // one plane an --clip: the next word is not a second plane
   cmd->add_option("--series", in.series,
                   "a DICOM folder holding several series: the one with this SeriesNumber or "
                   "SeriesInstanceUID (default: the largest 3-D image series; strata info FOLDER "
@@ -258,6 +295,7 @@ int main(int argc, char** argv) {
   add_eval_command(app);
   add_video_command(app, device);
   add_pick_command(app, device);
+  refuse_empty_values(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

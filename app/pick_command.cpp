@@ -87,7 +87,8 @@ void add_pick_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--camera", o->camera, "named camera position of the scene (default: its own)");
   cmd->add_option("--at", o->at,
                   "X,Y: a pixel's column and row from the top-left corner; repeat for more")
-      ->required();
+      ->required()
+      ->allow_extra_args(false);  // one pixel an --at: the next word is not a second pixel
   cmd->add_option("--runs", o->runs, "frames to render and pick (for the GPU time's median)")
       ->check(whole_range(1, 1000))
       ->capture_default_str();

@@ -279,13 +279,15 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
       ->check(whole_range(0, 16384))
       ->capture_default_str();
-  cmd->callback([&device, o] {
+  cmd->callback([cmd, &device, o] {
     // An unknown image extension is a usage error, found before any work (and before -o exists).
     try {
       check_image_extension(o->output);
     } catch (const Error& e) {
       throw UsageError(std::string("-o: ") + e.what());
     }
+    check_options_apply(cmd, !o->scene.file.empty(), {"--output", "--size", "--dump-graph"},
+                        {"--blur"});
     if (o->scene.file.empty()) {
       render_test_pattern(device, *o);
     } else if (o->no_labels) {

@@ -290,11 +290,10 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
                   "changes layer, as a share of the distance to the next plane")
       ->capture_default_str()
       ->check(finite_range(0.0, 100.0));
-  // (1: every frame written before the next renders, as before the worker threads)
   cmd->add_option("--threads", o->threads,
-                  "threads compressing frames (default: one per core; 1 on a CPU device)")
-      ->check(whole_range(1, 1024))
-      ->group("");
+                  "threads compressing frames (default: one per core; 1 on a CPU device, where "
+                  "rendering takes every core)")
+      ->check(whole_range(1, 1024));
   cmd->callback([&device, o] { video(device, *o); });
 }
 

@@ -529,8 +529,10 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
       ->check(whole_range(0, 16384))
       ->capture_default_str();
-  cmd->callback([&device, o] {
+  cmd->callback([cmd, &device, o] {
     const graph::Extent size = parse_size(o->size, "--size");
+    check_options_apply(cmd, !o->scene.file.empty(), {"--size", "--frames", "--frames-in-flight"},
+                        {"--blur"});
     if (o->scene.file.empty()) {
       view_pattern(device, *o, size);
     } else {

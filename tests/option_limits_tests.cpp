@@ -4,6 +4,8 @@
 #include <doctest/doctest.h>
 
 #include <chrono>
+#include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -93,6 +95,61 @@ TEST_SUITE("cli") {
              {"bench placement --runs -5", "--runs: -5 is not"},
              {"bench soak --habuffer-slots 1e12", "--habuffer-slots: 1e12 is not"},
              {"bench soak --every nan", "--every: nan is not"},
+         }) {
+      check_usage_error(bad);
+    }
+  }
+
+  // Read from each subcommand's --help, so that an option added later is covered too.
+  TEST_CASE("every_option_that_takes_a_value_refuses_an_empty_one") {
+    const std::regex value_option(R"(^\s+(?:-\w,)?(--[a-z0-9-]+) [A-Z])");
+    size_t checked = 0;
+    for (const std::string command :
+         {"render", "video", "view", "pick", "eval", "info", "bench sat", "bench render",
+          "bench placement", "bench view", "bench soak", "bench encode"}) {
+      const auto help = run_strata(command + " --help");
+      REQUIRE(help.exit_code == 0);
+      std::istringstream lines(help.output);
+      for (std::string line; std::getline(lines, line);) {
+        std::smatch m;
+        if (!std::regex_search(line, m, value_option)) continue;
+        // (an option's own check may say it first: "--runs: '' is not a whole number",
+        // "--order:  not in {scene,apollonius,optimized}")
+        const auto r = run_strata(command + " " + m[1].str() + " ''");
+        CAPTURE(r.output);
+        CHECK(r.exit_code == 2);
+        const std::string error = "strata: error: " + m[1].str() + ": ";
+        CHECK((r.output.starts_with(error + "an empty value") ||
+               r.output.starts_with(error + "'' is not") ||
+               r.output.starts_with(error + " not in {")));
+        ++checked;
+      }
+    }
+    CHECK(checked > 100);
+  }
+
+  TEST_CASE("options_for_the_other_kind_of_input_are_usage_errors") {
+    for (const BadOption& bad : std::vector<BadOption>{
+             // No scene: render and view draw a test pattern, which has no volume or labels.
+             {"render -o /tmp/never.png --size 16 --crop 0,0,0,1,1,1",
+              "--crop: needs a scene (with none given the test pattern is drawn)"},
+             {"render -o /tmp/never.png --size 16 --labels x.fcsv", "--labels: needs a scene"},
+             {"render -o /tmp/never.png --size 16 --hard", "--hard: needs a scene"},
+             {"view --camera front", "--camera: needs a scene"},
+             {"render " + kHead + " -o /tmp/never.png --blur 3",
+              "--blur: applies to the test pattern only (no scene)"},
+             // A scene file names its volumes' series and frames itself.
+             {"render " + kHead + " -o /tmp/never.png --series 2",
+              "--series: " + kHead + " is a scene file"},
+             {"render " + kHead + " -o /tmp/never.png --frame 2",
+              "--frame: " + kHead + " is a scene file"},
+             // One plane an --clip and one pixel an --at: the scene after them is no value.
+             {"render --clip 0,0,0,0,0,0 " + kHead + " -o /tmp/never.png",
+              "--clip: '0,0,0,0,0,0': the normal (NX,NY,NZ) must not be zero"},
+             {"render --clip 0,0,0,0,0,1,1 " + kHead + " -o /tmp/never.png",
+              "--clip: '0,0,0,0,0,1,1' is not PX,PY,PZ,NX,NY,NZ"},
+             {"pick --at 1,1 " + kHead + " --size 16 --at 99,1",
+              "--at: 99,1 lies outside the 16x16 image"},
          }) {
       check_usage_error(bad);
     }
