@@ -213,12 +213,19 @@ void Script::run(Viewer& viewer, const ScriptCommand& c) {
       for (int col = 0; col < 4; ++col) {
         for (int row = 0; row < 4; ++row) view.push_back(viewer.camera().view[col][row]);
       }
-      const nlohmann::json report = {{"frames", viewer.summary().frames},
-                                     {"settled", viewer.settled()},
-                                     {"busy", viewer.busy()},
-                                     {"trials", viewer.summary().trials},
-                                     {"panel", viewer.panel_rect()},
-                                     {"view", view}};
+      nlohmann::json report = {{"frames", viewer.summary().frames},
+                               {"settled", viewer.settled()},
+                               {"busy", viewer.busy()},
+                               {"trials", viewer.summary().trials},
+                               {"panel", viewer.panel_rect()},
+                               {"view", view},
+                               {"crop", nullptr},
+                               {"clip", nullptr}};
+      if (const auto& box = viewer.cuts().crop)
+        report["crop"] = {(*box)[0].x, (*box)[0].y, (*box)[0].z,
+                          (*box)[1].x, (*box)[1].y, (*box)[1].z};
+      if (const auto& plane = viewer.cuts().clip)
+        report["clip"] = {plane->x, plane->y, plane->z, plane->w};
       write_text_file(c.word, report.dump() + "\n");
       break;
     }
@@ -249,6 +256,14 @@ void Script::run(Viewer& viewer, const ScriptCommand& c) {
       } else {
         viewer.set_crop(std::array<glm::vec3, 2>{glm::vec3(float(n[0]), float(n[1]), float(n[2])),
                                                  glm::vec3(float(n[3]), float(n[4]), float(n[5]))});
+      }
+      break;
+    case ScriptOp::clip:
+      if (n.empty()) {
+        viewer.set_clip(std::nullopt);
+      } else {
+        viewer.set_clip(clip_plane(glm::vec3(float(n[0]), float(n[1]), float(n[2])),
+                                   glm::vec3(float(n[3]), float(n[4]), float(n[5]))));
       }
       break;
     case ScriptOp::quit:

@@ -272,27 +272,6 @@ Viewer::Viewer(Context& ctx, Scene& scene, const Camera& camera, const Labelling
   for (const Volume& v : scene.volumes) scene_cuts_.push_back(v.cut);
 }
 
-void Viewer::set_crop(std::optional<std::array<glm::vec3, 2>> box) {
-  if (box && !glm::all(glm::lessThan((*box)[0], (*box)[1])))
-    throw Error("crop box: each low corner value must be below the high one");
-  crop_ = box;
-  output_.wait_idle();  // (the volumes' records are rewritten)
-  for (size_t v = 0; v < scene_.volumes.size(); ++v) {
-    std::vector<glm::vec4> cut = scene_cuts_[v];
-    if (box) {
-      const std::vector<glm::vec4> planes = crop_planes((*box)[0], (*box)[1]);
-      cut.insert(cut.end(), planes.begin(), planes.end());
-    }
-    if (cut.size() > kMaxCutPlanes)
-      throw Error("volume '" + scene_.volumes[v].name + "': the crop box and its " +
-                  std::to_string(scene_cuts_[v].size()) + " planes are more than " +
-                  std::to_string(kMaxCutPlanes));
-    scene_.volumes[v].cut = std::move(cut);
-    labelled_->renderer().set_cut(uint32_t(v), scene_.volumes[v]);
-  }
-  settings_changed(true);  // (labels whose anchors are cut away hide)
-}
-
 Viewer::~Viewer() {
   try {
     output_.wait_idle();
@@ -346,6 +325,8 @@ void Viewer::extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds&
 void Viewer::mouse_button(int button, int action, int mods) {
   const bool left = button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT);
   try {
+    // A press on a cut-away's handle drags it (before placing labels and turning the camera).
+    if (!(mods & GLFW_MOD_SHIFT) && press_cut_handle(button, action)) return;
     // Place mode: a press on an anchor drags it along the surface under the pointer, elsewhere
     // a press places a label (both once the frame's pick comes back: no wait).
     if (place_mode_ && left && action == GLFW_PRESS && drag_button_ < 0) {
@@ -397,6 +378,11 @@ void Viewer::cursor(glm::vec2 position) {
       std::none_of(pending_picks_.begin(), pending_picks_.end(),
                    [](const PendingPick& p) { return p.drag; })) {
     ask_pick({mouse_, *anchor_drag_, true});
+  }
+  if (handle_drag_) return drag_cut_handle(delta);
+  if (cuts_.crop || cuts_.clip) {  // (the handle under the pointer is drawn larger)
+    const std::optional<int> hovered = cut_handle_near(mouse_);
+    if (hovered != hovered_handle_) hovered_handle_ = hovered, ui_event();
   }
   if (drag_button_ < 0 || delta == glm::vec2(0.0f)) return;
   const graph::Extent e = output_.extent();
@@ -1150,7 +1136,7 @@ void Viewer::draw_frame(std::optional<double> step) {
   ui_.begin_frame(extent, seconds);
   panel_ = glm::uvec4(0u);
   if (options_.show_panel) build_panel();
-  draw_crop_box();
+  draw_cut_aways();
   ui_.end_frame();
   if (panel_ != labelled_->settings().placement.keep_out) {
     labelled_->settings().placement.keep_out = panel_;  // (the panel moved, or was shown or hidden)

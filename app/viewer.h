@@ -133,6 +133,12 @@ struct ViewerSummary {
   std::vector<double> refine_seconds;
 };
 
+// The viewer's own cut-aways (world mm, LPS), on every volume besides its scene's.
+struct ViewerCuts {
+  std::optional<std::array<glm::vec3, 2>> crop;  // a box; what lies outside it is cut away
+  std::optional<glm::vec4> clip;                 // a plane (n, w), |n| = 1: keeps dot(n,p)+w >= 0
+};
+
 class Viewer {
  public:
   Viewer(Context& ctx, Scene& scene, const Camera& camera, const LabellingSettings& settings,
@@ -201,10 +207,13 @@ class Viewer {
   // after the atlas region there, else "Label ID"; returns its id. An Error where the ray meets
   // only background (move_label too) or no label has the id.
   int place_label(glm::vec2 at);
-  // Every volume's crop box (world mm, LPS), besides the cut-aways of its scene; none: only those.
-  // The panel's Crop section drags its faces; the box is drawn over the picture while it is on.
+  // The viewer's own cut-aways on every volume, besides its scene's (app/viewer_cut.cpp): a crop
+  // box (world mm, LPS) and a clipping plane (n, w) that keeps dot(n, p) + w >= 0; none: only the
+  // scene's. The panel's Cut-aways section sets them; while on they are drawn over the picture
+  // with a handle on each box face and on the plane, which a left drag moves.
   void set_crop(std::optional<std::array<glm::vec3, 2>> box);
-  const std::optional<std::array<glm::vec3, 2>>& crop() const { return crop_; }
+  void set_clip(std::optional<glm::vec4> plane);  // (the normal is made unit length)
+  const ViewerCuts& cuts() const { return cuts_; }
   void set_label_text(int id, const std::string& text);
   void move_label(int id, glm::vec2 at);  // its anchor to the point under `at`
   void delete_label(int id);
@@ -340,12 +349,24 @@ class Viewer {
   };
   std::vector<VolumeLook> looks_;
   std::vector<std::vector<glm::vec4>> scene_cuts_;  // each volume's cut-aways from the scene
-  std::optional<std::array<glm::vec3, 2>> crop_;
-  // The panel's box while a face is dragged: drawn at once, applied when the button is let go
-  // (each change waits for the frames in flight).
-  std::optional<std::optional<std::array<glm::vec3, 2>>> crop_dragged_;
-  void panel_crop();
-  void draw_crop_box();
+  ViewerCuts cuts_;
+  // The cut-aways while a face, the plane or a panel value is dragged: drawn at once, applied
+  // when the button is let go (each change waits for the frames in flight).
+  std::optional<ViewerCuts> cuts_dragged_;
+  std::optional<int> hovered_handle_;  // the handle under the pointer
+  std::optional<int> handle_drag_;  // the handle dragged: 0-5 the box's faces (axis * 2 + high), 6
+                                    // the plane
+  struct CutHandle {
+    glm::vec3 at;         // world
+    glm::vec3 direction;  // the way it moves: a face's axis, the plane's normal
+  };
+  std::array<std::optional<CutHandle>, 7> cut_handles(const ViewerCuts& cuts) const;
+  std::optional<int> cut_handle_near(glm::vec2 at) const;
+  bool press_cut_handle(int button, int action);  // true: a handle took the press or release
+  void drag_cut_handle(glm::vec2 delta);
+  void apply_cuts(const ViewerCuts& cuts);
+  void panel_cut_aways();
+  void draw_cut_aways();
   char label_filter_[64] = "";
   char position_name_[64] = "";
   std::string message_;

@@ -71,7 +71,7 @@ void Viewer::build_panel() {
     if (ImGui::CollapsingHeader("Forces")) panel_forces();
     if (ImGui::CollapsingHeader("Labels")) panel_labels();
     if (ImGui::CollapsingHeader("Rendering")) panel_rendering();
-    if (ImGui::CollapsingHeader("Crop")) panel_crop();
+    if (ImGui::CollapsingHeader("Cut-aways")) panel_cut_aways();
     if (ImGui::CollapsingHeader("Timings", ImGuiTreeNodeFlags_DefaultOpen)) panel_statistics();
     if (ImGui::CollapsingHeader("Debug views")) panel_debug();
   } catch (const Error& e) {
@@ -233,53 +233,6 @@ void Viewer::panel_labels() {
   ImGui::EndDisabled();
   ImGui::SameLine();
   if (ImGui::Button("Save labels (Ctrl+S)")) save_labels(default_labels_path());
-}
-
-// The crop box: on or off, its faces dragged per axis (world mm, LPS), within the content's box.
-void Viewer::panel_crop() {
-  const Bounds content = scene_bounds(scene_);
-  const std::optional<std::array<glm::vec3, 2>> shown = crop_dragged_ ? *crop_dragged_ : crop_;
-  bool on = shown.has_value();
-  std::array<glm::vec3, 2> box = shown ? *shown : std::array<glm::vec3, 2>{content.lo, content.hi};
-  bool edited = ImGui::Checkbox("crop box", &on);
-  if (on) {
-    const char* names[3] = {"x (L)", "y (P)", "z (S)"};
-    for (int a = 0; a < 3; ++a) {
-      const float step = std::max(0.001f, (content.hi[a] - content.lo[a]) / 400.0f);
-      edited |= ImGui::DragFloatRange2(names[a], &box[0][a], &box[1][a], step, content.lo[a],
-                                       content.hi[a], "%.1f mm");
-      box[1][a] = std::max(box[1][a], box[0][a] + step);
-    }
-  }
-  if (edited) crop_dragged_ = on ? std::optional(box) : std::nullopt;
-  if (crop_dragged_ && !ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
-    const std::optional<std::array<glm::vec3, 2>> applied = *crop_dragged_;
-    crop_dragged_.reset();
-    set_crop(applied);
-  }
-}
-
-// The crop box's twelve edges over the picture, while it is on.
-void Viewer::draw_crop_box() {
-  const std::optional<std::array<glm::vec3, 2>> shown = crop_dragged_ ? *crop_dragged_ : crop_;
-  if (!shown) return;
-  const graph::Extent e = labelled_->size();
-  const Camera camera = control_.camera();
-  const std::array<glm::vec3, 2>& b = *shown;
-  ImDrawList* draw = ImGui::GetBackgroundDrawList();
-  const ImU32 colour = IM_COL32(255, 200, 60, 220);
-  for (int c = 0; c < 8; ++c) {
-    for (int axis = 0; axis < 3; ++axis) {
-      if (c & (1 << axis)) continue;
-      const auto corner = [&](int k) {
-        return glm::vec3(b[(k & 1) ? 1 : 0].x, b[(k & 2) ? 1 : 0].y, b[(k & 4) ? 1 : 0].z);
-      };
-      const ProjectedPoint p = project(camera, corner(c), {e.width, e.height});
-      const ProjectedPoint q = project(camera, corner(c | (1 << axis)), {e.width, e.height});
-      if (p.eye_depth <= camera.near_plane || q.eye_depth <= camera.near_plane) continue;
-      draw->AddLine(ImVec2(p.pixel.x, p.pixel.y), ImVec2(q.pixel.x, q.pixel.y), colour, 1.5f);
-    }
-  }
 }
 
 void Viewer::panel_rendering() {

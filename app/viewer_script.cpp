@@ -151,6 +151,16 @@ ScriptCommand command(const std::vector<std::string>& w) {
         if (!(out.numbers[a] < out.numbers[a + 3]))
           throw Error("'crop': each low corner value must be below the high one");
     }
+  } else if (c == "clip") {
+    // (every volume's clipping plane through P keeping the side N points to; "clip off")
+    out.op = ScriptOp::clip;
+    if (!(w.size() == 2 && w[1] == "off")) {
+      need(7, "clip PX PY PZ NX NY NZ | clip off");
+      for (size_t i = 1; i < 7; ++i)
+        out.numbers.push_back(number(w[i], -kScriptMaxWorld, kScriptMaxWorld));
+      if (out.numbers[3] == 0.0 && out.numbers[4] == 0.0 && out.numbers[5] == 0.0)
+        throw Error("'clip': the normal (NX NY NZ) must not be zero");
+    }
   } else if (c == "place") {
     need(3, "place X Y");
     out.op = ScriptOp::place;

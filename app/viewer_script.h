@@ -12,7 +12,7 @@ namespace strata::app {
 
 // Limits that keep a script's run bounded: a number outside them is an error, never a hang.
 inline constexpr double kScriptMaxCoordinate = 16384.0;  // drag: window pixels, either sign
-inline constexpr double kScriptMaxWorld = 1e6;           // crop: world millimetres, either sign
+inline constexpr double kScriptMaxWorld = 1e6;           // crop, clip: world millimetres, either sign
 inline constexpr double kScriptMaxScroll = 100.0;        // scroll: wheel ticks, either sign
 inline constexpr double kScriptMaxFrames = 100000.0;     // frames N
 inline constexpr double kScriptMaxSleep = 600.0;         // sleep SECONDS
@@ -47,6 +47,7 @@ enum class ScriptOp {
   redo,
   save_labels,
   crop,
+  clip,
   quit
 };
 

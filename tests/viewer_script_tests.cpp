@@ -122,6 +122,18 @@ TEST_SUITE("cpu") {
     CHECK(parse_error("crop 0 0 0 1 1 nan").find("demo.txt:2: 'nan' is not a number") == 0);
   }
 
+  TEST_CASE("viewer_script_parser_reads_the_clipping_plane") {
+    const auto c = parse_viewer_script("clip 0 -15 2.5 0 0 -1\nclip off\n", "demo.txt");
+    REQUIRE(c.size() == 2);
+    CHECK(c[0].op == app::ScriptOp::clip);
+    CHECK(c[0].numbers == std::vector<double>{0, -15, 2.5, 0, 0, -1});
+    CHECK(c[1].op == app::ScriptOp::clip);
+    CHECK(c[1].numbers.empty());
+    CHECK(parse_error("clip 0 0 0 1").find("demo.txt:2: 'clip' takes the form") == 0);
+    CHECK(parse_error("clip 0 0 0 0 0 0").find("demo.txt:2: 'clip': the normal") == 0);
+    CHECK(parse_error("clip 0 0 0 0 0 inf").find("demo.txt:2: 'inf' is not a number") == 0);
+  }
+
   TEST_CASE("viewer_script_parser_refuses_unknown_names_before_anything_runs") {
     CHECK(parse_error("key ctrl").find("demo.txt:2: no key 'ctrl'") == 0);
     CHECK(parse_error("drag wheel 0 0 1 1").find("demo.txt:2: no mouse button 'wheel'") == 0);

@@ -16,6 +16,7 @@
 #include "engine/scene/camera.h"
 #include "engine/scene/io/label_file_loader.h"
 #include "engine/scene/io/scene_loader.h"
+#include "engine/scene/scene_bounds.h"
 #include "gpu_fixture.h"
 #include "test_files.h"
 
@@ -170,6 +171,57 @@ TEST_SUITE("window") {
           ++hidden_above;
     }
     CHECK(hidden_above > 0);
+  }
+
+  // The handles of the viewer's cut-aways, dragged as a user does (script drags: a press on the
+  // handle's pixel, the pointer moved, the release): the box's bottom face and a clipping plane
+  // move by what the pointer's move is in millimetres at the handle, and the picture changes with
+  // them.
+  TEST_CASE("viewer_crop_face_and_clipping_plane_follow_their_dragged_handles") {
+    const auto dir = test::fresh_folder("viewer", "cut-handles");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const std::string setup = "view anterior\ncrop -60 -90 -40 60 60 50\nclip 0 0 0 0 0 -1\n";
+    const auto first = view(dir, setup + "report " + d("r0.json") + "\nquit\n");
+    REQUIRE_MESSAGE(first.exit_code == 0, first.output);
+    const Scene scene = load_scene(kScene);
+    const auto report = [&](const char* name) {
+      return nlohmann::json::parse(test::read_file(dir / name));
+    };
+    Camera camera = scene.camera;
+    for (int col = 0; col < 4; ++col)
+      for (int row = 0; row < 4; ++row)
+        camera.view[col][row] = report("r0.json").at("view")[col * 4 + row];
+    const auto pixel = [&](glm::vec3 p) { return project(camera, p, {kWidth, kHeight}).pixel; };
+    // The bottom face's handle: its centre; the plane's: the centre of its cut through the
+    // content (the content's box at z = 0). Each is dragged 12 px down the picture (towards -z).
+    const glm::vec3 bottom(0.0f, -15.0f, -40.0f);
+    const Bounds content = scene_bounds(scene);
+    const glm::vec3 on_plane(0.5f * (content.lo.x + content.hi.x),
+                             0.5f * (content.lo.y + content.hi.y), 0.0f);
+    const auto drag = [&](glm::vec3 handle) {
+      const glm::vec2 from = pixel(handle);
+      return "drag left " + std::to_string(from.x) + " " + std::to_string(from.y) + " " +
+             std::to_string(from.x) + " " + std::to_string(from.y + 12.0f) + "\n";
+    };
+    const auto r =
+        view(dir, setup + "screenshot " + d("before.png") + "\n" + drag(bottom) + "report " +
+                      d("r1.json") + "\nscreenshot " + d("face.png") + "\n" + drag(on_plane) +
+                      "report " + d("r2.json") + "\nscreenshot " + d("plane.png") + "\nquit\n");
+    REQUIRE_MESSAGE(r.exit_code == 0, r.output);
+    // The millimetres 12 px are at each handle, along its direction (+z for both drags).
+    const auto mm = [&](glm::vec3 at) {
+      return 12.0f / glm::distance(pixel(at), pixel(at + glm::vec3(0, 0, 1)));
+    };
+    const nlohmann::json r1 = report("r1.json"), r2 = report("r2.json");
+    CHECK(r1.at("crop")[2].get<float>() == doctest::Approx(-40.0f - mm(bottom)).epsilon(0.1));
+    CHECK(r1.at("crop")[5].get<float>() == 50.0f);  // (the other faces stay)
+    CHECK(r1.at("clip")[3].get<float>() == 0.0f);
+    // The plane (0, 0, -1, w) keeps z <= w: dragged down, it keeps less.
+    CHECK(r2.at("clip")[3].get<float>() == doctest::Approx(-mm(on_plane)).epsilon(0.1));
+    CHECK(r2.at("crop") == r1.at("crop"));
+    const Rgba8Image before = read_png(d("before.png")), face = read_png(d("face.png"));
+    CHECK(changed_pixels(before, face) > 100);
+    CHECK(changed_pixels(face, read_png(d("plane.png"))) > 100);
   }
 
   TEST_CASE("viewer_places_renames_moves_deletes_undoes_and_saves_labels") {
