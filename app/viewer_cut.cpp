@@ -105,13 +105,16 @@ void Viewer::apply_cuts(const ViewerCuts& cuts) {
                   std::to_string(own.size()) + " are more than " + std::to_string(kMaxCutPlanes));
   }
   cuts_ = cuts;
-  output_.wait_idle();  // (the volumes' records are rewritten)
+  // (the volumes' records are copied at the start of the next frame, after the frames in flight:
+  // nothing waits)
+  Uploads uploads;
   for (size_t v = 0; v < scene_.volumes.size(); ++v) {
     std::vector<glm::vec4> cut = scene_cuts_[v];
     cut.insert(cut.end(), own.begin(), own.end());
     scene_.volumes[v].cut = std::move(cut);
-    labelled_->renderer().set_cut(uint32_t(v), scene_.volumes[v]);
+    labelled_->renderer().set_cut(uint32_t(v), scene_.volumes[v], &uploads);
   }
+  labelled_->runner().upload_in_next_frame(std::move(uploads));
   settings_changed(true);  // (labels whose anchors are cut away hide)
 }
 

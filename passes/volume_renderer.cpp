@@ -413,11 +413,15 @@ void VolumeRenderer::upload_transfer() {
   if (!inputs_.occupancy.empty()) upload(ctx_, occupancy_, as_bytes(inputs_.occupancy));
 }
 
-void VolumeRenderer::set_cut(uint32_t volume, const Volume& v) {
+void VolumeRenderer::set_cut(uint32_t volume, const Volume& v, Uploads* in_frame) {
   set_cut_planes(v, v.cut, inputs_.volumes.at(volume));
   std::vector<gpu::VolumeGpu> volume_data = inputs_.volumes;
   volume_data.resize(VR_MAX_VOLUMES);
-  upload(ctx_, volumes_, as_bytes(volume_data));
+  if (in_frame) {
+    in_frame->add(ctx_, volumes_, as_bytes(volume_data));
+  } else {
+    upload(ctx_, volumes_, as_bytes(volume_data));
+  }
   ++transfer_version_;  // (an interactive frame casts its rays again)
 }
 

@@ -135,9 +135,10 @@ class VolumeRenderer {
   // Rebuilds volume v's empty-space grid and its transfer-function row (the frames recorded
   // from now on use them).
   void set_transfer_function(uint32_t volume, const TransferFunction& tf);
-  // Volume v's cut-aways (`v.cut`, world planes) for the frames recorded from now on (waits: no
-  // frame may be in flight).
-  void set_cut(uint32_t volume, const Volume& v);
+  // Volume v's cut-aways (`v.cut`, world planes) for the frames recorded from now on: copied by
+  // `in_frame` (GraphRunner::upload_in_next_frame: no wait), else at once (waits: no frame may
+  // be in flight).
+  void set_cut(uint32_t volume, const Volume& v, Uploads* in_frame = nullptr);
   // What the driver reports about the resolve's compiled shader (registers, ...), if anything.
   std::vector<PipelineReport> pipeline_statistics() const;
 

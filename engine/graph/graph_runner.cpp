@@ -176,8 +176,9 @@ GraphRunner::GraphRunner(Context& ctx, Graph graph)
 }
 
 GraphRunner::~GraphRunner() {
-  // (frames may still run; never throws, and leaves what a hung GPU may still use)
-  if (frames_in_flight() > 1 && !ctx_.drain() && !ctx_.may_destroy()) return;
+  // (frames may still run, one in flight too where a window shows it; never throws, and leaves
+  // what a hung GPU may still use)
+  if (!ctx_.drain() && !ctx_.may_destroy()) return;
   vkDestroySampler(ctx_.device(), linear_sampler_, nullptr);
   for (VkQueryPool pool : queries_) vkDestroyQueryPool(ctx_.device(), pool, nullptr);
 }
