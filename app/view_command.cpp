@@ -220,12 +220,12 @@ void Script::run(Viewer& viewer, const ScriptCommand& c) {
                                {"panel", viewer.panel_rect()},
                                {"view", view},
                                {"crop", nullptr},
-                               {"clip", nullptr}};
+                               {"clip", nlohmann::json::array()}};
       if (const auto& box = viewer.cuts().crop)
         report["crop"] = {(*box)[0].x, (*box)[0].y, (*box)[0].z,
                           (*box)[1].x, (*box)[1].y, (*box)[1].z};
-      if (const auto& plane = viewer.cuts().clip)
-        report["clip"] = {plane->x, plane->y, plane->z, plane->w};
+      for (const glm::vec4& plane : viewer.cuts().planes)
+        report["clip"].push_back({plane.x, plane.y, plane.z, plane.w});
       write_text_file(c.word, report.dump() + "\n");
       break;
     }
@@ -260,9 +260,9 @@ void Script::run(Viewer& viewer, const ScriptCommand& c) {
       break;
     case ScriptOp::clip:
       if (n.empty()) {
-        viewer.set_clip(std::nullopt);
+        viewer.clear_clips();
       } else {
-        viewer.set_clip(clip_plane(glm::vec3(float(n[0]), float(n[1]), float(n[2])),
+        viewer.add_clip(clip_plane(glm::vec3(float(n[0]), float(n[1]), float(n[2])),
                                    glm::vec3(float(n[3]), float(n[4]), float(n[5]))));
       }
       break;

@@ -380,7 +380,7 @@ void Viewer::cursor(glm::vec2 position) {
     ask_pick({mouse_, *anchor_drag_, true});
   }
   if (handle_drag_) return drag_cut_handle(delta);
-  if (cuts_.crop || cuts_.clip) {  // (the handle under the pointer is drawn larger)
+  if (cuts_.crop || !cuts_.planes.empty()) {  // (the handle under the pointer is drawn larger)
     const std::optional<int> hovered = cut_handle_near(mouse_);
     if (hovered != hovered_handle_) hovered_handle_ = hovered, ui_event();
   }

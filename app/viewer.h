@@ -136,8 +136,9 @@ struct ViewerSummary {
 // The viewer's own cut-aways (world mm, LPS), on every volume besides its scene's.
 struct ViewerCuts {
   std::optional<std::array<glm::vec3, 2>> crop;  // a box; what lies outside it is cut away
-  std::optional<glm::vec4> clip;                 // a plane (n, w), |n| = 1: keeps dot(n,p)+w >= 0
+  std::vector<glm::vec4> planes;  // clipping planes (n, w), |n| = 1: each keeps dot(n,p)+w >= 0
 };
+inline constexpr size_t kViewerPlanes = 6;  // clipping planes the viewer adds at most
 
 class Viewer {
  public:
@@ -208,11 +209,12 @@ class Viewer {
   // only background (move_label too) or no label has the id.
   int place_label(glm::vec2 at);
   // The viewer's own cut-aways on every volume, besides its scene's (app/viewer_cut.cpp): a crop
-  // box (world mm, LPS) and a clipping plane (n, w) that keeps dot(n, p) + w >= 0; none: only the
-  // scene's. The panel's Cut-aways section sets them; while on they are drawn over the picture
-  // with a handle on each box face and on the plane, which a left drag moves.
+  // box (world mm, LPS) and up to six clipping planes; none: only the scene's. The panel's
+  // Cut-aways section sets them; while on they are drawn over the picture with a handle on each
+  // box face and each plane, which a left drag moves.
   void set_crop(std::optional<std::array<glm::vec3, 2>> box);
-  void set_clip(std::optional<glm::vec4> plane);  // (the normal is made unit length)
+  void add_clip(glm::vec4 plane);  // (the normal is made unit length; an Error past six)
+  void clear_clips();
   const ViewerCuts& cuts() const { return cuts_; }
   void set_label_text(int id, const std::string& text);
   void move_label(int id, glm::vec2 at);  // its anchor to the point under `at`
@@ -350,17 +352,17 @@ class Viewer {
   std::vector<VolumeLook> looks_;
   std::vector<std::vector<glm::vec4>> scene_cuts_;  // each volume's cut-aways from the scene
   ViewerCuts cuts_;
-  // The cut-aways while a face, the plane or a panel value is dragged: drawn at once, applied
-  // when the button is let go (each change waits for the frames in flight).
+  // The cut-aways while a face, a plane or a panel value is dragged: drawn at once, applied when
+  // the button is let go.
   std::optional<ViewerCuts> cuts_dragged_;
   std::optional<int> hovered_handle_;  // the handle under the pointer
-  std::optional<int> handle_drag_;  // the handle dragged: 0-5 the box's faces (axis * 2 + high), 6
-                                    // the plane
+  // The handle dragged: 0-5 the box's faces (axis * 2 + high), 6 on the planes in their order.
+  std::optional<int> handle_drag_;
   struct CutHandle {
     glm::vec3 at;         // world
     glm::vec3 direction;  // the way it moves: a face's axis, the plane's normal
   };
-  std::array<std::optional<CutHandle>, 7> cut_handles(const ViewerCuts& cuts) const;
+  std::vector<std::optional<CutHandle>> cut_handles(const ViewerCuts& cuts) const;
   std::optional<int> cut_handle_near(glm::vec2 at) const;
   bool press_cut_handle(int button, int action);  // true: a handle took the press or release
   void drag_cut_handle(glm::vec2 delta);

@@ -82,22 +82,27 @@ void Viewer::set_crop(std::optional<std::array<glm::vec3, 2>> box) {
   apply_cuts(cuts);
 }
 
-void Viewer::set_clip(std::optional<glm::vec4> plane) {
-  if (plane) {
-    const float length = glm::length(glm::vec3(*plane));
-    if (!(length > 1e-6f) || !std::isfinite(plane->w))
-      throw Error("clipping plane: the normal must not be zero");
-    *plane /= length;
-  }
+void Viewer::add_clip(glm::vec4 plane) {
+  const float length = glm::length(glm::vec3(plane));
+  if (!(length > 1e-6f) || !std::isfinite(plane.w))
+    throw Error("clipping plane: the normal must not be zero");
+  if (cuts_.planes.size() >= kViewerPlanes)
+    throw Error("clipping plane: the viewer keeps at most " + std::to_string(kViewerPlanes));
   ViewerCuts cuts = cuts_;
-  cuts.clip = plane;
+  cuts.planes.push_back(plane / length);
+  apply_cuts(cuts);
+}
+
+void Viewer::clear_clips() {
+  ViewerCuts cuts = cuts_;
+  cuts.planes.clear();
   apply_cuts(cuts);
 }
 
 void Viewer::apply_cuts(const ViewerCuts& cuts) {
   std::vector<glm::vec4> own;
   if (cuts.crop) own = crop_planes((*cuts.crop)[0], (*cuts.crop)[1]);
-  if (cuts.clip) own.push_back(*cuts.clip);
+  own.insert(own.end(), cuts.planes.begin(), cuts.planes.end());
   for (size_t v = 0; v < scene_.volumes.size(); ++v) {
     if (scene_cuts_[v].size() + own.size() > kMaxCutPlanes)
       throw Error("volume '" + scene_.volumes[v].name + "': its " +
@@ -118,8 +123,8 @@ void Viewer::apply_cuts(const ViewerCuts& cuts) {
   settings_changed(true);  // (labels whose anchors are cut away hide)
 }
 
-std::array<std::optional<Viewer::CutHandle>, 7> Viewer::cut_handles(const ViewerCuts& cuts) const {
-  std::array<std::optional<CutHandle>, 7> handles;
+std::vector<std::optional<Viewer::CutHandle>> Viewer::cut_handles(const ViewerCuts& cuts) const {
+  std::vector<std::optional<CutHandle>> handles(6);
   if (cuts.crop) {
     const std::array<glm::vec3, 2>& b = *cuts.crop;
     for (int face = 0; face < 6; ++face) {
@@ -131,17 +136,17 @@ std::array<std::optional<Viewer::CutHandle>, 7> Viewer::cut_handles(const Viewer
       handles[size_t(face)] = CutHandle{at, direction};
     }
   }
-  if (cuts.clip) {
-    const glm::vec3 n(*cuts.clip);
-    const std::array<glm::vec3, 2> box = content_box(scene_);
-    const std::vector<glm::vec3> polygon = plane_in_box(*cuts.clip, box);
+  const std::array<glm::vec3, 2> box = content_box(scene_);
+  for (const glm::vec4& plane : cuts.planes) {
+    const glm::vec3 n(plane);
+    const std::vector<glm::vec3> polygon = plane_in_box(plane, box);
     glm::vec3 at = 0.5f * (box[0] + box[1]);
-    at -= n * (glm::dot(n, at) + cuts.clip->w);  // (the content's centre on the plane)
+    at -= n * (glm::dot(n, at) + plane.w);  // (the content's centre on the plane)
     if (!polygon.empty()) {
       at = glm::vec3(0.0f);
       for (const glm::vec3& p : polygon) at += p / float(polygon.size());
     }
-    handles[6] = CutHandle{at, n};
+    handles.push_back(CutHandle{at, n});
   }
   return handles;
 }
@@ -184,8 +189,9 @@ bool Viewer::press_cut_handle(int button, int action) {
 void Viewer::drag_cut_handle(glm::vec2 delta) {
   if (!handle_drag_ || !cuts_dragged_) return;
   ViewerCuts& cuts = *cuts_dragged_;
-  const std::optional<CutHandle> handle = cut_handles(cuts)[size_t(*handle_drag_)];
-  if (!handle) return;
+  const std::vector<std::optional<CutHandle>> handles = cut_handles(cuts);
+  if (size_t(*handle_drag_) >= handles.size() || !handles[size_t(*handle_drag_)]) return;
+  const std::optional<CutHandle>& handle = handles[size_t(*handle_drag_)];
   const graph::Extent e = labelled_->size();
   const Camera camera = control_.camera();
   const ProjectedPoint from = project(camera, handle->at, {e.width, e.height});
@@ -207,7 +213,7 @@ void Viewer::drag_cut_handle(glm::vec2 delta) {
                      : std::clamp(face + mm, b[0][axis] + least,
                                   std::max(content[1][axis], b[0][axis] + least));
   } else {
-    glm::vec4& plane = *cuts.clip;
+    glm::vec4& plane = cuts.planes.at(size_t(*handle_drag_ - 6));
     const glm::vec2 range = plane_range(glm::vec3(plane), content);
     plane.w = -std::clamp(-plane.w + mm, range.x, range.y);
   }
@@ -231,30 +237,30 @@ void Viewer::panel_cut_aways() {
   } else {
     cuts.crop.reset();
   }
-  bool clip_on = cuts.clip.has_value();
-  edited |= ImGui::Checkbox("clipping plane", &clip_on);
-  if (clip_on && !cuts.clip) {  // (new: through the content's centre, the near half cut away)
-    const glm::vec3 forward = -glm::vec3(glm::inverse(control_.camera().view)[2]);
-    cuts.clip = glm::vec4(forward, -glm::dot(forward, 0.5f * (content[0] + content[1])));
-  }
-  if (clip_on) {
-    glm::vec4& plane = *cuts.clip;
+  const glm::vec3 centre = 0.5f * (content[0] + content[1]);
+  const auto through_centre = [&](glm::vec3 n) { return glm::vec4(n, -glm::dot(n, centre)); };
+  const glm::vec3 forward = -glm::vec3(glm::inverse(control_.camera().view)[2]);
+  for (size_t i = 0; i < cuts.planes.size(); ++i) {
+    ImGui::PushID(int(i));
+    glm::vec4& plane = cuts.planes[i];
+    ImGui::Text("clipping plane %zu", i + 1);
+    ImGui::SameLine();
+    if (ImGui::SmallButton("remove")) {
+      cuts.planes.erase(cuts.planes.begin() + long(i));
+      edited = true;
+      ImGui::PopID();
+      break;
+    }
     const auto side = std::find_if(std::begin(kSides), std::end(kSides), [&](const Side& s) {
       return glm::dot(s.normal, glm::vec3(plane)) > 0.9999f;
     });
     if (ImGui::BeginCombo("side",
                           side == std::end(kSides) ? "keep the far side of a view" : side->name)) {
       for (const Side& s : kSides) {
-        if (ImGui::Selectable(s.name, &s == side)) {
-          plane = glm::vec4(s.normal, -glm::dot(s.normal, 0.5f * (content[0] + content[1])));
-          edited = true;
-        }
+        if (ImGui::Selectable(s.name, &s == side)) plane = through_centre(s.normal), edited = true;
       }
-      if (ImGui::Selectable("keep the far side of this view")) {
-        const glm::vec3 forward = -glm::vec3(glm::inverse(control_.camera().view)[2]);
-        plane = glm::vec4(forward, -glm::dot(forward, 0.5f * (content[0] + content[1])));
-        edited = true;
-      }
+      if (ImGui::Selectable("keep the far side of this view"))
+        plane = through_centre(forward), edited = true;
       ImGui::EndCombo();
     }
     const glm::vec2 range = plane_range(glm::vec3(plane), content);
@@ -264,9 +270,14 @@ void Viewer::panel_cut_aways() {
       plane.w = -position;
       edited = true;
     }
-  } else {
-    cuts.clip.reset();
+    ImGui::PopID();
   }
+  ImGui::BeginDisabled(cuts.planes.size() >= kViewerPlanes);
+  if (ImGui::Button("add a clipping plane")) {  // (through the centre: the near half cut away)
+    cuts.planes.push_back(through_centre(forward));
+    edited = true;
+  }
+  ImGui::EndDisabled();
   ImGui::TextDisabled("or drag the handles in the picture");
   if (edited) cuts_dragged_ = cuts;
   if (cuts_dragged_ && !handle_drag_ && !ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
@@ -280,7 +291,7 @@ void Viewer::panel_cut_aways() {
 // with their handles, while they are on (drawn as dragged, before they apply).
 void Viewer::draw_cut_aways() {
   const ViewerCuts& cuts = cuts_dragged_ ? *cuts_dragged_ : cuts_;
-  if (!cuts.crop && !cuts.clip) return;
+  if (!cuts.crop && cuts.planes.empty()) return;
   const graph::Extent e = labelled_->size();
   const Camera camera = control_.camera();
   ImDrawList* draw = ImGui::GetBackgroundDrawList();
@@ -298,8 +309,8 @@ void Viewer::draw_cut_aways() {
       }
     }
   }
-  if (cuts.clip) {
-    const std::vector<glm::vec3> polygon = plane_in_box(*cuts.clip, content_box(scene_));
+  for (const glm::vec4& plane : cuts.planes) {
+    const std::vector<glm::vec3> polygon = plane_in_box(plane, content_box(scene_));
     for (size_t i = 0; i < polygon.size(); ++i)
       line(polygon[i], polygon[(i + 1) % polygon.size()], kPlaneColour);
   }

@@ -207,10 +207,11 @@ TEST_SUITE("window") {
       return "drag left " + std::to_string(from.x) + " " + std::to_string(from.y) + " " +
              std::to_string(from.x) + " " + std::to_string(from.y + 12.0f) + "\n";
     };
-    const auto r =
-        view(dir, setup + "screenshot " + d("before.png") + "\n" + drag(bottom) + "report " +
-                      d("r1.json") + "\nscreenshot " + d("face.png") + "\n" + drag(on_plane) +
-                      "report " + d("r2.json") + "\nscreenshot " + d("plane.png") + "\nquit\n");
+    const auto r = view(dir, setup + "screenshot " + d("before.png") + "\n" + drag(bottom) +
+                                 "report " + d("r1.json") + "\nscreenshot " + d("face.png") + "\n" +
+                                 drag(on_plane) + "report " + d("r2.json") + "\nscreenshot " +
+                                 d("plane.png") + "\nclip 0 0 0 1 0 0\nreport " + d("r3.json") +
+                                 "\nclip off\nreport " + d("r4.json") + "\nquit\n");
     REQUIRE_MESSAGE(r.exit_code == 0, r.output);
     CHECK(r.output.find("validation") == std::string::npos);
     // The millimetres 12 px are at each handle, along its direction (+z for both drags).
@@ -220,10 +221,14 @@ TEST_SUITE("window") {
     const nlohmann::json r1 = report("r1.json"), r2 = report("r2.json");
     CHECK(r1.at("crop")[2].get<float>() == doctest::Approx(-40.0f - mm(bottom)).epsilon(0.1));
     CHECK(r1.at("crop")[5].get<float>() == 50.0f);  // (the other faces stay)
-    CHECK(r1.at("clip")[3].get<float>() == 0.0f);
+    CHECK(r1.at("clip")[0][3].get<float>() == 0.0f);
     // The plane (0, 0, -1, w) keeps z <= w: dragged down, it keeps less.
-    CHECK(r2.at("clip")[3].get<float>() == doctest::Approx(-mm(on_plane)).epsilon(0.1));
+    CHECK(r2.at("clip")[0][3].get<float>() == doctest::Approx(-mm(on_plane)).epsilon(0.1));
     CHECK(r2.at("crop") == r1.at("crop"));
+    // (a second plane is added to the first; "clip off" removes both)
+    CHECK(report("r3.json").at("clip").size() == 2);
+    CHECK(report("r3.json").at("clip")[0] == r2.at("clip")[0]);
+    CHECK(report("r4.json").at("clip").empty());
     const Rgba8Image before = read_png(d("before.png")), face = read_png(d("face.png"));
     CHECK(changed_pixels(before, face) > 100);
     CHECK(changed_pixels(face, read_png(d("plane.png"))) > 100);
