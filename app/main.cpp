@@ -67,7 +67,22 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
     if (!in.preset.empty()) throw UsageError("give --preset or --window, not both");
     options.window = parse_window(in.window);
   }
-  Scene scene = load_scene(in.file, options);
+  Scene scene;
+  try {
+    scene = load_scene(in.file, options);
+  } catch (const Error& e) {
+    // A --series the folder does not hold is a usage error (as an unknown --camera is); the
+    // folder is listed again on this path only.
+    std::error_code error;
+    if (!in.series.empty() && std::filesystem::is_directory(in.file, error)) {
+      const std::vector<DicomSeries> held = list_dicom_series_isolated(in.file);
+      if (std::none_of(held.begin(), held.end(), [&](const DicomSeries& s) {
+            return s.uid == in.series || s.number == in.series;
+          }))
+        throw UsageError(std::string("--series: ") + e.what());
+    }
+    throw;
+  }
   if (!scene.labels.empty()) {  // (characters no font draws: the size does not matter)
     for (std::string& w : missing_glyph_warnings(Font(16.0f), scene.labels))
       scene.warnings.push_back(std::move(w));

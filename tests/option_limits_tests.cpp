@@ -143,6 +143,11 @@ TEST_SUITE("cli") {
               "--series: " + kHead + " is a scene file"},
              {"render " + kHead + " -o /tmp/never.png --frame 2",
               "--frame: " + kHead + " is a scene file"},
+             // A series the folder does not hold, as an unknown camera position.
+             {"render " STRATA_SOURCE_DIR "/assets/cache/dicom/CT5N -o /tmp/never.png --series 99",
+              "--series: " STRATA_SOURCE_DIR
+              "/assets/cache/dicom/CT5N: no series '99' (SeriesNumber or SeriesInstanceUID); "
+              "the folder holds: series 5"},
              // One plane an --clip and one pixel an --at: the scene after them is no value.
              {"render --clip 0,0,0,0,0,0 " + kHead + " -o /tmp/never.png",
               "--clip: '0,0,0,0,0,0': the normal (NX,NY,NZ) must not be zero"},
