@@ -1,6 +1,6 @@
 // The command lines the README and docs/ show: every option they name is an option of that
 // subcommand, and every example that names real files runs (exit 0) in a folder laid out like
-// the repository, smaller: pictures at 48 px, videos at 2 frames a second, one pick run. Viewer
+// the repository, smaller: pictures at 48 px, videos at 2 frames a second, one small pick. Viewer
 // and bench lines are only checked for their options (the window suite drives the viewer; the
 // bench tests run each bench).
 #include <doctest/doctest.h>
@@ -141,18 +141,29 @@ bool runnable(const std::vector<std::string>& w, const fs::path& folder) {
   return true;
 }
 
-// The example made small: pictures at 48 px, videos at 2 frames a second, picks run once; what it
-// writes goes to the working folder.
+// The example made small: pictures at 48 px, videos at 2 frames a second, picks run once an eighth
+// as wide; what it writes goes to the working folder.
 std::string made_small(std::vector<std::string> w) {
   const bool picture = w[0] == "render" || w[0] == "video";
   bool sized = false;
+  // A pick's picture an eighth as wide (512 px where none is given), its pixels with it.
+  const auto scaled = [](const std::string& pair, char separator) {
+    const size_t at = pair.find(separator);
+    const auto eighth = [](const std::string& n) { return std::to_string(std::stoi(n) / 8); };
+    return at == std::string::npos
+               ? eighth(pair)
+               : eighth(pair.substr(0, at)) + separator + eighth(pair.substr(at + 1));
+  };
   for (size_t i = 1; i + 1 < w.size(); ++i) {
     if (picture && w[i] == "--size") w[i + 1] = "48", sized = true;
     if (w[0] == "video" && w[i] == "--fps") w[i + 1] = "2";
     if (w[0] == "pick" && w[i] == "--runs") w[i + 1] = "1";
+    if (w[0] == "pick" && w[i] == "--size") w[i + 1] = scaled(w[i + 1], 'x'), sized = true;
+    if (w[0] == "pick" && w[i] == "--at") w[i + 1] = scaled(w[i + 1], ',');
     if (w[i] == "-o" && w[i + 1].starts_with("/tmp/")) w[i + 1].erase(0, 5);  // into the folder
   }
   if (picture && !sized) w.insert(w.end(), {"--size", "48"});
+  if (w[0] == "pick" && !sized) w.insert(w.end(), {"--size", "64"});
   std::string text;
   for (const std::string& word : w) text += (text.empty() ? "" : " ") + word;
   return text;
