@@ -870,9 +870,12 @@ void Viewer::set_preset(uint32_t volume, const std::string& name) {
 
 void Viewer::set_transfer(uint32_t volume) {
   const VolumeLook& look = looks_[volume];
-  output_.wait_idle();  // the table and grids are rewritten
+  // (the table goes with each frame; the empty-space grid is copied at the start of the next,
+  // after the frames in flight: a slider dragged waits for no frame)
+  Uploads uploads;
   labelled_->renderer().set_transfer_function(
-      volume, windowed(original_tfs_[volume], look.level, look.window, look.opacity));
+      volume, windowed(original_tfs_[volume], look.level, look.window, look.opacity), &uploads);
+  labelled_->runner().upload_in_next_frame(std::move(uploads));
   settings_changed(false);
 }
 

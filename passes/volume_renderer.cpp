@@ -408,9 +408,14 @@ VolumeRenderer::VolumeRenderer(Context& ctx, const Scene& scene, RenderSettings 
   upload_transfer();
 }
 
-void VolumeRenderer::upload_transfer() {
+void VolumeRenderer::upload_transfer(Uploads* in_frame) {
   ++transfer_version_;
-  if (!inputs_.occupancy.empty()) upload(ctx_, occupancy_, as_bytes(inputs_.occupancy));
+  if (inputs_.occupancy.empty()) return;
+  if (in_frame) {
+    in_frame->add(ctx_, occupancy_, as_bytes(inputs_.occupancy));
+  } else {
+    upload(ctx_, occupancy_, as_bytes(inputs_.occupancy));
+  }
 }
 
 void VolumeRenderer::set_cut(uint32_t volume, const Volume& v, Uploads* in_frame) {
@@ -425,10 +430,11 @@ void VolumeRenderer::set_cut(uint32_t volume, const Volume& v, Uploads* in_frame
   ++transfer_version_;  // (an interactive frame casts its rays again)
 }
 
-void VolumeRenderer::set_transfer_function(uint32_t volume, const TransferFunction& tf) {
+void VolumeRenderer::set_transfer_function(uint32_t volume, const TransferFunction& tf,
+                                           Uploads* in_frame) {
   inputs_.transfer_functions.at(volume) = tf;
   inputs_.update_transfer();
-  upload_transfer();
+  upload_transfer(in_frame);
 }
 
 void VolumeRenderer::set_table_size(uint32_t slots) {

@@ -133,8 +133,10 @@ class VolumeRenderer {
   void set_camera(const Camera& camera) { camera_ = camera; }
   RenderSettings& settings() { return settings_; }
   // Rebuilds volume v's empty-space grid and its transfer-function row (the frames recorded
-  // from now on use them).
-  void set_transfer_function(uint32_t volume, const TransferFunction& tf);
+  // from now on use them): the grid copied by `in_frame` (GraphRunner::upload_in_next_frame: no
+  // wait), else at once (waits: no frame may be in flight).
+  void set_transfer_function(uint32_t volume, const TransferFunction& tf,
+                             Uploads* in_frame = nullptr);
   // Volume v's cut-aways (`v.cut`, world planes) for the frames recorded from now on: copied by
   // `in_frame` (GraphRunner::upload_in_next_frame: no wait), else at once (waits: no frame may
   // be in flight).
@@ -162,7 +164,7 @@ class VolumeRenderer {
 
  private:
   uint32_t slots_for(graph::Extent viewport) const;
-  void upload_transfer();
+  void upload_transfer(Uploads* in_frame = nullptr);
   void record_build(graph::PassContext& pc) const;
 
   Context& ctx_;

@@ -603,6 +603,30 @@ TEST_SUITE("window") {
     CHECK(changed_pixels(read_png(files[0].string()), read_png(files[1].string())) > 1000);
   }
 
+  // A preset chosen in the viewer is copied in the next frame (no wait): the picture equals that
+  // of a viewer opened with it, byte for byte. mr-head shows the skin that mr-brain leaves
+  // transparent, so an empty-space grid left from mr-brain would skip it.
+  TEST_CASE("a_preset_switched_in_the_viewer_draws_what_a_viewer_opened_with_it_does") {
+    const auto dir = test::fresh_folder("viewer", "preset-in-frame");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto run = [&](const char* preset, const std::string& script) {
+      const auto path = test::write_file(dir / "script.txt", script);
+      const auto r = run_strata("--validate view " STRATA_SOURCE_DIR
+                                "/assets/cache/mricron/ch2.nii.gz --size 96 --no-optimize "
+                                "--no-panel --preset " +
+                                std::string(preset) + " --script " + path.string());
+      INFO(r.output);
+      CHECK(r.exit_code == 0);
+      CHECK(r.output.find("validation") == std::string::npos);
+    };
+    run("mr-brain", "screenshot " + d("brain.png") + "\npreset mr-head\nscreenshot " +
+                        d("switched.png") + "\nquit\n");
+    run("mr-head", "screenshot " + d("head.png") + "\nquit\n");
+    const Rgba8Image head = read_png(d("head.png"));
+    CHECK(changed_pixels(read_png(d("brain.png")), head) > 500);
+    CHECK(changed_pixels(read_png(d("switched.png")), head) == 0);
+  }
+
   // A volume opened directly: the fitted views and the presets are the viewer's too.
   TEST_CASE("viewer_opens_a_volume_with_its_anatomical_views_and_switches_presets") {
     const auto dir = test::fresh_folder("viewer", "volume");
