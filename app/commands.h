@@ -24,7 +24,8 @@ class UsageError : public Error {
   using Error::Error;
 };
 
-// COUNT numbers separated by commas for `option` (a usage error naming `form` otherwise).
+// COUNT numbers separated by commas, each within 1e9, for `option` (a usage error naming `form`
+// otherwise).
 std::vector<float> parse_numbers(const std::string& text, size_t count, const char* option,
                                  const char* form);
 // --window's "CENTER,WIDTH" (the volume's values; a usage error otherwise).

@@ -49,7 +49,8 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
                      " is a scene file; --frame chooses the frame of a 4-D volume opened directly "
                      "(a scene file names it in its volume's \"frame\")");
   if (!in.crop.empty()) {
-    const std::vector<float> v = parse_numbers(in.crop, 6, "--crop", "X0,Y0,Z0,X1,Y1,Z1");
+    const std::vector<float> v =
+        parse_numbers(in.crop, 6, "--crop", "X0,Y0,Z0,X1,Y1,Z1 (world mm, LPS)");
     const glm::vec3 lo(v[0], v[1], v[2]), hi(v[3], v[4], v[5]);
     if (!glm::all(glm::lessThan(lo, hi)))
       throw UsageError("--crop: '" + in.crop + "': each low corner value must be below the high");
@@ -57,7 +58,8 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
   }
   if (in.clip.size() > 6) throw UsageError("--clip: at most six planes");
   for (const std::string& text : in.clip) {
-    const std::vector<float> v = parse_numbers(text, 6, "--clip", "PX,PY,PZ,NX,NY,NZ");
+    const std::vector<float> v =
+        parse_numbers(text, 6, "--clip", "PX,PY,PZ,NX,NY,NZ (world mm, LPS)");
     const glm::vec3 normal(v[3], v[4], v[5]);
     if (!(glm::length(normal) > 1e-6f))
       throw UsageError("--clip: '" + text + "': the normal (NX,NY,NZ) must not be zero");
@@ -121,20 +123,17 @@ std::vector<float> parse_numbers(const std::string& text, size_t count, const ch
     start = comma + 1;
   }
   if (out.size() != count || std::count(text.begin(), text.end(), ',') != std::ptrdiff_t(count - 1))
-    throw UsageError(std::string(option) + ": '" + text + "' is not " + form +
-                     " (world coordinates in mm, LPS)");
+    throw UsageError(std::string(option) + ": '" + text + "' is not " + form);
   return out;
 }
 
 glm::vec2 parse_window(const std::string& text) {
-  float center = 0.0f, width = 0.0f;
-  char comma = 0, extra = 0;
-  const int n = std::sscanf(text.c_str(), "%f%c%f%c", &center, &comma, &width, &extra);
-  if (n != 3 || comma != ',' || !(std::abs(center) <= 1e9f) || !(width > 0.0f && width <= 1e9f))
-    throw UsageError("--window: '" + text +
-                     "' is not CENTER,WIDTH (the volume's values, e.g. 40,80 for brain or "
-                     "400,1800 for bone in HU; width > 0)");
-  return {center, width};
+  const char* form =
+      "CENTER,WIDTH (the volume's values, e.g. 40,80 for brain or 400,1800 for bone in HU; "
+      "width > 0)";
+  const std::vector<float> v = parse_numbers(text, 2, "--window", form);
+  if (!(v[1] > 0.0f)) throw UsageError("--window: '" + text + "' is not " + form);
+  return {v[0], v[1]};
 }
 
 Camera option_camera(const Scene& scene, const std::string& name, const char* option) {

@@ -345,9 +345,12 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
 void LabelledRenderer::project_and_layer(const Camera& camera) {
   const std::vector<ProjectedPoint> anchors = project_anchors(scene_, camera, size_);
   // (a label whose anchor a cut-away removes is hidden with what it names)
+  std::vector<glm::vec3> points;
+  for (const Label& label : scene_.labels) points.push_back(label.anchor);
+  const std::vector<bool> cut = anchors_cut_away(scene_, points);
   std::vector<bool> shown(anchors.size());
   for (size_t i = 0; i < anchors.size(); ++i)
-    shown[i] = anchors[i].visible && !hidden_[i] && !anchor_cut_away(scene_, scene_.labels[i].anchor);
+    shown[i] = anchors[i].visible && !hidden_[i] && !cut[i];
   std::vector<float> depths;
   for (size_t i = 0; i < anchors.size(); ++i)
     depths.push_back(shown[i] ? anchors[i].eye_depth : std::nanf(""));
@@ -359,8 +362,7 @@ void LabelledRenderer::project_and_layer(const Camera& camera) {
     l.previous = anchors[i].pixel;  // (the GPU's forces state replaces it once drawn)
     l.anchor_depth = anchors[i].eye_depth;
     l.layer = layering_.label_layer[i];
-    l.flags = (shown[i] ? LABEL_ENABLED : 0u) |
-              (settings_.internal ? LABEL_INTERNAL : 0u);
+    l.flags = (shown[i] ? LABEL_ENABLED : 0u) | (settings_.internal ? LABEL_INTERNAL : 0u);
   }
 }
 

@@ -369,9 +369,10 @@ TEST_SUITE("gpu") {
     both.volumes[1].cut = {clip_plane(glm::vec3(0.0f, 0.0f, 2.0f), glm::vec3(0.0f, 0.0f, -1.0f))};
     CHECK(render_gpu(ctx, both, camera, {}, size).final == alone);
     // (a label anchored in the cut-away ball is cut away with it; one in the kept ball is not)
-    CHECK(anchor_cut_away(both, glm::vec3(0.0f, 0.0f, 20.0f)));
-    CHECK(!anchor_cut_away(both, glm::vec3(0.0f, 0.0f, -20.0f)));
-    CHECK(!anchor_cut_away(both, glm::vec3(0.0f, 0.0f, 60.0f)));  // (in no volume)
+    // (and one in no volume is not)
+    CHECK(anchors_cut_away(both, {glm::vec3(0.0f, 0.0f, 20.0f), glm::vec3(0.0f, 0.0f, -20.0f),
+                                  glm::vec3(0.0f, 0.0f, 60.0f)}) ==
+          std::vector<bool>{true, false, false});
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "two_overlapping_volumes_match_the_reference") {

@@ -100,8 +100,8 @@ std::vector<glm::vec4> crop_planes(glm::vec3 lo, glm::vec3 hi) {
   for (int axis = 0; axis < 3; ++axis) {
     glm::vec3 n(0.0f);
     n[axis] = 1.0f;
-    planes.push_back(glm::vec4(n, -lo[axis]));   // p >= lo
-    planes.push_back(glm::vec4(-n, hi[axis]));   // p <= hi
+    planes.push_back(glm::vec4(n, -lo[axis]));  // p >= lo
+    planes.push_back(glm::vec4(-n, hi[axis]));  // p <= hi
   }
   return planes;
 }
@@ -117,16 +117,18 @@ bool cut_away(const Volume& volume, glm::vec3 p) {
   return false;
 }
 
-bool anchor_cut_away(const Scene& scene, glm::vec3 anchor) {
-  bool cut = false;
+std::vector<bool> anchors_cut_away(const Scene& scene, const std::vector<glm::vec3>& anchors) {
+  std::vector<bool> cut(anchors.size(), false), kept(anchors.size(), false);
   for (const Volume& v : scene.volumes) {
-    const glm::vec3 i = glm::vec3(glm::inverse(v.index_to_world()) * glm::vec4(anchor, 1.0f));
-    const bool inside = glm::all(glm::greaterThanEqual(i, glm::vec3(-0.5f))) &&
-                        glm::all(glm::lessThanEqual(i, glm::vec3(v.dims) - 0.5f));
-    if (!inside) continue;
-    if (!cut_away(v, anchor)) return false;
-    cut = true;
+    const glm::mat4 world_to_index = glm::inverse(v.index_to_world());
+    for (size_t a = 0; a < anchors.size(); ++a) {
+      const glm::vec3 i = glm::vec3(world_to_index * glm::vec4(anchors[a], 1.0f));
+      if (glm::all(glm::greaterThanEqual(i, glm::vec3(-0.5f))) &&
+          glm::all(glm::lessThanEqual(i, glm::vec3(v.dims) - 0.5f)))
+        (cut_away(v, anchors[a]) ? cut : kept)[a] = true;
+    }
   }
+  for (size_t a = 0; a < anchors.size(); ++a) cut[a] = cut[a] && !kept[a];
   return cut;
 }
 

@@ -179,8 +179,8 @@ struct Scene {
 // The scene's camera, or its named position `name` (an Error listing the names if there is none).
 Camera camera_for(const Scene& scene, const std::string& name);
 
-// Whether the volumes around a label's anchor all cut it away: some volume's box (its voxel
+// For each anchor, whether the volumes around it all cut it away: some volume's box (its voxel
 // centres') holds it and cuts it, none that holds it keeps it.
-bool anchor_cut_away(const Scene& scene, glm::vec3 anchor);
+std::vector<bool> anchors_cut_away(const Scene& scene, const std::vector<glm::vec3>& anchors);
 
 }  // namespace strata
