@@ -167,18 +167,16 @@ std::string describe_label_file(const LabelFile& file, const Scene* scene) {
   out += "  bounds: LPS " + vec(bounds.lo) + " .. " + vec(bounds.hi) + " mm, RAS " + vec(ras_lo) +
          " .. " + vec(ras_hi) + " mm\n";
   std::vector<const Label*> outside;
-  for (const Label& l : scene ? file.labels : std::vector<Label>{}) {
-    const bool inside =
-        std::any_of(scene->volumes.begin(), scene->volumes.end(), [&](const Volume& v) {
-          // (the box of the voxel centres, in the volume's own index space: oblique volumes too)
-          const glm::vec3 i =
-              glm::vec3(glm::inverse(v.index_to_world()) * glm::vec4(l.anchor, 1.0f));
-          const glm::vec3 top = glm::vec3(v.dims) - 1.0f;
-          constexpr float slack = 1e-3f;
-          return glm::all(glm::greaterThanEqual(i, glm::vec3(-slack))) &&
-                 glm::all(glm::lessThanEqual(i, top + slack));
-        });
-    if (!inside) outside.push_back(&l);
+  if (scene) {
+    std::vector<glm::vec3> anchors;
+    for (const Label& l : file.labels) anchors.push_back(l.anchor);
+    std::vector<bool> inside(anchors.size(), false);
+    for (const Volume& v : scene->volumes) {
+      const std::vector<bool> in = inside_volume(v, anchors);
+      for (size_t a = 0; a < anchors.size(); ++a) inside[a] = inside[a] || in[a];
+    }
+    for (size_t a = 0; a < anchors.size(); ++a)
+      if (!inside[a]) outside.push_back(&file.labels[a]);
   }
   if (!scene) {
     out += "  inside a scene's volumes: not checked (--scene SCENE)\n";

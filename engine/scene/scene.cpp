@@ -117,16 +117,23 @@ bool cut_away(const Volume& volume, glm::vec3 p) {
   return false;
 }
 
+std::vector<bool> inside_volume(const Volume& volume, const std::vector<glm::vec3>& points) {
+  const glm::mat4 world_to_index = glm::inverse(volume.index_to_world());
+  std::vector<bool> inside;
+  for (const glm::vec3& p : points) {
+    const glm::vec3 i = glm::vec3(world_to_index * glm::vec4(p, 1.0f));
+    inside.push_back(glm::all(glm::greaterThanEqual(i, glm::vec3(-0.5f))) &&
+                     glm::all(glm::lessThanEqual(i, glm::vec3(volume.dims) - 0.5f)));
+  }
+  return inside;
+}
+
 std::vector<bool> anchors_cut_away(const Scene& scene, const std::vector<glm::vec3>& anchors) {
   std::vector<bool> cut(anchors.size(), false), kept(anchors.size(), false);
   for (const Volume& v : scene.volumes) {
-    const glm::mat4 world_to_index = glm::inverse(v.index_to_world());
-    for (size_t a = 0; a < anchors.size(); ++a) {
-      const glm::vec3 i = glm::vec3(world_to_index * glm::vec4(anchors[a], 1.0f));
-      if (glm::all(glm::greaterThanEqual(i, glm::vec3(-0.5f))) &&
-          glm::all(glm::lessThanEqual(i, glm::vec3(v.dims) - 0.5f)))
-        (cut_away(v, anchors[a]) ? cut : kept)[a] = true;
-    }
+    const std::vector<bool> inside = inside_volume(v, anchors);
+    for (size_t a = 0; a < anchors.size(); ++a)
+      if (inside[a]) (cut_away(v, anchors[a]) ? cut : kept)[a] = true;
   }
   for (size_t a = 0; a < anchors.size(); ++a) cut[a] = cut[a] && !kept[a];
   return cut;

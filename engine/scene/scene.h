@@ -179,6 +179,9 @@ struct Scene {
 // The scene's camera, or its named position `name` (an Error listing the names if there is none).
 Camera camera_for(const Scene& scene, const std::string& name);
 
+// For each point (world), whether it lies in the volume's box (its voxels', in its own index
+// space: oblique volumes too).
+std::vector<bool> inside_volume(const Volume& volume, const std::vector<glm::vec3>& points);
 // For each anchor, whether the volumes around it all cut it away: some volume's box (its voxel
 // centres') holds it and cuts it, none that holds it keeps it.
 std::vector<bool> anchors_cut_away(const Scene& scene, const std::vector<glm::vec3>& anchors);
