@@ -8,6 +8,7 @@
 
 #include "app/commands.h"
 #include "engine/core/error.h"
+#include "engine/core/files_read.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/volume_loader.h"
 #include "engine/scene/transfer_function_presets.h"
@@ -85,6 +86,10 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
     }
     throw;
   }
+  // DICOM series and meshes are read in a child process (isolated_read.h), which records
+  // nothing here: their files and folders count as read all the same.
+  for (const Volume& v : scene.volumes) record_file_read(v.source);
+  for (const Mesh& m : scene.meshes) record_file_read(m.source);
   if (!scene.labels.empty()) {  // (characters no font draws: the size does not matter)
     for (std::string& w : missing_glyph_warnings(Font(16.0f), scene.labels))
       scene.warnings.push_back(std::move(w));

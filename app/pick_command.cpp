@@ -44,6 +44,10 @@ glm::vec2 parse_pixel(const std::string& text, graph::Extent size) {
 
 void pick(DeviceOptions& device, const PickOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
+  // (one frame picks at most PICK_MAX pixels: its buffers are sized for them)
+  if (o.at.size() > PICK_MAX)
+    throw UsageError("--at: " + std::to_string(o.at.size()) + " pixels, at most " +
+                     std::to_string(PICK_MAX) + " in one run (pick the rest in another run)");
   std::vector<glm::vec2> pixels;
   for (const std::string& text : o.at) pixels.push_back(parse_pixel(text, size));
   Context ctx(device.context());
@@ -86,7 +90,9 @@ void add_pick_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--size", o->size, "the picture's size, N or WxH")->capture_default_str();
   cmd->add_option("--camera", o->camera, "named camera position of the scene (default: its own)");
   cmd->add_option("--at", o->at,
-                  "X,Y: a pixel's column and row from the top-left corner; repeat for more")
+                  "X,Y: a pixel's column and row from the top-left corner; repeat for more, "
+                  "up to " +
+                      std::to_string(PICK_MAX))
       ->required()
       ->allow_extra_args(false);  // one pixel an --at: the next word is not a second pixel
   cmd->add_option("--runs", o->runs, "frames to render and pick (for the GPU time's median)")

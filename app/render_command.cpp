@@ -2,6 +2,7 @@
 #include <filesystem>
 
 #include "app/commands.h"
+#include "app/output_files.h"
 #include "app/progress.h"
 #include "engine/core/image.h"
 #include "engine/core/text_file.h"
@@ -40,10 +41,14 @@ void print_graph(const RenderOptions& o, graph::GraphRunner& runner) {
   if (o.dump_graph) std::fputs(graph::describe(runner.graph(), runner.compiled()).c_str(), stdout);
 }
 
+// --dump-layers: layer l's file in the folder.
+std::filesystem::path layer_file(const std::string& folder, uint32_t l) {
+  return std::filesystem::path(folder) / ("layer-" + std::to_string(l) + ".png");
+}
+
 // Layer images (premultiplied) written as straight-alpha PNGs.
 void dump_layers(const std::vector<glm::vec4>& layers, graph::Extent size, uint32_t count,
                  const std::string& folder) {
-  std::filesystem::create_directories(folder);
   const size_t pixels = size_t{size.width} * size.height;
   for (uint32_t l = 0; l < count; ++l) {
     std::vector<uint8_t> rgba(pixels * 4);
@@ -54,7 +59,7 @@ void dump_layers(const std::vector<glm::vec4>& layers, graph::Extent size, uint3
         rgba[p * 4 + ch] = uint8_t(std::clamp(straight[ch], 0.0f, 1.0f) * 255.0f + 0.5f);
       rgba[p * 4 + 3] = uint8_t(std::clamp(c.a, 0.0f, 1.0f) * 255.0f + 0.5f);
     }
-    const std::string path = folder + "/layer-" + std::to_string(l) + ".png";
+    const std::string path = layer_file(folder, l).string();
     write_png(path, size.width, size.height, rgba);
     std::printf("wrote %s\n", path.c_str());
   }
@@ -157,9 +162,19 @@ void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions
   }
 }
 
-// Every output file's format is known before anything renders.
-void check_outputs(const std::vector<Still>& all) {
-  for (const Still& still : all) check_image_extension(still.image);
+// Every output file is known, writable and none of the inputs before anything renders (the
+// layers' folders are made here).
+void check_outputs(const std::vector<Still>& all, uint32_t layer_count) {
+  for (const Still& still : all) {
+    check_image_extension(still.image);
+    check_output_file("-o", still.image);
+    if (!still.layout.empty()) check_output_file("--layout", still.layout);
+    if (still.layers.empty()) continue;
+    check_output_folder("--dump-layers", still.layers);
+    create_output_folder("--dump-layers", still.layers);
+    for (uint32_t l = 0; l < layer_count; ++l)
+      check_output_file("--dump-layers", layer_file(still.layers, l));
+  }
 }
 
 // What a render of a scene opens before anything renders: the device, the scene, and its stills
@@ -175,7 +190,7 @@ struct SceneRender {
     check_image_size(ctx, size, "--size");
     scene = load_scene_reporting(o.scene, ctx);
     stills = app::stills(scene, o);
-    check_outputs(stills);
+    check_outputs(stills, o.scene.layer_count(scene));
   }
 };
 
@@ -223,6 +238,7 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
 void render_test_pattern(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   check_image_extension(o.output);
+  check_output_file("-o", o.output);
   Context ctx(device.context());
   check_image_size(ctx, size, "--size");
   TestPattern pattern(ctx);

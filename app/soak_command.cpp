@@ -22,6 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/output_files.h"
 #include "app/progress.h"
 #include "app/viewer.h"
 #include "engine/core/text_file.h"
@@ -247,6 +248,7 @@ void soak(DeviceOptions& device, const SoakOptions& o) {
   const std::string scene_file = find_data_file(o.scene);
   const graph::Extent size = parse_size(o.size, "--size");
   Scene scene = load_scene_reporting(scene_file);
+  if (!o.json.empty()) check_output_file("--json", o.json);
   Context ctx(device.context());
   check_image_size(ctx, {size.width * 5 / 4, size.height}, "--size");
   LabellingSettings settings;

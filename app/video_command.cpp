@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "app/commands.h"
+#include "app/output_files.h"
 #include "app/progress.h"
 #include "engine/core/frame_writer.h"
 #include "engine/core/text_file.h"
@@ -70,14 +71,6 @@ bool is_mp4(const std::filesystem::path& output) {
   throw UsageError("-o: '" + output.string() + "': cannot write a video as '" +
                    output.extension().string() +
                    "' (expected NAME.mp4, or a folder without an extension for PNG frames)");
-}
-
-// Folders are made before the video is opened, so one that cannot be made leaves no MP4.
-void create_folder(const std::string& option, const std::filesystem::path& folder) {
-  std::error_code error;
-  std::filesystem::create_directories(folder, error);
-  if (error)
-    throw Error(option + ": " + folder.string() + ": cannot create the folder: " + error.message());
 }
 
 // A frame's layout: written into `folder` (empty: not written), and kept for the report (read
@@ -158,6 +151,37 @@ void print_written(const VideoOptions& o, graph::Extent size, size_t frames, dou
               size.width, size.height, o.fps, o.output.c_str(), seconds, rate < 10.0 ? 2 : 1, rate);
 }
 
+// The folders of numbered files the video writes: PNG frames (-o FOLDER) and layouts.
+std::vector<FrameFolder> frame_folders(const VideoOptions& o, bool mp4) {
+  std::vector<FrameFolder> folders;
+  if (!mp4) folders.push_back({"-o", o.output, "png"});
+  if (!o.layout_dir.empty()) folders.push_back({"--layout-dir", o.layout_dir, "json"});
+  if (!o.still_layouts.empty()) folders.push_back({"--still-layouts", o.still_layouts, "json"});
+  return folders;
+}
+
+// Every output is checked before anything renders; then the folders are made and cleared of an
+// earlier run's frames before the video is opened, so a folder that cannot be made leaves no MP4.
+void prepare_outputs(const VideoOptions& o, bool mp4, size_t frames) {
+  const std::vector<FrameFolder> folders = frame_folders(o, mp4);
+  if (mp4) check_output_file("-o", o.output);
+  for (const FrameFolder& f : folders) f.check(frames);
+  // (the frames' layouts and the stills' have the same names)
+  const auto same = [](const std::filesystem::path& a, const std::filesystem::path& b) {
+    std::error_code error;
+    return std::filesystem::weakly_canonical(a, error) ==
+           std::filesystem::weakly_canonical(b, error);
+  };
+  if (!o.layout_dir.empty() && !o.still_layouts.empty() && same(o.layout_dir, o.still_layouts))
+    throw UsageError("--still-layouts: " + o.still_layouts +
+                     " is --layout-dir's folder too: the stills' layouts would replace the "
+                     "frames'; give another folder");
+  for (const FrameFolder& f : folders) {
+    create_output_folder(f.option, f.folder);
+    f.remove_earlier_frames();
+  }
+}
+
 void video(DeviceOptions& device, const VideoOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const std::filesystem::path output = o.output;
@@ -165,9 +189,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   Context ctx(device.context());
   const Scene scene = load_scene_reporting(o.scene, ctx);
   const std::vector<Camera> cameras = sampled_cameras(camera_path(scene, o), o.fps);
-  if (!mp4) create_folder("-o", output);
-  if (!o.layout_dir.empty()) create_folder("--layout-dir", o.layout_dir);
-  if (!o.still_layouts.empty()) create_folder("--still-layouts", o.still_layouts);
+  prepare_outputs(o, mp4, cameras.size());
   // Frames are compressed on worker threads while the next one renders; an MP4 goes to a
   // temporary file, put in place by finish(): an error on the way leaves no MP4.
   FrameWriter writer(output, writer_settings(ctx, mp4, size, o));

@@ -13,6 +13,7 @@
 #include <backends/imgui_impl_glfw.h>
 
 #include "app/commands.h"
+#include "app/output_files.h"
 #include "app/viewer.h"
 #include "app/viewer_script.h"
 #include "engine/core/text_file.h"
@@ -102,6 +103,10 @@ class Script {
       : path_(std::move(path)), lines_(std::move(lines)), settle_limit_(settle_limit) {}
 
   bool done() const { return next_ >= lines_.size(); }
+  // The files the script writes, as outputs (app/output_files.h), once the scene is read.
+  void check_outputs(const std::string& labels) const {
+    check_script_outputs(path_, lines_, labels);
+  }
   // Frames the last command asked for that are still due.
   uint32_t frames_due() const { return frames_; }
   void frame_drawn() {
@@ -387,6 +392,7 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   context.presentation = true;
   Context ctx(context);
   Scene scene = load_scene_reporting(o.scene, ctx);  // volumes checked against the device
+  if (script) script->check_outputs(o.scene.labels);
   const Camera camera = option_camera(scene, o.camera);
   const std::string title = "strata - " + std::filesystem::path(o.scene.file).filename().string();
   Window window(size, o.size, title);

@@ -52,6 +52,22 @@ TEST_SUITE("cpu") {
     CHECK(test::folder_bytes(threaded) == files);
   }
 
+  // What a video removes as an earlier run's frames: frame_file_name's names, nothing else.
+  TEST_CASE("earlier_frames_are_the_files_named_as_frames_and_no_others") {
+    const auto folder = test::fresh_folder("frame_writer", "earlier");
+    for (const char* name : {"frame-00000.png", "frame-00017.png", "frame-123456.png",
+                             "frame-00001.json", "frame-1.png", "frame-000001.png",
+                             "frame-0000a.png", "frame-00002.png.txt", "xframe-00003.png"})
+      test::write_file(folder / name, "");
+    std::filesystem::create_directory(folder / "frame-00004.png");
+    CHECK(frame_files_in(folder, "png") ==
+          std::vector<std::filesystem::path>{folder / "frame-00000.png", folder / "frame-00017.png",
+                                             folder / "frame-123456.png"});
+    CHECK(frame_files_in(folder, "json") ==
+          std::vector<std::filesystem::path>{folder / "frame-00001.json"});
+    CHECK(frame_files_in(folder / "missing", "png").empty());
+  }
+
   TEST_CASE("a_frame_writer_error_names_the_first_bad_frame_in_frame_order") {
     const auto folder = test::fresh_folder("frame_writer", "bad");
     for (unsigned threads : {1u, 3u}) {

@@ -179,6 +179,17 @@ TEST_SUITE("cli") {
       check_usage_error(bad);
     }
   }
+
+  // One frame picks at most 256 pixels: more --at is a usage error naming the limit, found before
+  // the scene is read, and --help says so.
+  TEST_CASE("pick_with_more_pixels_than_a_frame_picks_is_a_usage_error_naming_the_limit") {
+    std::string at;
+    for (int i = 0; i < 257; ++i) at += " --at 1,1";
+    check_usage_error({"pick /nonexistent/scene.json" + at,
+                       "--at: 257 pixels, at most 256 in one run (pick the rest in another run)"});
+    const auto help = run_strata("pick --help");
+    CHECK(help.output.find("up to 256") != std::string::npos);
+  }
 }
 
 }  // namespace strata

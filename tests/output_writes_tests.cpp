@@ -1,13 +1,21 @@
 // Writes that cannot lose data, end to end: a write that fails (a file-size limit standing in for
 // a full disk, a folder that cannot be made) leaves the old file or nothing; an output extension
-// strata cannot write is a usage error before any work; the viewer's "save position" writes only
-// the scene it opened, or a new file, and every scene it writes loads.
+// strata cannot write is a usage error before any work; no output replaces a file the command
+// read; every output is checked before anything renders; a folder of frames holds one run; the
+// viewer's "save position" writes only the scene it opened, or a new file, and every scene it
+// writes loads.
 #include <doctest/doctest.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
+#include "engine/core/files_read.h"
+#include "engine/core/frame_writer.h"
+#include "engine/core/png.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/volume_loader.h"
 #include "gpu_fixture.h"
@@ -24,7 +32,67 @@ using test::run_strata;
 // ignored, so a write past it fails with EFBIG as on a full disk.
 const std::string kSmallFiles = "trap '' XFSZ; ulimit -f 1;";
 
+// A small scene of its own files in `dir`: scene.json with the volume scan.mha, its transfer
+// function tf.json and a label whose picture is `picture`; labels.csv beside it for --labels.
+struct SceneFiles {
+  fs::path scene, volume, transfer_function, picture, labels;
+};
+
+SceneFiles write_scene(const fs::path& dir, const std::string& picture = "pic.png") {
+  SceneFiles files{dir / "scene.json", dir / "scan.mha", dir / "tf.json", dir / picture,
+                   dir / "labels.csv"};
+  Volume volume;
+  volume.dims = {16, 16, 16};
+  volume.voxels.resize(volume.voxel_count());
+  for (size_t i = 0; i < volume.voxels.size(); ++i) volume.voxels[i] = std::byte(i * 37 % 256);
+  write_metaimage(files.volume, volume, false);
+  test::write_file(files.transfer_function,
+                   R"({"strata_transfer_function": 1, "stops": [
+                      {"position": 0, "color": [1, 1, 1, 0]},
+                      {"position": 1, "color": [1, 0.8, 0.6, 0.5]}]})");
+  fs::create_directories(files.picture.parent_path());
+  write_png(files.picture.string(), 4, 2, std::vector<uint8_t>(4 * 2 * 4, 200));
+  test::write_file(files.labels, "label,r,a,s\nB,-8,-8,8\n");
+  test::write_file(files.scene, R"({"strata_scene": 1,
+    "volumes": [{"file": "scan.mha", "transfer_function": "tf.json"}],
+    "labels": [{"id": 1, "text": "A", "anchor": [8, 8, 8], "image": ")" +
+                                    picture + R"(", "image_height": 8}]})");
+  return files;
+}
+
+// strata run so that it cannot write into a folder of mode 0555: as itself, or where it is root
+// (who writes anywhere), as the user nobody.
+std::string unprivileged() {
+  return ::geteuid() == 0 ? "setpriv --reuid=65534 --regid=65534 --clear-groups" : "";
+}
+
 }  // namespace
+
+TEST_SUITE("cpu") {
+  TEST_CASE("an_input_is_known_by_its_identity_whatever_the_spelling_or_link") {
+    const fs::path dir = test::fresh_folder("output_writes", "files_read");
+    const fs::path input = test::write_file(dir / "input.json", "{}");
+    const fs::path other = test::write_file(dir / "other.json", "{}");
+    fs::create_directories(dir / "sub");
+    fs::create_symlink(input, dir / "link.json");
+    fs::create_hard_link(input, dir / "hard.json");
+    const fs::path series = dir / "series";
+    const fs::path slice = test::write_file(series / "deeper/IM0001", "DICM");
+    record_file_read(input);
+    record_file_read(series);
+    for (const fs::path& same : {input, dir / "sub/../input.json", dir / "./input.json",
+                                 dir / "link.json", dir / "hard.json"}) {
+      CAPTURE(same);
+      CHECK(input_replaced_by(same) == input);
+    }
+    CHECK(input_replaced_by(other) == std::nullopt);
+    CHECK(input_replaced_by(dir / "new.json") == std::nullopt);
+    // A file of a folder read whole is that folder's; a new file there, or the folder, is not.
+    CHECK(input_replaced_by(slice) == series);
+    CHECK(input_replaced_by(series / "new.png") == std::nullopt);
+    CHECK(input_replaced_by(series) == std::nullopt);
+  }
+}
 
 TEST_SUITE("cli") {
   TEST_CASE("render_that_cannot_write_its_png_leaves_the_old_file_and_no_other") {
@@ -56,7 +124,158 @@ TEST_SUITE("cli") {
     CHECK(fs::is_empty(dir));
   }
 
+  // Each output over one of the files the command read (the scene, its volume, transfer
+  // function and label picture, a --labels file), however it is spelled, is refused before
+  // anything renders, naming the option and the input; nothing in the folder changes.
+  TEST_CASE("no_output_replaces_a_file_the_command_read") {
+    const fs::path dir = test::fresh_folder("output_writes", "over_inputs");
+    const SceneFiles in = write_scene(dir, "frames/frame-00002.png");
+    fs::create_directories(dir / "sub");
+    fs::create_symlink(in.scene, dir / "link.json");
+    fs::create_hard_link(in.scene, dir / "hard.json");
+    const std::string scene = in.scene.string(), out = (dir / "out.png").string();
+    const std::string render = "render --size 32 " + scene + " -o ";
+    const std::string video = "video " + scene + " --orbit 12 --seconds 0.1 --size 32 -o ";
+    struct Case {
+      std::string args, option;
+      fs::path output, input;
+    };
+    const std::vector<Case> cases = {
+        {render + out + " --layout " + scene, "--layout", in.scene, in.scene},
+        {render + out + " --layout " + (dir / "sub/../scene.json").string(), "--layout",
+         dir / "sub/../scene.json", in.scene},
+        {render + out + " --layout " + (dir / "link.json").string(), "--layout", dir / "link.json",
+         in.scene},
+        {render + out + " --layout " + (dir / "hard.json").string(), "--layout", dir / "hard.json",
+         in.scene},
+        {render + out + " --labels " + in.labels.string() + " --layout " + in.labels.string(),
+         "--layout", in.labels, in.labels},
+        {render + in.picture.string(), "-o", in.picture, in.picture},
+        {render + in.picture.string() + " --no-labels", "-o", in.picture, in.picture},
+        {render + out + " --layout " + in.transfer_function.string(), "--layout",
+         in.transfer_function, in.transfer_function},
+        {render + out + " --layout " + in.volume.string(), "--layout", in.volume, in.volume},
+        {video + (dir / "frames").string(), "-o", in.picture, in.picture},
+        {"bench soak " + scene + " --frames 1 --json " + scene, "--json", in.scene, in.scene},
+    };
+    const auto before = test::folder_bytes(dir);
+    for (const Case& c : cases) {
+      CAPTURE(c.args);
+      const auto r = run_strata(c.args);
+      CAPTURE(r.output);
+      CHECK(r.exit_code == 2);
+      CHECK(r.output.find("strata: error: " + c.option + ": " + c.output.string() +
+                          " would replace the input " + c.input.string() + "; give another file") !=
+            std::string::npos);
+      CHECK(r.output.find("wrote") == std::string::npos);
+      CHECK(test::folder_bytes(dir) == before);
+    }
+    // (the same commands write outputs of their own)
+    CHECK(run_strata(render + out + " --layout " + (dir / "layout.json").string()).exit_code == 0);
+  }
+
+  // A --layout or --dump-layers that cannot be written is found before anything renders: the
+  // error names the option, the folder and why, and no picture is written.
+  TEST_CASE("every_output_is_checked_writable_before_anything_renders") {
+    const fs::path dir = test::fresh_folder("output_writes", "unwritable");
+    const SceneFiles in = write_scene(dir);
+    fs::create_directories(dir / "read-only");
+    fs::permissions(dir / "read-only", fs::perms(0555));
+    fs::create_directories(dir / "open");  // (-o's folder, writable by anyone)
+    fs::permissions(dir / "open", fs::perms::all);
+    const std::string png = (dir / "open/out.png").string();
+    const std::string render = "render --size 32 " + in.scene.string() + " -o " + png;
+    struct Case {
+      std::string args, message, as;
+    };
+    const std::vector<Case> cases = {
+        {render + " --layout " + (dir / "missing/l.json").string(),
+         "--layout: " + (dir / "missing/l.json").string() + ": the folder " +
+             (dir / "missing").string() + " does not exist"},
+        {render + " --layout " + dir.string(), "--layout: " + dir.string() + ": is a folder"},
+        {render + " --dump-layers " + (in.scene / "layers").string(),
+         "--dump-layers: " + (in.scene / "layers").string() +
+             ": cannot create the folder: " + in.scene.string() + " is not a folder"},
+        {render + " --dump-layers " + (dir / "read-only/layers").string(),
+         "--dump-layers: " + (dir / "read-only/layers").string() +
+             ": cannot create the folder: cannot write into the folder " +
+             (dir / "read-only").string() + ": Permission denied",
+         unprivileged()},
+        {render + " --layout " + (dir / "read-only/l.json").string(),
+         "--layout: " + (dir / "read-only/l.json").string() + ": cannot write into the folder " +
+             (dir / "read-only").string() + ": Permission denied",
+         unprivileged()},
+    };
+    for (const Case& c : cases) {
+      CAPTURE(c.args);
+      const auto r = run_strata(c.args, c.as);
+      CAPTURE(r.output);
+      CHECK(r.exit_code == 1);
+      CHECK(r.output.find("strata: error: " + c.message) != std::string::npos);
+      CHECK(!fs::exists(png));
+    }
+  }
+
+  // A second run into the folders of a first, with fewer frames, leaves only its own frames and
+  // layouts (the first run's are removed, and said so); files of other names stay.
+  TEST_CASE("frames_into_a_folder_of_an_earlier_run_leave_only_this_runs_frames") {
+    const fs::path dir = test::fresh_folder("output_writes", "earlier_frames");
+    const SceneFiles in = write_scene(dir);
+    const fs::path frames = dir / "frames", layouts = dir / "layouts";
+    const std::string video = "video " + in.scene.string() + " --size 32 --fps 30 --orbit 12 -o " +
+                              frames.string() + " --layout-dir " + layouts.string();
+    REQUIRE(run_strata(video + " --seconds 0.3").exit_code == 0);
+    CHECK(test::folder_bytes(frames).size() == 10);
+    const std::vector<std::string> others = {"frame-1.png", "frame-000001.png", "notes.txt",
+                                             "frame-00001.png.txt"};
+    for (const std::string& name : others) test::write_file(frames / name, "not a frame");
+    const auto r = run_strata(video + " --seconds 0.1");
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    CHECK(r.output.find("strata: " + frames.string() +
+                        ": removed 10 png files of an earlier run (frame-00000.png to "
+                        "frame-00009.png)") != std::string::npos);
+    CHECK(r.output.find("strata: " + layouts.string() + ": removed 10 json files") !=
+          std::string::npos);
+    std::vector<std::string> expected = others;
+    for (size_t f = 0; f < 4; ++f) expected.push_back(frame_file_name(f, "png"));
+    std::vector<std::string> found;
+    for (const auto& [name, bytes] : test::folder_bytes(frames)) found.push_back(name);
+    std::sort(expected.begin(), expected.end());
+    CHECK(found == expected);
+    CHECK(test::folder_bytes(layouts).size() == 4);
+    // The stills' layouts would replace the frames' of the same names.
+    const auto same =
+        run_strata(video + " --seconds 0.1 --still-layouts " + layouts.string() + "/.");
+    CHECK(same.exit_code == 2);
+    CHECK(same.output.find("--still-layouts: " + layouts.string() +
+                           "/. is --layout-dir's folder too") != std::string::npos);
+  }
+
 #if STRATA_VIDEO
+  // An MP4 on a full disk (a file-size limit) fails at the first frame that does not fit, before
+  // the rest are rendered; FFmpeg's buffering had it fail only at the index, after all of them.
+  TEST_CASE("video_on_a_full_disk_fails_at_the_first_frame_that_does_not_fit") {
+    const fs::path dir = test::fresh_folder("output_writes", "full_disk");
+    const SceneFiles in = write_scene(dir);
+    const fs::path mp4 = dir / "out.mp4";
+    const auto r = run_strata("video " + in.scene.string() +
+                                  " --size 64 --fps 30 --orbit 180 --seconds 3 -o " + mp4.string(),
+                              "trap '' XFSZ; ulimit -f 4;");
+    INFO(r.output);
+    CHECK(r.exit_code == 1);
+    CHECK(r.output.find(mp4.string() + ": writing a frame: File too large") != std::string::npos);
+    CHECK(!fs::exists(mp4));
+    // A disk with no room at all (/dev/full) fails at the header, before the first frame.
+    fs::create_symlink("/dev/full", dir / "full.mp4");
+    const auto full =
+        run_strata("video " + in.scene.string() + " --size 32 --orbit 12 --seconds 0.1 -o " +
+                   (dir / "full.mp4").string());
+    CHECK(full.exit_code == 1);
+    CHECK(full.output.find("full.mp4: writing the header: No space left on device") !=
+          std::string::npos);
+  }
+
   TEST_CASE("video_that_cannot_write_its_mp4_or_make_its_layout_folder_leaves_no_mp4") {
     const fs::path dir = test::fresh_folder("output_writes", "video");
     const std::string video = "video " STRATA_SOURCE_DIR
@@ -115,6 +334,42 @@ void check_only_saved(const fs::path& folder, const std::map<std::string, std::s
 }  // namespace
 
 TEST_SUITE("window") {
+  // A script's outputs over the scene's files, or over the script itself, are refused before the
+  // window opens, naming the script's line; `save` to the label file the viewer opened is its
+  // purpose and passes.
+  TEST_CASE("viewer_script_outputs_over_inputs_are_refused_before_the_window_opens") {
+    const fs::path dir = test::fresh_folder("output_writes", "viewer_inputs");
+    const SceneFiles in = write_scene(dir);
+    const fs::path script = dir / "s.txt";
+    struct Case {
+      std::string lines, refused;
+    };
+    const std::vector<Case> cases = {
+        {"report " + in.scene.string() + "\n",
+         ":1: report: " + in.scene.string() + " would replace the input " + in.scene.string()},
+        {"screenshot " + script.string() + "\n",
+         ":1: screenshot: " + script.string() + " would replace the input " + script.string()},
+        {"layout " + in.transfer_function.string() + "\n", ":1: layout: "},
+        {"capture " + in.picture.string() + "\n", ":1: capture: "},
+        {"record start " + in.volume.string() + "\n", ":1: record start: "},
+        {"save " + in.labels.string() + "\nsave " + in.scene.string() + "\n",
+         ":2: save: " + in.scene.string() + " would replace the input"},
+    };
+    const auto before = test::folder_bytes(dir);
+    for (const Case& c : cases) {
+      test::write_file(script, c.lines + "quit\n");
+      const auto r = run_strata("view " + in.scene.string() + " --labels " + in.labels.string() +
+                                " --size 64 --no-panel --script " + script.string());
+      CAPTURE(c.lines);
+      CAPTURE(r.output);
+      CHECK(r.exit_code == 2);
+      CHECK(r.output.find("strata: error: " + script.string() + c.refused) != std::string::npos);
+      CHECK(r.output.find("view: ") == std::string::npos);  // (no frame drawn)
+      fs::remove(script);
+      CHECK(test::folder_bytes(dir) == before);
+    }
+  }
+
   TEST_CASE("viewer_save_position_writes_only_its_scene_or_a_new_file_and_all_load") {
     const fs::path root = test::fresh_folder("output_writes", "viewer");
     const fs::path scripts = test::fresh_folder("output_writes", "viewer_scripts");

@@ -14,6 +14,29 @@ std::string frame_file_name(size_t frame, const char* extension) {
   return name;
 }
 
+std::vector<std::filesystem::path> frame_files_in(const std::filesystem::path& folder,
+                                                  const char* extension) {
+  const std::string suffix = std::string(".") + extension;
+  const auto is_frame = [&](const std::string& name) {
+    if (!name.starts_with("frame-") || !name.ends_with(suffix)) return false;
+    const std::string digits = name.substr(6, name.size() - 6 - suffix.size());
+    // (%05zu: five digits, or more without a leading zero)
+    const bool width = digits.size() == 5 || (digits.size() > 5 && digits[0] != '0');
+    return width &&
+           std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  std::vector<std::filesystem::path> found;
+  std::error_code error;
+  for (std::filesystem::directory_iterator it(folder, error), end; !error && it != end;
+       it.increment(error)) {
+    std::error_code kind;
+    if (is_frame(it->path().filename().string()) && !it->is_directory(kind))
+      found.push_back(it->path());
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
 unsigned default_frame_threads() {
   return std::max(1u, std::thread::hardware_concurrency());
 }

@@ -17,6 +17,10 @@ namespace strata {
 
 // "frame-00012.png": frame 12's file in a folder of frames (layouts use the same names).
 std::string frame_file_name(size_t frame, const char* extension);
+// The files in `folder` named as frame_file_name names them, sorted: an earlier run's frames.
+// Nothing for a folder that does not exist.
+std::vector<std::filesystem::path> frame_files_in(const std::filesystem::path& folder,
+                                                  const char* extension);
 
 // The thread count of a writer when none is asked for: one per hardware thread, at least one.
 unsigned default_frame_threads();

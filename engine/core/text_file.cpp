@@ -8,6 +8,7 @@
 
 #include "engine/core/atomic_file.h"
 #include "engine/core/error.h"
+#include "engine/core/files_read.h"
 
 namespace strata {
 
@@ -36,6 +37,7 @@ uint64_t check_input_file(const std::filesystem::path& path) {
                 "only files");
   const uint64_t size = fs::file_size(path, ec);
   if (ec) throw Error(path.string() + ": cannot read the file (" + ec.message() + ")");
+  record_file_read(path);  // (no output of the command may replace it: files_read.h)
   return size;
 }
 

@@ -15,7 +15,7 @@ inline constexpr uint64_t kMaxTextFileBytes = uint64_t{64} << 20;
 // The size of a file strata is about to read, after checking that it is one: Error "<file>: no
 // such file", "<file>: is a folder, not a file" or "<file>: is not a regular file (a FIFO, device
 // or socket)". Reading a FIFO or a device could block forever or never end, so every reader
-// checks its inputs here first.
+// checks its inputs here first; each is recorded as read (files_read.h).
 uint64_t check_input_file(const std::filesystem::path& path);
 
 // The file's bytes after check_input_file and a check against max_bytes ("<file>: is N MiB; ...

@@ -112,7 +112,12 @@ VideoFile::VideoFile(const std::string& path, uint32_t width, uint32_t height, d
   c.file = std::make_unique<AtomicFile>(path, "MP4");
   c.check(avio_open(&c.format->pb, c.file->temporary().c_str(), AVIO_FLAG_WRITE),
           "opening the file");
+  // Every packet goes to the file as it comes, so a full disk stops the video at the first frame
+  // that does not fit, not after every frame was rendered (FFmpeg would buffer them).
+  c.format->flush_packets = 1;
   c.check(avformat_write_header(c.format, nullptr), "writing the header");
+  avio_flush(c.format->pb);
+  c.check(c.format->pb->error, "writing the header");
 }
 
 VideoFile::~VideoFile() = default;
