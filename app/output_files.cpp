@@ -2,9 +2,12 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
+#include <utility>
 
 #include "app/commands.h"
 #include "engine/core/error.h"
@@ -100,33 +103,19 @@ void FrameFolder::remove_earlier_frames() const {
 
 void check_script_outputs(const std::string& script, const std::vector<ScriptCommand>& commands,
                           const std::string& labels) {
+  static constexpr std::pair<ScriptOp, const char*> kWriting[] = {
+      {ScriptOp::screenshot, "screenshot"}, {ScriptOp::capture, "capture"},
+      {ScriptOp::layout, "layout"},         {ScriptOp::record_start, "record start"},
+      {ScriptOp::report, "report"},         {ScriptOp::save_labels, "save"}};
   for (const ScriptCommand& c : commands) {
-    const std::string where = script + ":" + std::to_string(c.line) + ": ";
-    switch (c.op) {
-      case ScriptOp::screenshot:
-        if (!c.word.empty()) check_output_file(where + "screenshot", c.word);
-        break;
-      case ScriptOp::capture:
-        check_output_file(where + "capture", c.word);
-        break;
-      case ScriptOp::layout:
-        check_output_file(where + "layout", c.word);
-        break;
-      case ScriptOp::record_start:
-        check_output_file(where + "record start", c.word);
-        break;
-      case ScriptOp::report:
-        check_output_file(where + "report", c.word);
-        break;
-      case ScriptOp::save_labels: {
-        std::error_code error;
-        if (labels.empty() || !fs::equivalent(c.word, labels, error))
-          check_output_file(where + "save", c.word);
-        break;
-      }
-      default:
-        break;
-    }
+    const auto* writing = std::find_if(std::begin(kWriting), std::end(kWriting),
+                                       [&](const auto& w) { return w.first == c.op; });
+    // (a screenshot without a name gets a new one; save may write the label file opened)
+    std::error_code error;
+    if (writing == std::end(kWriting) || c.word.empty() ||
+        (c.op == ScriptOp::save_labels && !labels.empty() && fs::equivalent(c.word, labels, error)))
+      continue;
+    check_output_file(script + ":" + std::to_string(c.line) + ": " + writing->second, c.word);
   }
 }
 

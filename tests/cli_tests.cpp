@@ -561,7 +561,8 @@ TEST_SUITE("cli") {
     CHECK(size.output.find("--size: '0x10' is not a size") != std::string::npos);
     const auto file = run_strata("render --size 8 -o /nonexistent-dir/out.png");
     CHECK(file.exit_code == 1);
-    CHECK(file.output.find("/nonexistent-dir/out.png: cannot write PNG") != std::string::npos);
+    CHECK(file.output.find("-o: /nonexistent-dir/out.png: the folder /nonexistent-dir does not "
+                           "exist") != std::string::npos);
     const auto usage = run_strata("frobnicate");
     CHECK(usage.exit_code == 2);
   }
