@@ -253,15 +253,17 @@ TEST_SUITE("cli") {
   }
 
 #if STRATA_VIDEO
-  // An MP4 on a full disk (a file-size limit) fails at the first frame that does not fit, before
-  // the rest are rendered; FFmpeg's buffering had it fail only at the index, after all of them.
+  // An MP4 on a full disk (a file-size limit of 4 KiB) fails at the first frame that does not
+  // fit, before the rest are rendered, not at the index after all of them (the whole video, about
+  // 20 KiB, would fit FFmpeg's buffer).
   TEST_CASE("video_on_a_full_disk_fails_at_the_first_frame_that_does_not_fit") {
     const fs::path dir = test::fresh_folder("output_writes", "full_disk");
     const SceneFiles in = write_scene(dir);
     const fs::path mp4 = dir / "out.mp4";
-    const auto r = run_strata("video " + in.scene.string() +
-                                  " --size 64 --fps 30 --orbit 180 --seconds 3 -o " + mp4.string(),
-                              "trap '' XFSZ; ulimit -f 4;");
+    const auto r =
+        run_strata("video " + in.scene.string() +
+                       " --size 64 --fps 30 --orbit 180 --seconds 1.5 -o " + mp4.string(),
+                   "trap '' XFSZ; ulimit -f 4;");
     INFO(r.output);
     CHECK(r.exit_code == 1);
     CHECK(r.output.find(mp4.string() + ": writing a frame: File too large") != std::string::npos);
