@@ -60,7 +60,9 @@ void check_output_file(const std::string& option, const fs::path& path) {
   check_writable_folder(option, path.string(), folder_of(path));
 }
 
-void check_output_folder(const std::string& option, const fs::path& folder) {
+void check_output_folder(const std::string& option, const fs::path& folder,
+                         const std::vector<fs::path>& files) {
+  for (const fs::path& file : files) refuse_input(option, file);
   // The folder, or the nearest one above it that exists: the rest is made there.
   fs::path existing = folder.lexically_normal();
   bool made = false;
@@ -81,9 +83,9 @@ void create_output_folder(const std::string& option, const fs::path& folder) {
 }
 
 void FrameFolder::check(size_t count) const {
-  check_output_folder(option, folder);
-  for (size_t f = 0; f < count; ++f) refuse_input(option, folder / frame_file_name(f, extension));
-  for (const fs::path& earlier : frame_files_in(folder, extension)) refuse_input(option, earlier);
+  std::vector<fs::path> files = frame_files_in(folder, extension);
+  for (size_t f = 0; f < count; ++f) files.push_back(folder / frame_file_name(f, extension));
+  check_output_folder(option, folder, files);
 }
 
 void FrameFolder::remove_earlier_frames() const {

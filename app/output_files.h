@@ -19,9 +19,11 @@ namespace strata::app {
 // folder, or its folder does not exist or cannot be written to (saying which and why).
 void check_output_file(const std::string& option, const std::filesystem::path& path);
 
-// A folder `option` names for the files it writes: an Error when it is a file, or cannot be made
-// or written to (the nearest folder that exists is not writable), saying which and why.
-void check_output_folder(const std::string& option, const std::filesystem::path& folder);
+// A folder `option` names and the files to be written (or removed) in it: an Error when it is a
+// file, or cannot be made or written to (the nearest folder that exists is not writable), saying
+// which and why; a UsageError when one of the files is an input, as check_output_file.
+void check_output_folder(const std::string& option, const std::filesystem::path& folder,
+                         const std::vector<std::filesystem::path>& files = {});
 // Makes the folder and those above it; an Error naming the option, the folder and why not.
 void create_output_folder(const std::string& option, const std::filesystem::path& folder);
 

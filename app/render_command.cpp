@@ -162,19 +162,19 @@ void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions
   }
 }
 
-// Every output file is known, writable and none of the inputs before anything renders (the
-// layers' folders are made here).
-void check_outputs(const std::vector<Still>& all, uint32_t layer_count) {
+// Every output file is known, writable and none of the inputs before anything renders; then the
+// layers' folders are made.
+void prepare_outputs(const std::vector<Still>& all, uint32_t layer_count) {
   for (const Still& still : all) {
     check_image_extension(still.image);
     check_output_file("-o", still.image);
     if (!still.layout.empty()) check_output_file("--layout", still.layout);
-    if (still.layers.empty()) continue;
-    check_output_folder("--dump-layers", still.layers);
-    create_output_folder("--dump-layers", still.layers);
-    for (uint32_t l = 0; l < layer_count; ++l)
-      check_output_file("--dump-layers", layer_file(still.layers, l));
+    std::vector<std::filesystem::path> layers;
+    for (uint32_t l = 0; l < layer_count; ++l) layers.push_back(layer_file(still.layers, l));
+    if (!still.layers.empty()) check_output_folder("--dump-layers", still.layers, layers);
   }
+  for (const Still& still : all)
+    if (!still.layers.empty()) create_output_folder("--dump-layers", still.layers);
 }
 
 // What a render of a scene opens before anything renders: the device, the scene, and its stills
@@ -190,7 +190,7 @@ struct SceneRender {
     check_image_size(ctx, size, "--size");
     scene = load_scene_reporting(o.scene, ctx);
     stills = app::stills(scene, o);
-    check_outputs(stills, o.scene.layer_count(scene));
+    prepare_outputs(stills, o.scene.layer_count(scene));
   }
 };
 

@@ -41,6 +41,7 @@ struct SceneFiles {
 SceneFiles write_scene(const fs::path& dir, const std::string& picture = "pic.png") {
   SceneFiles files{dir / "scene.json", dir / "scan.mha", dir / "tf.json", dir / picture,
                    dir / "labels.csv"};
+  fs::create_directories(dir);
   Volume volume;
   volume.dims = {16, 16, 16};
   volume.voxels.resize(volume.voxel_count());
@@ -140,7 +141,7 @@ TEST_SUITE("cli") {
       std::string args, option;
       fs::path output, input;
     };
-    const std::vector<Case> cases = {
+    std::vector<Case> cases = {
         {render + out + " --layout " + scene, "--layout", in.scene, in.scene},
         {render + out + " --layout " + (dir / "sub/../scene.json").string(), "--layout",
          dir / "sub/../scene.json", in.scene},
@@ -158,6 +159,11 @@ TEST_SUITE("cli") {
         {video + (dir / "frames").string(), "-o", in.picture, in.picture},
         {"bench soak " + scene + " --frames 1 --json " + scene, "--json", in.scene, in.scene},
     };
+    // (a second scene whose picture lies where --dump-layers writes a layer)
+    const SceneFiles layers = write_scene(dir / "second", "layers/layer-1.png");
+    cases.push_back({"render --size 32 " + layers.scene.string() + " -o " + out +
+                         " --dump-layers " + (dir / "second/layers").string(),
+                     "--dump-layers", layers.picture, layers.picture});
     const auto before = test::folder_bytes(dir);
     for (const Case& c : cases) {
       CAPTURE(c.args);
