@@ -666,7 +666,9 @@ TEST_SUITE("loaders") {
   TEST_CASE("dicom_bad_series_give_one_error_naming_the_folder_or_file") {
     const fs::path same = copy_ct5n("dicom_same_position", {"2062", "2392"});
     fs::copy_file(ct5n / "2062", same / "2062-copy");
-    CHECK_LOAD_ERROR(same, "2062 and 2062-copy are at the same position");
+    CHECK_LOAD_ERROR(same,
+                     "2062 and 2062-copy are at the same position (8.7625 mm along the normal): "
+                     "the same image twice (one SOPInstanceUID), a copied file; remove one");
 
     const fs::path none = output_folder("dicom_none");
     write_file(none / "notes.txt", "no images here\n");
