@@ -471,9 +471,9 @@ TEST_SUITE("loaders") {
     write_file(folder / ".DS_Store", noise);  // hidden files are left out of the warning
     const Loaded loaded = load(folder);
     CHECK(loaded.volume.dims == glm::uvec3(kColumns, kRows, 4));
-    CHECK(loaded.warnings == std::vector<std::string>{
-                                 folder.string() +
-                                 ": skipped 2 files that are not DICOM images: IM2, README.txt"});
+    CHECK(loaded.warnings ==
+          std::vector<std::string>{folder.string() +
+                                   ": skipped 2 files that are not DICOM images: IM2, README.txt"});
     // Many files: the first eight named on the one line.
     for (int n = 0; n < 20; ++n) write_file(folder / ("notes" + std::to_string(n + 10)), "x\n");
     const Loaded many = load(folder);
@@ -525,12 +525,12 @@ TEST_SUITE("loaders") {
       const char* element = by_acquisition ? "AcquisitionNumber" : "TemporalPositionIdentifier";
       const Loaded first = load(folder);
       check_voxels_at_their_positions(first.volume, positions);
-      CHECK(first.warnings == std::vector<std::string>{
-                                  folder.string() +
-                                  ": the series holds 2 time points (its slices repeat their "
-                                  "positions, " +
-                                  element + " tells them apart); showing time point 0 (" +
-                                  element + " 1; choose with --frame 0 to 1)"});
+      CHECK(first.warnings ==
+            std::vector<std::string>{folder.string() +
+                                     ": the series holds 2 time points (its slices repeat their "
+                                     "positions, " +
+                                     element + " tells them apart); showing time point 0 (" +
+                                     element + " 1; choose with --frame 0 to 1)"});
       const Loaded second = load(folder, {.frame = 1});
       CHECK(second.volume.dims == glm::uvec3(kColumns, kRows, 5));
       CHECK(second.volume.value(1, 0, 4) == 1401.0f);
@@ -549,8 +549,8 @@ TEST_SUITE("loaders") {
     std::vector<DataSet> slices;
     for (int echo : {1, 2})
       for (size_t k = 0; k < positions.size(); ++k)
-        slices.push_back(ct_slice(positions[k], int(k)).set(0x0018, 0x0086, "IS",
-                                                             std::to_string(echo)));
+        slices.push_back(
+            ct_slice(positions[k], int(k)).set(0x0018, 0x0086, "IS", std::to_string(echo)));
     CHECK_ERROR(write_slices("echoes", slices),
                 " are at the same position (30 mm along the normal) and differ in EchoNumbers "
                 "(1, 2): the series holds several volumes; split it into one folder a volume "

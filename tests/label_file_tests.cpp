@@ -344,8 +344,8 @@ TEST_SUITE("loaders") {
     CHECK(error_of([&] { strata::load_scene(three, {.labels = most}); }) ==
           most.string() +
               ": 4094 labels, 4097 with the scene's 3; strata places at most 4096 in a scene");
-    const fs::path referring = write_file(folder / "referring.json",
-                                          "{\"strata_scene\": 1, \"labels\": \"points.csv\"}");
+    const fs::path referring =
+        write_file(folder / "referring.json", "{\"strata_scene\": 1, \"labels\": \"points.csv\"}");
     CHECK(error_of([&] { strata::load_scene(referring); }) ==
           referring.string() + ": labels: " + file.string() +
               ": 5000 labels; strata places at most 4096 in a scene");

@@ -489,8 +489,8 @@ std::vector<fs::path> dicom_subfolders(const fs::path& folder, size_t most) {
   std::string names;
   for (size_t i = 0; i < below.size() && i < 3; ++i)
     names += (i ? ", " : "") + printable(below[i].lexically_relative(folder).string(), 80);
-  const std::string here = concat(
-      "no DICOM files in the folder itself (", files == 0 ? "it holds only subfolders" : what, ")");
+  const std::string here = concat("no DICOM files in the folder itself (",
+                                  files == 0 ? "it holds only subfolders" : what, ")");
   if (below.size() == 1)
     fail(folder, concat(here, "; its subfolder ", names, " holds DICOM files: open ",
                         below[0].string(), " (strata reads one folder's files as a series)"));

@@ -75,8 +75,8 @@ std::optional<TimePoints> split_by_time(const std::vector<Slice>& slices, size_t
 
 std::optional<TimePoints> time_points(const std::vector<Slice>& slices) {
   // Slices without a position are refused as a series later; time cannot order them.
-  if (slices.size() < 2 || !std::all_of(slices.begin(), slices.end(),
-                                        [](const Slice& s) { return s.placed; }))
+  if (slices.size() < 2 ||
+      !std::all_of(slices.begin(), slices.end(), [](const Slice& s) { return s.placed; }))
     return std::nullopt;
   const size_t repeats = most_at_one_position(slices, slice_normal(slices.front()));
   if (repeats < 2) return std::nullopt;
@@ -159,21 +159,21 @@ double check_even(const fs::path& where, const std::vector<Slice>& slices, doubl
     const double step = slices[k + 1].along_normal - slices[k].along_normal;
     smallest = std::min(smallest, step);
     largest = std::max(largest, step);
-    if (uneven == slices.size() && std::fabs(step - mean) > std::max(1e-3, 0.01 * mean))
-      uneven = k;
+    if (uneven == slices.size() && std::fabs(step - mean) > std::max(1e-3, 0.01 * mean)) uneven = k;
   }
   if (uneven == slices.size()) return mean;
   const double bound = std::min(2.0 * glm::dot(half, glm::abs(normal)), 0.1 * mean);
   const Deviation worst = largest_deviation(slices, mean);
-  const std::string rounding = concat("rounding of the positions (printed to ",
-                                      mm(printed_digit(half, normal)), ") explains up to ",
-                                      mm(bound));
+  const std::string rounding =
+      concat("rounding of the positions (printed to ", mm(printed_digit(half, normal)),
+             ") explains up to ", mm(bound));
   if (worst.mm <= bound) {
     warnings.push_back(concat(where.string(), ": ImagePositionPatient: slice steps of ",
-                              mm(smallest), " to ", mm(largest), "; the largest deviation from "
-                              "even spacing is ", mm(worst.mm), " (", name_of(slices[worst.slice]),
-                              "), within what ", rounding, ": read as evenly spaced ", mean,
-                              " mm apart"));
+                              mm(smallest), " to ", mm(largest),
+                              "; the largest deviation from "
+                              "even spacing is ",
+                              mm(worst.mm), " (", name_of(slices[worst.slice]), "), within what ",
+                              rounding, ": read as evenly spaced ", mean, " mm apart"));
     return mean;
   }
   const double step = slices[uneven + 1].along_normal - slices[uneven].along_normal;
@@ -263,8 +263,8 @@ std::vector<Slice> one_time_point(const fs::path& where, std::vector<Slice> slic
   warnings.push_back(concat(where.string(), ": the series holds ", count,
                             " time points (its slices repeat their positions, ", name,
                             " tells them apart); showing time point ", frame, " (", name, " ",
-                            printable(chosen.front().keys[times->key]), "; choose with --frame 0 to ",
-                            count - 1, ")"));
+                            printable(chosen.front().keys[times->key]),
+                            "; choose with --frame 0 to ", count - 1, ")"));
   return std::move(chosen);
 }
 

@@ -298,9 +298,10 @@ bool fcsv_defined(std::string_view field, const FileLine& line) {
   const std::string_view status = trim(field);
   if (status == "2") return true;
   if (status == "0" || status == "1" || status == "3") return false;
-  line.fail("16 fields, expected 14 (or 16 as Slicer 5 writes, with the position status 0, 1, 2 "
-            "or 3 as the 15th, not '" +
-            std::string(status) + "')" + std::string(quote_commas));
+  line.fail(
+      "16 fields, expected 14 (or 16 as Slicer 5 writes, with the position status 0, 1, 2 "
+      "or 3 as the 15th, not '" +
+      std::string(status) + "')" + std::string(quote_commas));
 }
 
 ReadLabels read_fcsv(const fs::path& path, const std::string& text) {
