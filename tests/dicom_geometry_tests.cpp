@@ -537,7 +537,7 @@ TEST_SUITE("loaders") {
       CHECK(second.warnings[0].find("showing time point 1 (" + std::string(element) + " 2;") !=
             std::string::npos);
       CHECK(load_error(folder, {.frame = 2}) ==
-            folder.string() + ": frame 2 is out of range: the image has 2 frames, 0 to 1");
+            folder.string() + ": frame 2 is out of range: the series holds 2 time points, 0 to 1");
       CHECK(strata::list_dicom_series_isolated(folder).at(0).time_points == 2);
     }
     CHECK(load_error(write_series("one_time_point", stack({0.0, 0.0, 0.0})), {.frame = 1})

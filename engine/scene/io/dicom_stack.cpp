@@ -255,11 +255,13 @@ std::vector<Slice> one_time_point(const fs::path& where, std::vector<Slice> slic
     choose_frame(where, 1, options, warnings);
     return slices;
   }
-  std::vector<std::string> frame_warning;  // worded for 4-D files; the one below names the element
   const size_t count = times->points.size();
-  const uint64_t frame = choose_frame(where, count, options, frame_warning);
+  const int64_t frame = options.frame.value_or(0);
+  if (frame < 0 || uint64_t(frame) >= count)
+    fail(where, concat("frame ", frame, " is out of range: the series holds ", count,
+                       " time points, 0 to ", count - 1));
   const char* name = kKeyTags[times->key].name;
-  std::vector<Slice>& chosen = times->points[frame];
+  std::vector<Slice>& chosen = times->points[size_t(frame)];
   warnings.push_back(concat(where.string(), ": the series holds ", count,
                             " time points (its slices repeat their positions, ", name,
                             " tells them apart); showing time point ", frame, " (", name, " ",
