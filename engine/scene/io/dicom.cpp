@@ -309,7 +309,9 @@ void check_one_volume(const fs::path& file, const std::vector<Slice>& frames) {
                         s.frame + 1, " '", s.stack, "'): strata reads one stack of slices"));
     if (s.time != first.time)
       fail(file, concat("holds several time points (frame 1 has TemporalPositionIndex ", first.time,
-                        ", frame ", s.frame + 1, " ", s.time, "): strata reads one 3-D volume"));
+                        ", frame ", s.frame + 1, " ", s.time,
+                        "): strata reads an enhanced file of one time point; dcm2niix converts "
+                        "it to a 4-D NIfTI, whose --frame picks one"));
   }
 }
 
