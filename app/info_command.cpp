@@ -160,6 +160,9 @@ std::string describe_label_file(const LabelFile& file, const Scene* scene) {
   std::string systems;
   for (const std::string& s : file.coordinate_systems) systems += (systems.empty() ? "" : ", ") + s;
   std::string out = format("labels: %zu, written in %s\n", file.labels.size(), systems.c_str());
+  if (const auto problem =
+          label_limit_problem(file.labels.size(), scene ? scene->labels.size() : 0))
+    out += "  too many for a scene: " + *problem + "\n";
   Bounds bounds;
   for (const Label& l : file.labels) bounds.add(l.anchor);
   const glm::vec3 ras_lo(-bounds.hi.x, -bounds.hi.y, bounds.lo.z);

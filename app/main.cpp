@@ -196,7 +196,8 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
   cmd->add_option("--labels", in.labels,
                   "labels from a file: 3D Slicer markups (.mrk.json, .fcsv) or CSV "
                   "(docs/scene-format.md)");
-  cmd->add_option("--frame", in.frame, "a 4-D volume's frame, from 0 (default: the first)")
+  cmd->add_option("--frame", in.frame,
+                  "a 4-D volume's frame or a DICOM series' time point, from 0 (default: the first)")
       ->check(whole_range(0, 1e6));
   cmd->add_option("--window", in.window,
                   "CENTER,WIDTH: every volume shown as a grey ramp over these values (Hounsfield "

@@ -418,6 +418,21 @@ TEST_SUITE("cli") {
     CHECK(usage.exit_code == 2);
   }
 
+  TEST_CASE("info_says_when_a_label_file_passes_the_label_limit_with_the_scene") {
+    const auto folder = test::fresh_folder("cli", "info_label_limit");
+    std::string csv = "text,l,p,s\n";
+    for (int i = 0; i < 4090; ++i) csv += "L," + std::to_string(i % 50) + ",0,0\n";
+    const std::string file = test::write_file(folder / "many.csv", csv);
+    const auto alone = run_strata("info " + file);
+    CHECK(alone.exit_code == 0);
+    CHECK(alone.output.find("too many") == std::string::npos);
+    const auto r =
+        run_strata("info " + file + " --scene " STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    CHECK(r.exit_code == 0);
+    CHECK(r.output.find("  too many for a scene: 4090 labels, 4") != std::string::npos);
+    CHECK(r.output.find("; strata places at most 4096 in a scene\n") != std::string::npos);
+  }
+
   TEST_CASE("info_imports_a_thesis_scene_and_warns_about_its_missing_volume") {
     const auto r = run_strata(std::string("info ") + STRATA_SOURCE_DIR
                               "/tests/data/voly-labeller/scenes/dice.xml");

@@ -1,7 +1,10 @@
 // DICOM that loads right or not at all: sheared stacks keep each slice where its
-// ImagePositionPatient puts it, a damaged slice anywhere in a folder is an error naming it, pixel
-// formats strata cannot show as grey values are refused, and a lone image without a position opens
-// as a 2-D image. Every file is written here (explicit VR little endian, tiny images).
+// ImagePositionPatient puts it, positions rounded in the header still make an evenly spaced stack
+// while a missing slice does not, a damaged slice anywhere in a folder is an error naming it and a
+// skipped file is named in a warning, a series of several time points opens the one --frame
+// chooses, pixel formats strata cannot show as grey values are refused, and a lone image without a
+// position opens as a 2-D image. Every file is written here (explicit VR little endian, tiny
+// images).
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -139,19 +142,27 @@ fs::path write_series(const std::string& name, const std::vector<glm::dvec3>& po
   return folder;
 }
 
+// One file per data set, IM0, IM1, ... in the order given.
+fs::path write_slices(const std::string& name, const std::vector<DataSet>& slices) {
+  const fs::path folder = output_folder(name);
+  for (size_t k = 0; k < slices.size(); ++k)
+    write_file(folder / ("IM" + std::to_string(k)), part10(slices[k]));
+  return folder;
+}
+
 struct Loaded {
   Volume volume;
   std::vector<std::string> warnings;
 };
 
-Loaded load(const fs::path& path) {
+Loaded load(const fs::path& path, const strata::VolumeReadOptions& options = {}) {
   Loaded loaded;
-  loaded.volume = strata::load_volume(path, {}, loaded.warnings);
+  loaded.volume = strata::load_volume(path, options, loaded.warnings);
   return loaded;
 }
 
-std::string load_error(const fs::path& path) {
-  return strata::test::error_of([&] { load(path); });
+std::string load_error(const fs::path& path, const strata::VolumeReadOptions& options = {}) {
+  return strata::test::error_of([&] { load(path, options); });
 }
 
 #define CHECK_ERROR(file, reason)                        \
@@ -394,5 +405,166 @@ TEST_SUITE("loaders") {
     write_file(folder / "sc2.dcm", part10(d));
     CHECK(load_error(folder).find("ImagePositionPatient is missing: a slice of a series") !=
           std::string::npos);
+  }
+
+  // ---- positions rounded in the header
+
+  // As a GE scanner writes an oblique MR series: 20 slices 7 mm apart, rows and columns turned by
+  // 20° about z and 30° about x, positions printed to 0.1 mm, so steps of 6.90 to 7.04 mm.
+  TEST_CASE("dicom_oblique_positions_rounded_to_a_tenth_of_a_millimetre_load_with_a_warning") {
+    const glm::dvec3 row(0.9396926207859084, 0.3420201433256687, 0.0);
+    const glm::dvec3 column(-0.29619813272602386, 0.8137976813493738, 0.5);
+    const glm::dvec3 normal = glm::cross(row, column);
+    const auto series = [&](const std::string& name, std::vector<double> along) {
+      std::vector<DataSet> slices;
+      for (size_t k = 0; k < along.size(); ++k) {
+        const glm::dvec3 p = glm::dvec3(-101.37, 42.81, -18.53) + along[k] * normal;
+        char position[64];
+        std::snprintf(position, sizeof position, "%.1f\\%.1f\\%.1f", p.x, p.y, p.z);
+        slices.push_back(ct_slice({}, int(k))
+                             .set(0x0020, 0x0032, "DS", position)
+                             .set(0x0020, 0x0037, "DS", ds(row) + "\\" + ds(column)));
+      }
+      return write_slices(name, slices);
+    };
+    std::vector<double> along;
+    for (int k = 0; k < 20; ++k) along.push_back(7.0 * k);
+    const fs::path folder = series("rounded", along);
+    const Loaded loaded = load(folder);
+    const Volume& v = loaded.volume;
+    CHECK(v.dims == glm::uvec3(kColumns, kRows, 20));
+    CHECK(v.spacing.z == doctest::Approx(7.0).epsilon(0.001));
+    CHECK(glm::length(glm::dvec3(v.direction[2]) - normal) < 1e-5);  // not sheared
+    CHECK(v.value(0, 0, 19) == 1900.0f);
+    REQUIRE(loaded.warnings.size() == 1);
+    INFO(loaded.warnings[0]);
+    CHECK(loaded.warnings[0].starts_with(folder.string() +
+                                         ": ImagePositionPatient: slice steps of 6.9 mm to 7.04 "
+                                         "mm; the largest deviation from even spacing is 0.0977 "
+                                         "mm (IM"));
+    CHECK(loaded.warnings[0].find("within what rounding of the positions (printed to 0.1 mm) "
+                                  "explains up to 0.151 mm: read as evenly spaced 7.0016") !=
+          std::string::npos);
+
+    // A missing slice, or one 0.4 mm out of place, is more than rounding explains.
+    std::vector<double> gap = along;
+    gap.erase(gap.begin() + 8);
+    CHECK_ERROR(series("rounded_gap", gap), "slice spacing is not uniform: ");
+    std::vector<double> moved = along;
+    moved[10] += 0.4;
+    const fs::path uneven = series("rounded_uneven", moved);
+    CHECK_ERROR(uneven, "IM10 lies 0.");
+    CHECK_ERROR(uneven,
+                "from even spacing, more than rounding of the positions (printed to 0.1 mm) "
+                "explains up to 0.151 mm (a missing slice, or slices at uneven distances)");
+  }
+
+  // ---- files that are not slices
+
+  // Random bytes in place of the last slice: the rest loads, and the warning names the file.
+  TEST_CASE("dicom_folder_names_every_skipped_file_in_one_warning") {
+    const fs::path folder = write_series("skipped", stack({0.0, 0.0, 0.0}));
+    std::string noise;
+    for (int n = 0; n < 600; ++n) noise += char(n * 37 % 251 + 1);
+    write_file(folder / "IM2", noise);  // the last along the normal
+    write_file(folder / "README.txt", "five CT slices\n");
+    write_file(folder / ".DS_Store", noise);  // hidden files are left out of the warning
+    const Loaded loaded = load(folder);
+    CHECK(loaded.volume.dims == glm::uvec3(kColumns, kRows, 4));
+    CHECK(loaded.warnings ==
+          std::vector<std::string>{folder.string() +
+                                   ": skipped 2 files that are not DICOM images: IM2, README.txt"});
+    // Many files: the first eight named on the one line.
+    for (int n = 0; n < 20; ++n) write_file(folder / ("notes" + std::to_string(n + 10)), "x\n");
+    const Loaded many = load(folder);
+    REQUIRE(many.warnings.size() == 1);
+    CHECK(many.warnings[0] == folder.string() +
+                                  ": skipped 22 files that are not DICOM images: IM2, README.txt, "
+                                  "notes10, notes11, notes12, notes13, notes14, notes15 and 14 "
+                                  "more");
+  }
+
+  TEST_CASE("dicom_folder_whose_series_lies_in_subfolders_names_them") {
+    const fs::path folder = output_folder("nested");
+    const std::vector<glm::dvec3> positions = stack({0.0, 0.0, 0.0});
+    for (size_t k = 0; k < positions.size(); ++k)
+      write_file(folder / "DICOM" / "SE1" / ("IM" + std::to_string(k)),
+                 part10(ct_slice(positions[k], int(k))));
+    CHECK(load_error(folder) ==
+          folder.string() +
+              ": no DICOM files in the folder itself (it holds only subfolders); its subfolder "
+              "DICOM/SE1 holds DICOM files: open " +
+              (folder / "DICOM" / "SE1").string() +
+              " (strata reads one folder's files as a series)");
+    CHECK(load(folder / "DICOM" / "SE1").volume.dims.z == 5);
+    fs::copy(folder / "DICOM" / "SE1", folder / "DICOM" / "SE2", fs::copy_options::recursive);
+    write_file(folder / "README.txt", "two series\n");
+    CHECK(load_error(folder) ==
+          folder.string() +
+              ": no DICOM files in the folder itself (none of its 1 files is a DICOM image); its "
+              "subfolders DICOM/SE1, DICOM/SE2 hold DICOM files: open one of them (strata reads "
+              "one folder's files as a series)");
+  }
+
+  // ---- several volumes in one series
+
+  // Two time points of five slices each, told apart by TemporalPositionIdentifier or, without it,
+  // by AcquisitionNumber; time point 1 stores 100 k + n + 1000.
+  TEST_CASE("dicom_series_of_two_time_points_opens_the_one_frame_chooses") {
+    for (const bool by_acquisition : {false, true}) {
+      CAPTURE(by_acquisition);
+      std::vector<DataSet> slices;
+      const std::vector<glm::dvec3> positions = stack({0.0, 0.0, 0.0});
+      for (int t : {1, 0})  // the files of the later time point first
+        for (size_t k = 0; k < positions.size(); ++k) {
+          DataSet d = ct_slice(positions[k], int(k) + 10 * t);
+          d.set(0x0020, by_acquisition ? 0x0012 : 0x0100, "IS", std::to_string(t + 1));
+          slices.push_back(d);
+        }
+      const fs::path folder = write_slices("time_points", slices);
+      const char* element = by_acquisition ? "AcquisitionNumber" : "TemporalPositionIdentifier";
+      const Loaded first = load(folder);
+      check_voxels_at_their_positions(first.volume, positions);
+      CHECK(first.warnings ==
+            std::vector<std::string>{folder.string() +
+                                     ": the series holds 2 time points (its slices repeat their "
+                                     "positions, " +
+                                     element + " tells them apart); showing time point 0 (" +
+                                     element + " 1; choose with --frame 0 to 1)"});
+      const Loaded second = load(folder, {.frame = 1});
+      CHECK(second.volume.dims == glm::uvec3(kColumns, kRows, 5));
+      CHECK(second.volume.value(1, 0, 4) == 1401.0f);
+      CHECK(second.warnings[0].find("showing time point 1 (" + std::string(element) + " 2;") !=
+            std::string::npos);
+      CHECK(load_error(folder, {.frame = 2}) ==
+            folder.string() + ": frame 2 is out of range: the series holds 2 time points, 0 to 1");
+      CHECK(strata::list_dicom_series_isolated(folder).at(0).time_points == 2);
+    }
+    CHECK(load_error(write_series("one_time_point", stack({0.0, 0.0, 0.0})), {.frame = 1})
+              .ends_with(": frame 1 is out of range: the image has one frame, 0"));
+  }
+
+  TEST_CASE("dicom_slices_at_one_position_say_what_tells_them_apart") {
+    const std::vector<glm::dvec3> positions = stack({0.0, 0.0, 0.0}, 3);
+    std::vector<DataSet> slices;
+    for (int echo : {1, 2})
+      for (size_t k = 0; k < positions.size(); ++k)
+        slices.push_back(
+            ct_slice(positions[k], int(k)).set(0x0018, 0x0086, "IS", std::to_string(echo)));
+    CHECK_ERROR(write_slices("echoes", slices),
+                " are at the same position (30 mm along the normal) and differ in EchoNumbers "
+                "(1, 2): the series holds several volumes; split it into one folder a volume "
+                "(dcm2niix does) and open one");
+    // A copy of a slice, and a slice repeated under another SOPInstanceUID.
+    slices.resize(3);
+    slices.push_back(slices[1]);
+    for (size_t k = 0; k < slices.size(); ++k) slices[k].set(0x0008, 0x0018, "UI", "1.2.3");
+    CHECK_ERROR(write_slices("copied", slices),
+                "IM1 and IM3 are at the same position (32.5 mm along the normal): the same image "
+                "twice (one SOPInstanceUID), a copied file; remove one");
+    slices[3].set(0x0008, 0x0018, "UI", "1.2.4");
+    CHECK_ERROR(write_slices("repeated", slices),
+                "IM1 and IM3 are at the same position (32.5 mm along the normal): a repeated "
+                "slice (no TemporalPositionIdentifier");
   }
 }

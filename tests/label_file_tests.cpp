@@ -6,6 +6,7 @@
 
 #include "engine/core/error.h"
 #include "engine/scene/io/label_file_loader.h"
+#include "engine/scene/io/scene_loader.h"
 #include "test_files.h"
 
 namespace {
@@ -185,6 +186,8 @@ TEST_SUITE("loaders") {
           prefix + "line 1: both RAS (r, a) and LPS (l, p) columns: keep one system");
     CHECK(load("text,r,R,a,s\n") == prefix + "line 1: two 'r' columns");
     CHECK(load("text,r,a,s\nA,1,2\n") == prefix + "line 2: 3 fields, the header names 4");
+    CHECK(load("text,r,a,s\nCaudate, left,1,2,3\n") ==
+          prefix + "line 2: 5 fields, the header names 4; a comma inside a text must be quoted");
     CHECK(load("text,r,a,s\nA,1,two,3\n") == prefix + "line 2: column 'a': 'two' is not a number");
     CHECK(load("text,r,a,s\nA,1,2,3mm\n") == prefix + "line 2: column 's': '3mm' is not a number");
     CHECK(load("text,r,a,s\nA,,2,3\n") == prefix + "line 2: column 'r': '' is not a number");
@@ -225,9 +228,20 @@ TEST_SUITE("loaders") {
           prefix + "line 2: CoordinateSystem 'IJK' is not LPS, RAS, 0 (RAS) or 1 (LPS)");
     CHECK(load(lps) == prefix + "no points");
     CHECK(load(lps + "1,1,2,3,0,0,0,1,1,1,0,A,,,2\n") ==
-          prefix + "line 3: 15 fields, expected 14 (or 16, as Slicer 5 writes)");
+          prefix +
+              "line 3: 15 fields, expected 14 (or 16, as Slicer 5 writes); a comma inside a "
+              "label or description must be quoted");
     CHECK(load(lps + "1,1,2,3,0,0,0,1,1,1,0,A,,,7,0\n") ==
-          prefix + "line 3: position status '7' is not 0, 1, 2 or 3");
+          prefix +
+              "line 3: 16 fields, expected 14 (or 16 as Slicer 5 writes, with the position "
+              "status 0, 1, 2 or 3 as the 15th, not '7'); a comma inside a label or description "
+              "must be quoted");
+    // Slicer 4's 14 fields with two unquoted commas in the label look like Slicer 5's 16.
+    CHECK(load(lps + "1,1,2,3,0,0,0,1,1,1,0,Caudate, left, head,,\n") ==
+          prefix +
+              "line 3: 16 fields, expected 14 (or 16 as Slicer 5 writes, with the position "
+              "status 0, 1, 2 or 3 as the 15th, not ''); a comma inside a label or description "
+              "must be quoted");
     CHECK(load(lps + "1,abc,2,3,0,0,0,1,1,1,0,A,,\n") ==
           prefix + "line 3: column 'x': 'abc' is not a number");
     CHECK(load(lps + "1,1,2,inf,0,0,0,1,1,1,0,A,,\n") ==
@@ -310,5 +324,33 @@ TEST_SUITE("loaders") {
     CHECK(load("markups-schema-v1..3.json") != "(no error)");
     CHECK(load("markups-schema-v1.0.3.jsonx") != "(no error)");
     CHECK(load("markups-schema-v11.0.3.json") != "(no error)");
+  }
+
+  // The error names the label file that brings the scene past the limit, not the scene.
+  TEST_CASE("label_file_past_the_label_limit_is_named_in_the_error") {
+    const fs::path folder = test_folder("label_limit");
+    std::string csv = "text,l,p,s\n";
+    for (int i = 0; i < 5000; ++i) csv += "L," + std::to_string(i) + ",0,0\n";
+    const fs::path file = write_file(folder / "points.csv", csv);
+    const fs::path empty = write_file(folder / "empty.json", "{\"strata_scene\": 1}");
+    CHECK(error_of([&] { strata::load_scene(empty, {.labels = file}); }) ==
+          file.string() + ": 5000 labels; strata places at most 4096 in a scene");
+    const fs::path three = write_file(
+        folder / "three.json",
+        "{\"strata_scene\": 1, \"labels\": [{\"id\": 0, \"text\": \"A\", \"anchor\": [0, 0, 0]},"
+        "{\"id\": 1, \"text\": \"B\", \"anchor\": [0, 0, 0]},"
+        "{\"id\": 2, \"text\": \"C\", \"anchor\": [0, 0, 0]}]}");
+    const fs::path most = write_file(folder / "most.csv", csv.substr(0, csv.find("L,4094,")));
+    CHECK(error_of([&] { strata::load_scene(three, {.labels = most}); }) ==
+          most.string() +
+              ": 4094 labels, 4097 with the scene's 3; strata places at most 4096 in a scene");
+    const fs::path referring =
+        write_file(folder / "referring.json", "{\"strata_scene\": 1, \"labels\": \"points.csv\"}");
+    CHECK(error_of([&] { strata::load_scene(referring); }) ==
+          referring.string() + ": labels: " + file.string() +
+              ": 5000 labels; strata places at most 4096 in a scene");
+    CHECK(strata::label_limit_problem(4096, 0) == std::nullopt);
+    CHECK(strata::label_limit_problem(4000, 97) ==
+          "4000 labels, 4097 with the scene's 97; strata places at most 4096 in a scene");
   }
 }

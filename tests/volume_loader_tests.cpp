@@ -666,7 +666,9 @@ TEST_SUITE("loaders") {
   TEST_CASE("dicom_bad_series_give_one_error_naming_the_folder_or_file") {
     const fs::path same = copy_ct5n("dicom_same_position", {"2062", "2392"});
     fs::copy_file(ct5n / "2062", same / "2062-copy");
-    CHECK_LOAD_ERROR(same, "2062 and 2062-copy are at the same position");
+    CHECK_LOAD_ERROR(same,
+                     "2062 and 2062-copy are at the same position (8.7625 mm along the normal): "
+                     "the same image twice (one SOPInstanceUID), a copied file; remove one");
 
     const fs::path none = output_folder("dicom_none");
     write_file(none / "notes.txt", "no images here\n");
@@ -867,6 +869,7 @@ TEST_SUITE("loaders") {
     std::string file;
     std::string slope = "1";
     std::string stack = "1";
+    uint32_t time = 1;             // TemporalPositionIndex
     std::string orientation = "";  // per-frame ImageOrientationPatient instead of the shared one
   };
 
@@ -891,7 +894,10 @@ TEST_SUITE("loaders") {
     std::vector<std::string> per_frame;
     std::string pixels;
     for (const CtFrame& f : ct.frames) {
-      std::string item = macro(0x0020, 0x9111, dicom_element(0x0020, 0x9056, "SH", f.stack));
+      std::string item =
+          macro(0x0020, 0x9111,
+                dicom_element(0x0020, 0x9056, "SH", f.stack) +
+                    dicom_element(0x0020, 0x9128, "UL", element_bytes<uint32_t>({f.time})));
       item += macro(0x0020, 0x9113, dicom_element(0x0020, 0x0032, "DS", ct5n_position(f.file)));
       if (!f.orientation.empty())
         item += macro(0x0020, 0x9116, dicom_element(0x0020, 0x0037, "DS", f.orientation));
@@ -1039,6 +1045,12 @@ TEST_SUITE("loaders") {
     stacks[2].stack = "2";
     CHECK_LOAD_ERROR(file("stacks.dcm", {stacks}),
                      "holds several stacks (frame 1 has StackID '1', frame 3 '2')");
+    std::vector<CtFrame> times = shuffled_ct5n();
+    times[2].time = 2;
+    CHECK_LOAD_ERROR(file("times.dcm", {times}),
+                     "holds several time points (frame 1 has TemporalPositionIndex 1, frame 3 2): "
+                     "strata reads an enhanced file of one time point; dcm2niix converts it to a "
+                     "4-D NIfTI, whose --frame picks one");
     std::vector<CtFrame> twice = shuffled_ct5n();
     twice[4].file = "2693";
     CHECK_LOAD_ERROR(file("twice.dcm", {twice}), "frame 1 and frame 5 are at the same position");

@@ -13,6 +13,7 @@
 // taken as they are.
 #include <algorithm>
 #include <bit>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -25,6 +26,8 @@
 #include <gdcmTrace.h>
 #include <gdcmTransferSyntax.h>
 
+#include "engine/scene/io/dicom_slice.h"
+#include "engine/scene/io/dicom_stack.h"
 #include "engine/scene/io/dicom_structure.h"
 #include "engine/scene/io/volume_io.h"
 #include "engine/scene/io/volume_loader.h"
@@ -37,26 +40,6 @@ using namespace dicom;
 namespace fs = std::filesystem;
 
 const gdcm::Tag pixel_data_tag(0x7fe0, 0x0010);
-
-// One slice: a single-frame file, or one frame of a multi-frame file.
-struct Slice {
-  fs::path file;
-  size_t frame = 0;  // in its file, from 0
-  size_t frames_in_file = 1;
-  uint32_t rows = 0, columns = 0;
-  glm::dvec3 position{0.0}, row_cosine{0.0}, column_cosine{0.0};
-  glm::dvec2 pixel_spacing{0.0};  // (along a row = between columns, between rows)
-  int bits_allocated = 0, bits_stored = 0, high_bit = 0;
-  bool is_signed = false;
-  Rescale rescale;
-  std::string series, syntax;                        // SeriesInstanceUID, TransferSyntaxUID
-  std::string series_number, description, modality;  // SeriesNumber, SeriesDescription, Modality
-  std::string time_position;                         // TemporalPositionIdentifier
-  std::string stack, time;  // StackID and TemporalPositionIndex of enhanced files' frames
-  double thickness = 0.0;
-  double along_normal = 0.0;  // the position projected onto the slice normal
-  bool placed = true;         // false: no ImagePositionPatient (a secondary capture, a 2-D image)
-};
 
 // Element values of one data set (the file's, or a functional group's item) as text: GDCM's
 // StringFilter renders binary VRs such as US too. Parsed by hand so that malformed values become
@@ -118,9 +101,32 @@ glm::dvec3 unit(const fs::path& file, const std::vector<double>& v, size_t first
 
 // ---- the attributes of one slice, wherever they are
 
+// The place value of a decimal string's last digit: 0.1 for "-12.3", 1 for "40", 0.01 for
+// "1.5E-1".
+double last_digit(std::string_view number) {
+  number = trim(number);
+  int exponent = 0;
+  if (const size_t e = number.find_first_of("eE"); e != std::string_view::npos) {
+    std::string_view digits = number.substr(e + 1);
+    if (digits.starts_with('+')) digits.remove_prefix(1);
+    std::from_chars(digits.data(), digits.data() + digits.size(), exponent);
+    number = number.substr(0, e);
+  }
+  const size_t point = number.find('.');
+  const int decimals = point == std::string_view::npos ? 0 : int(number.size() - point - 1);
+  return std::pow(10.0, std::clamp(exponent - decimals, -30, 30));
+}
+
 void read_position(const Elements& e, Slice& s) {
   const auto position = e.numbers(0x0020, 0x0032, "ImagePositionPatient", 3);
   s.position = glm::dvec3(position[0], position[1], position[2]);
+  const std::string text = e.text(0x0020, 0x0032);
+  size_t begin = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const size_t end = std::min(text.find('\\', begin), text.size());
+    s.position_digit[axis] = last_digit(std::string_view(text).substr(begin, end - begin));
+    begin = end + 1;
+  }
   if (!std::isfinite(float(s.position.x)) || !std::isfinite(float(s.position.y)) ||
       !std::isfinite(float(s.position.z)))
     fail(e.path(), concat("ImagePositionPatient = ", position[0], " ", position[1], " ",
@@ -303,7 +309,9 @@ void check_one_volume(const fs::path& file, const std::vector<Slice>& frames) {
                         s.frame + 1, " '", s.stack, "'): strata reads one stack of slices"));
     if (s.time != first.time)
       fail(file, concat("holds several time points (frame 1 has TemporalPositionIndex ", first.time,
-                        ", frame ", s.frame + 1, " ", s.time, "): strata reads one 3-D volume"));
+                        ", frame ", s.frame + 1, " ", s.time,
+                        "): strata reads an enhanced file of one time point; dcm2niix converts "
+                        "it to a 4-D NIfTI, whose --frame picks one"));
   }
 }
 
@@ -414,7 +422,9 @@ std::vector<Slice> read_file_slices(const fs::path& file) {
   common.series_number = e.text(0x0020, 0x0011);
   common.description = e.text(0x0008, 0x103e);
   common.modality = e.text(0x0008, 0x0060);
-  common.time_position = e.text(0x0020, 0x0100);
+  common.instance = e.text(0x0008, 0x0018);
+  for (size_t key = 0; key < kKeyTags.size(); ++key)
+    common.keys[key] = e.text(kKeyTags[key].group, kKeyTags[key].element);
   // A Siemens mosaic tiles a whole stack of slices into one image; read as one slice it would
   // show as a grid of stripes.
   const std::string image_type = e.text(0x0008, 0x0008);
@@ -428,11 +438,6 @@ std::vector<Slice> read_file_slices(const fs::path& file) {
   std::vector<Slice> slices = read_frames(reader.GetFile(), e, common);
   check_pixel_data_length(e, slices.front());
   return slices;
-}
-
-// "2062", or "frame 5" inside a multi-frame file (whose name the error already gives).
-std::string name_of(const Slice& s) {
-  return s.frames_in_file > 1 ? concat("frame ", s.frame + 1) : s.file.filename().string();
 }
 
 void check_consistent(const fs::path& where, const Slice& first, const Slice& s) {
@@ -453,8 +458,57 @@ void check_consistent(const fs::path& where, const Slice& first, const Slice& s)
                        " have different SeriesInstanceUIDs"));
 }
 
+// Where DICOM files are below a folder that holds none itself (a DICOM/PA0/ST0/SE0 tree, an
+// archive unpacked into a folder of its own): the subfolders, at most 4 levels down, that hold a
+// file which begins as DICOM does; at most `most` of them, the first 10000 files looked at.
+std::vector<fs::path> dicom_subfolders(const fs::path& folder, size_t most) {
+  std::vector<fs::path> found;
+  std::error_code error;
+  fs::recursive_directory_iterator entry(folder, fs::directory_options::skip_permission_denied,
+                                         error);
+  for (size_t looked = 0; !error && entry != fs::recursive_directory_iterator() && looked < 10000;
+       entry.increment(error)) {
+    if (entry.depth() >= 3) entry.disable_recursion_pending();
+    std::error_code entry_error;
+    const fs::path parent = entry->path().parent_path();
+    if (!entry->is_regular_file(entry_error) || parent == folder ||
+        std::find(found.begin(), found.end(), parent) != found.end())
+      continue;
+    ++looked;
+    if (file_kind(entry->path()) == Kind::other) continue;
+    found.push_back(parent);
+    if (found.size() == most) break;
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+[[noreturn]] void fail_no_dicom(const fs::path& folder, size_t files) {
+  const std::string what = files == 0 ? std::string("the folder is empty")
+                                      : concat("none of its ", files, " files is a DICOM image");
+  const std::vector<fs::path> below = dicom_subfolders(folder, 4);
+  if (below.empty()) fail(folder, concat("no DICOM files (", what, ")"));
+  std::string names;
+  for (size_t i = 0; i < below.size() && i < 3; ++i)
+    names += (i ? ", " : "") + printable(below[i].lexically_relative(folder).string(), 80);
+  const std::string here = concat("no DICOM files in the folder itself (",
+                                  files == 0 ? "it holds only subfolders" : what, ")");
+  if (below.size() == 1)
+    fail(folder, concat(here, "; its subfolder ", names, " holds DICOM files: open ",
+                        below[0].string(), " (strata reads one folder's files as a series)"));
+  fail(folder, concat(here, "; its subfolders ", names, below.size() > 3 ? " and more" : "",
+                      " hold DICOM files: open one of them (strata reads one folder's files as a "
+                      "series)"));
+}
+
+// A folder's image files, as slices, and the names of the files that are not DICOM images.
+struct FolderSlices {
+  std::vector<Slice> slices;
+  std::vector<std::string> skipped;  // hidden files (".DS_Store") left out
+};
+
 // Every image file's slices; a folder holds single-frame slices or one multi-frame file.
-std::vector<Slice> read_folder(const fs::path& folder) {
+FolderSlices read_folder(const fs::path& folder) {
   std::vector<fs::path> files;
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(folder, error)) {
@@ -465,17 +519,29 @@ std::vector<Slice> read_folder(const fs::path& folder) {
   }
   if (error) fail(folder, concat("cannot list the folder: ", error.message()));
   std::sort(files.begin(), files.end());
-  std::vector<Slice> slices;
+  FolderSlices read;
   for (const fs::path& file : files) {
-    if (file.filename().string().front() != '.') check_not_a_damaged_slice(file);
+    const std::string name = file.filename().string();
+    if (name.front() != '.') check_not_a_damaged_slice(file);
     std::vector<Slice> more = read_file_slices(file);
-    slices.insert(slices.end(), more.begin(), more.end());
+    if (more.empty() && name.front() != '.') read.skipped.push_back(name);
+    read.slices.insert(read.slices.end(), more.begin(), more.end());
   }
-  if (slices.empty())
-    fail(folder, files.empty() ? std::string("no DICOM files (the folder is empty)")
-                               : concat("no DICOM files (none of its ", files.size(),
-                                        " files is a DICOM image)"));
-  return slices;
+  if (read.slices.empty()) fail_no_dicom(folder, files.size());
+  return read;
+}
+
+// One line however many: the first names, then how many more.
+std::string skipped_warning(const fs::path& folder, const std::vector<std::string>& skipped) {
+  constexpr size_t kNamed = 8;
+  std::string names;
+  for (size_t i = 0; i < skipped.size() && i < kNamed; ++i)
+    names += (i ? ", " : "") + printable(skipped[i], 60);
+  if (skipped.size() > kNamed) names += concat(" and ", skipped.size() - kNamed, " more");
+  return concat(folder.string(), ": skipped ", skipped.size(),
+                skipped.size() == 1 ? " file that is not a DICOM image: "
+                                    : " files that are not DICOM images: ",
+                names);
 }
 
 // A folder's slices by series (SeriesInstanceUID; files without one together), in the order
@@ -529,12 +595,7 @@ DicomSeries describe_series(const std::vector<Slice>& g) {
   out.columns = first.columns;
   out.rows = first.rows;
   out.images = uint32_t(g.size());
-  std::vector<std::string> times;
-  for (const Slice& s : g) {
-    const std::string& t = s.time.empty() ? s.time_position : s.time;
-    if (std::find(times.begin(), times.end(), t) == times.end()) times.push_back(t);
-  }
-  out.time_points = uint32_t(times.size());
+  out.time_points = uint32_t(count_time_points(g));
   out.orientation = first.placed ? orientation_name(first) : "unplaced";
   return out;
 }
@@ -596,77 +657,6 @@ size_t choose_series(const fs::path& folder, const std::vector<std::vector<Slice
              "strata info ",
              folder.string(), " lists them"));
   return best;
-}
-
-// Sorts along the normal and returns the uniform distance between slices.
-double sort_and_space(const fs::path& where, std::vector<Slice>& slices, glm::dvec3 normal) {
-  for (Slice& s : slices) s.along_normal = glm::dot(s.position, normal);
-  std::stable_sort(slices.begin(), slices.end(),
-                   [](const Slice& a, const Slice& b) { return a.along_normal < b.along_normal; });
-  if (slices.size() == 1) return slices[0].thickness > 0.0 ? slices[0].thickness : 1.0;
-  const double mean = (slices.back().along_normal - slices.front().along_normal) /
-                      static_cast<double>(slices.size() - 1);
-  for (size_t k = 0; k + 1 < slices.size(); ++k)
-    if (slices[k + 1].along_normal - slices[k].along_normal < 1e-4)
-      fail(where,
-           concat(name_of(slices[k]), " and ", name_of(slices[k + 1]),
-                  " are at the same position (", slices[k].along_normal, " mm along the normal)"));
-  for (size_t k = 0; k + 1 < slices.size(); ++k) {
-    const double step = slices[k + 1].along_normal - slices[k].along_normal;
-    if (std::fabs(step - mean) > std::max(1e-3, 0.01 * mean))
-      fail(where, concat("slice spacing is not uniform: ", step, " mm between ", name_of(slices[k]),
-                         " and ", name_of(slices[k + 1]), ", ", mean, " mm on average"));
-  }
-  return mean;
-}
-
-// The k axis: the slice normal, or, when the slices also move sideways from one to the next
-// (gantry tilt, a sheared stack), the line through their positions. The voxels are not resampled:
-// the grid is sheared instead, so that every slice stays where its ImagePositionPatient puts it.
-struct StackAxis {
-  glm::dvec3 direction{0.0};
-  double spacing = 0.0;
-};
-
-// Sideways drift below this is rounding in the positions' decimal strings: the grid stays
-// orthogonal.
-constexpr double kRoundingMm = 0.01;
-
-std::string degrees_text(double degrees) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.*f", degrees < 0.1 ? 3 : 1, degrees);
-  return text;
-}
-
-StackAxis stack_axis(const fs::path& where, const std::vector<Slice>& slices, glm::dvec3 normal,
-                     double step, std::vector<std::string>& warnings) {
-  if (slices.size() < 2) return {normal, step};
-  const glm::dvec3 first = slices.front().position;
-  const auto sideways = [&](glm::dvec3 d) { return d - glm::dot(d, normal) * normal; };
-  double drift = 0.0;
-  for (const Slice& s : slices) drift = std::max(drift, glm::length(sideways(s.position - first)));
-  if (drift < kRoundingMm) return {normal, step};
-
-  const glm::dvec3 along = (slices.back().position - first) / double(slices.size() - 1);
-  for (size_t k = 0; k < slices.size(); ++k) {
-    const double off = glm::length(sideways(slices[k].position - (first + double(k) * along)));
-    if (off > std::max(kRoundingMm, 0.01 * glm::length(along)))
-      fail(where, concat("ImagePositionPatient: the slices do not lie on one line: ",
-                         name_of(slices[k]), " is ", off, " mm sideways from the line through ",
-                         name_of(slices.front()), " and ", name_of(slices.back()),
-                         " (strata reads evenly spaced slices, sheared at most uniformly)"));
-  }
-  const glm::dvec3 direction = glm::normalize(along);
-  const double tilt = glm::degrees(std::acos(std::clamp(glm::dot(direction, normal), -1.0, 1.0)));
-  const std::string sheared = concat("ImagePositionPatient: the slices are sheared by ",
-                                     degrees_text(tilt), "° (gantry tilt): each moves ",
-                                     glm::length(sideways(along)), " mm sideways from the last");
-  if (tilt > 45.0)
-    fail(where, sheared + "; more than 45° is not a stack of slices strata can show");
-  warnings.push_back(concat(where.string(), ": ", sheared,
-                            "; shown on a sheared grid, each slice at its own position "
-                            "(not resampled)"));
-  return {direction, glm::length(along)};
 }
 
 // ---- pixels
@@ -823,10 +813,8 @@ Volume assemble(const fs::path& where, std::vector<Slice> slices, const VolumeLi
   check_placed(where, slices, warnings);
   for (const Slice& s : slices) check_consistent(where, slices.front(), s);
   check_high_bit(slices);
+  const StackAxis axis = order_stack(where, slices, warnings);
   const Slice& first = slices.front();
-  const glm::dvec3 normal = glm::normalize(glm::cross(first.row_cosine, first.column_cosine));
-  const double step = sort_and_space(where, slices, normal);
-  const StackAxis axis = stack_axis(where, slices, normal, step, warnings);
 
   const StoredType stored = first.bits_allocated == 8
                                 ? (first.is_signed ? StoredType::int8 : StoredType::uint8)
@@ -862,19 +850,25 @@ void quiet_gdcm() {
 
 }  // namespace
 
+std::string dicom::name_of(const Slice& s) {
+  return s.frames_in_file > 1 ? concat("frame ", s.frame + 1) : s.file.filename().string();
+}
+
 Volume load_dicom_series(const std::filesystem::path& folder, const VolumeReadOptions& options,
                          std::vector<std::string>& warnings) {
   std::error_code error;
   if (!fs::exists(folder, error)) fail(folder, "no such file");
   if (!fs::is_directory(folder, error)) fail(folder, "not a folder (a DICOM series is a folder)");
-  choose_frame(folder, 1, options, warnings);
   quiet_gdcm();
-  std::vector<std::vector<Slice>> groups = by_series(folder, read_folder(folder));
-  std::vector<Slice> slices =
+  FolderSlices read = read_folder(folder);
+  if (!read.skipped.empty()) warnings.push_back(skipped_warning(folder, read.skipped));
+  std::vector<std::vector<Slice>> groups = by_series(folder, std::move(read.slices));
+  std::vector<Slice> chosen =
       std::move(groups[choose_series(folder, groups, options.series, warnings)]);
-  const std::string series = groups.size() > 1 ? slices.front().series : std::string();
+  const std::string series = groups.size() > 1 ? chosen.front().series : std::string();
   // A folder holding one multi-frame file: errors about its frames name the file.
-  const fs::path where = slices.front().frames_in_file > 1 ? slices.front().file : folder;
+  const fs::path where = chosen.front().frames_in_file > 1 ? chosen.front().file : folder;
+  std::vector<Slice> slices = one_time_point(where, std::move(chosen), options, warnings);
   Volume volume = assemble(where, std::move(slices), options.limits, warnings);
   volume.name = volume_name(folder);
   volume.source = folder;
@@ -887,7 +881,7 @@ std::vector<DicomSeries> list_dicom_series(const std::filesystem::path& folder) 
   if (!fs::is_directory(folder, error)) fail(folder, "not a folder (a DICOM series is a folder)");
   quiet_gdcm();
   std::vector<DicomSeries> out;
-  for (const std::vector<Slice>& g : by_series(folder, read_folder(folder)))
+  for (const std::vector<Slice>& g : by_series(folder, read_folder(folder).slices))
     out.push_back(describe_series(g));
   return out;
 }

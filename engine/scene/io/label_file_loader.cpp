@@ -289,12 +289,19 @@ Axes fcsv_axes(std::string_view value, const FileLine& line) {
   line.fail("CoordinateSystem '" + std::string(value) + "' is not LPS, RAS, 0 (RAS) or 1 (LPS)");
 }
 
-// Slicer 5's position status: 0 undefined, 1 preview, 2 defined, 3 missing.
+// A comma in an unquoted label or description splits it into two fields.
+constexpr std::string_view quote_commas = "; a comma inside a label or description must be quoted";
+
+// Slicer 5's position status: 0 undefined, 1 preview, 2 defined, 3 missing. A row of 16 fields
+// with another 15th is most likely a Slicer 4 row with two commas in its text.
 bool fcsv_defined(std::string_view field, const FileLine& line) {
   const std::string_view status = trim(field);
   if (status == "2") return true;
   if (status == "0" || status == "1" || status == "3") return false;
-  line.fail("position status '" + std::string(status) + "' is not 0, 1, 2 or 3");
+  line.fail(
+      "16 fields, expected 14 (or 16 as Slicer 5 writes, with the position status 0, 1, 2 "
+      "or 3 as the 15th, not '" +
+      std::string(status) + "')" + std::string(quote_commas));
 }
 
 ReadLabels read_fcsv(const fs::path& path, const std::string& text) {
@@ -324,7 +331,8 @@ ReadLabels read_fcsv(const fs::path& path, const std::string& text) {
     const bool slicer5 = layout.slicer && count == layout.count + 2;
     if (count != layout.count && !slicer5) {
       line.fail(std::to_string(count) + " fields, expected " + std::to_string(layout.count) +
-                (layout.slicer ? " (or 16, as Slicer 5 writes)" : " as the columns line names"));
+                (layout.slicer ? " (or 16, as Slicer 5 writes)" : " as the columns line names") +
+                std::string(count > layout.count ? quote_commas : ""));
     }
     const size_t index = point_index++;
     if (slicer5 && !fcsv_defined(row.fields[slicer_position_status], line)) continue;
@@ -403,7 +411,8 @@ ReadLabels read_csv(const fs::path& path, const std::string& text) {
     const FileLine line{file, row.line};
     if (row.fields.size() != layout.count) {
       line.fail(std::to_string(row.fields.size()) + " fields, the header names " +
-                std::to_string(layout.count));
+                std::to_string(layout.count) +
+                (row.fields.size() > layout.count ? "; a comma inside a text must be quoted" : ""));
     }
     if (layout.defined && !csv_defined(row.fields[*layout.defined], line)) continue;
     glm::dvec3 position(0.0);
@@ -548,6 +557,15 @@ ReadLabels read_markups(const fs::path& path) {
 
 std::vector<Label> load_label_file(const fs::path& path, int64_t first_id) {
   return read_label_file(path, first_id).labels;
+}
+
+std::optional<std::string> label_limit_problem(size_t in_file, size_t in_scene) {
+  if (in_file + in_scene <= size_t(kMaxLabels)) return std::nullopt;
+  return std::to_string(in_file) + " labels" +
+         (in_scene == 0 ? std::string()
+                        : ", " + std::to_string(in_file + in_scene) + " with the scene's " +
+                              std::to_string(in_scene)) +
+         "; strata places at most " + std::to_string(kMaxLabels) + " in a scene";
 }
 
 LabelFile read_label_file(const fs::path& path, int64_t first_id) {

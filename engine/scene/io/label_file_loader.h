@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,10 @@ namespace strata {
 // line>: <reason>".
 // An id past 2147483647 is an error naming the label's line or entry.
 std::vector<Label> load_label_file(const std::filesystem::path& path, int64_t first_id = 0);
+
+// Why a label file's `in_file` labels cannot join a scene that holds `in_scene` already: more than
+// kMaxLabels together. Errors and `strata info --scene` put the label file's name before it.
+std::optional<std::string> label_limit_problem(size_t in_file, size_t in_scene);
 
 // The same, with the coordinate systems the file's points were written in ("LPS", "RAS"; in the
 // order first met: a markups file may hold lists in both).

@@ -43,6 +43,15 @@ void check_keys(const json& object, const Field& field, std::initializer_list<co
   }
 }
 
+// A label file's labels, their ids after the scene's; refused, naming the file, where together
+// they pass kMaxLabels.
+std::vector<Label> labels_to_add(const std::filesystem::path& path, const Scene& scene) {
+  std::vector<Label> labels = load_label_file(path, next_label_id(scene));
+  if (const auto problem = label_limit_problem(labels.size(), scene.labels.size()))
+    throw Error(path.string() + ": " + *problem);
+  return labels;
+}
+
 float number(const json& value, const Field& field) {
   if (!value.is_number() || !std::isfinite(value.get<double>())) field.fail("expected a number");
   // (1e39 is a finite double but no float)
@@ -520,8 +529,7 @@ Scene SceneReader::read(const json& root) {
   each(root, field, "atlas", [&](const json& v, const Field& f) { atlas(v, f); });
   if (const json* labels = optional(root, "labels"); labels && labels->is_string()) {
     const std::filesystem::path path = resolve(*labels, field / "labels");
-    for (Label& l :
-         (field / "labels").wrap([&] { return load_label_file(path, next_label_id(scene_)); }))
+    for (Label& l : (field / "labels").wrap([&] { return labels_to_add(path, scene_); }))
       scene_.labels.push_back(std::move(l));
   } else {
     each(root, field, "labels", [&](const json& v, const Field& f) { label(v, f); });
@@ -576,8 +584,7 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
                 kVolumeExtensions + ")");
   }
   if (!options.labels.empty()) {
-    for (Label& l : load_label_file(options.labels, next_label_id(scene)))
-      scene.labels.push_back(std::move(l));
+    for (Label& l : labels_to_add(options.labels, scene)) scene.labels.push_back(std::move(l));
   }
   if (scene.labels.size() > size_t(kMaxLabels))
     throw Error(path.string() + ": " + std::to_string(scene.labels.size()) +
