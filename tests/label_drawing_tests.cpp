@@ -970,10 +970,11 @@ TEST_SUITE("gpu") {
     CHECK(draw_matching_the_reference(ctx, s).covers[0].hidden == 1.0f);
   }
 
-  // The whole labelled frame: an opaque quad (a mesh) with one anchor behind it and one in front,
-  // with the default layering and ghosting (nothing lies behind the quad for a lens to show). The
-  // layout says which anchor is hidden, and the picture draws it so: the quad seen through its
-  // ring, a dashed leader; the other a filled mark with a solid leader.
+  // The whole labelled frame, a still and the frames of a video: an opaque quad (a mesh) with one
+  // anchor behind it and one in front, with the default layering and ghosting (nothing lies
+  // behind the quad for a lens to show). The layout says which anchor is hidden, and the picture
+  // draws it so: the quad seen through its ring, a dashed leader; the other a filled mark with a
+  // solid leader.
   TEST_CASE_FIXTURE(test::GpuTest, "an_anchor_behind_a_mesh_is_flagged_hidden_and_drawn_so") {
     Scene scene;
     scene.meshes = {test::quad(0.0f, {0.3f, 0.5f, 0.8f, 1.0f}, 12.0f)};
@@ -981,45 +982,54 @@ TEST_SUITE("gpu") {
     scene.camera = {glm::lookAt(glm::vec3(0.0f, 0.0f, 60.0f), glm::vec3(0.0f), {0, 1, 0}), 30.0f,
                     1.0f, 200.0f};
     const graph::Extent size{128, 128};
-    const LabelledFrame frame = render_labelled(ctx, scene, scene.camera, size, {});
-    REQUIRE(frame.labels.size() == 2);
-    const auto pixel = [&](glm::vec2 p) {
-      const size_t i = 4 * (size_t(p.y) * size.width + size_t(p.x));
-      return glm::vec3(frame.image[i], frame.image[i + 1], frame.image[i + 2]) / 255.0f;
-    };
-    for (size_t i = 0; i < 2; ++i) {
-      const LabelLayout& l = frame.labels[i];
-      CAPTURE(l.text);
-      REQUIRE(l.placed);
-      const bool hidden = i == 0;
-      CHECK(l.anchor_hidden == std::optional(hidden));
-      // The mark's middle, then the leader from the mark's edge to the box: white all along, or
-      // dashes (white) and gaps (the quad, bluish, or the background).
-      const glm::vec3 centre = pixel(l.anchor);
-      CHECK((hidden ? centre.b > centre.r + 0.2f
-                    : glm::all(glm::greaterThan(centre, glm::vec3(0.9f)))));
-      const glm::vec2 end = glm::clamp(l.anchor, l.box_origin, l.box_origin + l.box_size);
-      const float length = glm::distance(l.anchor, end);
-      REQUIRE(length > 24.0f);
-      const glm::vec2 along = (end - l.anchor) / length, across(-along.y, along.x);
-      int white = 0, other = 0;
-      for (float t = 7.0f; t < length - 2.0f; t += 1.0f) {
-        float whitest = 0.0f;  // (of the pixels across the line: one has its centre near it)
-        for (const float k : {-1.0f, 0.0f, 1.0f}) {
-          const glm::vec3 c = pixel(l.anchor + t * along + k * across);
-          whitest = std::max(whitest, std::min({c.r, c.g, c.b}));
+    const auto check = [&size](const LabelledFrame& frame) {
+      REQUIRE(frame.labels.size() == 2);
+      const auto pixel = [&](glm::vec2 p) {
+        const size_t i = 4 * (size_t(p.y) * size.width + size_t(p.x));
+        return glm::vec3(frame.image[i], frame.image[i + 1], frame.image[i + 2]) / 255.0f;
+      };
+      for (size_t i = 0; i < 2; ++i) {
+        const LabelLayout& l = frame.labels[i];
+        CAPTURE(l.text);
+        REQUIRE(l.placed);
+        REQUIRE(l.opacity == 1.0f);
+        const bool hidden = i == 0;
+        CHECK(l.anchor_hidden == std::optional(hidden));
+        // The mark's middle, then the leader from the mark's edge to the box: white all along,
+        // or dashes (white) and gaps (the quad, bluish, or the background).
+        const glm::vec3 centre = pixel(l.anchor);
+        CHECK((hidden ? centre.b > centre.r + 0.2f
+                      : glm::all(glm::greaterThan(centre, glm::vec3(0.9f)))));
+        const glm::vec2 end = glm::clamp(l.anchor, l.box_origin, l.box_origin + l.box_size);
+        const float length = glm::distance(l.anchor, end);
+        REQUIRE(length > 24.0f);
+        const glm::vec2 along = (end - l.anchor) / length, across(-along.y, along.x);
+        int white = 0, other = 0;
+        for (float t = 7.0f; t < length - 2.0f; t += 1.0f) {
+          float whitest = 0.0f;  // (of the pixels across the line: one has its centre near it)
+          for (const float k : {-1.0f, 0.0f, 1.0f}) {
+            const glm::vec3 c = pixel(l.anchor + t * along + k * across);
+            whitest = std::max(whitest, std::min({c.r, c.g, c.b}));
+          }
+          (whitest > 0.6f ? white : other) += 1;
         }
-        (whitest > 0.6f ? white : other) += 1;
+        CHECK(white > 6);
+        CHECK((hidden ? other > 6 : other == 0));
       }
-      CHECK(white > 6);
-      CHECK((hidden ? other > 6 : other == 0));
-    }
-    const nlohmann::json layout = nlohmann::json::parse(layout_json(frame));
+    };
+    LabelledRenderer renderer(ctx, scene, scene.camera, size, {});
+    renderer.run();
+    const LabelledFrame still = renderer.result();
+    check(still);
+    const nlohmann::json layout = nlohmann::json::parse(layout_json(still));
     CHECK(layout["labels"][0]["anchor_hidden"] == true);
     CHECK(layout["labels"][1]["anchor_hidden"] == false);
+    LabelledRenderer video(ctx, scene, scene.camera, size, {});
+    for (int frame = 0; frame < 20; ++frame) video.advance(0.05);  // (faded in by then)
+    check(video.result());
     if (std::getenv("STRATA_KEEP_IMAGES")) {
       write_png(test::output_dir() + "/hidden_anchor_mesh.png", size.width, size.height,
-                frame.image);
+                still.image);
     }
   }
 

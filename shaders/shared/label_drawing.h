@@ -210,6 +210,10 @@ STRATA_INLINE vec4 label_anchor_mark(vec2 p, vec2 anchor, float anchor_hidden) {
 // depth_alpha; and the depth image (`depth`: where the picture before ghosting first reaches
 // depth_alpha, 0 where it never does), where that depth lies in the label's own layer (from
 // `layer_near` on: ghosting opens only the layers in front of it) and in front of the anchor.
+// The second counts what lies in front before ghosting: where a lens opens layers in front that
+// helped the depth image's sum reach depth_alpha in the label's own layer, it may call hidden an
+// anchor that the opened picture shows through a thinner own layer (the frame has no depth image
+// of the ghosted picture).
 STRATA_INLINE float anchor_hidden(float front_alpha, float depth, float anchor_depth,
                                   float layer_near, float depth_alpha, float step) {
   float by_front = smoothstep(depth_alpha - LABEL_HIDDEN_ALPHA_RAMP,
