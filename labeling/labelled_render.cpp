@@ -391,11 +391,11 @@ void LabelledRenderer::build_graph() {
   glyphs_id_ = glyph_buffer;
   const graph::ResourceId labelled = graph.add_image("labels.final", {VK_FORMAT_R8G8B8A8_UNORM});
   labelled_id_ = labelled;
-  // (offline frames measure what hides each anchor: LabelLayout::front_alpha)
+  // (what hides each anchor: drawn by every frame, read back by offline ones: LabelLayout)
   const uint32_t n = std::max(slots_.count(), 1u);
-  front_alpha_id_ = extension_ ? 0 : graph.add_buffer("labels.front_alpha", {[n](graph::Extent) {
-                                                        return VkDeviceSize{n} * sizeof(float);
-                                                      }});
+  covers_id_ = graph.add_buffer("labels.anchor_cover", {[n](graph::Extent) {
+                                  return VkDeviceSize{n} * sizeof(gpu::AnchorCoverGpu);
+                                }});
   p.drawing->add_to(graph, {.layers = rendered.layers,
                             .layer_count = render.layer_count,
                             .labels = labels,
@@ -404,7 +404,9 @@ void LabelledRenderer::build_graph() {
                             .output = labelled,
                             .background = render.background,
                             .ghost = graph_ghost_,
-                            .front_alpha = front_alpha_id_});
+                            .depth = rendered.depth,
+                            .frame = rendered.frame,
+                            .covers = covers_id_});
   if (extension_) {
     extension_(graph, {labelled, rendered, placed_, moved.drawn, render.layer_count, slots_.count(),
                        beside_ == nullptr});
@@ -670,11 +672,13 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
     const std::vector<glm::vec4> layers = download_layers();
     const std::vector<float> visible =
         label_visibility(layers, size_, layering_.layer_count, frame.labels);
-    const std::vector<std::byte> front = runner_->download_buffer(front_alpha_id_);
+    const std::vector<std::byte> covers = runner_->download_buffer(covers_id_);
     for (size_t i = 0; i < frame.labels.size(); ++i) {
+      gpu::AnchorCoverGpu cover;
+      std::memcpy(&cover, covers.data() + slots_.of(i) * sizeof(cover), sizeof(cover));
       frame.labels[i].visible = visible[i];
-      std::memcpy(&frame.labels[i].front_alpha, front.data() + slots_.of(i) * sizeof(float),
-                  sizeof(float));
+      frame.labels[i].front_alpha = cover.front_alpha;
+      frame.labels[i].anchor_hidden = cover.hidden >= gpu::LABEL_HIDDEN_AT;
     }
   }
   for (LabelLayout& l : frame.labels) {
@@ -727,6 +731,8 @@ std::string layout_json(const LabelledFrame& frame) {
   using ordered_json = nlohmann::ordered_json;
   ordered_json labels = ordered_json::array();
   for (const LabelLayout& l : frame.labels) {
+    const ordered_json anchor_hidden =
+        l.anchor_hidden ? ordered_json(*l.anchor_hidden) : ordered_json();  // (null: not measured)
     ordered_json entry = {{"id", l.id},
                           {"text", l.text},
                           {"layer", l.layer},
@@ -740,6 +746,7 @@ std::string layout_json(const LabelledFrame& frame) {
                           {"cost", shortest_double(l.cost)},
                           {"opacity", shortest_double(l.opacity)},
                           {"front_alpha", shortest_double(l.front_alpha)},
+                          {"anchor_hidden", anchor_hidden},
                           {"target", ordered_json()}};
     if (const auto& t = l.target_origin) {
       entry["target"] = {shortest_double(t->x), shortest_double(t->y),

@@ -83,9 +83,13 @@ struct LabelLayout {
   float cost = 0.0f;
   float opacity = 0.0f;  // as drawn: the forces fade it from 0 (hidden) to 1 (fully drawn)
   // The alpha the volume's layers in front of the label's own composite to at its anchor (what
-  // hides the anchor; ghosting lowers it; labels drawn over it do not count): labels.front_alpha;
+  // hides the anchor; ghosting lowers it; labels drawn over it do not count): labels.anchor_cover;
   // NaN where it was not measured, 0 on the front layer.
   float front_alpha = std::numeric_limits<float>::quiet_NaN();
+  // Whether its anchor is hidden (the picture as drawn is opaque in front of it: anchor_hidden in
+  // shaders/shared/label_drawing.h); the connector is then drawn dashed, the anchor's mark
+  // hollow. None where it was not measured, as front_alpha.
+  std::optional<bool> anchor_hidden;
   // The top-left corner of the placement's box this frame, where the label is heading (its size
   // is box_size); none where the placement did not place it.
   std::optional<glm::vec2> target_origin;
@@ -332,7 +336,7 @@ class LabelledRenderer {
   RenderStats stats_;
   Placement::Outputs placed_{};
   graph::ResourceId layers_id_ = 0;
-  graph::ResourceId front_alpha_id_ = 0;  // labels.front_alpha (offline frames only)
+  graph::ResourceId covers_id_ = 0;       // labels.anchor_cover
   graph::ResourceId picks_id_ = 0;        // picking.points
   std::vector<glm::vec2> pick_requests_;  // asked, in no frame yet
   // Per frame slot: the pixels its frame picks (request_pick), and the points come back.

@@ -101,6 +101,9 @@ LayoutLabel read_label(const json& object, const Field& field) {
   if (const json* a = optional(object, "front_alpha"); a && !a->is_null()) {
     label.front_alpha = opacity(*a, field / "front_alpha");
   }
+  if (const json* h = optional(object, "anchor_hidden"); h && !h->is_null()) {
+    label.anchor_hidden = boolean(*h, field / "anchor_hidden");
+  }
   label.target = drawn;
   if (const json* t = optional(object, "target")) {
     label.target = t->is_null() ? std::nullopt : std::optional(box(*t, field / "target"));

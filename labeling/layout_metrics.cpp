@@ -201,6 +201,10 @@ FrameMetrics frame_metrics(const Layout& layout) {
     m.rear_front_alpha_max = std::max(m.rear_front_alpha_max, label.front_alpha);
   }
   m.rear_front_alpha_mean = m.rear_anchors == 0 ? 0.0 : front_sum / double(m.rear_anchors);
+  m.anchors_hidden =
+      size_t(std::count_if(layout.labels.begin(), layout.labels.end(), [](const LayoutLabel& l) {
+        return l.shown && l.anchor_hidden.value_or(false);
+      }));
   return m;
 }
 
@@ -227,6 +231,7 @@ FrameMetrics sum_frame_metrics(const std::vector<FrameMetrics>& frames) {
     total.rear_anchors += f.rear_anchors;
     total.rear_anchors_seen += f.rear_anchors_seen;
     total.rear_front_alpha_max = std::max(total.rear_front_alpha_max, f.rear_front_alpha_max);
+    total.anchors_hidden += f.anchors_hidden;
     leader_length_sum += f.leader_length_mean * double(f.shown + f.illegible);  // (drawn)
     total.leader_length_max = std::max(total.leader_length_max, f.leader_length_max);
   }
@@ -404,7 +409,8 @@ ordered_json to_json(const FrameMetrics& m, const FrameMetrics* still) {
                       {"rear_anchors", m.rear_anchors},
                       {"rear_anchors_seen", m.rear_anchors_seen},
                       {"rear_front_alpha_mean", m.rear_front_alpha_mean},
-                      {"rear_front_alpha_max", m.rear_front_alpha_max}};
+                      {"rear_front_alpha_max", m.rear_front_alpha_max},
+                      {"anchors_hidden", m.anchors_hidden}};
   if (still) {
     out["still_opaque"] = still->opaque;
     out["opaque_of_still"] = optional_number(ratio(m.opaque, still->opaque));

@@ -50,6 +50,9 @@ struct LayoutLabel {
   // The alpha of the layers in front of the label's own at its anchor (the file's "front_alpha";
   // NaN without it or with null).
   double front_alpha = std::numeric_limits<double>::quiet_NaN();
+  // Whether the picture hides the anchor (the file's "anchor_hidden"; none without it or with
+  // null).
+  std::optional<bool> anchor_hidden;
 };
 
 struct Layout {
@@ -63,9 +66,9 @@ struct Layout {
 
 // A layout file. Every error is "<file>: <field>: <reason>", e.g.
 // "a.json: labels[3].box: expected 4 numbers". Required: width, height, labels, and per label
-// id (unique), anchor, box (size >= 0) and shown; text, layer, cost, placed, opacity, target
-// and the top level's seconds are optional (defaults above). Unknown keys are ignored, so files
-// from later versions still read.
+// id (unique), anchor, box (size >= 0) and shown; text, layer, cost, placed, opacity, target,
+// front_alpha, anchor_hidden and the top level's seconds are optional (defaults above). Unknown
+// keys are ignored, so files from later versions still read.
 Layout read_layout(const std::filesystem::path& path);
 // The same from JSON already parsed (`strata video --report` reads the layouts it writes);
 // `source` names it in errors.
@@ -133,6 +136,9 @@ struct FrameMetrics {
   size_t rear_anchors_seen = 0;
   double rear_front_alpha_mean = 0.0;
   double rear_front_alpha_max = 0.0;
+  // Shown labels whose anchor the picture hides (anchor_hidden): drawn with a dashed leader to a
+  // hollow mark.
+  size_t anchors_hidden = 0;
 };
 
 inline constexpr double seen_front_alpha = 0.3;

@@ -6,6 +6,7 @@
 #include <glm/gtc/packing.hpp>
 
 #include "engine/core/error.h"
+#include "shared/volume_shading.h"  // split_depth
 
 namespace strata {
 
@@ -29,6 +30,9 @@ struct LabelDrawReference {
   }
   LabelGpu label_at(uint i) const { return data.labels[i]; }
   bool layer_frames() const { return data.layer_frames; }
+  float anchor_hidden_at(uint i) const {
+    return i < data.covers.size() ? data.covers[i].hidden : 0.0f;
+  }
   PlacementGpu placement_at(uint i) const { return data.placements[i]; }
   GlyphGpu glyph_at(uint i) const { return data.glyphs[i]; }
 
@@ -90,8 +94,8 @@ LabelDrawing::LabelDrawing(Context& ctx, const FontAtlas& font, const ImageAtlas
                            LabelDrawing* from)
     : ghost_pipeline_(
           reuse_or_create(ctx, from ? &from->ghost_pipeline_ : nullptr, "labels_ghost.comp")),
-      front_alpha_(
-          reuse_or_create(ctx, from ? &from->front_alpha_ : nullptr, "labels_front_alpha.comp")),
+      anchor_cover_(
+          reuse_or_create(ctx, from ? &from->anchor_cover_ : nullptr, "labels_anchor_cover.comp")),
       draw_(reuse_or_create(ctx, from ? &from->draw_ : nullptr, "label_draw.comp")),
       composite_(reuse_or_create(ctx, from ? &from->composite_ : nullptr, "label_composite.comp")) {
   set_atlases(ctx, font, images);
@@ -159,19 +163,17 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
                     },
                     "labels"});
   }
-  if (in.front_alpha != 0) {
-    graph.add_pass({"labels.front_alpha",
-                    graph::PassKind::compute,
-                    {{in.layers, Use::storage_read, GHOST_BINDING_LAYERS},
-                     {in.labels, Use::storage_read, GHOST_BINDING_LABELS},
-                     {in.front_alpha, Use::storage_write, GHOST_BINDING_FRONT_ALPHA}},
-                    [this](graph::PassContext& pc) {
-                      pc.dispatch(front_alpha_,
-                                  ghost_params(ghost_, pc.viewport, layer_count_, label_count_),
-                                  {label_count_, 1, 1});
-                    },
-                    "labels"});
-  }
+  graph.add_pass({"labels.anchor_cover",
+                  graph::PassKind::compute,
+                  {{in.layers, Use::storage_read, ANCHOR_COVER_BINDING_LAYERS},
+                   {in.labels, Use::storage_read, ANCHOR_COVER_BINDING_LABELS},
+                   {in.depth, Use::storage_read, ANCHOR_COVER_BINDING_DEPTH},
+                   {in.frame, Use::uniform, ANCHOR_COVER_BINDING_FRAME},
+                   {in.covers, Use::storage_write, ANCHOR_COVER_BINDING_COVERS}},
+                  [this](graph::PassContext& pc) {
+                    pc.dispatch(anchor_cover_, params(pc.viewport), {label_count_, 1, 1});
+                  },
+                  "labels"});
   graph.add_pass(
       {"labels.draw",
        graph::PassKind::compute,
@@ -179,6 +181,7 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
         {in.labels, Use::storage_read, LABEL_DRAW_BINDING_LABELS},
         {in.placements, Use::storage_read, LABEL_DRAW_BINDING_PLACEMENTS},
         {in.glyphs, Use::storage_read, LABEL_DRAW_BINDING_GLYPHS},
+        {in.covers, Use::storage_read, LABEL_DRAW_BINDING_COVERS},
         {atlas, Use::sampled, LABEL_DRAW_BINDING_ATLAS},
         {images, Use::sampled, LABEL_DRAW_BINDING_IMAGES}},
        [this](graph::PassContext& pc) {
@@ -191,6 +194,7 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
        {{in.layers, Use::storage_read, LABEL_DRAW_BINDING_LAYERS},
         {in.labels, Use::storage_read, LABEL_DRAW_BINDING_LABELS},
         {in.placements, Use::storage_read, LABEL_DRAW_BINDING_PLACEMENTS},
+        {in.covers, Use::storage_read, LABEL_DRAW_BINDING_COVERS},
         {in.output, Use::storage_write, LABEL_DRAW_BINDING_FINAL}},
        [this](graph::PassContext& pc) {
          pc.dispatch(composite_, params(pc.viewport), {pc.viewport.width, pc.viewport.height, 1});
@@ -268,24 +272,29 @@ std::vector<glm::vec4> ghost_reference(std::span<const glm::vec4> layers, graph:
   return out;
 }
 
-std::vector<float> front_alpha_reference(std::span<const glm::vec4> layers, graph::Extent size,
-                                         uint32_t layer_count,
-                                         std::span<const gpu::LabelGpu> labels) {
+std::vector<gpu::AnchorCoverGpu> anchor_cover_reference(std::span<const glm::vec4> layers,
+                                                        std::span<const float> depth,
+                                                        graph::Extent size, uint32_t layer_count,
+                                                        const gpu::FrameGpu& frame,
+                                                        std::span<const gpu::LabelGpu> labels) {
   check_layers(layers, size, layer_count);
   const size_t pixels = size_t{size.width} * size.height;
-  std::vector<float> out;
+  if (depth.size() != pixels) throw Error("labels: the depth image is not the layers' size");
+  std::vector<gpu::AnchorCoverGpu> out;
   for (const gpu::LabelGpu& l : labels) {
     const glm::vec2 a = glm::floor(l.anchor);
     if (a.x < 0.0f || a.y < 0.0f || a.x >= float(size.width) || a.y >= float(size.height)) {
-      out.push_back(0.0f);
+      out.push_back({0.0f, 0.0f});
       continue;
     }
     const size_t p = size_t(a.y) * size.width + size_t(a.x);
+    const uint32_t layer = std::min({l.layer, layer_count, uint32_t(VR_MAX_LAYERS)});
     float front = 0.0f;
-    for (uint32_t k = 0; k < std::min(l.layer, layer_count); ++k) {
-      front += (1.0f - front) * layers[k * pixels + p].a;
-    }
-    out.push_back(front);
+    for (uint32_t k = 0; k < layer; ++k) front += (1.0f - front) * layers[k * pixels + p].a;
+    glm::vec4 splits[2] = {frame.splits[0], frame.splits[1]};
+    const float near = layer > 0 ? gpu::split_depth(splits, layer - 1) : frame.near_depth;
+    out.push_back({front, gpu::anchor_hidden(front, depth[p], l.anchor_depth, near,
+                                             frame.depth_alpha, frame.step)});
   }
   return out;
 }
@@ -310,8 +319,9 @@ std::vector<uint8_t> composite_reference(std::span<const glm::vec4> layers, grap
     for (size_t i = 0; i < count; ++i) {
       const gpu::LabelGpu& label = data.labels[i];
       if (label.layer >= layer_count) continue;
+      const float hidden = i < data.covers.size() ? data.covers[i].hidden : 0.0f;
       const glm::vec4 behind =
-          gpu::label_behind(label, data.placements[i], centre, front[label.layer]);
+          gpu::label_behind(label, data.placements[i], centre, front[label.layer], hidden);
       c = glm::vec4(glm::vec3(gpu::label_over(behind, c)), 1.0f);
     }
     for (int ch = 0; ch < 4; ++ch) {

@@ -1,10 +1,13 @@
 // Labels drawn into the depth layers, then the layers composited into the final image (the
 // thesis's depth cue: a label on a rear layer is partly covered by what lies in front of it).
-//   labels.ghost      with ghosting on: the layers in front of each shown rear label made more
-//                     transparent around its anchor and connector, in place (shared/ghost.h)
-//   labels.draw       per pixel of each layer: its shown labels (connector, box, text, anchor
-//                     marker) over the layer's content, in place
-//   labels.composite  the layers front to back over the background into an rgba8 image
+//   labels.ghost         with ghosting on: the layers in front of each shown rear label made more
+//                        transparent around its anchor and connector, in place (shared/ghost.h)
+//   labels.anchor_cover  per label: what hides its anchor (AnchorCoverGpu: the layers in front
+//                        as the lenses leave them, and whether the anchor is hidden)
+//   labels.draw          per pixel of each layer: its shown labels (connector, box, text, anchor
+//                        mark; dashed and hollow where the anchor is hidden) over the layer's
+//                        content, in place
+//   labels.composite     the layers front to back over the background into an rgba8 image
 // The shapes and the per-pixel loop are shared with the CPU reference below
 // (shaders/shared/label_drawing.h, label_draw_pixel.h).
 #pragma once
@@ -53,12 +56,14 @@ class LabelDrawing {
     graph::ResourceId glyphs;      // GlyphGpu[], with content
     graph::ResourceId output;      // a viewport-sized rgba8 image the composite overwrites
     glm::vec3 background{0.0f};
-    bool ghost = false;  // with the ghosting pass (its settings: set_ghost)
-    // A float per label, written after the ghosting: the alpha of the layers in front of the
-    // label's own at its anchor (labels_front_alpha.comp); 0: not measured.
-    graph::ResourceId front_alpha = 0;
+    bool ghost = false;       // with the ghosting pass (its settings: set_ghost)
+    graph::ResourceId depth;  // the renderer's r32f depth image (VolumeRenderer::Outputs)
+    graph::ResourceId frame;  // the renderer's FrameGpu: layer splits, ray step, depth_alpha
+    // An AnchorCoverGpu per label, written after the ghosting (labels_anchor_cover.comp) and read
+    // by the drawing; the caller sizes it and may read it back.
+    graph::ResourceId covers;
   };
-  // Adds both passes; the font and image atlases are imported with their handles.
+  // Adds the passes; the font and image atlases are imported with their handles.
   void add_to(graph::Graph& graph, const Inputs& in);
 
   // New font and image atlases (new label texts): uploaded into new images, which bind() hands
@@ -85,7 +90,7 @@ class LabelDrawing {
   std::optional<Image> images_;
   graph::ResourceId atlas_id_ = 0, images_id_ = 0;  // as imported into the graph last built
   ComputePipeline ghost_pipeline_;
-  ComputePipeline front_alpha_;
+  ComputePipeline anchor_cover_;
   ComputePipeline draw_;
   ComputePipeline composite_;
   GhostSettings ghost_;
@@ -101,6 +106,8 @@ struct LabelDrawData {
   std::span<const gpu::PlacementGpu> placements;
   std::span<const gpu::GlyphGpu> glyphs;
   bool layer_frames = false;  // as LabelDrawing::set_layer_frames
+  // What hides each label's anchor (anchor_cover_reference); none: every anchor is seen.
+  std::span<const gpu::AnchorCoverGpu> covers = {};
 };
 
 // labels.draw on the CPU. `layers` holds layer_count images of `size`, layer after layer, rows
@@ -110,11 +117,14 @@ std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, 
                                              uint32_t layer_count, const LabelDrawData& data,
                                              const FontAtlas& font, const ImageAtlas& images = {});
 
-// labels.front_alpha on the CPU: for each label, the composited alpha of the layers in front of
-// its own at the pixel of its anchor (0 outside the image).
-std::vector<float> front_alpha_reference(std::span<const glm::vec4> layers, graph::Extent size,
-                                         uint32_t layer_count,
-                                         std::span<const gpu::LabelGpu> labels);
+// labels.anchor_cover on the CPU: for each label, the composited alpha of the layers in front of
+// its own at the pixel of its anchor and how hidden the anchor is (0 outside the image). `depth`:
+// the depth image, a float per pixel; `frame`: the layer splits, near plane, step and depth_alpha.
+std::vector<gpu::AnchorCoverGpu> anchor_cover_reference(std::span<const glm::vec4> layers,
+                                                        std::span<const float> depth,
+                                                        graph::Extent size, uint32_t layer_count,
+                                                        const gpu::FrameGpu& frame,
+                                                        std::span<const gpu::LabelGpu> labels);
 
 // labels.ghost on the CPU: the layers (shaped as for draw_labels_reference) with ghosting
 // applied, rounded to half precision.

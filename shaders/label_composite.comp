@@ -4,13 +4,17 @@
 #include "shared/volume_render.h"  // VR_MAX_LAYERS
 
 // The depth layers, labels drawn, composited front to back (layer 0 is nearest) over the
-// background: the final image. Then, on top, the connectors and anchors of rear labels where the
-// layers in front of theirs hide them (label_behind): every leader can be followed to its anchor.
+// background: the final image. Then, on top, the connectors and anchors' marks of rear labels where
+// the layers in front of theirs hide them (label_behind): every leader can be followed to its
+// anchor.
 layout(local_size_x = LABEL_DRAW_GROUP, local_size_y = LABEL_DRAW_GROUP) in;
 layout(binding = LABEL_DRAW_BINDING_LAYERS, rgba16f) readonly uniform image2DArray layers;
 layout(binding = LABEL_DRAW_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
 layout(binding = LABEL_DRAW_BINDING_PLACEMENTS, std430) readonly buffer Placements {
   PlacementGpu placements[];
+};
+layout(binding = LABEL_DRAW_BINDING_COVERS, std430) readonly buffer Covers {
+  AnchorCoverGpu covers[];
 };
 layout(binding = LABEL_DRAW_BINDING_FINAL, rgba8) writeonly uniform image2D final_image;
 layout(push_constant) uniform Push { LabelDrawParams params; };
@@ -21,8 +25,9 @@ shared uint tile_labels[LABEL_MAX / 32u];
 void main() {
   const uint lane = gl_LocalInvocationIndex;
   const uint lanes = LABEL_DRAW_GROUP * LABEL_DRAW_GROUP;
-  const uint count = min(min(params.label_count, LABEL_MAX),
-                         uint(min(labels.length(), placements.length())));
+  const uint count =
+      min(min(params.label_count, LABEL_MAX),
+          uint(min(min(labels.length(), placements.length()), covers.length())));
   const uint words = (count + 31u) / 32u;  // (the bit set's words in use: only those are cleared)
   for (uint w = lane; w < words; w += lanes) tile_labels[w] = 0u;
   barrier();
@@ -58,7 +63,8 @@ void main() {
     while (bits != 0u) {
       const uint i = w * 32u + uint(findLSB(bits));
       bits &= bits - 1u;
-      const vec4 behind = label_behind(labels[i], placements[i], p, front[labels[i].layer]);
+      const vec4 behind =
+          label_behind(labels[i], placements[i], p, front[labels[i].layer], covers[i].hidden);
       result = vec4(vec3(label_over(behind, result)), 1.0);
     }
   }

@@ -12,6 +12,9 @@ layout(binding = LABEL_DRAW_BINDING_PLACEMENTS, std430) readonly buffer Placemen
   PlacementGpu placements[];
 };
 layout(binding = LABEL_DRAW_BINDING_GLYPHS, std430) readonly buffer Glyphs { GlyphGpu glyphs[]; };
+layout(binding = LABEL_DRAW_BINDING_COVERS, std430) readonly buffer Covers {
+  AnchorCoverGpu covers[];
+};
 layout(binding = LABEL_DRAW_BINDING_ATLAS) uniform sampler2D atlas;
 layout(binding = LABEL_DRAW_BINDING_IMAGES) uniform sampler2D images;
 layout(push_constant) uniform Push { LabelDrawParams params; };
@@ -26,6 +29,7 @@ GlyphGpu glyph_at(uint i) { return glyphs[i]; }
 float atlas_coverage(vec2 uv) { return textureLod(atlas, uv, 0.0).r; }
 vec4 image_texel(vec2 uv) { return textureLod(images, uv, 0.0); }
 bool layer_frames() { return params.layer_frames != 0u; }
+float anchor_hidden_at(uint i) { return i < uint(covers.length()) ? covers[i].hidden : 0.0; }
 
 #include "shared/label_draw_pixel.h"
 

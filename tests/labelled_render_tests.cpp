@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 
@@ -14,6 +15,7 @@
 #include "gpu_fixture.h"
 #include "labeling/labelled_render.h"
 #include "labeling/placement_beside.h"
+#include "shared/label_drawing.h"
 
 namespace strata {
 
@@ -158,8 +160,8 @@ TEST_SUITE("gpu") {
       const Scene scene = load_scene(std::string(STRATA_SOURCE_DIR "/assets/scenes/") + file);
       LabelledRenderer renderer(ctx, scene, camera_for(scene, "front"), {64, 64}, {});
       const graph::GraphRunner& runner = renderer.runner();
-      CHECK(runner.graph().passes().size() == 25);  // (with picking, labels.ghost, .front_alpha)
-      CHECK(graph::barrier_count(runner.compiled()) == 59);
+      CHECK(runner.graph().passes().size() == 25);  // (with picking, labels.ghost, .anchor_cover)
+      CHECK(graph::barrier_count(runner.compiled()) == 60);
       const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
       CHECK(loop.name == "placement.labels");
     }
@@ -237,7 +239,8 @@ TEST_SUITE("gpu") {
   TEST_CASE_FIXTURE(test::GpuTest, "ghosting_opens_rear_anchors_and_leaves_the_rest_unchanged") {
     // head.json from the front at 192²: with ghosting the layers in front of the shown rear
     // labels' anchors open; the placement is the same, and so is every pixel of every layer
-    // farther than two lens radii from all of those anchors.
+    // farther than two lens radii from all of those anchors and off their connectors (an anchor
+    // the lens opens is no longer hidden: its connector is drawn solid, not dashed).
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
     const graph::Extent size{192, 192};
     const Camera camera = camera_for(scene, "front");
@@ -249,6 +252,7 @@ TEST_SUITE("gpu") {
     const LabelledFrame before = a.result(), after = b.result();
     REQUIRE(before.layering.layer_count == after.layering.layer_count);
     std::vector<glm::vec2> rear;
+    std::vector<std::array<glm::vec2, 2>> connectors;
     size_t seen_before = 0, seen_after = 0;
     for (size_t i = 0; i < before.labels.size(); ++i) {
       const LabelLayout &x = before.labels[i], &y = after.labels[i];
@@ -257,6 +261,8 @@ TEST_SUITE("gpu") {
       CHECK(x.box_origin == y.box_origin);
       if (!x.placed || x.layer == 0) continue;
       rear.push_back(x.anchor);
+      connectors.push_back(
+          {x.anchor, glm::clamp(x.anchor, x.box_origin, x.box_origin + x.box_size)});
       seen_before += x.front_alpha <= 0.3f ? 1 : 0;
       seen_after += y.front_alpha <= 0.3f ? 1 : 0;
       CHECK(y.front_alpha <= x.front_alpha);
@@ -273,7 +279,10 @@ TEST_SUITE("gpu") {
     for (size_t q = 0; q < pixels; ++q) {
       const glm::vec2 p(float(q % size.width) + 0.5f, float(q / size.width) + 0.5f);
       if (std::any_of(rear.begin(), rear.end(),
-                      [&](glm::vec2 anchor) { return glm::length(p - anchor) <= far; })) {
+                      [&](glm::vec2 anchor) { return glm::length(p - anchor) <= far; }) ||
+          std::any_of(connectors.begin(), connectors.end(), [&](const auto& c) {
+            return gpu::label_segment_distance(p, c[0], c[1]) <= 3.0f;
+          })) {
         continue;
       }
       ++compared;

@@ -123,6 +123,38 @@ TEST_SUITE("cpu") {
                       doctest::Contains("labels[0].front_alpha: expected a number from 0 to 1"));
   }
 
+  TEST_CASE("anchor_hidden_is_written_read_back_and_counted_over_shown_labels") {
+    // Hidden anchors (two shown, one not shown), a seen one and one not measured: the file says
+    // which (null where not measured), reads back the same, and eval counts the shown hidden ones.
+    LabelledFrame frame;
+    frame.size = {80, 48};
+    const std::optional<bool> hidden[5] = {true, true, true, false, std::nullopt};
+    for (int i = 0; i < 5; ++i) {
+      LabelLayout l;
+      l.id = i + 1;
+      l.box_origin = {float(i * 15), 4.0f};
+      l.box_size = {10.0f, 8.0f};
+      l.placed = l.shown = i != 2;
+      l.opacity = l.placed ? 1.0f : 0.0f;
+      l.anchor_hidden = hidden[i];
+      frame.labels.push_back(l);
+    }
+    const nlohmann::json layout = nlohmann::json::parse(layout_json(frame));
+    CHECK(layout["labels"][0]["anchor_hidden"] == true);
+    CHECK(layout["labels"][3]["anchor_hidden"] == false);
+    CHECK(layout["labels"][4]["anchor_hidden"].is_null());
+    const Layout read = parse_layout(layout, "frame.json");
+    for (size_t i = 0; i < 5; ++i) CHECK(read.labels[i].anchor_hidden == hidden[i]);
+    const FrameMetrics m = frame_metrics(read);
+    CHECK(m.anchors_hidden == 2);
+    CHECK(to_json(m)["anchors_hidden"] == 2);
+    CHECK(sum_frame_metrics({m, m}).anchors_hidden == 4);
+    nlohmann::json bad = layout;
+    bad["labels"][0]["anchor_hidden"] = 1;
+    CHECK_THROWS_WITH(parse_layout(bad, "frame.json"),
+                      doctest::Contains("labels[0].anchor_hidden: expected true or false"));
+  }
+
   TEST_CASE("layout_json_writes_non_finite_numbers_as_null") {
     // JSON has no inf or NaN: a label that was never placed must not make the file unreadable.
     LabelledFrame frame;

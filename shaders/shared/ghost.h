@@ -18,11 +18,9 @@
 #include "volume_render.h"  // VR_MAX_LAYERS
 
 #define GHOST_GROUP 16
-#define GHOST_BINDING_LAYERS 0       // rgba16f 2D array, premultiplied, changed in place
-#define GHOST_BINDING_LABELS 1       // LabelGpu[]
-#define GHOST_BINDING_PLACEMENTS 2   // PlacementGpu[]: where the labels are drawn, their opacity
-#define GHOST_BINDING_FRONT_ALPHA 3  // float[] per label (labels_front_alpha.comp)
-#define GHOST_FRONT_ALPHA_GROUP 64
+#define GHOST_BINDING_LAYERS 0      // rgba16f 2D array, premultiplied, changed in place
+#define GHOST_BINDING_LABELS 1      // LabelGpu[]
+#define GHOST_BINDING_PLACEMENTS 2  // PlacementGpu[]: where the labels are drawn, their opacity
 
 STRATA_BEGIN
 

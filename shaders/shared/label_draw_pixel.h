@@ -8,6 +8,7 @@
 //   float atlas_coverage(vec2 uv)      the font atlas, bilinear, clamped to its edge
 //   vec4 image_texel(vec2 uv)          the image atlas (premultiplied), bilinear, clamped likewise
 //   bool layer_frames()                borders in their layer's colour
+//   float anchor_hidden_at(uint i)     how hidden label i's anchor is (AnchorCoverGpu::hidden)
 
 // Text coverage of a label at p. Glyph quads overlap only in their zero-coverage borders, so the
 // largest coverage is the text's.
@@ -43,8 +44,9 @@ vec4 image_color(vec2 p, vec2 top_left, LabelGpu label) {
 }
 
 // Label i drawn over `content` (premultiplied) at pixel centre p if it is shown on `layer`, as
-// opaque as its placement says. External labels: connector, box, picture, text, then the anchor
-// marker on top. Internal labels: the box centred on the anchor, no connector or marker.
+// opaque as its placement says. External labels: connector, box, picture, text, then the anchor's
+// mark on top (the connector dashed and the mark hollow where the anchor is hidden). Internal
+// labels: the box centred on the anchor, no connector or mark.
 vec4 draw_label_at(uint i, vec2 p, uint layer, vec4 content) {
   LabelGpu label = label_at(i);
   if ((label.flags & LABEL_ENABLED) == 0u || label.layer != layer) return content;
@@ -53,13 +55,14 @@ vec4 draw_label_at(uint i, vec2 p, uint layer, vec4 content) {
   bool is_internal = (label.flags & LABEL_INTERNAL) != 0u;
   vec2 centre = is_internal ? label.anchor : placement.position;
   if (label_far_from(p, label.anchor, centre, label.size)) return content;
+  float hidden = is_internal ? 0.0f : anchor_hidden_at(i);
   vec4 color = label_frame(p, label.anchor, centre, label.size, !is_internal,
-                           label_border_color(label.layer, layer_frames()));
+                           label_border_color(label.layer, layer_frames()), hidden);
   vec2 top_left = centre - 0.5f * label.size;
   color = label_over(image_color(p, top_left, label), color);
   float text = text_coverage(p, top_left, label);
   color = label_over(label_premultiplied(LABEL_TEXT_COLOR, text), color);
-  if (!is_internal) color = label_over(label_anchor_marker(p, label.anchor), color);
+  if (!is_internal) color = label_over(label_anchor_mark(p, label.anchor, hidden), color);
   return label_over(color * placement.opacity, content);  // (premultiplied: a fade)
 }
 

@@ -17,6 +17,15 @@
 #define LABEL_DRAW_BINDING_ATLAS 4       // R8 font coverage, sampled bilinearly
 #define LABEL_DRAW_BINDING_FINAL 5       // rgba8: the layers composited over the background
 #define LABEL_DRAW_BINDING_IMAGES 6      // rgba8 label pictures, premultiplied, sampled bilinearly
+#define LABEL_DRAW_BINDING_COVERS 7      // AnchorCoverGpu[], one per label
+
+// labels.anchor_cover (labels_anchor_cover.comp): what hides each label's anchor.
+#define ANCHOR_COVER_GROUP 64
+#define ANCHOR_COVER_BINDING_LAYERS 0  // rgba16f 2D array, as the ghosting leaves it
+#define ANCHOR_COVER_BINDING_LABELS 1  // LabelGpu[]
+#define ANCHOR_COVER_BINDING_DEPTH 2   // r32f: the renderer's depth image
+#define ANCHOR_COVER_BINDING_FRAME 3   // FrameGpu (uniform): layer splits, step, depth_alpha
+#define ANCHOR_COVER_BINDING_COVERS 4  // AnchorCoverGpu[], written
 
 STRATA_BEGIN
 
@@ -30,6 +39,12 @@ struct LabelDrawParams {
   uint pad0;
   uint pad1;
   uint pad2;
+};
+
+// What hides a label's anchor, measured after the ghosting and before the labels are drawn.
+struct AnchorCoverGpu {
+  float front_alpha;  // the layers in front of the label's own, composited, at the anchor's pixel
+  float hidden;       // 0 (seen) to 1 (hidden): anchor_hidden; hidden from LABEL_HIDDEN_AT on
 };
 
 // The look of a label. Colours are straight alpha.
@@ -57,15 +72,36 @@ const vec4 LABEL_MARKER_COLOR = vec4(1.0f, 1.0f, 1.0f, 1.0f);
 const vec4 LABEL_MARKER_OUTLINE_COLOR = vec4(0.05f, 0.05f, 0.05f, 1.0f);
 const float LABEL_MARKER_RADIUS = 4.0f;
 const float LABEL_MARKER_OUTLINE = 1.5f;
-// Where a rear label's connector or anchor lies behind content of the layers in front of its own,
-// the composite draws it again on top, dashed, with a dark halo, fading in as that content gets
-// opaque (front alpha from LABEL_BEHIND_FROM to LABEL_BEHIND_TO) up to LABEL_BEHIND_OPACITY.
+// A hidden anchor's mark is hollow, as medical illustration marks what lies behind a surface: a
+// white band LABEL_RING_BAND wide around a circle of LABEL_RING_RADIUS, outlined dark on both
+// sides, the content seen through its middle.
+const float LABEL_RING_RADIUS = 3.5f;
+const float LABEL_RING_BAND = 1.5f;
+const float LABEL_RING_OUTLINE = 0.75f;
+// How far from its anchor a mark reaches, filled or hollow (the ring is the larger).
+const float LABEL_ANCHOR_REACH = LABEL_RING_RADIUS + 0.5f * LABEL_RING_BAND + LABEL_RING_OUTLINE;
+// A dashed connector: white dashes LABEL_DASH_ON long every LABEL_DASH pixels from the anchor's
+// mark on, with a dark halo. A label whose anchor is hidden (anchor_hidden) draws its connector
+// so in its own layer, and its anchor's mark hollow. Where a rear label's connector or anchor
+// lies behind content of the layers in front of its own, the composite draws them again on top,
+// fading in as that content gets opaque (front alpha from LABEL_BEHIND_FROM to LABEL_BEHIND_TO)
+// up to LABEL_BEHIND_OPACITY.
 const vec4 LABEL_HALO_COLOR = vec4(0.0f, 0.0f, 0.0f, 0.8f);
 const float LABEL_HALO_WIDTH = 1.0f;
-const float LABEL_DASH = 8.0f;  // pixels: a dash about 3 long, then a gap
+const float LABEL_DASH = 7.0f;
+const float LABEL_DASH_ON = 4.0f;
 const float LABEL_BEHIND_FROM = 0.15f;
 const float LABEL_BEHIND_TO = 0.6f;
 const float LABEL_BEHIND_OPACITY = 0.85f;
+// An anchor counts as hidden (a layout's anchor_hidden) from AnchorCoverGpu::hidden
+// LABEL_HIDDEN_AT on: where the picture as drawn is at least the renderer's depth_alpha opaque in
+// front of it (anchor_hidden). The drawing changes over ramps around that threshold, so a label
+// turns dashed smoothly as the camera moves: front alpha within LABEL_HIDDEN_ALPHA_RAMP of
+// depth_alpha; an opaque depth from LABEL_HIDDEN_DEPTH_STEPS to twice as many ray steps in front
+// of the anchor (less is the anchor's own surface: an anchor picked on a surface is seen).
+const float LABEL_HIDDEN_AT = 0.5f;
+const float LABEL_HIDDEN_ALPHA_RAMP = 0.1f;
+const float LABEL_HIDDEN_DEPTH_STEPS = 2.0f;
 
 // Eq. 3.9's "over" for premultiplied colours, front to back.
 STRATA_INLINE vec4 label_over(vec4 front, vec4 back) {
@@ -95,16 +131,45 @@ STRATA_INLINE float label_box_distance(vec2 p, vec2 centre, vec2 half_size, floa
   return length(max(q, vec2(0.0f))) + min(max(q.x, q.y), 0.0f) - radius;
 }
 
+// How much of a dash covers p, `along` pixels from the anchor along the connector: none within
+// the anchor's mark, then a dash from its edge on; a ramp at each end (no step for CPU and GPU
+// rounding to land on).
+STRATA_INLINE float label_dash(float along) {
+  float s = along - LABEL_ANCHOR_REACH;
+  float phase = s - LABEL_DASH * floor(s / LABEL_DASH) - 0.5f * LABEL_DASH_ON;
+  if (phase > 0.5f * LABEL_DASH) phase -= LABEL_DASH;
+  float dash = clamp(0.5f * LABEL_DASH_ON + 0.5f - abs(phase), 0.0f, 1.0f);
+  return min(dash, clamp(s + 0.5f, 0.0f, 1.0f));
+}
+
+// The connector from the anchor to `end` at p, dashed, with a halo, premultiplied.
+STRATA_INLINE vec4 label_dashed_connector(vec2 p, vec2 anchor, vec2 end) {
+  vec2 ab = end - anchor;
+  float length2 = dot(ab, ab);
+  float along = length2 > 0.0f ? dot(p - anchor, ab) / sqrt(length2) : 0.0f;
+  float dash = label_dash(along);
+  float d = label_segment_distance(p, anchor, end);
+  vec4 color = label_premultiplied(
+      LABEL_HALO_COLOR, dash * label_edge_coverage(d - LABEL_LINE_HALF_WIDTH - LABEL_HALO_WIDTH));
+  return label_over(
+      label_premultiplied(LABEL_LINE_COLOR, dash * label_edge_coverage(d - LABEL_LINE_HALF_WIDTH)),
+      color);
+}
+
 // The connector (from the anchor to the nearest point of the box), the box and its border at p,
-// premultiplied: everything of a label but its text and anchor marker.
+// premultiplied: everything of a label but its text and anchor mark. The connector is solid,
+// dashed as far as the anchor is hidden (anchor_hidden: 0 to 1).
 STRATA_INLINE vec4 label_frame(vec2 p, vec2 anchor, vec2 centre, vec2 size, bool connector,
-                               vec4 border) {
+                               vec4 border, float anchor_hidden) {
   vec2 half_size = 0.5f * size;
   vec4 color = vec4(0.0f);
   if (connector) {
     vec2 end = clamp(anchor, centre - half_size, centre + half_size);
     float d = label_segment_distance(p, anchor, end);
     color = label_premultiplied(LABEL_LINE_COLOR, label_edge_coverage(d - LABEL_LINE_HALF_WIDTH));
+    if (anchor_hidden > 0.0f) {
+      color = mix(color, label_dashed_connector(p, anchor, end), anchor_hidden);
+    }
   }
   float d = label_box_distance(p, centre, half_size, LABEL_BOX_RADIUS);
   float outer = label_edge_coverage(d);
@@ -123,19 +188,50 @@ STRATA_INLINE vec4 label_anchor_marker(vec2 p, vec2 anchor) {
                     rim);
 }
 
-// How much of a dash covers p, `along` pixels from the anchor along the connector: a ramp at each
-// end (no step for CPU and GPU rounding to land on).
-STRATA_INLINE float label_dash(float along) {
-  float phase = along - LABEL_DASH * floor(along / LABEL_DASH) - 2.0f;
-  if (phase > 0.5f * LABEL_DASH) phase -= LABEL_DASH;
-  return clamp(2.0f - abs(phase), 0.0f, 1.0f);
+// A hidden anchor's ring, premultiplied.
+STRATA_INLINE vec4 label_anchor_ring(vec2 p, vec2 anchor) {
+  float band = abs(length(p - anchor) - LABEL_RING_RADIUS);  // (from the ring's middle)
+  vec4 outline =
+      label_premultiplied(LABEL_MARKER_OUTLINE_COLOR,
+                          label_edge_coverage(band - 0.5f * LABEL_RING_BAND - LABEL_RING_OUTLINE));
+  return label_over(
+      label_premultiplied(LABEL_MARKER_COLOR, label_edge_coverage(band - 0.5f * LABEL_RING_BAND)),
+      outline);
+}
+
+// The anchor's mark: filled, hollow as far as the anchor is hidden (0 to 1).
+STRATA_INLINE vec4 label_anchor_mark(vec2 p, vec2 anchor, float anchor_hidden) {
+  vec4 filled = label_anchor_marker(p, anchor);
+  return anchor_hidden > 0.0f ? mix(filled, label_anchor_ring(p, anchor), anchor_hidden) : filled;
+}
+
+// How hidden an anchor is, 0 to 1 (hidden from LABEL_HIDDEN_AT on), by two measures, the larger:
+// the layers in front of the label's own as the ghosting leaves them (`front_alpha`), against
+// depth_alpha; and the depth image (`depth`: where the picture before ghosting first reaches
+// depth_alpha, 0 where it never does), where that depth lies in the label's own layer (from
+// `layer_near` on: ghosting opens only the layers in front of it) and in front of the anchor.
+// The second counts what lies in front before ghosting: where a lens opens layers in front that
+// helped the depth image's sum reach depth_alpha in the label's own layer, it may call hidden an
+// anchor that the opened picture shows through a thinner own layer (the frame has no depth image
+// of the ghosted picture).
+STRATA_INLINE float anchor_hidden(float front_alpha, float depth, float anchor_depth,
+                                  float layer_near, float depth_alpha, float step) {
+  float by_front = smoothstep(depth_alpha - LABEL_HIDDEN_ALPHA_RAMP,
+                              depth_alpha + LABEL_HIDDEN_ALPHA_RAMP, front_alpha);
+  float by_own_layer = 0.0f;
+  if (depth > 0.0f && depth >= layer_near && step > 0.0f) {
+    float steps = (anchor_depth - depth) / step;
+    by_own_layer = clamp(steps / LABEL_HIDDEN_DEPTH_STEPS - 1.0f, 0.0f, 1.0f);
+  }
+  return max(by_front, by_own_layer);
 }
 
 // What the composite draws over the final image for a label on a rear layer (layer > 0) at p,
-// premultiplied: its connector dashed with a halo, and its anchor marker, as far as the layers in
+// premultiplied: its connector dashed with a halo, and its anchor's mark, as far as the layers in
 // front of its own hide them there (`front_alpha`: their composite alpha at p). Nothing for front,
 // internal, disabled or hidden labels.
-STRATA_INLINE vec4 label_behind(LabelGpu label, PlacementGpu placement, vec2 p, float front_alpha) {
+STRATA_INLINE vec4 label_behind(LabelGpu label, PlacementGpu placement, vec2 p, float front_alpha,
+                                float anchor_hidden) {
   if ((label.flags & LABEL_ENABLED) == 0u || (label.flags & LABEL_INTERNAL) != 0u ||
       label.layer == 0u || placement.shown != PLACEMENT_SHOWN) {
     return vec4(0.0f);
@@ -144,24 +240,15 @@ STRATA_INLINE vec4 label_behind(LabelGpu label, PlacementGpu placement, vec2 p, 
   if (hidden <= 0.0f) return vec4(0.0f);
   vec2 half_size = 0.5f * label.size;
   vec2 end = clamp(label.anchor, placement.position - half_size, placement.position + half_size);
-  vec2 ab = end - label.anchor;
-  float length2 = dot(ab, ab);
-  float along = length2 > 0.0f ? dot(p - label.anchor, ab) / sqrt(length2) : 0.0f;
-  float dash = label_dash(along);
-  float d = label_segment_distance(p, label.anchor, end);
-  vec4 color = label_premultiplied(
-      LABEL_HALO_COLOR, dash * label_edge_coverage(d - LABEL_LINE_HALF_WIDTH - LABEL_HALO_WIDTH));
-  color = label_over(
-      label_premultiplied(LABEL_LINE_COLOR, dash * label_edge_coverage(d - LABEL_LINE_HALF_WIDTH)),
-      color);
-  color = label_over(label_anchor_marker(p, label.anchor), color);
+  vec4 color = label_dashed_connector(p, label.anchor, end);
+  color = label_over(label_anchor_mark(p, label.anchor, anchor_hidden), color);
   return color * (hidden * LABEL_BEHIND_OPACITY * placement.opacity);
 }
 
 // True when p lies outside everything a label draws (box, connector, marker and their ramps), so
 // the label's shapes need not be evaluated there: they would all be exactly zero.
 STRATA_INLINE bool label_far_from(vec2 p, vec2 anchor, vec2 centre, vec2 size) {
-  float margin = LABEL_MARKER_RADIUS + 1.0f;
+  float margin = LABEL_ANCHOR_REACH + 1.0f;
   vec2 lo = min(centre - 0.5f * size, anchor) - margin;
   vec2 hi = max(centre + 0.5f * size, anchor) + margin;
   return p.x < lo.x || p.y < lo.y || p.x > hi.x || p.y > hi.y;
@@ -192,7 +279,7 @@ STRATA_INLINE bool label_segment_misses_box(vec2 a, vec2 b, vec2 lo, vec2 hi) {
 // the connector never comes near.
 STRATA_INLINE bool label_far_from_tile(vec2 tile_lo, vec2 tile_hi, vec2 anchor, vec2 centre,
                                        vec2 size) {
-  float margin = LABEL_MARKER_RADIUS + 1.0f;  // (label_far_from's rectangle first)
+  float margin = LABEL_ANCHOR_REACH + 1.0f;  // (label_far_from's rectangle first)
   vec2 lo = min(centre - 0.5f * size, anchor) - margin;
   vec2 hi = max(centre + 0.5f * size, anchor) + margin;
   if (tile_hi.x < lo.x || tile_hi.y < lo.y || tile_lo.x > hi.x || tile_lo.y > hi.y) return true;
@@ -204,7 +291,7 @@ STRATA_INLINE bool label_far_from_tile(vec2 tile_lo, vec2 tile_hi, vec2 anchor, 
         tile_lo.y > centre.y + half_size.y + box_margin)) {
     return false;
   }
-  float marker_margin = LABEL_MARKER_RADIUS + 1.5f;
+  float marker_margin = LABEL_ANCHOR_REACH + 1.5f;
   if (!(tile_hi.x < anchor.x - marker_margin || tile_lo.x > anchor.x + marker_margin ||
         tile_hi.y < anchor.y - marker_margin || tile_lo.y > anchor.y + marker_margin)) {
     return false;
