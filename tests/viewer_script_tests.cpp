@@ -9,6 +9,7 @@
 
 #include "app/viewer_script.h"
 #include "engine/core/error.h"
+#include "engine/scene/scene.h"
 #include "gpu_fixture.h"
 #include "test_files.h"
 
@@ -132,6 +133,16 @@ TEST_SUITE("cpu") {
     CHECK(parse_error("clip 0 0 0 1").find("demo.txt:2: 'clip' takes the form") == 0);
     CHECK(parse_error("clip 0 0 0 0 0 0").find("demo.txt:2: 'clip': the normal") == 0);
     CHECK(parse_error("clip 0 0 0 0 0 inf").find("demo.txt:2: 'inf' is not a number") == 0);
+  }
+
+  // --clip's rule: a normal no longer than 1e-6 gives no direction.
+  TEST_CASE("viewer_script_clip_refuses_the_normals_that_clip_option_calls_zero") {
+    const std::string zero = "demo.txt:2: 'clip': the normal (NX NY NZ) must not be zero";
+    CHECK(parse_error("clip 0 0 0 1e-7 0 0").find(zero) == 0);
+    CHECK(parse_error("clip 0 0 0 0 -1e-7 1e-7").find(zero) == 0);
+    CHECK(parse_viewer_script("clip 0 0 0 1e-5 0 0\n", "demo.txt").size() == 1);
+    CHECK(!clip_normal_usable({1e-7f, 0.0f, 0.0f}));
+    CHECK(clip_normal_usable({1e-5f, 0.0f, 0.0f}));
   }
 
   TEST_CASE("viewer_script_parser_refuses_unknown_names_before_anything_runs") {
