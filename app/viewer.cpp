@@ -936,9 +936,14 @@ bool Viewer::busy() const {
          labelled_->trial_finished();
 }
 
+// (not while recording: a video's frames are a fixed time step apart, trials would be in them)
+bool Viewer::optimisation_pending() const {
+  return options_.optimize_on_idle && !optimisation_.done && scene_.labels.size() >= 2 && !video_;
+}
+
+// (baseline: a settled normal frame's cost)
 bool Viewer::optimisation_due() const {
-  const Optimisation& o = optimisation_;
-  return options_.optimize_on_idle && !o.done && scene_.labels.size() >= 2 && o.baseline >= 0.0 &&
+  return optimisation_pending() && optimisation_.baseline >= 0.0 &&
          seconds_between(last_change_, Clock::now()) >= options_.idle_seconds;
 }
 
@@ -972,7 +977,7 @@ std::string Viewer::unsettled() const {
 }
 
 std::optional<double> Viewer::wake_in() const {
-  if (!options_.optimize_on_idle || optimisation_.done || scene_.labels.size() < 2) return {};
+  if (!optimisation_pending()) return {};
   constexpr double kTrialPoll = 0.01;  // (a trial placement beside the frames: is it back?)
   if (optimisation_.in_flight >= 0) return kTrialPoll;
   return std::max(0.0, options_.idle_seconds - seconds_between(last_change_, Clock::now()));
@@ -981,12 +986,7 @@ std::optional<double> Viewer::wake_in() const {
 int Viewer::next_trial() {
   Optimisation& o = optimisation_;
   const size_t n = scene_.labels.size();
-  if (!options_.optimize_on_idle || n < 2 || o.done || drag_button_ >= 0 || control_.animating() ||
-      video_) {
-    return -1;
-  }
-  if (seconds_between(last_change_, Clock::now()) < options_.idle_seconds) return -1;
-  if (o.baseline < 0.0) return -1;  // no settled normal frame yet
+  if (!optimisation_due() || drag_button_ >= 0 || control_.animating()) return -1;
   if (o.orders.empty()) {
     for (uint32_t t = 0; t < options_.optimize_tries; ++t) {
       o.orders.push_back(random_order(uint32_t(n), serial_ * 131 + t + 1));

@@ -161,9 +161,9 @@ class Viewer {
   // False: the viewer may sleep until the next event (or wake_in()); a recording draws anyway.
   // (Beside the frames a trial placement runs without frames: none is due meanwhile.)
   bool busy() const;
-  // Nothing will change without input: no frame due, the optimisation on idle finished (or off).
-  // Scripts run their next command at rest.
-  bool at_rest() const { return !busy() && !optimisation_due(); }
+  // Nothing will change without input: no frame due, the optimisation on idle finished (or off,
+  // or paused by a recording). Scripts run their next command at rest.
+  bool at_rest() const { return !busy() && !optimisation_pending(); }
   // Seconds until something happens without input (the optimisation on idle), if anything will.
   std::optional<double> wake_in() const;
   // What keeps the viewer busy, in words ("2 labels moving or fading (Thalamus R, Insula L)").
@@ -279,7 +279,9 @@ class Viewer {
   graph::GraphRunner& prepare(uint32_t slot, graph::Extent extent, double seconds);
   void read_slot(uint32_t slot);
   int next_trial();
-  // The optimisation on idle is due: the view rested, not every trial has come back.
+  // The optimisation on idle is pending (not every trial has come back), and due (the view has
+  // rested since the last change).
+  bool optimisation_pending() const;
   bool optimisation_due() const;
   // Trial `trial`'s cost came back; after the last one the cheapest order is kept if it beats
   // the baseline.

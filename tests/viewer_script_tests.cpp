@@ -176,7 +176,7 @@ TEST_SUITE("window") {
       const auto script = test::write_file(dir / "script.txt", "frames 1\n" + line + "\nquit\n");
       const auto start = std::chrono::steady_clock::now();
       const auto r = test::run_strata("view " STRATA_SOURCE_DIR
-                                      "/assets/scenes/head.json --size 48x32 --no-optimize "
+                                      "/assets/scenes/head.json --size 48x32 "
                                       "--no-panel --script " +
                                       script.string());
       CAPTURE(r.output);
@@ -200,7 +200,7 @@ TEST_SUITE("window") {
                                          "settle-limit 8\ndrag left 20 60 180 60\nkey r\nquit\n");
     const auto start = std::chrono::steady_clock::now();
     const auto r = test::run_strata("view " STRATA_SOURCE_DIR
-                                    "/assets/scenes/head.json --size 200x150 --no-optimize "
+                                    "/assets/scenes/head.json --size 200x150 "
                                     "--no-panel --frame-budget 0 --settle-limit 60 --script " +
                                     script.string());
     CAPTURE(r.output);
