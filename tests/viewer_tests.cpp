@@ -106,6 +106,15 @@ size_t changed_pixels(const Rgba8Image& a, const Rgba8Image& b,
   return n;
 }
 
+// The viewer's camera as a `report` file gives its view matrix (the test scene's lens).
+Camera reported_camera(const std::filesystem::path& report) {
+  const auto json = nlohmann::json::parse(test::read_file(report));
+  Camera camera = load_scene(kScene).camera;
+  for (int col = 0; col < 4; ++col)
+    for (int row = 0; row < 4; ++row) camera.view[col][row] = json.at("view")[col * 4 + row];
+  return camera;
+}
+
 // Runs `strata view` on the test scene with `script` (written into `dir`).
 test::CommandResult view(const std::filesystem::path& dir, const std::string& script,
                          const std::string& options = "--no-panel") {
@@ -192,10 +201,7 @@ TEST_SUITE("window") {
     const auto report = [&](const char* name) {
       return nlohmann::json::parse(test::read_file(dir / name));
     };
-    Camera camera = scene.camera;
-    for (int col = 0; col < 4; ++col)
-      for (int row = 0; row < 4; ++row)
-        camera.view[col][row] = report("r0.json").at("view")[col * 4 + row];
+    const Camera camera = reported_camera(dir / "r0.json");
     const auto pixel = [&](glm::vec3 p) { return project(camera, p, {kWidth, kHeight}).pixel; };
     // The bottom face's handle: its centre; the plane's: the centre of its cut through the
     // content (the content's box at z = 0). Each is dragged 12 px down the picture (towards -z).
@@ -262,15 +268,8 @@ TEST_SUITE("window") {
     }
     CHECK(ras[0].text == "Thalamus R – Ödem \"rechts\"");
     // (each placed or moved anchor projects to the centre of its pixel in its view's camera)
-    const Scene scene = load_scene(kScene);
-    const auto camera_of = [&](const char* report) {
-      const auto json = nlohmann::json::parse(test::read_file(dir / report));
-      Camera camera = scene.camera;
-      for (int col = 0; col < 4; ++col)
-        for (int row = 0; row < 4; ++row) camera.view[col][row] = json.at("view")[col * 4 + row];
-      return camera;
-    };
-    const Camera front = camera_of("front.json"), left = camera_of("left.json");
+    const Camera front = reported_camera(dir / "front.json");
+    const Camera left = reported_camera(dir / "left.json");
     const struct {
       size_t index;
       const Camera* camera;
@@ -376,6 +375,32 @@ TEST_SUITE("window") {
     INFO(latin1.output);
     CHECK(latin1.exit_code == 1);
     CHECK(latin1.output.find(":1: label 1: the text is not UTF-8") != std::string::npos);
+  }
+
+  // A place picks the picture as drawn, `strata pick` the scene's picture without labels
+  // (docs/viewer.md): inside a ghosting lens (a scene label's, then the lens of the label just
+  // placed there) a place goes through what the lens opens, behind the point `strata pick`
+  // finds; with ghosting off, a place finds that point.
+  TEST_CASE("viewer_place_picks_through_ghosting_lenses_and_without_them_where_pick_does") {
+    const auto dir = test::fresh_folder("viewer", "place-lens");
+    const auto r = view(dir, "place 80 60\nplace 80 60\nreport " + (dir / "r.json").string() +
+                                 "\nset ghost 0\nplace 80 60\nsave " +
+                                 (dir / "placed.mrk.json").string() + "\nquit\n");
+    REQUIRE_MESSAGE(r.exit_code == 0, r.output);
+    const std::vector<Label> placed = load_label_file(dir / "placed.mrk.json");
+    REQUIRE(placed.size() == 3);
+    const auto pick = run_strata("pick " + kScene + " --size 160x120 --at 80,60");
+    REQUIRE_MESSAGE(pick.exit_code == 0, pick.output);
+    glm::vec3 picked{0.0f};
+    REQUIRE(std::sscanf(pick.output.substr(pick.output.find("80,60: LPS ")).c_str(),
+                        "80,60: LPS %f %f %f", &picked.x, &picked.y, &picked.z) == 3);
+    const Camera camera = reported_camera(dir / "r.json");
+    const auto at = [&](glm::vec3 p) { return project(camera, p, {kWidth, kHeight}); };
+    for (const Label& l : placed)
+      CHECK(glm::distance(at(l.anchor).pixel, glm::vec2(80.5f, 60.5f)) <= 0.05f);
+    CHECK(at(placed[0].anchor).eye_depth > at(picked).eye_depth + 0.5f);
+    CHECK(at(placed[1].anchor).eye_depth > at(placed[0].anchor).eye_depth + 0.5f);
+    CHECK(glm::distance(placed[2].anchor, picked) <= 0.02f);
   }
 
   TEST_CASE("viewer_script_rotates_zooms_pans_jumps_reweights_and_hides") {
