@@ -115,6 +115,11 @@ Camera reported_camera(const std::filesystem::path& report) {
   return camera;
 }
 
+// (--no-optimize: after each of its many steps the optimisation on idle's trials, and the labels'
+// move to the order it keeps, would more than double the test's time; nothing here depends on
+// the order)
+const std::string kManySteps = "--no-optimize --no-panel";
+
 // Runs `strata view` on the test scene with `script` (written into `dir`).
 test::CommandResult view(const std::filesystem::path& dir, const std::string& script,
                          const std::string& options = "--no-panel") {
@@ -214,11 +219,13 @@ TEST_SUITE("window") {
       return "drag left " + std::to_string(from.x) + " " + std::to_string(from.y) + " " +
              std::to_string(from.x) + " " + std::to_string(from.y + 12.0f) + "\n";
     };
-    const auto r = view(dir, setup + "screenshot " + d("before.png") + "\n" + drag(bottom) +
-                                 "report " + d("r1.json") + "\nscreenshot " + d("face.png") + "\n" +
-                                 drag(on_plane) + "report " + d("r2.json") + "\nscreenshot " +
-                                 d("plane.png") + "\nclip 0 0 0 1 0 0\nreport " + d("r3.json") +
-                                 "\nclip off\nreport " + d("r4.json") + "\nquit\n");
+    const auto r = view(dir,
+                        setup + "screenshot " + d("before.png") + "\n" + drag(bottom) + "report " +
+                            d("r1.json") + "\nscreenshot " + d("face.png") + "\n" + drag(on_plane) +
+                            "report " + d("r2.json") + "\nscreenshot " + d("plane.png") +
+                            "\nclip 0 0 0 1 0 0\nreport " + d("r3.json") + "\nclip off\nreport " +
+                            d("r4.json") + "\nquit\n",
+                        kManySteps);
     REQUIRE_MESSAGE(r.exit_code == 0, r.output);
     CHECK(r.output.find("validation") == std::string::npos);
     // The millimetres 12 px are at each handle, along its direction (+z for both drags).
@@ -252,7 +259,8 @@ TEST_SUITE("window") {
             "text 0 \"Thalamus R – Ödem \\\"rechts\\\"\"\nmove 4 90 45\n"
             "delete 5\nundo\nreport " +
             d("left.json") + "\nsave " + d("own.mrk.json") + " ras\nsave " + d("own.fcsv") +
-            " lps\nquit\n");
+            " lps\nquit\n",
+        kManySteps);
     REQUIRE_MESSAGE(r.exit_code == 0, r.output);
     // (new labels take the lowest ids the scene's 11 leave free: 0, 4, 5, 6, 7)
     for (const char* id : {"(label 0)", "(label 4)", "(label 5)", "(label 6)", "(label 7)"})
