@@ -1091,8 +1091,11 @@ graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double 
   }
   const bool interactive = options_.frame_budget_ms > 0.0;
   labelled_->set_placement_beside((options_.placement_beside || interactive) && !debug_choice_);
-  // (beside the frames, trials are placements of their own, one at a time)
+  // (beside the frames, trials are placements of their own, one at a time; those in flight when
+  // the placement moves are lost, and the trials start again)
   const bool beside = labelled_->placement_beside();
+  if (beside != trials_beside_) optimisation_ = {};
+  trials_beside_ = beside;
   const int trial = !beside || labelled_->trial_ready() ? next_trial() : -1;
   if (trial >= 0) labelled_->set_trial_order(optimisation_.orders[size_t(trial)]);
   labelled_->prepare_frame(seconds, trial >= 0);

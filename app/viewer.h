@@ -358,6 +358,7 @@ class Viewer {
     double baseline = -1.0;  // the kept order's cost (a normal frame's)
     bool done = false;
   } optimisation_;
+  bool trials_beside_ = false;  // the placement was beside the frames in the last frame
 
   // Panel state.
   std::vector<TransferFunction> original_tfs_;  // per volume: the scene's, or the preset chosen
