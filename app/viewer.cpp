@@ -964,7 +964,7 @@ std::string Viewer::unsettled() const {
     }
     parts.push_back(text + (moving_labels_.size() > 3 ? ", ...)" : ")"));
   }
-  if (settled_ && optimisation_due()) {
+  if (settled_ && optimisation_pending()) {
     const Optimisation& o = optimisation_;
     const auto back =
         std::count_if(o.costs.begin(), o.costs.end(), [](double c) { return !std::isnan(c); });
