@@ -62,8 +62,9 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
     const std::vector<float> v =
         parse_numbers(text, 6, "--clip", "PX,PY,PZ,NX,NY,NZ (world mm, LPS)");
     const glm::vec3 normal(v[3], v[4], v[5]);
-    if (!(glm::length(normal) > 1e-6f))
-      throw UsageError("--clip: '" + text + "': the normal (NX,NY,NZ) must not be zero");
+    if (!clip_normal_usable(normal))
+      throw UsageError("--clip: '" + text +
+                       "': the normal (NX,NY,NZ) must not be zero (a length above 1e-6)");
     options.cut.push_back(clip_plane(glm::vec3(v[0], v[1], v[2]), normal));
   }
   if (!in.window.empty()) {

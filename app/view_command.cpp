@@ -432,7 +432,7 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   while (!viewer.quit_requested()) {
     glfwPollEvents();
     if (script && script->frames_due() == 0 && !script->sleeping()) {
-      if (!viewer.busy()) {
+      if (viewer.at_rest()) {
         if (script->done()) break;
         script->run_next(viewer);
         continue;

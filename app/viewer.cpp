@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <numeric>
+#include <utility>
 
 #define GLFW_INCLUDE_VULKAN
 #include <GLFW/glfw3.h>
 #include <imgui.h>
+#include <nlohmann/json.hpp>
 
 #include "engine/core/error.h"
 #include "engine/core/png.h"
@@ -206,6 +208,16 @@ void check_range(const Parameter& p, float value) {
               number_text(p.hi) + "]");
 }
 
+// What a label file can hold (label_file_writer.h decides UTF-8 by nlohmann's rules too).
+bool is_utf8(const std::string& text) {
+  try {
+    (void)nlohmann::json(text).dump();
+    return true;
+  } catch (const nlohmann::json::type_error&) {
+    return false;
+  }
+}
+
 }  // namespace
 
 bool HeadlessOutput::draw(const WindowTarget::Prepare& prepare) {
@@ -269,6 +281,11 @@ Viewer::Viewer(Context& ctx, Scene& scene, const Camera& camera, const Labelling
                                                      : TransferFunction{});
   }
   looks_.resize(scene.volumes.size());
+  const size_t own = scene.labels.size() - std::min(scene.added_labels, scene.labels.size());
+  for (size_t i = 0; i < own; ++i) {
+    scene_labels_.push_back(
+        {.id = scene.labels[i].id, .text = scene.labels[i].text, .anchor = scene.labels[i].anchor});
+  }
   for (const Volume& v : scene.volumes) scene_cuts_.push_back(v.cut);
 }
 
@@ -337,7 +354,7 @@ void Viewer::mouse_button(int button, int action, int mods) {
         drag_undone_ = false;
         select_label(*i);
       } else {
-        ask_pick({mouse_, 0, false});
+        ask_pick({mouse_, {}, false});
       }
       return;
     }
@@ -559,20 +576,20 @@ void Viewer::apply_picks() {
     pending_picks_.pop_front();
     if (!hit.hit) {
       const std::string what =
-          pick.move_id == 0
+          !pick.move_id
               ? "nothing under the pixel to place a label on (background)"
-              : "nothing under the pixel to move label " + std::to_string(pick.move_id) + " to";
+              : "nothing under the pixel to move label " + std::to_string(*pick.move_id) + " to";
       missed_pick_ = what;
       if (!pick.drag) message_ = what;  // (a drag over the background: the anchor waits)
       ui_event();
       continue;
     }
-    if (pick.move_id == 0) {
+    if (!pick.move_id) {
       add_label(hit.point);
     } else if (std::any_of(scene_.labels.begin(), scene_.labels.end(),
-                           [&](const Label& l) { return l.id == pick.move_id; })) {
+                           [&](const Label& l) { return l.id == *pick.move_id; })) {
       // (a drag is one edit to undo: the labels before its first move)
-      const size_t i = label_index(pick.move_id);
+      const size_t i = label_index(*pick.move_id);
       edit_labels([&](std::vector<Label>& labels) { labels[i].anchor = hit.point; },
                   !pick.drag || !drag_undone_);
       drag_undone_ = drag_undone_ || pick.drag;
@@ -613,14 +630,14 @@ void Viewer::edit_labels(const std::function<void(std::vector<Label>&)>& edit, b
 
 int Viewer::place_label(glm::vec2 at) {
   const size_t labels = scene_.labels.size();
-  pick_now({at, 0, false});
+  pick_now({at, {}, false});
   if (scene_.labels.size() == labels) throw Error("no label was placed");
   return scene_.labels.back().id;
 }
 
 void Viewer::add_label(glm::vec3 point) {
   Label label;
-  label.id = int(next_label_id(scene_));
+  label.id = unused_label_ids(scene_.labels, 1).front();
   label.anchor = point;
   label.text = atlas_region_at(scene_, point);
   if (label.text.empty()) label.text = "Label " + std::to_string(label.id);
@@ -637,6 +654,7 @@ void Viewer::add_label(glm::vec3 point) {
 void Viewer::set_label_text(int id, const std::string& text) {
   const size_t i = label_index(id);
   if (text.empty()) throw Error("a label's text cannot be empty");
+  if (!is_utf8(text)) throw Error("label " + std::to_string(id) + ": the text is not UTF-8");
   edit_labels([&](std::vector<Label>& labels) { labels[i].text = text; });
 }
 
@@ -672,9 +690,17 @@ bool Viewer::redo_labels() {
 }
 
 void Viewer::save_labels(const std::filesystem::path& path, LabelAxes axes) {
-  write_label_file(path, scene_.labels, axes);
-  message_ = "wrote " + std::to_string(scene_.labels.size()) + " labels to " + path.string() +
-             (axes == LabelAxes::lps ? " (LPS)" : " (RAS)");
+  // (the scene's own labels stay in its file: loaded with it, the saved ones are not doubled)
+  std::vector<Label> own;
+  for (const Label& label : scene_.labels) {
+    if (std::none_of(scene_labels_.begin(), scene_labels_.end(),
+                     [&](const Label& l) { return l.id == label.id && same_label(l, label); }))
+      own.push_back(label);
+  }
+  write_label_file(path, own, axes);
+  message_ = "wrote " + std::to_string(own.size()) + " labels to " + path.string() +
+             (axes == LabelAxes::lps ? " (LPS)" : " (RAS)") + ", placed or edited; the scene's " +
+             std::to_string(scene_.labels.size() - own.size()) + " stay in its file";
   std::printf("view: %s\n", message_.c_str());
   std::fflush(stdout);
   ui_event();
@@ -904,9 +930,20 @@ bool Viewer::busy() const {
   if (ui_frames_ > 0 || !settled_ || control_.animating()) return true;
   if (!same_view(control_.camera(), applied_camera_)) return true;  // moved since the last frame
   if (drag_button_ >= 0) return false;  // a still mouse button: nothing moves
-  // Optimisation on idle: due once the view has rested, until every trial has come back.
-  const Optimisation& o = optimisation_;
-  return options_.optimize_on_idle && !o.done && scene_.labels.size() >= 2 && o.baseline >= 0.0 &&
+  if (!optimisation_due()) return false;
+  // (trial frames; beside the frames, a frame starts each trial placement and takes it up)
+  return !labelled_->placement_beside() || optimisation_.in_flight < 0 ||
+         labelled_->trial_finished();
+}
+
+// (not while recording: a video's frames are a fixed time step apart, trials would be in them)
+bool Viewer::optimisation_pending() const {
+  return options_.optimize_on_idle && !optimisation_.done && scene_.labels.size() >= 2 && !video_;
+}
+
+// (baseline: a settled normal frame's cost)
+bool Viewer::optimisation_due() const {
+  return optimisation_pending() && optimisation_.baseline >= 0.0 &&
          seconds_between(last_change_, Clock::now()) >= options_.idle_seconds;
 }
 
@@ -927,7 +964,7 @@ std::string Viewer::unsettled() const {
     }
     parts.push_back(text + (moving_labels_.size() > 3 ? ", ...)" : ")"));
   }
-  if (settled_ && busy()) {
+  if (settled_ && optimisation_pending()) {
     const Optimisation& o = optimisation_;
     const auto back =
         std::count_if(o.costs.begin(), o.costs.end(), [](double c) { return !std::isnan(c); });
@@ -940,19 +977,16 @@ std::string Viewer::unsettled() const {
 }
 
 std::optional<double> Viewer::wake_in() const {
-  if (!options_.optimize_on_idle || optimisation_.done || scene_.labels.size() < 2) return {};
+  if (!optimisation_pending()) return {};
+  constexpr double kTrialPoll = 0.01;  // (a trial placement beside the frames: is it back?)
+  if (optimisation_.in_flight >= 0) return kTrialPoll;
   return std::max(0.0, options_.idle_seconds - seconds_between(last_change_, Clock::now()));
 }
 
 int Viewer::next_trial() {
   Optimisation& o = optimisation_;
   const size_t n = scene_.labels.size();
-  if (!options_.optimize_on_idle || n < 2 || o.done || drag_button_ >= 0 || control_.animating() ||
-      video_) {
-    return -1;
-  }
-  if (seconds_between(last_change_, Clock::now()) < options_.idle_seconds) return -1;
-  if (o.baseline < 0.0) return -1;  // no settled normal frame yet
+  if (!optimisation_due() || drag_button_ >= 0 || control_.animating()) return -1;
   if (o.orders.empty()) {
     for (uint32_t t = 0; t < options_.optimize_tries; ++t) {
       o.orders.push_back(random_order(uint32_t(n), serial_ * 131 + t + 1));
@@ -962,6 +996,28 @@ int Viewer::next_trial() {
   if (o.submitted >= o.orders.size()) return -1;
   ++summary_.trials;
   return int(o.submitted++);
+}
+
+void Viewer::trial_back(int trial, double cost) {
+  Optimisation& o = optimisation_;
+  if (trial < 0 || size_t(trial) >= o.costs.size()) return;  // (one of an earlier serial)
+  o.costs[size_t(trial)] = cost;
+  const bool all =
+      std::none_of(o.costs.begin(), o.costs.end(), [](double c) { return std::isnan(c); });
+  if (!all || o.done) return;
+  const size_t best = size_t(std::min_element(o.costs.begin(), o.costs.end()) - o.costs.begin());
+  o.done = true;
+  if (!(o.costs[best] < o.baseline * (1.0 - 1e-4))) return;
+  labelled_->set_order(o.orders[best]);
+  // (beside the frames, a placement in the new order: not settled before it is taken up)
+  labelled_->placement_due();
+  change_frame_ = labelled_->frame_number() + 1;
+  ++summary_.adopted;
+  settled_ = false;  // the labels move to the cheaper layout
+  char text[96];
+  std::snprintf(text, sizeof text, "optimised on idle: cost %.6g -> %.6g", o.baseline,
+                o.costs[best]);
+  message_ = text;
 }
 
 // The results of the frame that last used `slot` (it has finished).
@@ -984,28 +1040,7 @@ void Viewer::read_slot(uint32_t slot) {
   if (done.serial != serial_) return;  // made before the last change
 
   Optimisation& o = optimisation_;
-  if (done.trial >= 0) {
-    if (size_t(done.trial) < o.costs.size()) {
-      o.costs[size_t(done.trial)] = labelled_->total_cost();
-      const bool all =
-          std::none_of(o.costs.begin(), o.costs.end(), [](double c) { return std::isnan(c); });
-      if (all && !o.done) {
-        const size_t best =
-            size_t(std::min_element(o.costs.begin(), o.costs.end()) - o.costs.begin());
-        o.done = true;
-        if (o.costs[best] < o.baseline * (1.0 - 1e-4)) {
-          labelled_->set_order(o.orders[best]);
-          ++summary_.adopted;
-          settled_ = false;  // the labels move to the cheaper layout
-          char text[96];
-          std::snprintf(text, sizeof text, "optimised on idle: cost %.6g -> %.6g", o.baseline,
-                        o.costs[best]);
-          message_ = text;
-        }
-      }
-    }
-    return;
-  }
+  if (done.trial >= 0) return trial_back(done.trial, labelled_->total_cost());
   // Beside the frames, the labels head for a placement made before the last change: not settled.
   placement_due_ = labelled_->placed_frame_number() < change_frame_;
   if (placement_due_) {
@@ -1056,9 +1091,19 @@ graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double 
   }
   const bool interactive = options_.frame_budget_ms > 0.0;
   labelled_->set_placement_beside((options_.placement_beside || interactive) && !debug_choice_);
-  const int trial = labelled_->placement_beside() ? -1 : next_trial();
+  // (beside the frames, trials are placements of their own, one at a time; those in flight when
+  // the placement moves are lost, and the trials start again)
+  const bool beside = labelled_->placement_beside();
+  if (beside != trials_beside_) optimisation_ = {};
+  trials_beside_ = beside;
+  const int trial = !beside || labelled_->trial_ready() ? next_trial() : -1;
   if (trial >= 0) labelled_->set_trial_order(optimisation_.orders[size_t(trial)]);
   labelled_->prepare_frame(seconds, trial >= 0);
+  if (beside) {
+    if (const std::optional<double> cost = labelled_->take_trial_cost())
+      trial_back(std::exchange(optimisation_.in_flight, -1), *cost);
+    if (trial >= 0) optimisation_.in_flight = trial;
+  }
   count_placements();
   debug_.set_enabled(debug_choice_.has_value());
   if (debug_choice_) {
@@ -1066,7 +1111,8 @@ graph::GraphRunner& Viewer::prepare(uint32_t slot, graph::Extent extent, double 
     debug_.set_placement(uint32_t(labelled_->placement_order_count()),
                          labelled_->settings().placement.margin_em * labelled_->units().em);
   }
-  slots_[slot] = {generation_, serial_, trial, labelled_->renderer().settings().divisor};
+  slots_[slot] = {generation_, serial_, beside ? -1 : trial,
+                  labelled_->renderer().settings().divisor};
   last_slot_ = slot;
   return labelled_->runner();
 }

@@ -99,8 +99,8 @@ struct ViewerOptions {
   // viewer left running for hours keeps no per-frame list.
   bool keep_frame_spans = false;
   // The placement beside the frames (LabelledRenderer::set_placement_beside): frames never wait
-  // for it. Off while a debug view of the placement's buffers is shown, and no optimisation on
-  // idle with it (its trials are frames that place).
+  // for it. Off while a debug view of the placement's buffers is shown. The optimisation on
+  // idle's trials are then placements beside the frames too, never adopted.
   bool placement_beside = false;
   // Interactive rendering (a CPU device's default): while the camera moves, rays are cast for
   // every d-th pixel each way only, d chosen so that a frame takes about this long, and the
@@ -159,7 +159,11 @@ class Viewer {
 
   // Whether a frame is due: the camera moves, labels move or fade, trials run, the UI answers.
   // False: the viewer may sleep until the next event (or wake_in()); a recording draws anyway.
+  // (Beside the frames a trial placement runs without frames: none is due meanwhile.)
   bool busy() const;
+  // Nothing will change without input: no frame due, the optimisation on idle finished (or off,
+  // or paused by a recording). Scripts run their next command at rest.
+  bool at_rest() const { return !busy() && !optimisation_pending(); }
   // Seconds until something happens without input (the optimisation on idle), if anything will.
   std::optional<double> wake_in() const;
   // What keeps the viewer busy, in words ("2 labels moving or fading (Thalamus R, Insula L)").
@@ -222,7 +226,9 @@ class Viewer {
   // Every edit above, undone and redone; false when there is nothing to.
   bool undo_labels();
   bool redo_labels();
-  // The scene's labels as .mrk.json or .fcsv (by extension), LPS or RAS.
+  // The labels placed or edited (and those a label file opened with the scene added) as
+  // .mrk.json or .fcsv (by extension), LPS or RAS; the scene's own labels, as its file holds
+  // them, are left out (they load with the scene).
   void save_labels(const std::filesystem::path& path, LabelAxes axes = LabelAxes::lps);
   // Place mode (key P, the panel): a left click places a label instead of turning the view.
   bool place_mode() const { return place_mode_; }
@@ -252,11 +258,11 @@ class Viewer {
   };
   void changed();
   void apply_camera();
-  // Picks (LabelledRenderer::request_pick): a pixel whose point places a new label (move_id 0)
+  // Picks (LabelledRenderer::request_pick): a pixel whose point places a new label (no move_id)
   // or moves label move_id's anchor, as a drag (one undo for all its moves) or not.
   struct PendingPick {
     glm::vec2 at{0.0f};
-    int move_id = 0;
+    std::optional<int> move_id;  // (0 is a label's id too)
     bool drag = false;
   };
   void ask_pick(const PendingPick& pick);
@@ -273,6 +279,13 @@ class Viewer {
   graph::GraphRunner& prepare(uint32_t slot, graph::Extent extent, double seconds);
   void read_slot(uint32_t slot);
   int next_trial();
+  // The optimisation on idle is pending (not every trial has come back), and due (the view has
+  // rested since the last change).
+  bool optimisation_pending() const;
+  bool optimisation_due() const;
+  // Trial `trial`'s cost came back; after the last one the cheapest order is kept if it beats
+  // the baseline.
+  void trial_back(int trial, double cost);
   void build_panel();
   void panel_labelling();
   void panel_forces();
@@ -335,14 +348,17 @@ class Viewer {
   std::chrono::steady_clock::time_point last_move_;
   bool refining_ = false;  // the camera rested; its full-quality frame has not come back yet
 
-  // Optimisation on idle: random orders tried in trial frames, the cheapest kept.
+  // Optimisation on idle: random orders tried in trial frames (beside the frames: trial
+  // placements, one at a time), the cheapest kept.
   struct Optimisation {
     std::vector<std::vector<uint32_t>> orders;
     std::vector<double> costs;  // NaN until read back
     uint32_t submitted = 0;
+    int in_flight = -1;      // beside the frames: the trial whose placement runs
     double baseline = -1.0;  // the kept order's cost (a normal frame's)
     bool done = false;
   } optimisation_;
+  bool trials_beside_ = false;  // the placement was beside the frames in the last frame
 
   // Panel state.
   std::vector<TransferFunction> original_tfs_;  // per volume: the scene's, or the preset chosen
@@ -389,6 +405,7 @@ class Viewer {
   char edit_text_[256] = "";  // the panel's text of the selected label
   std::filesystem::path default_labels_path() const;  // Ctrl+S: SCENE-labels.mrk.json beside it
   std::vector<std::vector<Label>> undo_, redo_;       // the scene's labels before each edit
+  std::vector<Label> scene_labels_;  // the scene file's own labels (id, text and anchor)
 
   // Output.
   std::unique_ptr<VideoFile> video_;

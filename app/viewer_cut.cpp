@@ -83,9 +83,9 @@ void Viewer::set_crop(std::optional<std::array<glm::vec3, 2>> box) {
 }
 
 void Viewer::add_clip(glm::vec4 plane) {
-  const float length = glm::length(glm::vec3(plane));
-  if (!(length > 1e-6f) || !std::isfinite(plane.w))
+  if (!clip_normal_usable(glm::vec3(plane)) || !std::isfinite(plane.w))
     throw Error("clipping plane: the normal must not be zero");
+  const float length = glm::length(glm::vec3(plane));
   if (cuts_.planes.size() >= kViewerPlanes)
     throw Error("clipping plane: the viewer keeps at most " + std::to_string(kViewerPlanes));
   ViewerCuts cuts = cuts_;

@@ -7,6 +7,7 @@
 
 #include "engine/core/error.h"
 #include "engine/scene/fitted_camera.h"
+#include "engine/scene/scene.h"
 #include "engine/scene/transfer_function_presets.h"
 #include "engine/scene/value_limits.h"
 
@@ -158,8 +159,8 @@ ScriptCommand command(const std::vector<std::string>& w) {
       need(7, "clip PX PY PZ NX NY NZ | clip off");
       for (size_t i = 1; i < 7; ++i)
         out.numbers.push_back(number(w[i], -kScriptMaxWorld, kScriptMaxWorld));
-      if (out.numbers[3] == 0.0 && out.numbers[4] == 0.0 && out.numbers[5] == 0.0)
-        throw Error("'clip': the normal (NX NY NZ) must not be zero");
+      if (!clip_normal_usable(glm::vec3(out.numbers[3], out.numbers[4], out.numbers[5])))
+        throw Error("'clip': the normal (NX NY NZ) must not be zero (a length above 1e-6)");
     }
   } else if (c == "place") {
     need(3, "place X Y");

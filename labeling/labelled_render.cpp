@@ -321,12 +321,13 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
   parts_->forces.set_frame(forces, units(), seconds, settings_.placement.hard,
                            parts_->placement.order_count());
   if (beside_) {
+    beside_->take_trial([this] { trial_cost_ = total_cost(); });
     beside_->set_frame_number(frame_number_);
-    beside_->prepare(*runner_,
-                     slot_labels());  // (a placement started now takes this frame's params)
+    // (a placement started now takes this frame's params)
+    beside_->prepare(*runner_, slot_labels(), trial);
     parts_->forces.set_order_count(beside_->adopted_order_count());
   }
-  parts_->forces.set_trial(trial);
+  parts_->forces.set_trial(trial && !beside_);
   if (extension_) {
     // (the frame picks what was asked since the last; PICK_MAX at a time)
     picks_in_slot_.resize(std::max<size_t>(picks_in_slot_.size(), slot_ + 1));

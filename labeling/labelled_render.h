@@ -10,6 +10,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/core/font.h"
@@ -185,8 +186,17 @@ class LabelledRenderer {
   void use_slot(uint32_t slot, bool read = true);
   // Sets the next frame up, `seconds` after the last, without running it (the caller records
   // runner() into its own command buffer). A trial frame places the labels (in the order given
-  // to set_trial_order) but leaves the forces' state as it was (optimisation on idle).
+  // to set_trial_order) but leaves the forces' state as it was (optimisation on idle); beside the
+  // frames it starts a trial placement instead (trial_ready() must hold), which the frames never
+  // adopt, and the frame is a normal one.
   void prepare_frame(double seconds, bool trial = false);
+  // Beside the frames: whether the next frame may start a trial placement (none due or in
+  // flight), and whether the one in flight has finished (the next frame takes it up).
+  bool trial_ready() const { return beside_ && beside_->idle(); }
+  bool trial_finished() const { return beside_ && beside_->trial_finished(); }
+  // Beside the frames: the total cost (total_cost()) of the trial placement the last frame
+  // prepared took up, once; none where it took none.
+  std::optional<double> take_trial_cost() { return std::exchange(trial_cost_, std::nullopt); }
   // The placement beside the frames (labeling/placement_beside.h): the viewer's frames render
   // and move the labels toward the newest finished placement without waiting for one; stills,
   // trial frames and run() need it off (the default). Rebuilds the graph.
@@ -316,6 +326,7 @@ class LabelledRenderer {
   void set_placement_frame(bool moving, const std::vector<uint32_t>& within);
   std::vector<uint32_t> within_;  // the order inside each layer set_order() was last given
   std::vector<uint32_t> trial_within_;
+  std::optional<double> trial_cost_;  // take_trial_cost()
   bool afresh_ = false;
   // set_camera was called since the last frame: the placement keeps its edge margin (a camera at
   // rest lets the labels settle where a still would put them).

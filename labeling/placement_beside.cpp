@@ -89,10 +89,21 @@ void PlacementBeside::wait_idle() {
   slots_.wait_all();
 }
 
+bool PlacementBeside::take_trial(const std::function<void()>& read) {
+  if (!trial_finished()) return false;
+  taken_ = started_;
+  placement_.readback().use_slot(*runner_, started_slot_);
+  read();
+  placement_.readback().use_slot(*runner_, adopted_slot_);
+  return true;
+}
+
 void PlacementBeside::build(uint32_t layer_count, graph::Extent size) {
   wait_idle();
+  if (trial_) taken_ = started_;  // (a trial for the old graph: its results are not read)
   layer_count_ = layer_count;
   placement_.readback().set_slots(2);
+  adopted_slot_ = 0;
   for (Snapshot& s : snapshots_) {
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT;
     s.final = Image(ctx_, {.format = VK_FORMAT_R8G8B8A8_UNORM,
@@ -233,15 +244,17 @@ VkSemaphoreSubmitInfo PlacementBeside::at(VkSemaphore semaphore, uint64_t value)
   return info;
 }
 
-void PlacementBeside::prepare(graph::GraphRunner& frame, const std::vector<gpu::LabelGpu>& labels) {
+void PlacementBeside::prepare(graph::GraphRunner& frame, const std::vector<gpu::LabelGpu>& labels,
+                              bool trial) {
   if (!runner_) throw Error("placement beside the frames: build() before prepare()");
   frame_labels_ = labels;
   graph::FrameSubmission& submission = frame.submission();
   submission = {};
   adopt_now_ = start_now_ = false;
-  if (started_ > adopted_ && finished()) {
+  if (trial_finished()) taken_ = started_;  // (a trial nobody read: dropped)
+  if (started_ > taken_ && !trial_ && finished()) {
     adopt();
-    submission.wait.push_back(at(placed_, adopted_));
+    submission.wait.push_back(at(placed_, taken_));
   }
   // (the frames write the snapshot of the placement after the one in flight)
   const Snapshot& next = snapshots_[(started_ + 1) % 2];
@@ -250,26 +263,30 @@ void PlacementBeside::prepare(graph::GraphRunner& frame, const std::vector<gpu::
   frame.bind_image(frame_snapshot_ids_[1], next.layers.handle(), next.layers.view(),
                    VK_FORMAT_R16G16B16A16_SFLOAT);
   frame.bind_buffer(frame_snapshot_ids_[2], next.state.handle());
-  if (started_ == adopted_ && !paused_ && due_) start(frame);
+  if (started_ == taken_ && !paused_ && (due_ || trial)) start(frame, !due_);
 }
 
 void PlacementBeside::adopt() {
-  adopted_ = started_;
+  taken_ = started_;
+  adopted_slot_ = started_slot_;
   adopt_now_ = true;
   adopted_order_count_ = started_order_count_;
   adopted_frame_ = start_frame_;
   ++stats_.adopted;
   stats_.latency_frames.push_back(uint32_t(frame_ - start_frame_));
   timings_ = runner_->timings();
-  placement_.readback().use_slot(*runner_, uint32_t(adopted_ % 2));
+  placement_.readback().use_slot(*runner_, adopted_slot_);
 }
 
 // Records the next placement now (the placement's labels and order are this frame's) and submits
-// it after the frame, which feeds it.
-void PlacementBeside::start(graph::GraphRunner& frame) {
+// it after the frame, which feeds it. Its results go to the readback slot the adopted placement's
+// are not in.
+void PlacementBeside::start(graph::GraphRunner& frame, bool trial) {
   const uint64_t k = ++started_;
   start_now_ = true;
-  due_ = false;
+  trial_ = trial;
+  if (!trial) due_ = false;
+  started_slot_ = 1 - adopted_slot_;
   start_frame_ = frame_;
   started_order_count_ = placement_.order_count();
   const Snapshot& s = snapshots_[k % 2];
@@ -278,12 +295,12 @@ void PlacementBeside::start(graph::GraphRunner& frame) {
   runner_->bind_image(runner_snapshot_ids_[1], s.layers.handle(), s.layers.view(),
                       VK_FORMAT_R16G16B16A16_SFLOAT);
   runner_->bind_buffer(runner_snapshot_ids_[2], s.state.handle());
-  placement_.readback().use_slot(*runner_, uint32_t(k % 2));
+  placement_.readback().use_slot(*runner_, started_slot_);
   const uint32_t slot = slots_.next();
   const VkCommandBuffer cmd = slots_.begin(slot);
   runner_->record(cmd, slot);
   // (the host reads the adopted placement's results until this one is adopted)
-  placement_.readback().use_slot(*runner_, uint32_t(adopted_ % 2));
+  placement_.readback().use_slot(*runner_, adopted_slot_);
   graph::FrameSubmission& submission = frame.submission();
   submission.signal.push_back(at(fed_, k));
   submission.submitted = [this, slot, k] {

@@ -9,6 +9,10 @@
 // snapshot, and its submission signals the timeline the placement's submission waits for. There
 // are two snapshots: the frames write only the one no placement reads. Each frame moves the
 // adopted targets with the anchors (follow_anchor), so labels follow the camera in between.
+//
+// A trial placement (the viewer's optimisation on idle) runs the same way in another insertion
+// order, but is never adopted: its results are read (take_trial) and the labels stay on the
+// adopted placement's targets.
 #pragma once
 
 #include <array>
@@ -61,9 +65,19 @@ class PlacementBeside {
   void build(uint32_t layer_count, graph::Extent size);
 
   // Before the frame is recorded, with the frame's `labels` (Placement::set_frame was given them,
-  // LabelForces::set_frame not yet): adopts a finished placement, starts the next one, and sets
-  // the frame's submission (its waits and signals, and the placement's submission after it).
-  void prepare(graph::GraphRunner& frame, const std::vector<gpu::LabelGpu>& labels);
+  // LabelForces::set_frame not yet): adopts a finished placement, starts the next one (a `trial`
+  // where none is due and idle() held), and sets the frame's submission (its waits and signals,
+  // and the placement's submission after it).
+  void prepare(graph::GraphRunner& frame, const std::vector<gpu::LabelGpu>& labels,
+               bool trial = false);
+  // Whether the next frame may start a trial: no placement due, none in flight but a finished
+  // trial, not paused.
+  bool idle() const { return (started_ == taken_ || trial_finished()) && !due_ && !paused_; }
+  // The trial in flight has finished, and take_trial reads it.
+  bool trial_finished() const { return trial_ && started_ > taken_ && finished(); }
+  // A finished trial taken up: `read` sees its results (the Placement's readback) and then the
+  // readback is the adopted placement's again. False where no trial has finished.
+  bool take_trial(const std::function<void()>& read);
   // Labels in the adopted placement's insertion order (the forces' keeping apart).
   uint32_t adopted_order_count() const { return adopted_order_count_; }
   // The frame that started the adopted placement (LabelledRenderer counts them from 1; 0: none
@@ -95,7 +109,7 @@ class PlacementBeside {
   };
   bool finished() const;
   void adopt();
-  void start(graph::GraphRunner& frame);
+  void start(graph::GraphRunner& frame, bool trial);
   VkSemaphoreSubmitInfo at(VkSemaphore semaphore, uint64_t value) const;
 
   Context& ctx_;
@@ -112,7 +126,11 @@ class PlacementBeside {
   FrameSlots slots_;
   VkSemaphore fed_ = VK_NULL_HANDLE;     // frame k fed placement k (its snapshot is written)
   VkSemaphore placed_ = VK_NULL_HANDLE;  // placement k finished
-  uint64_t started_ = 0, adopted_ = 0;   // placements, counted from 1
+  // Placements started and taken up (adopted, or read as a trial), counted from 1.
+  uint64_t started_ = 0, taken_ = 0;
+  bool trial_ = false;  // the last placement started is a trial
+  // The Placement's readback slots: the adopted placement's results, and the started one's.
+  uint32_t adopted_slot_ = 0, started_slot_ = 0;
   uint64_t frame_ = 0, start_frame_ = 0, adopted_frame_ = 0;
   uint32_t layer_count_ = 1;
   uint32_t order_count_ = 0, adopted_order_count_ = 0, started_order_count_ = 0;

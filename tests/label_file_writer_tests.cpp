@@ -15,6 +15,7 @@
 #include "engine/core/error.h"
 #include "engine/scene/io/label_file_loader.h"
 #include "engine/scene/io/label_file_writer.h"
+#include "engine/scene/io/scene_loader.h"
 #include "test_files.h"
 
 namespace {
@@ -211,6 +212,40 @@ TEST_SUITE("loaders") {
     const std::vector<strata::Label> lines = {label(8, "two\nlines", {1.0f, 2.0f, 3.0f})};
     strata::write_label_file(folder / "lines.mrk.json", lines);
     check_same(strata::load_label_file(folder / "lines.mrk.json"), lines);
+  }
+
+  TEST_CASE("fcsv_writer_refuses_a_nul_that_would_make_the_file_unreadable") {
+    const fs::path folder = test_folder("nul");
+    const std::vector<strata::Label> labels = {label(8, std::string("a\0b", 3), {1, 2, 3})};
+    CHECK(error_of([&] { strata::write_label_file(folder / "nul.fcsv", labels); }) ==
+          (folder / "nul.fcsv").string() +
+              ": labels[0] (id 8): the text has a NUL character, which a .fcsv file cannot hold "
+              "(write .mrk.json)");
+    CHECK(!fs::exists(folder / "nul.fcsv"));
+    // (JSON escapes it, and reads it back)
+    strata::write_label_file(folder / "nul.mrk.json", labels);
+    check_same(strata::load_label_file(folder / "nul.mrk.json"), labels);
+  }
+
+  TEST_CASE("a_label_file_holding_the_scenes_own_labels_adds_them_once_with_a_warning") {
+    const fs::path folder = test_folder("merge");
+    const fs::path scene =
+        strata::test::write_file(folder / "scene.json", R"({"strata_scene": 1, "labels": [
+            {"id": 7, "text": "Thalamus R – Ödem", "anchor": [-20.5, 12.25, 30]},
+            {"id": 8, "text": "Pons", "anchor": [0, 25.75, -12.5]}]})");
+    // (as the viewer saved labels before it kept the scene's own apart: those and one more)
+    const std::vector<strata::Label> saved = {label(0, "Thalamus R – Ödem", {-20.5f, 12.25f, 30}),
+                                              label(1, "Pons", {0, 25.75f, -12.5f}),
+                                              label(2, "Pons", {0, 25.75f, -12.0f})};
+    strata::write_label_file(folder / "saved.mrk.json", saved, LabelAxes::ras);
+    const strata::Scene loaded = strata::load_scene(scene, {.labels = folder / "saved.mrk.json"});
+    REQUIRE(loaded.labels.size() == 3);
+    CHECK(loaded.labels[2].anchor == saved[2].anchor);
+    CHECK(loaded.added_labels == 1);
+    REQUIRE(loaded.warnings.size() == 1);
+    CHECK(loaded.warnings[0] == (folder / "saved.mrk.json").string() +
+                                    ": 2 of its labels the scene has already (the same text and "
+                                    "anchor): added once");
   }
 
   TEST_CASE("written_markups_json_is_valid_by_slicers_published_schema") {

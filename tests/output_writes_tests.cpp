@@ -314,8 +314,8 @@ namespace {
 std::string save_positions(const fs::path& scene, const fs::path& script_folder) {
   const fs::path script = test::write_file(script_folder / "save.txt",
                                            "save-position mine\nsave-position mine2\nquit\n");
-  const auto r = run_strata("view " + scene.string() +
-                            " --size 64 --no-optimize --no-panel --script " + script.string());
+  const auto r =
+      run_strata("view " + scene.string() + " --size 64 --no-panel --script " + script.string());
   INFO(r.output);
   CHECK(r.exit_code == 0);
   return r.output;

@@ -254,13 +254,19 @@ TEST_SUITE("loaders") {
               ": line 3: label id 2147483648 is past the largest, 2147483647 (this file's ids "
               "start at 2147483647, after the labels before it)");
     CHECK(strata::load_label_file(csv, INT_MAX - 1).back().id == INT_MAX);
-    // A scene whose label has the largest id, with --labels: the file's first label has no id.
-    const std::string scene =
-        R"({"strata_scene": 1, "labels": [{"id": 2147483647, "text": "a", "anchor": [0, 0, 0]}]})";
-    const std::string error = scene_error(folder, scene, {.labels = csv});
-    CHECK(error == csv.string() +
-                       ": line 2: label id 2147483648 is past the largest, 2147483647 (this "
-                       "file's ids start at 2147483648, after the labels before it)");
+  }
+
+  TEST_CASE("labels_added_to_a_scene_with_the_largest_id_take_the_lowest_unused_ids") {
+    const fs::path folder = folder_for("ids-free");
+    const fs::path csv = write_file(folder / "more.csv", "text,l,p,s\na,0,0,0\nb,1,0,0\n");
+    const fs::path scene = write_file(folder / "scene.json", R"({"strata_scene": 1, "labels": [
+        {"id": 2147483647, "text": "a", "anchor": [0, 0, 9]},
+        {"id": 1, "text": "b", "anchor": [0, 0, 8]}]})");
+    const strata::Scene loaded = strata::load_scene(scene, {.labels = csv});
+    REQUIRE(loaded.labels.size() == 4);
+    CHECK(loaded.labels[2].id == 0);
+    CHECK(loaded.labels[3].id == 2);
+    CHECK(loaded.added_labels == 2);
   }
 
   TEST_CASE("nrrd_2d_in_a_2d_space_opens_as_one_slice_with_its_spacing_and_orientation") {

@@ -9,6 +9,7 @@
 
 #include "app/viewer_script.h"
 #include "engine/core/error.h"
+#include "engine/scene/scene.h"
 #include "gpu_fixture.h"
 #include "test_files.h"
 
@@ -134,6 +135,16 @@ TEST_SUITE("cpu") {
     CHECK(parse_error("clip 0 0 0 0 0 inf").find("demo.txt:2: 'inf' is not a number") == 0);
   }
 
+  // --clip's rule: a normal no longer than 1e-6 gives no direction.
+  TEST_CASE("viewer_script_clip_refuses_the_normals_that_clip_option_calls_zero") {
+    const std::string zero = "demo.txt:2: 'clip': the normal (NX NY NZ) must not be zero";
+    CHECK(parse_error("clip 0 0 0 1e-7 0 0").find(zero) == 0);
+    CHECK(parse_error("clip 0 0 0 0 -1e-7 1e-7").find(zero) == 0);
+    CHECK(parse_viewer_script("clip 0 0 0 1e-5 0 0\n", "demo.txt").size() == 1);
+    CHECK(!clip_normal_usable({1e-7f, 0.0f, 0.0f}));
+    CHECK(clip_normal_usable({1e-5f, 0.0f, 0.0f}));
+  }
+
   TEST_CASE("viewer_script_parser_refuses_unknown_names_before_anything_runs") {
     CHECK(parse_error("key ctrl").find("demo.txt:2: no key 'ctrl'") == 0);
     CHECK(parse_error("drag wheel 0 0 1 1").find("demo.txt:2: no mouse button 'wheel'") == 0);
@@ -165,7 +176,7 @@ TEST_SUITE("window") {
       const auto script = test::write_file(dir / "script.txt", "frames 1\n" + line + "\nquit\n");
       const auto start = std::chrono::steady_clock::now();
       const auto r = test::run_strata("view " STRATA_SOURCE_DIR
-                                      "/assets/scenes/head.json --size 48x32 --no-optimize "
+                                      "/assets/scenes/head.json --size 48x32 "
                                       "--no-panel --script " +
                                       script.string());
       CAPTURE(r.output);
@@ -189,7 +200,7 @@ TEST_SUITE("window") {
                                          "settle-limit 8\ndrag left 20 60 180 60\nkey r\nquit\n");
     const auto start = std::chrono::steady_clock::now();
     const auto r = test::run_strata("view " STRATA_SOURCE_DIR
-                                    "/assets/scenes/head.json --size 200x150 --no-optimize "
+                                    "/assets/scenes/head.json --size 200x150 "
                                     "--no-panel --frame-budget 0 --settle-limit 60 --script " +
                                     script.string());
     CAPTURE(r.output);

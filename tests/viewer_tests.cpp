@@ -15,6 +15,7 @@
 #include "engine/core/png.h"
 #include "engine/scene/camera.h"
 #include "engine/scene/io/label_file_loader.h"
+#include "engine/scene/io/label_file_writer.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/scene_bounds.h"
 #include "gpu_fixture.h"
@@ -105,9 +106,23 @@ size_t changed_pixels(const Rgba8Image& a, const Rgba8Image& b,
   return n;
 }
 
+// The viewer's camera as a `report` file gives its view matrix (the test scene's lens).
+Camera reported_camera(const std::filesystem::path& report) {
+  const auto json = nlohmann::json::parse(test::read_file(report));
+  Camera camera = load_scene(kScene).camera;
+  for (int col = 0; col < 4; ++col)
+    for (int row = 0; row < 4; ++row) camera.view[col][row] = json.at("view")[col * 4 + row];
+  return camera;
+}
+
+// (--no-optimize: after each of its many steps the optimisation on idle's trials, and the labels'
+// move to the order it keeps, would more than double the test's time; nothing here depends on
+// the order)
+const std::string kManySteps = "--no-optimize --no-panel";
+
 // Runs `strata view` on the test scene with `script` (written into `dir`).
 test::CommandResult view(const std::filesystem::path& dir, const std::string& script,
-                         const std::string& options = "--no-optimize --no-panel") {
+                         const std::string& options = "--no-panel") {
   const auto path = test::write_file(dir / "script.txt", script);
   return run_strata("--validate view " + kScene + " --size " + std::to_string(kWidth) + "x" +
                     std::to_string(kHeight) + " " + options + " --screenshot-dir " + dir.string() +
@@ -120,7 +135,7 @@ TEST_SUITE("window") {
   // Labels of one's own (issue 36's session): five labels placed on head.json from two views, one
   // dragged by its anchor in place mode, one renamed in non-ASCII text, one moved, one deleted
   // and the deletion undone, saved as .mrk.json
-  // in RAS and as .fcsv in LPS. Both files hold the scene's 11 labels and the 5 new ones with the
+  // in RAS and as .fcsv in LPS. Both files hold the 5 new ones (not the scene's 11) with the
   // same points (within 0.01 mm); each new anchor lies on the ray of the pixel it was placed or
   // moved at (the camera from `report`); `strata render --labels` shows them on the scan.
   // The crop box from a script: the picture shows the head cut below z = 40 (from the front, its
@@ -183,18 +198,15 @@ TEST_SUITE("window") {
     const std::string setup = "view anterior\ncrop -60 -90 -40 60 60 50\nclip 0 0 0 0 0 -1\n";
     // (one frame in flight: the plane changes the layers, and the graph made again must wait
     // for the frame the window still shows)
-    const auto first = view(dir, setup + "report " + d("r0.json") + "\nquit\n",
-                            "--no-optimize --no-panel --frames-in-flight 1");
+    const auto first =
+        view(dir, setup + "report " + d("r0.json") + "\nquit\n", "--no-panel --frames-in-flight 1");
     REQUIRE_MESSAGE(first.exit_code == 0, first.output);
     CHECK(first.output.find("validation") == std::string::npos);
     const Scene scene = load_scene(kScene);
     const auto report = [&](const char* name) {
       return nlohmann::json::parse(test::read_file(dir / name));
     };
-    Camera camera = scene.camera;
-    for (int col = 0; col < 4; ++col)
-      for (int row = 0; row < 4; ++row)
-        camera.view[col][row] = report("r0.json").at("view")[col * 4 + row];
+    const Camera camera = reported_camera(dir / "r0.json");
     const auto pixel = [&](glm::vec3 p) { return project(camera, p, {kWidth, kHeight}).pixel; };
     // The bottom face's handle: its centre; the plane's: the centre of its cut through the
     // content (the content's box at z = 0). Each is dragged 12 px down the picture (towards -z).
@@ -207,11 +219,13 @@ TEST_SUITE("window") {
       return "drag left " + std::to_string(from.x) + " " + std::to_string(from.y) + " " +
              std::to_string(from.x) + " " + std::to_string(from.y + 12.0f) + "\n";
     };
-    const auto r = view(dir, setup + "screenshot " + d("before.png") + "\n" + drag(bottom) +
-                                 "report " + d("r1.json") + "\nscreenshot " + d("face.png") + "\n" +
-                                 drag(on_plane) + "report " + d("r2.json") + "\nscreenshot " +
-                                 d("plane.png") + "\nclip 0 0 0 1 0 0\nreport " + d("r3.json") +
-                                 "\nclip off\nreport " + d("r4.json") + "\nquit\n");
+    const auto r = view(dir,
+                        setup + "screenshot " + d("before.png") + "\n" + drag(bottom) + "report " +
+                            d("r1.json") + "\nscreenshot " + d("face.png") + "\n" + drag(on_plane) +
+                            "report " + d("r2.json") + "\nscreenshot " + d("plane.png") +
+                            "\nclip 0 0 0 1 0 0\nreport " + d("r3.json") + "\nclip off\nreport " +
+                            d("r4.json") + "\nquit\n",
+                        kManySteps);
     REQUIRE_MESSAGE(r.exit_code == 0, r.output);
     CHECK(r.output.find("validation") == std::string::npos);
     // The millimetres 12 px are at each handle, along its direction (+z for both drags).
@@ -242,40 +256,37 @@ TEST_SUITE("window") {
         "view anterior\nplace 80 40\nplace 66 70\nkey p\ndrag left 80 40 72 34\nkey p\nreport " +
             d("front.json") +
             "\nview left\nplace 80 60\nplace 60 50\nplace 100 70\n"
-            "text 101 \"Thalamus R – Ödem \\\"rechts\\\"\"\nmove 102 90 45\n"
-            "delete 103\nundo\nreport " +
+            "text 0 \"Thalamus R – Ödem \\\"rechts\\\"\"\nmove 4 90 45\n"
+            "delete 5\nundo\nreport " +
             d("left.json") + "\nsave " + d("own.mrk.json") + " ras\nsave " + d("own.fcsv") +
-            " lps\nquit\n");
+            " lps\nquit\n",
+        kManySteps);
     REQUIRE_MESSAGE(r.exit_code == 0, r.output);
+    // (new labels take the lowest ids the scene's 11 leave free: 0, 4, 5, 6, 7)
+    for (const char* id : {"(label 0)", "(label 4)", "(label 5)", "(label 6)", "(label 7)"})
+      CHECK(r.output.find(id) != std::string::npos);
     const std::vector<Label> ras = load_label_file(d("own.mrk.json"));
     const std::vector<Label> lps = load_label_file(d("own.fcsv"));
-    REQUIRE(ras.size() == 16);
-    REQUIRE(lps.size() == 16);
+    REQUIRE(ras.size() == 5);
+    REQUIRE(lps.size() == 5);
     for (size_t i = 0; i < ras.size(); ++i) {
       CAPTURE(i);
       CHECK(ras[i].text == lps[i].text);
       CHECK(glm::distance(ras[i].anchor, lps[i].anchor) <= 0.01f);
     }
-    CHECK(ras[11].text == "Thalamus R – Ödem \"rechts\"");
+    CHECK(ras[0].text == "Thalamus R – Ödem \"rechts\"");
     // (each placed or moved anchor projects to the centre of its pixel in its view's camera)
-    const Scene scene = load_scene(kScene);
-    const auto camera_of = [&](const char* report) {
-      const auto json = nlohmann::json::parse(test::read_file(dir / report));
-      Camera camera = scene.camera;
-      for (int col = 0; col < 4; ++col)
-        for (int row = 0; row < 4; ++row) camera.view[col][row] = json.at("view")[col * 4 + row];
-      return camera;
-    };
-    const Camera front = camera_of("front.json"), left = camera_of("left.json");
+    const Camera front = reported_camera(dir / "front.json");
+    const Camera left = reported_camera(dir / "left.json");
     const struct {
       size_t index;
       const Camera* camera;
       glm::vec2 pixel;
-    } placed[] = {{11, &front, {72, 34}},
-                  {12, &left, {90, 45}},
-                  {13, &left, {80, 60}},
-                  {14, &left, {60, 50}},
-                  {15, &left, {100, 70}}};
+    } placed[] = {{0, &front, {72, 34}},
+                  {1, &left, {90, 45}},
+                  {2, &left, {80, 60}},
+                  {3, &left, {60, 50}},
+                  {4, &left, {100, 70}}};
     for (const auto& p : placed) {
       CAPTURE(p.index);
       const ProjectedPoint at = project(*p.camera, ras[p.index].anchor, {kWidth, kHeight});
@@ -287,13 +298,117 @@ TEST_SUITE("window") {
         d("own.mrk.json") + " --size 384 --layout " + d("render.json") + " -o " + d("render.png"));
     REQUIRE_MESSAGE(rendered.exit_code == 0, rendered.output);
     const auto layout = nlohmann::json::parse(test::read_file(dir / "render.json"));
-    for (size_t i = 11; i < ras.size(); ++i) {
+    for (size_t i = 0; i < ras.size(); ++i) {
       CAPTURE(ras[i].text);
       bool drawn = false;
       for (const auto& l : layout.at("labels"))
         drawn = drawn || (l.at("text") == ras[i].text && l.at("placed").get<bool>());
       CHECK(drawn);
     }
+  }
+
+  // The workflow of docs/viewer.md: open the scene, place a label, save; open the scene with the
+  // saved file, place one more, save to the same file; three times. The file holds the labels
+  // placed (1, 2, 3), never the scene's own, and the scene with it draws each label once. A file
+  // that holds the scene's labels too (as saved before) adds them once, with a warning.
+  TEST_CASE("saved_labels_read_back_once_over_three_open_edit_save_cycles") {
+    const auto dir = test::fresh_folder("viewer", "save-cycles");
+    const std::string saved = (dir / "mine.mrk.json").string();
+    const char* pixels[] = {"80 60", "60 50", "100 70"};
+    for (size_t cycle = 0; cycle < 3; ++cycle) {
+      CAPTURE(cycle);
+      const auto r = view(
+          dir, std::string("view left\nplace ") + pixels[cycle] + "\nsave " + saved + "\nquit\n",
+          "--no-panel" + (cycle > 0 ? " --labels " + saved : std::string()));
+      REQUIRE_MESSAGE(r.exit_code == 0, r.output);
+      CHECK(r.output.find("the scene's 11 stay in its file") != std::string::npos);
+      CHECK(load_label_file(saved).size() == cycle + 1);
+    }
+    const auto labels_drawn = [&](const std::string& file) {
+      const auto layout = dir / "layout.json";
+      const auto r = run_strata("render " + kScene + " --labels " + file + " --size 96 --layout " +
+                                layout.string() + " -o " + (dir / "render.png").string());
+      INFO(r.output);
+      CHECK(r.exit_code == 0);
+      return std::pair{nlohmann::json::parse(test::read_file(layout)).at("labels").size(),
+                       r.output};
+    };
+    CHECK(labels_drawn(saved).first == 14);
+    // (the scene's 11 and the 3 placed in one file)
+    std::vector<Label> both = load_scene(kScene).labels;
+    for (const Label& l : load_label_file(saved)) both.push_back(l);
+    const auto old = dir / "old.mrk.json";
+    write_label_file(old, both, LabelAxes::ras);
+    const auto [count, output] = labels_drawn(old.string());
+    CHECK(count == 14);
+    CHECK(output.find("strata: warning: " + old.string() +
+                      ": 11 of its labels the scene has already (the same text and anchor): "
+                      "added once") != std::string::npos);
+  }
+
+  // Labels placed in a scene whose largest id is 2147483647 take the lowest ids free (a file's
+  // labels added with --labels too); a text that is not UTF-8 is refused when it is entered, and
+  // a text with a NUL when it is saved into a .fcsv file (which cannot hold it).
+  TEST_CASE("viewer_labels_take_free_ids_and_texts_a_file_cannot_hold_are_refused_with_why") {
+    const auto dir = test::fresh_folder("viewer", "ids-text");
+    const auto scene = test::write_file(
+        dir / "scene.json",
+        R"({"strata_scene": 1, "volumes": [{"name": "head", "file": ")" STRATA_SOURCE_DIR
+        R"(/assets/cache/mricron/ch2.nii.gz"}], "labels": [
+          {"id": 2147483647, "text": "Top", "anchor": [0, 17, 60]},
+          {"id": 1, "text": "Middle", "anchor": [0, 17, 19]}]})");
+    const std::vector<Label> nul = {
+        Label{.id = 5, .text = std::string("a\0b", 3), .anchor = {0.0f, 17.0f, 30.0f}}};
+    write_label_file(dir / "nul.mrk.json", nul);
+    const auto run = [&](const std::string& script) {
+      return run_strata("--validate view " + scene.string() + " --size 160x120 --no-panel " +
+                        "--labels " + (dir / "nul.mrk.json").string() + " --script " +
+                        test::write_file(dir / "script.txt", script).string());
+    };
+    const auto fcsv = dir / "own.fcsv";
+    const auto placed =
+        run("view anterior\nplace 80 60\nplace 70 50\nsave " + fcsv.string() + "\nquit\n");
+    INFO(placed.output);
+    CHECK(placed.exit_code == 1);
+    CHECK(placed.output.find("(label 2)") != std::string::npos);
+    CHECK(placed.output.find("(label 3)") != std::string::npos);
+    CHECK(placed.output.find("-2147483648") == std::string::npos);
+    CHECK(placed.output.find(fcsv.string() +
+                             ": labels[0] (id 0): the text has a NUL character, which a .fcsv file "
+                             "cannot hold (write .mrk.json)") != std::string::npos);
+    CHECK(!std::filesystem::exists(fcsv));
+    const auto latin1 =
+        run("text 1 \"\xD6"
+            "dem\"\nquit\n");
+    INFO(latin1.output);
+    CHECK(latin1.exit_code == 1);
+    CHECK(latin1.output.find(":1: label 1: the text is not UTF-8") != std::string::npos);
+  }
+
+  // A place picks the picture as drawn, `strata pick` the scene's picture without labels
+  // (docs/viewer.md): inside a ghosting lens (a scene label's, then the lens of the label just
+  // placed there) a place goes through what the lens opens, behind the point `strata pick`
+  // finds; with ghosting off, a place finds that point.
+  TEST_CASE("viewer_place_picks_through_ghosting_lenses_and_without_them_where_pick_does") {
+    const auto dir = test::fresh_folder("viewer", "place-lens");
+    const auto r = view(dir, "place 80 60\nplace 80 60\nreport " + (dir / "r.json").string() +
+                                 "\nset ghost 0\nplace 80 60\nsave " +
+                                 (dir / "placed.mrk.json").string() + "\nquit\n");
+    REQUIRE_MESSAGE(r.exit_code == 0, r.output);
+    const std::vector<Label> placed = load_label_file(dir / "placed.mrk.json");
+    REQUIRE(placed.size() == 3);
+    const auto pick = run_strata("pick " + kScene + " --size 160x120 --at 80,60");
+    REQUIRE_MESSAGE(pick.exit_code == 0, pick.output);
+    glm::vec3 picked{0.0f};
+    REQUIRE(std::sscanf(pick.output.substr(pick.output.find("80,60: LPS ")).c_str(),
+                        "80,60: LPS %f %f %f", &picked.x, &picked.y, &picked.z) == 3);
+    const Camera camera = reported_camera(dir / "r.json");
+    const auto at = [&](glm::vec3 p) { return project(camera, p, {kWidth, kHeight}); };
+    for (const Label& l : placed)
+      CHECK(glm::distance(at(l.anchor).pixel, glm::vec2(80.5f, 60.5f)) <= 0.05f);
+    CHECK(at(placed[0].anchor).eye_depth > at(picked).eye_depth + 0.5f);
+    CHECK(at(placed[1].anchor).eye_depth > at(placed[0].anchor).eye_depth + 0.5f);
+    CHECK(glm::distance(placed[2].anchor, picked) <= 0.02f);
   }
 
   TEST_CASE("viewer_script_rotates_zooms_pans_jumps_reweights_and_hides") {
@@ -313,7 +428,9 @@ TEST_SUITE("window") {
                  "\nset weights.anchor_constraint 0\nset weights.distance_to_anchor 1\n"
                  "set weights.leader_crossing 0\nlayout " +
                  d("weighted.json") + "\nquit\n",
-             // (the layouts this test expects are those of the placement in each frame)
+             // (the layouts this test expects are those of the placement in each frame, in the
+             // scene's insertion order: the optimisation on idle's orders would blur what the
+             // weights change)
              "--no-optimize --no-panel --frame-budget 0");
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
@@ -384,9 +501,9 @@ TEST_SUITE("window") {
                         "screenshot " + d("picture.png") + "\ncapture " + d("window.png") +
                             "\nkey f12\nreport " + d("still-1.json") + "\nsleep 1.5\nreport " +
                             d("still-2.json") + "\nrecord start " + d("clip.mp4") +
-                            "\ndrag left 80 60 100 60\nframes 4\nrecord stop\nreport " +
-                            d("recorded.json") + "\nquit\n",
-                        "--no-optimize");
+                            "\ndrag left 80 60 100 60\nframes 4\nreport " + d("recorded.json") +
+                            "\nrecord stop\nquit\n",
+                        "");
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
 
@@ -408,7 +525,8 @@ TEST_SUITE("window") {
     CHECK(nlohmann::json::parse(test::read_file(d("still-1.json"))).at("settled") == true);
     CHECK(frames("still-2.json") == frames("still-1.json"));
 
-    // Every frame drawn while recording is in the video.
+    // Every frame drawn while recording is in the video (the optimisation on idle waits for the
+    // recording's end).
     const int recorded = frames("recorded.json") - frames("still-2.json");
     CHECK(recorded >= 4);
 #if STRATA_VIDEO
@@ -424,8 +542,8 @@ TEST_SUITE("window") {
     const auto script = test::write_file(
         dir / "script.txt", "report " + d("open.json") + "\nlayout " + d("open-layout.json") +
                                 "\nscreenshot " + d("open.png") + "\nquit\n");
-    const auto r = run_strata("--validate view " + kScene +
-                              " --size 640x240 --no-optimize --script " + script.string());
+    const auto r =
+        run_strata("--validate view " + kScene + " --size 640x240 --script " + script.string());
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     const auto panel = nlohmann::json::parse(test::read_file(d("open.json"))).at("panel");
@@ -452,7 +570,7 @@ TEST_SUITE("window") {
     CHECK(open_drawn >= 3);
     // Without the panel, labels take that room.
     const auto bare = run_strata(
-        "--validate view " + kScene + " --size 640x240 --no-optimize --no-panel --script " +
+        "--validate view " + kScene + " --size 640x240 --no-panel --script " +
         test::write_file(dir / "bare.txt", "layout " + d("bare-layout.json") + "\nquit\n")
             .string());
     INFO(bare.output);
@@ -471,10 +589,9 @@ TEST_SUITE("window") {
     const auto script = test::write_file(
         dir / "script.txt", "layout " + d("rest.json") + "\ndrag left 40 60 120 60\nlayout " +
                                 d("turned.json") + "\nquit\n");
-    const auto r =
-        run_strata("--validate view " + kScene + " --size " + std::to_string(kWidth) + "x" +
-                   std::to_string(kHeight) +
-                   " --no-panel --no-optimize --placement beside --script " + script.string());
+    const auto r = run_strata("--validate view " + kScene + " --size " + std::to_string(kWidth) +
+                              "x" + std::to_string(kHeight) +
+                              " --no-panel --placement beside --script " + script.string());
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     CHECK(r.output.find("view: placement beside the frames: ") != std::string::npos);
@@ -516,7 +633,7 @@ TEST_SUITE("window") {
                                            "view left\ncapture " + d(name) + ".png\nquit\n");
       // (the head's volume alone: no labels to tell the pictures apart)
       return run_strata("--validate view " STRATA_SOURCE_DIR "/assets/cache/mricron/ch2.nii.gz" +
-                        size + " --no-panel --no-optimize --frame-budget " + budget + " --script " +
+                        size + " --no-panel --frame-budget " + budget + " --script " +
                         script.string());
     };
     const auto fast = run("1", "fast");
@@ -531,6 +648,32 @@ TEST_SUITE("window") {
     CHECK(full.output.find("1 x 1 pixels to a ray at most") != std::string::npos);
     // At rest, the same picture as without interactive rendering.
     CHECK(changed_pixels(read_png(d("fast.png")), read_png(d("full.png"))) == 0);
+  }
+
+  // The optimisation on idle (the default) with the placement beside the frames (lavapipe's
+  // default with interactive rendering): its trials are placements of their own, which the frames
+  // never adopt. A script's first command runs once all are back, well within the settle limit,
+  // and the viewer at rest then draws nothing.
+  TEST_CASE("viewer_with_its_default_optimisation_settles_well_within_the_limit_and_then_sleeps") {
+    const auto dir = test::fresh_folder("viewer", "optimize-beside");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto start = std::chrono::steady_clock::now();
+    const auto r = view(dir,
+                        "screenshot " + d("x.png") + "\nreport " + d("rest.json") +
+                            "\nsleep 1\nreport " + d("slept.json") + "\nquit\n",
+                        "--no-panel --settle-limit 60");
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    // (well within the limit: about 5 s on lavapipe)
+    CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(30));
+    CHECK(r.output.find("view: placement beside the frames: ") != std::string::npos);
+    const auto report = [&](const char* name) {
+      return nlohmann::json::parse(test::read_file(d(name)));
+    };
+    CHECK(report("rest.json").at("trials") == 8);
+    CHECK(report("rest.json").at("settled") == true);
+    CHECK(report("rest.json").at("busy") == false);
+    CHECK(report("slept.json").at("frames") == report("rest.json").at("frames"));
   }
 
   TEST_CASE("viewer_tries_insertion_orders_when_the_camera_rests") {
@@ -560,8 +703,8 @@ TEST_SUITE("window") {
     const auto dir = test::fresh_folder("viewer", "xdotool");
     const std::string log = (dir / "log.txt").string();
     const std::string command = std::string(STRATA_BINARY) + " --validate view " + kScene +
-                                " --size 160x120 --no-optimize --no-panel --screenshot-dir " +
-                                dir.string() + " > " + log + " 2>&1 &";
+                                " --size 160x120 --no-panel --screenshot-dir " + dir.string() +
+                                " > " + log + " 2>&1 &";
     REQUIRE(std::system(command.c_str()) == 0);
     const auto sh = [](const std::string& c) { return std::system(c.c_str()); };
     REQUIRE(sh("xdotool search --sync --name 'strata - head.json' > /dev/null") == 0);
@@ -612,7 +755,7 @@ TEST_SUITE("window") {
     const auto run = [&](const char* preset, const std::string& script) {
       const auto path = test::write_file(dir / "script.txt", script);
       const auto r = run_strata("--validate view " STRATA_SOURCE_DIR
-                                "/assets/cache/mricron/ch2.nii.gz --size 96 --no-optimize "
+                                "/assets/cache/mricron/ch2.nii.gz --size 96 "
                                 "--no-panel --preset " +
                                 std::string(preset) + " --script " + path.string());
       INFO(r.output);
@@ -636,7 +779,7 @@ TEST_SUITE("window") {
                                 d("brain.png") + "\nview superior\nscreenshot " + d("top.png") +
                                 "\npreset ct-bone\nscreenshot " + d("bone.png") + "\nquit\n");
     const auto r = run_strata("--validate view " STRATA_SOURCE_DIR
-                              "/assets/cache/mricron/ch2.nii.gz --size 96 --no-optimize "
+                              "/assets/cache/mricron/ch2.nii.gz --size 96 "
                               "--no-panel --script " +
                               script.string());
     INFO(r.output);

@@ -60,6 +60,11 @@ inline constexpr size_t kMaxCutPlanes = 12;  // VR_MAX_CUT_PLANES
 std::vector<glm::vec4> crop_planes(glm::vec3 lo, glm::vec3 hi);
 // The plane through `point` that keeps the side `normal` points to.
 glm::vec4 clip_plane(glm::vec3 point, glm::vec3 normal);
+// Whether `normal` gives a clipping plane a direction: longer than 1e-6 (--clip and the
+// viewer's planes, one rule).
+inline bool clip_normal_usable(glm::vec3 normal) {
+  return glm::length(normal) > 1e-6f;
+}
 // Whether a volume's cut-aways remove world point p (false for a volume without any).
 bool cut_away(const Volume& volume, glm::vec3 p);
 
@@ -113,6 +118,12 @@ struct Label {
   float priority = 0.0f;
 };
 
+// One label written to a label file and read back: the same text and anchor (a label file
+// gives its labels ids of its own).
+inline bool same_label(const Label& a, const Label& b) {
+  return a.text == b.text && a.anchor == b.anchor;
+}
+
 // The thesis program's final paper settings (eq. 3.1; docs/ARCHITECTURE.md, "Thesis equations
 // in the code").
 struct CostWeights {
@@ -164,6 +175,9 @@ struct Scene {
   std::vector<TransferFunction> transfer_functions;
   std::vector<Mesh> meshes;
   std::vector<Label> labels;
+  // The last this many labels came from a label file opened with the scene (--labels), not
+  // from the scene's own file: the viewer saves them with the labels placed in it.
+  size_t added_labels = 0;
   Camera camera;
   bool has_camera = false;  // the file gave the camera's view (else complete_scene fits one)
   std::vector<CameraPose> camera_positions;  // named poses ("--camera NAME")

@@ -100,6 +100,10 @@ std::string fcsv_field(const Label& label, size_t index) {
   if (label.text.find_first_of("\r\n") != std::string::npos)
     fail(label, index,
          "the text has a line break, which a .fcsv row cannot hold (write .mrk.json)");
+  // (strata's own reader refuses a text file with a NUL byte, as other tools' do)
+  if (label.text.find('\0') != std::string::npos)
+    fail(label, index,
+         "the text has a NUL character, which a .fcsv file cannot hold (write .mrk.json)");
   if (label.text.find_first_of(",\"") == std::string::npos) return label.text;
   std::string quoted = "\"";
   for (const char c : label.text) {

@@ -22,7 +22,8 @@ std::string markups_json_text(std::span<const Label> labels, LabelAxes axes);
 
 // Slicer's fiducial list (.fcsv, the header Slicer 4.11 writes): a row per label, the text quoted
 // as Slicer quotes it when it holds a comma or a quote. Errors as markups_json_text, and a text
-// with a line break, which Slicer reads as the end of the row.
+// with a line break, which Slicer reads as the end of the row, or a NUL character, which makes
+// the file unreadable.
 std::string fcsv_text(std::span<const Label> labels, LabelAxes axes);
 
 // By extension, .mrk.json or .fcsv, written whole or not at all (AtomicFile). Errors: one

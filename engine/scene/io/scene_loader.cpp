@@ -218,7 +218,8 @@ std::vector<glm::vec4> cut_planes(const json& object, const Field& field) {
     if (!clip->is_array()) clips.fail("expected an array of planes {\"point\", \"normal\"}");
     for (size_t i = 0; i < clip->size(); ++i) {
       const Field plane = clips[i];
-      if (!(*clip)[i].is_object()) plane.fail("expected {\"point\": [x, y, z], \"normal\": [x, y, z]}");
+      if (!(*clip)[i].is_object())
+        plane.fail("expected {\"point\": [x, y, z], \"normal\": [x, y, z]}");
       check_keys((*clip)[i], plane, {"point", "normal"});
       const glm::vec3 point = vec3(required((*clip)[i], plane, "point"), plane / "point");
       const glm::vec3 normal = vec3(required((*clip)[i], plane, "normal"), plane / "normal");
@@ -583,9 +584,7 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
                 "' (expected a scene: .json, or .xml from the thesis program; or a volume: " +
                 kVolumeExtensions + ")");
   }
-  if (!options.labels.empty()) {
-    for (Label& l : labels_to_add(options.labels, scene)) scene.labels.push_back(std::move(l));
-  }
+  if (!options.labels.empty()) add_label_file(scene, options.labels);
   if (scene.labels.size() > size_t(kMaxLabels))
     throw Error(path.string() + ": " + std::to_string(scene.labels.size()) +
                 " labels; strata places at most " + std::to_string(kMaxLabels) + " in a scene");
@@ -598,6 +597,46 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
   }
   complete_scene(scene, options.preset, options.window);
   return scene;
+}
+
+void add_label_file(Scene& scene, const std::filesystem::path& path) {
+  const size_t own = scene.labels.size();
+  size_t same = 0;
+  std::vector<Label> read = load_label_file(path);
+  const std::vector<int> ids = unused_label_ids(scene.labels, read.size());
+  for (size_t i = 0; i < read.size(); ++i) {
+    Label& l = read[i];
+    l.id = ids[i];
+    // (a file the viewer saved before it kept the scene's labels apart holds them too)
+    const bool known = std::any_of(scene.labels.begin(), scene.labels.begin() + ptrdiff_t(own),
+                                   [&](const Label& o) { return same_label(o, l); });
+    if (known) {
+      ++same;
+    } else {
+      scene.labels.push_back(std::move(l));
+    }
+  }
+  scene.added_labels = scene.labels.size() - own;
+  if (const auto problem = label_limit_problem(scene.added_labels, own))
+    throw Error(path.string() + ": " + *problem);
+  if (same > 0)
+    scene.warnings.push_back(path.string() + ": " + std::to_string(same) +
+                             " of its labels the scene has already (the same text and anchor): "
+                             "added once");
+}
+
+std::vector<int> unused_label_ids(const std::vector<Label>& labels, size_t count) {
+  std::set<int> used;
+  for (const Label& l : labels) used.insert(l.id);
+  std::vector<int> ids;
+  for (int64_t id = 0; ids.size() < count; ++id) {
+    if (id > std::numeric_limits<int>::max())
+      throw Error(std::to_string(count) +
+                  " new labels: no label id left; the scene's labels take " +
+                  "every free one from 0 to 2147483647");
+    if (!used.count(int(id))) ids.push_back(int(id));
+  }
+  return ids;
 }
 
 int64_t next_label_id(const Scene& scene) {

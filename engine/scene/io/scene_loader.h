@@ -42,6 +42,15 @@ Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOption
 void complete_scene(Scene& scene, const std::string& preset = "",
                     std::optional<glm::vec2> window = {});
 
+// The labels of a label file (load_label_file) added to the scene's, with the lowest ids no
+// label has, but for those the scene has already (same_label): a warning names the file and
+// counts them. Scene::added_labels counts those added.
+void add_label_file(Scene& scene, const std::filesystem::path& path);
+
+// The `count` lowest ids from 0 that none of `labels` has: new labels' ids. An Error where the
+// ids up to 2147483647 run out.
+std::vector<int> unused_label_ids(const std::vector<Label>& labels, size_t count);
+
 // One more than the highest label id (0 for none): where added labels' ids start.
 // (int64_t: one past a label with id 2147483647 is no int.)
 int64_t next_label_id(const Scene& scene);
