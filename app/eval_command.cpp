@@ -39,8 +39,9 @@ nlohmann::ordered_json evaluate(const EvalOptions& o) {
 }  // namespace
 
 void add_eval_command(CLI::App& app) {
-  CLI::App* cmd = app.add_subcommand(
-      "eval", "Layout-quality metrics of --layout files (overlaps, crossings, movement) as JSON");
+  CLI::App* cmd = app.add_subcommand("eval",
+                                     "Layout-quality metrics of --layout files (overlaps, "
+                                     "crossings, movement, active ranges) as JSON");
   auto o = std::make_shared<EvalOptions>();
   cmd->add_option("LAYOUT", o->files,
                   "layout files from `strata render --layout` or `strata video --layout-dir`, "

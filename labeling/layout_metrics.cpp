@@ -371,6 +371,7 @@ SequenceMetrics sequence_metrics(const std::vector<Layout>& frames,
     m.opaque_flips_per_label_per_second =
         movements.label_seconds > 0.0 ? double(m.opaque_flips) / movements.label_seconds : 0.0;
   }
+  m.ranges = active_range_metrics(frames, stills);
   return m;
 }
 
@@ -378,7 +379,8 @@ SequenceMetrics sequence_metrics(const std::vector<Layout>& frames,
 
 namespace {
 
-ordered_json optional_number(std::optional<double> value) {
+template <typename Number>
+ordered_json optional_number(std::optional<Number> value) {
   return value ? ordered_json(*value) : ordered_json();
 }
 
@@ -444,6 +446,21 @@ ordered_json temporal_json(const SequenceMetrics& m) {
       {"opaque_flips_per_label_per_second", optional_number(m.opaque_flips_per_label_per_second)}};
 }
 
+void add_ranges_json(const ActiveRangeMetrics& r, bool stills, ordered_json& out) {
+  out["readable_label_frames"] = r.readable_label_frames;
+  out["readable_label_seconds"] = optional_number(r.readable_label_seconds);
+  if (stills) {
+    out["still_readable_label_seconds"] = optional_number(r.still_readable_label_seconds);
+    out["readable_of_stills"] = optional_number(r.readable_of_stills);
+  }
+  out["visible_stretches"] = r.visible_stretches;
+  out["active_ranges"] = r.active_ranges;
+  out["extra_ranges"] = r.extra_ranges;
+  out["extra_ranges_per_label_per_second"] = optional_number(r.extra_ranges_per_label_per_second);
+  out["short_ranges"] = optional_number(r.short_ranges);
+  out["short_ranges_inside"] = optional_number(r.short_ranges_inside);
+}
+
 }  // namespace
 
 ordered_json to_json(const SequenceMetrics& m, bool with_per_frame) {
@@ -458,6 +475,7 @@ ordered_json to_json(const SequenceMetrics& m, bool with_per_frame) {
   }
   out["total"] = to_json(m.total, stills ? &m.stills_total : nullptr);
   out["sequence"] = temporal_json(m);
+  add_ranges_json(m.ranges, stills, out["sequence"]);
   return out;
 }
 

@@ -1,8 +1,8 @@
 // Layout quality, measured from the layout files `strata render --layout` and `strata video
 // --layout-dir` write: overlaps, cut boxes, leader crossings, occluded anchors, leader lengths
-// per frame, and movement, jumps, layer switches and flips over a sequence, optionally against
-// stills of the same views. `strata eval`, `strata video --report`, the tests, the docs
-// (docs/layout-metrics.md) and the benchmarks share these definitions. No GPU.
+// per frame, and movement, jumps, layer switches, flips and active ranges over a sequence,
+// optionally against stills of the same views. `strata eval`, `strata video --report`, the
+// tests, the docs (docs/layout-metrics.md) and the benchmarks share these definitions. No GPU.
 //
 // Pixels, y down. A box is its top-left corner and its size. A label's leader is the segment
 // from its anchor to the closest point of its box (as shaders/shared/label_drawing.h draws it);
@@ -159,6 +159,32 @@ inline constexpr double apparent_opacity = 0.1;
 // one frame.
 inline constexpr double jump_threshold_of_width = 0.04;
 
+// How steadily labels stay readable (issue 50; computed in active_ranges.cpp). A label is
+// readable in a frame where it is shown with opacity >= opaque_opacity; its active ranges are its
+// runs of readable frames; a visible stretch is a run of frames in which the label is in the file
+// and its anchor lies in the closed image rectangle (or the label is readable).
+
+// A range is short below this many seconds, less a tolerance for the rounding of the time steps.
+inline constexpr double short_range_seconds = 1.0;
+
+// Each frame k >= 1 weighs its `seconds` and frame 0 nothing, as the sequence's duration does;
+// the figures in seconds are none when the sequence has no duration (one frame, or a frame from
+// 1 on without seconds).
+struct ActiveRangeMetrics {
+  size_t readable_label_frames = 0;  // labels shown with opacity >= opaque_opacity, over frames
+  std::optional<double> readable_label_seconds;
+  // With stills: theirs, weighed by the sequence's frames, and ours / theirs (none when 0).
+  std::optional<double> still_readable_label_seconds;
+  std::optional<double> readable_of_stills;
+  size_t visible_stretches = 0;  // runs of frames in which a label's anchor is in view
+  size_t active_ranges = 0;      // runs of frames in which a label is readable
+  size_t extra_ranges = 0;       // ranges beyond the first of their stretch
+  // extra_ranges / the label-seconds (each label-frame pair counts frame k + 1's seconds).
+  std::optional<double> extra_ranges_per_label_per_second;
+  std::optional<size_t> short_ranges;         // shorter than short_range_seconds
+  std::optional<size_t> short_ranges_inside;  // of those, touching neither end of the sequence
+};
+
 // Labels are matched by id between consecutive frames k and k + 1; a label-frame pair is a label
 // present in both. A label's offset is its box centre minus its anchor; its movement from k to
 // k + 1 is the length of the offset's change, in pixels (how far the box moved relative to its
@@ -193,12 +219,18 @@ struct SequenceMetrics {
   // Stills of the same views, frame by frame (empty: none given).
   std::vector<FrameMetrics> stills;
   FrameMetrics stills_total;  // sum_frame_metrics(stills)
+
+  ActiveRangeMetrics ranges;  // active_range_metrics(frames, stills)
 };
 
 // `stills`: empty, or the layouts of still placements of the same cameras, one per frame, each
 // the size of its frame (an Error otherwise).
 SequenceMetrics sequence_metrics(const std::vector<Layout>& frames,
                                  const std::vector<Layout>& stills = {});
+
+// `stills`: empty, or one per frame (as for sequence_metrics, which checks them).
+ActiveRangeMetrics active_range_metrics(const std::vector<Layout>& frames,
+                                        const std::vector<Layout>& stills = {});
 
 // The nearest-rank percentile (0 < q <= 1) of values: the ceil(q n)-th smallest; 0 when empty.
 double nearest_rank_percentile(std::vector<double> values, double q);

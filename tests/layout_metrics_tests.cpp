@@ -2,6 +2,9 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -401,6 +404,119 @@ TEST_SUITE("cpu") {
     CHECK(test::error_of([&] {
             sequence_metrics({frame(1.0), frame(1.0)}, {still});
           }) == "stills: 1 layouts for 2 frames");
+  }
+
+  // Frames of labels 1, 2, ... given as one string each, a character per frame: 'R' readable,
+  // 'f' shown but fading (opacity 0.3), '-' hidden with its anchor in the image, 'o' hidden with
+  // its anchor outside it, ' ' not in the file. Every frame has the time step `step`.
+  std::vector<Layout> labelled_frames(const std::vector<std::string>& labels,
+                                      std::optional<double> step) {
+    std::vector<Layout> frames(labels.front().size(), layout(100, 100, {}));
+    for (size_t k = 0; k < frames.size(); ++k) {
+      frames[k].seconds = step;
+      for (size_t i = 0; i < labels.size(); ++i) {
+        const char c = labels[i][k];
+        if (c == ' ') continue;
+        LayoutLabel l = label(int(i) + 1, {c == 'o' ? -10.0 : 50.0, 50}, {60, 40}, {20, 10},
+                              c == 'R' || c == 'f');
+        if (c == 'f') l = fading(l, 0.3);
+        frames[k].labels.push_back(l);
+      }
+    }
+    return frames;
+  }
+
+  TEST_CASE("a_label_hidden_or_faded_for_one_frame_mid_stretch_has_one_extra_range") {
+    const ActiveRangeMetrics m = sequence_metrics(labelled_frames({"RRRR-RRRR"}, 0.5)).ranges;
+    CHECK(m.visible_stretches == 1);
+    CHECK(m.active_ranges == 2);
+    CHECK(m.extra_ranges == 1);
+    CHECK(m.readable_label_frames == 8);
+    REQUIRE(m.readable_label_seconds);
+    CHECK(*m.readable_label_seconds == doctest::Approx(3.5));  // frame 0 weighs nothing
+    REQUIRE(m.extra_ranges_per_label_per_second);
+    CHECK(*m.extra_ranges_per_label_per_second == doctest::Approx(1.0 / 4.0));  // 8 pairs of 0.5 s
+    const ActiveRangeMetrics faded = sequence_metrics(labelled_frames({"RRfRR"}, 0.5)).ranges;
+    CHECK(faded.active_ranges == 2);
+    CHECK(faded.extra_ranges == 1);
+    // A label always readable, beside it, adds a range and its label-seconds, no extra range.
+    const ActiveRangeMetrics two =
+        sequence_metrics(labelled_frames({"RRRR-RRRR", "RRRRRRRRR"}, 0.5)).ranges;
+    CHECK(two.active_ranges == 3);
+    CHECK(two.extra_ranges == 1);
+    CHECK(*two.extra_ranges_per_label_per_second == doctest::Approx(1.0 / 8.0));
+  }
+
+  TEST_CASE("a_half_second_range_in_the_middle_is_short_and_at_the_ends_is_counted_apart") {
+    // At 0.25 s a frame: label 1's ranges are frames 0-1 (0.25 s: frame 0 weighs nothing), 4-5
+    // (0.5 s) and 8-9 (0.5 s): three short, one inside. Label 2's 1 s in the middle is not short.
+    const ActiveRangeMetrics m =
+        sequence_metrics(labelled_frames({"RR--RR--RR", "--RRRR----"}, 0.25)).ranges;
+    CHECK(m.active_ranges == 4);
+    CHECK(m.extra_ranges == 2);
+    REQUIRE(m.short_ranges);
+    CHECK(*m.short_ranges == 3);
+    REQUIRE(m.short_ranges_inside);
+    CHECK(*m.short_ranges_inside == 1);
+    // Ten steps of 0.1 s sum to a hair under 1 s in doubles: still 1 s, not short.
+    const ActiveRangeMetrics tenths =
+        sequence_metrics(labelled_frames({"-RRRRRRRRRR-"}, 0.1)).ranges;
+    CHECK(*tenths.short_ranges == 0);
+  }
+
+  TEST_CASE("a_label_leaving_the_image_or_the_file_and_returning_starts_a_new_stretch") {
+    const ActiveRangeMetrics out = sequence_metrics(labelled_frames({"RRRoooRRR"}, 0.5)).ranges;
+    CHECK(out.visible_stretches == 2);
+    CHECK(out.active_ranges == 2);
+    CHECK(out.extra_ranges == 0);
+    const ActiveRangeMetrics gone = sequence_metrics(labelled_frames({"RRR   RRR"}, 0.5)).ranges;
+    CHECK(gone.visible_stretches == 2);
+    CHECK(gone.extra_ranges == 0);
+    // Out of the image between two ranges, even when back in it for a frame: no extra range;
+    // hidden in view: one stretch, one extra range.
+    CHECK(sequence_metrics(labelled_frames({"RRo-oRR"}, 0.5)).ranges.extra_ranges == 0);
+    CHECK(sequence_metrics(labelled_frames({"RR---RR"}, 0.5)).ranges.extra_ranges == 1);
+  }
+
+  TEST_CASE("range_counts_stay_and_per_second_figures_are_null_without_seconds") {
+    const SequenceMetrics m = sequence_metrics(labelled_frames({"RR-RR", "-RRRR"}, std::nullopt));
+    CHECK(m.ranges.active_ranges == 3);
+    CHECK(m.ranges.extra_ranges == 1);
+    CHECK(m.ranges.readable_label_frames == 8);
+    CHECK_FALSE(m.ranges.readable_label_seconds);
+    CHECK_FALSE(m.ranges.extra_ranges_per_label_per_second);
+    CHECK_FALSE(m.ranges.short_ranges);
+    CHECK_FALSE(m.ranges.short_ranges_inside);
+    const nlohmann::ordered_json sequence = to_json(m)["sequence"];
+    CHECK(sequence["extra_ranges"] == 1);
+    CHECK(sequence["readable_label_seconds"].is_null());
+    CHECK(sequence["short_ranges_inside"].is_null());
+    CHECK_FALSE(sequence.contains("readable_of_stills"));
+    // Frame 0's seconds are not needed; one frame has no duration.
+    std::vector<Layout> frames = labelled_frames({"RRR"}, 0.5);
+    frames[0].seconds.reset();
+    CHECK(sequence_metrics(frames).ranges.readable_label_seconds);
+    CHECK_FALSE(sequence_metrics(labelled_frames({"R"}, 0.5)).ranges.short_ranges);
+  }
+
+  TEST_CASE("readable_label_seconds_compare_with_the_stills_of_the_same_frames") {
+    // Frames 1-3 weigh 0.5 s: the sequence reads 3 + 1 label-frames, the stills 3 + 3.
+    const std::vector<Layout> stills = labelled_frames({"----", "----"}, std::nullopt);
+    const std::vector<Layout> readable_stills = labelled_frames({"RRRR", "RRRR"}, std::nullopt);
+    const SequenceMetrics m =
+        sequence_metrics(labelled_frames({"RRRR", "R--R"}, 0.5), readable_stills);
+    REQUIRE(m.ranges.still_readable_label_seconds);
+    CHECK(*m.ranges.still_readable_label_seconds == doctest::Approx(3.0));
+    CHECK(*m.ranges.readable_label_seconds == doctest::Approx(2.0));
+    REQUIRE(m.ranges.readable_of_stills);
+    CHECK(*m.ranges.readable_of_stills == doctest::Approx(2.0 / 3.0));
+    const nlohmann::ordered_json sequence = to_json(m)["sequence"];
+    CHECK(sequence["readable_of_stills"].get<double>() == doctest::Approx(2.0 / 3.0));
+    // Stills that read nothing give no ratio.
+    const SequenceMetrics none = sequence_metrics(labelled_frames({"RRRR", "R--R"}, 0.5), stills);
+    CHECK(*none.ranges.still_readable_label_seconds == 0.0);
+    CHECK_FALSE(none.ranges.readable_of_stills);
+    CHECK(to_json(none)["sequence"]["readable_of_stills"].is_null());
   }
 
   TEST_CASE("read_layout_reads_opacity_target_and_seconds_and_defaults_them_for_older_files") {
