@@ -1,14 +1,18 @@
 // `strata video`: the labelled scene along a camera path or a turntable, one frame every 1 / fps
 // seconds, with the labels moved by the forces between frames (a fixed time step, so the same
-// command gives the same frames). Frames go into an H.264 MP4 (-o NAME.mp4) or a folder as a
-// numbered PNG sequence, and with --layout-dir each frame's layout as JSON (for `strata eval`),
-// with --still-layouts a still placement's of the same camera, and with --report the
+// command gives the same frames). By default the path is first rehearsed without writing a frame
+// and each label's active ranges planned over all of it (labeling/video_plan.h); `--plan off`
+// places every frame as the viewer would. Frames go into an H.264 MP4 (-o NAME.mp4) or a folder
+// as a numbered PNG sequence, and with --layout-dir each frame's layout as JSON (for `strata
+// eval`), with --still-layouts a still placement's of the same camera, and with --report the
 // layout-quality summary of `strata eval` over the frames at the end.
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <optional>
 
 #include "app/commands.h"
 #include "app/output_files.h"
@@ -18,6 +22,7 @@
 #include "labeling/camera_path.h"
 #include "labeling/labelled_render.h"
 #include "labeling/layout_metrics.h"
+#include "labeling/video_plan.h"
 
 namespace strata::app {
 namespace {
@@ -37,6 +42,7 @@ struct VideoOptions {
   bool screen_space = false;
   bool no_forces = false;
   bool hard = false;
+  bool plan = true;  // --plan: the labels' ranges planned over the whole path first
   LabelLookOptions look;
   ForceSettings forces;
   float layer_margin = LayerHysteresis{}.margin;
@@ -73,14 +79,18 @@ bool is_mp4(const std::filesystem::path& output) {
                    "' (expected NAME.mp4, or a folder without an extension for PNG frames)");
 }
 
-// A frame's layout: written into `folder` (empty: not written), and kept for the report (read
-// back from the JSON, so that it measures exactly what `strata eval` would read).
+// A frame's layout as `strata eval` reads it (the JSON parsed back, so that a plan and the report
+// see exactly what the files say).
+Layout measured_layout(const LabelledFrame& frame, size_t f) {
+  return parse_layout(nlohmann::json::parse(layout_json(frame)), frame_file_name(f, "json"));
+}
+
+// A frame's layout: written into `folder` (empty: not written), and kept for the report.
 void record_layout(const std::string& folder, size_t f, const LabelledFrame& frame,
-                   std::vector<Layout>* kept) {
-  const std::string text = layout_json(frame);
-  const std::filesystem::path path = std::filesystem::path(folder) / frame_file_name(f, "json");
-  if (!folder.empty()) write_text_file(path, text);
-  if (kept) kept->push_back(parse_layout(nlohmann::json::parse(text), path));
+                   const Layout& layout, std::vector<Layout>* kept) {
+  if (!folder.empty())
+    write_text_file(std::filesystem::path(folder) / frame_file_name(f, "json"), layout_json(frame));
+  if (kept) kept->push_back(layout);
 }
 
 LabellingSettings labelling_settings(const Scene& scene, const VideoOptions& o) {
@@ -182,6 +192,77 @@ void prepare_outputs(const VideoOptions& o, bool mp4, size_t frames) {
   }
 }
 
+// What every drawing of the path shares.
+struct PathDrawing {
+  Context& ctx;
+  const Scene& scene;
+  const std::vector<Camera>& cameras;
+  graph::Extent size;
+  LabellingSettings settings;
+  const VideoOptions& o;
+};
+
+// Each frame of a drawing with its layout (`visible` NaN and `shown` placed where legibility was
+// not measured).
+using FrameDone = std::function<void(size_t f, LabelledFrame& frame, const Layout& layout)>;
+
+// The path drawn once by a renderer of its own (so that every drawing starts alike and the same
+// plan gives the same frames). With a plan (`follower`), each frame leaves out the labels it
+// withholds; `measured`: legibility read (the layers downloaded).
+void draw_path(const PathDrawing& d, PlanFollower* follower, bool measured, const FrameDone& done) {
+  LabelledRenderer renderer(d.ctx, d.scene, d.cameras.front(), d.size, d.settings);
+  for (size_t f = 0; f < d.cameras.size(); ++f) {
+    if (follower) renderer.set_withheld(follower->withheld(f));
+    if (f == 0) renderer.run();  // the first frame: the labels settled on their placement
+    LabelledFrame frame = next_frame(renderer, d.cameras[f], f, d.o, measured);
+    const Layout layout = measured_layout(frame, f);
+    if (follower) follower->saw(layout);
+    done(f, frame, layout);
+  }
+}
+
+std::vector<int> label_ids(const Scene& scene) {
+  std::vector<int> ids;
+  for (const Label& label : scene.labels) ids.push_back(label.id);
+  return ids;
+}
+
+// Rehearsals with a plan, at most, after the free one.
+constexpr int kMaxPlannedRehearsals = 3;
+
+// Each label's ranges over the whole path (labeling/video_plan.h): a free rehearsal gives the
+// first plan, and each rehearsal with it drops the ranges it drew short, until it drew none.
+ActiveRanges plan_video(const PathDrawing& d) {
+  Progress progress("rehearsal frame", size_t(kMaxPlannedRehearsals + 1) * d.cameras.size());
+  const std::vector<int> ids = label_ids(d.scene);
+  int rehearsals = 0;
+  // (legibility is not read: a plan keeps what is drawn, so that --layout-dir changes no frame)
+  const auto rehearse = [&](PlanFollower* follower) {
+    std::vector<Layout> layouts;
+    const size_t before = size_t(rehearsals++) * d.cameras.size();
+    draw_path(d, follower, false, [&](size_t f, LabelledFrame&, const Layout& layout) {
+      layouts.push_back(layout);
+      progress.step_done(before + f + 1);
+    });
+    return layouts;
+  };
+  const double lead = d.settings.forces.fade_seconds * opaque_opacity + 1.0 / d.o.fps;
+  ActiveRanges plan = first_plan(rehearse(nullptr), lead);
+  size_t dropped = 0;
+  for (int k = 0; k < kMaxPlannedRehearsals; ++k) {
+    PlanFollower follower(plan, ids);
+    const size_t short_ranges = drop_short_ranges(plan, rehearse(&follower));
+    dropped += short_ranges;
+    if (short_ranges == 0) break;
+  }
+  size_t ranges = 0;
+  for (const auto& [id, r] : plan) ranges += r.size();
+  std::printf(
+      "planned %zu ranges of %zu labels in %d rehearsals (%zu short ones dropped), %.1f s\n",
+      ranges, plan.size(), rehearsals, dropped, progress.seconds());
+  return plan;
+}
+
 void video(DeviceOptions& device, const VideoOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const std::filesystem::path output = o.output;
@@ -190,33 +271,36 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   const Scene scene = load_scene_reporting(o.scene, ctx);
   const std::vector<Camera> cameras = sampled_cameras(camera_path(scene, o), o.fps);
   prepare_outputs(o, mp4, cameras.size());
+  const PathDrawing drawing{ctx, scene, cameras, size, labelling_settings(scene, o), o};
+  std::optional<PlanFollower> follower;
+  if (o.plan) follower.emplace(plan_video(drawing), label_ids(scene));
+
   // Frames are compressed on worker threads while the next one renders; an MP4 goes to a
   // temporary file, put in place by finish(): an error on the way leaves no MP4.
   FrameWriter writer(output, writer_settings(ctx, mp4, size, o));
-
-  const LabellingSettings settings = labelling_settings(scene, o);
-  LabelledRenderer renderer(ctx, scene, cameras.front(), size, settings);
   Progress progress("frame", cameras.size());
-  renderer.run();  // the first frame: the labels settled on their placement
   // --still-layouts: a second renderer places every frame's camera afresh, as a still.
   std::unique_ptr<LabelledRenderer> still;
   if (!o.still_layouts.empty()) {
-    still = std::make_unique<LabelledRenderer>(ctx, scene, cameras.front(), size, settings);
+    still = std::make_unique<LabelledRenderer>(ctx, scene, cameras.front(), size, drawing.settings);
   }
-  // (legibility only where a layout is used: it reads the layers back)
+  // (legibility only where a layout is written: it reads the layers back)
   const bool measured = !o.layout_dir.empty() || o.report;
   std::vector<Layout> frame_layouts, still_layouts;  // for the report
-  for (size_t f = 0; f < cameras.size(); ++f) {
-    LabelledFrame frame = next_frame(renderer, cameras[f], f, o, measured);
-    writer.write(std::move(frame.image));  // (the picture is the frame's own copy)
-    if (measured) record_layout(o.layout_dir, f, frame, o.report ? &frame_layouts : nullptr);
-    if (still) {
-      still->set_camera(cameras[f]);
-      still->run();
-      record_layout(o.still_layouts, f, still->result(), o.report ? &still_layouts : nullptr);
-    }
-    if (f + 1 < cameras.size()) progress.step_done(f + 1);  // (the last once it is written)
-  }
+  draw_path(drawing, follower ? &*follower : nullptr, measured,
+            [&](size_t f, LabelledFrame& frame, const Layout& layout) {
+              writer.write(std::move(frame.image));  // (the picture is the frame's own copy)
+              if (measured)
+                record_layout(o.layout_dir, f, frame, layout, o.report ? &frame_layouts : nullptr);
+              if (still) {
+                still->set_camera(cameras[f]);
+                still->run();
+                const LabelledFrame placed = still->result();
+                record_layout(o.still_layouts, f, placed, measured_layout(placed, f),
+                              o.report ? &still_layouts : nullptr);
+              }
+              if (f + 1 < cameras.size()) progress.step_done(f + 1);  // (the last once written)
+            });
   writer.finish();
   progress.step_done(cameras.size());
   print_written(o, size, cameras.size(), progress.seconds());
@@ -263,6 +347,16 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--screen-space", o->screen_space,
                 "labels live on screen (the thesis), not as offsets from their anchors");
   cmd->add_flag("--no-forces", o->no_forces, "place every frame from scratch (labels jump)");
+  cmd->add_option_function<std::string>(
+         "--plan",
+         [o](const std::string& value) {
+           if (value != "on" && value != "off")
+             throw UsageError("--plan: '" + value + "': expected on or off");
+           o->plan = value == "on";
+         },
+         "on: each label's active ranges planned over the whole path before the frames are drawn "
+         "(one steady range per stretch in view); off: every frame placed as the viewer would")
+      ->default_str("on");
   cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
   add_label_look_options(cmd, o->look);
   cmd->add_option("--label-speed", o->forces.speed_widths,

@@ -1,23 +1,22 @@
-// Active ranges and visible stretches (issue 50), declared in layout_metrics.h.
+// Active ranges and visible stretches, declared in layout_metrics.h.
 #include "labeling/layout_metrics.h"
+#include "labeling/video_plan.h"
 
 #include <map>
 
 namespace strata {
 
-namespace {
-
-enum class State : char { absent, out_of_view, visible, readable };
-
 bool readable(const LayoutLabel& label) {
   return label.shown && label.opacity >= opaque_opacity;
 }
+
+using State = FrameState;
 
 // In view: the anchor in the closed image rectangle, or the label readable (so a range lies in
 // one stretch). The files do not say whether an anchor is cut away (its label is then hidden),
 // so a cut-away does not end a stretch; nor does anchor_hidden: such a label is still drawn, with
 // a dashed leader.
-State state_of(const LayoutLabel& label, const Layout& frame) {
+FrameState frame_state(const LayoutLabel& label, const Layout& frame) {
   if (readable(label)) return State::readable;
   const bool in_image = label.anchor.x >= 0.0 && label.anchor.y >= 0.0 &&
                         label.anchor.x <= double(frame.width) &&
@@ -25,17 +24,24 @@ State state_of(const LayoutLabel& label, const Layout& frame) {
   return in_image ? State::visible : State::out_of_view;
 }
 
-// Each label's state in every frame, by id.
-std::map<int, std::vector<State>> timelines(const std::vector<Layout>& frames) {
+std::map<int, std::vector<FrameState>> label_timelines(const std::vector<Layout>& frames) {
   std::map<int, std::vector<State>> out;
   for (size_t k = 0; k < frames.size(); ++k) {
     for (const LayoutLabel& l : frames[k].labels) {
       auto [it, added] = out.try_emplace(l.id, frames.size(), State::absent);
-      it->second[k] = state_of(l, frames[k]);
+      it->second[k] = frame_state(l, frames[k]);
     }
   }
   return out;
 }
+
+std::vector<double> frame_weights(const std::vector<Layout>& frames) {
+  std::vector<double> weight(frames.size(), 0.0);
+  for (size_t k = 1; k < frames.size(); ++k) weight[k] = frames[k].seconds.value_or(0.0);
+  return weight;
+}
+
+namespace {
 
 double readable_seconds(const std::vector<Layout>& layouts, const std::vector<double>& weight) {
   double sum = 0.0;
@@ -49,10 +55,6 @@ struct Counts {
   size_t stretches = 0, ranges = 0, extra = 0, short_ranges = 0, short_inside = 0;
   double label_seconds = 0.0;
 };
-
-bool in_view(State s) {
-  return s == State::visible || s == State::readable;
-}
 
 // One label's stretches and ranges.
 void count_ranges(const std::vector<State>& states, const std::vector<double>& weight, Counts& c) {
@@ -85,13 +87,10 @@ ActiveRangeMetrics active_range_metrics(const std::vector<Layout>& frames,
                                         const std::vector<Layout>& stills) {
   ActiveRangeMetrics m;
   bool timed = frames.size() > 1;
-  std::vector<double> weight(frames.size(), 0.0);  // frame 0: 0
-  for (size_t k = 1; k < frames.size(); ++k) {
-    timed = timed && frames[k].seconds.has_value();
-    weight[k] = frames[k].seconds.value_or(0.0);
-  }
+  for (size_t k = 1; k < frames.size(); ++k) timed = timed && frames[k].seconds.has_value();
+  const std::vector<double> weight = frame_weights(frames);
   Counts c;
-  for (const auto& [id, states] : timelines(frames)) count_ranges(states, weight, c);
+  for (const auto& [id, states] : label_timelines(frames)) count_ranges(states, weight, c);
   for (const Layout& frame : frames) {
     for (const LayoutLabel& l : frame.labels) m.readable_label_frames += readable(l) ? 1 : 0;
   }
@@ -108,6 +107,9 @@ ActiveRangeMetrics active_range_metrics(const std::vector<Layout>& frames,
     m.still_readable_label_seconds = readable_seconds(stills, weight);
     if (*m.still_readable_label_seconds > 0.0)
       m.readable_of_stills = *m.readable_label_seconds / *m.still_readable_label_seconds;
+    m.bound_label_seconds = best_consistent_seconds(stills, weight);
+    if (*m.bound_label_seconds > 0.0)
+      m.readable_of_bound = *m.readable_label_seconds / *m.bound_label_seconds;
   }
   return m;
 }

@@ -492,9 +492,9 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
   if (moving && !afresh_) settings.weights.previous_position = settings_.forces.previous_weight;
   // While the camera moves, kept-apart labels keep room to slide along the image's edge.
   if (moving && camera_moved_ && settings_.forces.keep_apart) settings.edge_em = settings.margin_em;
-  parts_->placement.set_frame(
-      slot_labels(), slots_.to_slots(insertion_order(labels_, layering_, within, priorities_)),
-      settings, slots_.used());
+  std::vector<uint32_t> order = insertion_order(labels_, layering_, within, priorities_);
+  std::erase_if(order, [this](uint32_t i) { return i < withheld_.size() && withheld_[i]; });
+  parts_->placement.set_frame(slot_labels(), slots_.to_slots(order), settings, slots_.used());
   parts_->forces.set_active(slots_.used());
   parts_->drawing->set_layer_frames(settings_.layer_colors);
   const GhostSettings ghost{settings_.ghost.strength, settings_.ghost.radius * side,

@@ -242,6 +242,10 @@ class LabelledRenderer {
   // anchors are layered again, as by set_camera).
   void set_label_hidden(size_t index, bool hidden);
   bool label_hidden(size_t index) const { return hidden_.at(index); }
+  // Labels (by scene index; true: withheld) the placement leaves out from the next frame on, as
+  // if it found no place for them: drawn ones fade out where they are (a planned video's ranges,
+  // labeling/video_plan.h).
+  void set_withheld(std::vector<bool> withheld) { withheld_ = std::move(withheld); }
   // The label font's size in pixels, and the scale of text and boxes (HiDPI, --label-scale):
   // rebuild the glyphs, box sizes and the graph.
   void set_font_pixels(float pixels);
@@ -338,6 +342,7 @@ class LabelledRenderer {
   Extension extension_;
   uint32_t frames_in_flight_ = 1;
   std::vector<bool> hidden_;
+  std::vector<bool> withheld_;
   std::vector<int> label_ids_;  // the scene's label ids when its labels were last taken
   void take_scene_labels();
   std::vector<float> priorities_;  // the scene's, per label

@@ -452,6 +452,8 @@ void add_ranges_json(const ActiveRangeMetrics& r, bool stills, ordered_json& out
   if (stills) {
     out["still_readable_label_seconds"] = optional_number(r.still_readable_label_seconds);
     out["readable_of_stills"] = optional_number(r.readable_of_stills);
+    out["bound_label_seconds"] = optional_number(r.bound_label_seconds);
+    out["readable_of_bound"] = optional_number(r.readable_of_bound);
   }
   out["visible_stretches"] = r.visible_stretches;
   out["active_ranges"] = r.active_ranges;

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -176,6 +177,10 @@ struct ActiveRangeMetrics {
   // With stills: theirs, weighed by the sequence's frames, and ours / theirs (none when 0).
   std::optional<double> still_readable_label_seconds;
   std::optional<double> readable_of_stills;
+  // With stills: the most readable label-seconds with one range per stretch, none short inside,
+  // each label where the stills put it (best_consistent_seconds in video_plan.h), and ours / it.
+  std::optional<double> bound_label_seconds;
+  std::optional<double> readable_of_bound;
   size_t visible_stretches = 0;  // runs of frames in which a label's anchor is in view
   size_t active_ranges = 0;      // runs of frames in which a label is readable
   size_t extra_ranges = 0;       // ranges beyond the first of their stretch
@@ -227,6 +232,24 @@ struct SequenceMetrics {
 // the size of its frame (an Error otherwise).
 SequenceMetrics sequence_metrics(const std::vector<Layout>& frames,
                                  const std::vector<Layout>& stills = {});
+
+// A label's state in one frame of a sequence.
+enum class FrameState : char {
+  absent,       // not in the frame's file
+  out_of_view,  // its anchor outside the image
+  visible,      // its anchor in view, the label not readable
+  readable,
+};
+inline bool in_view(FrameState s) {
+  return s == FrameState::visible || s == FrameState::readable;
+}
+bool readable(const LayoutLabel& label);
+// In view: the anchor in the closed image rectangle, or the label readable.
+FrameState frame_state(const LayoutLabel& label, const Layout& frame);
+// Each label's state in every frame, by id.
+std::map<int, std::vector<FrameState>> label_timelines(const std::vector<Layout>& frames);
+// What each frame weighs in seconds: its time step, frame 0 nothing.
+std::vector<double> frame_weights(const std::vector<Layout>& frames);
 
 // `stills`: empty, or one per frame (as for sequence_metrics, which checks them).
 ActiveRangeMetrics active_range_metrics(const std::vector<Layout>& frames,

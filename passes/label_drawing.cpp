@@ -239,7 +239,7 @@ std::vector<glm::vec4> draw_labels_reference(std::span<const glm::vec4> layers, 
 gpu::GhostParams ghost_params(const GhostSettings& ghost, graph::Extent size, uint32_t layer_count,
                               uint32_t label_count) {
   return {size.width,     size.height,  layer_count,         label_count,
-          ghost.strength, ghost.radius, ghost.leader_radius, 0u};
+          ghost.strength, ghost.radius, ghost.leader_radius, GHOST_BOX_SHARE * ghost.radius};
 }
 
 std::vector<glm::vec4> ghost_reference(std::span<const glm::vec4> layers, graph::Extent size,
@@ -253,17 +253,17 @@ std::vector<glm::vec4> ghost_reference(std::span<const glm::vec4> layers, graph:
   if (ghost.strength <= 0.0f) return out;
   for (size_t q = 0; q < pixels; ++q) {
     const glm::vec2 p(float(q % size.width) + 0.5f, float(q / size.width) + 0.5f);
-    float open_on[VR_MAX_LAYERS] = {};
+    gpu::GhostOpenings open = gpu::ghost_no_openings();
     float alpha[VR_MAX_LAYERS] = {};
     for (size_t i = 0; i < count; ++i) {
       const gpu::LabelGpu& label = data.labels[i];
       if (label.layer >= std::min(layer_count, uint32_t(VR_MAX_LAYERS))) continue;
-      open_on[label.layer] =
-          std::max(open_on[label.layer], gpu::ghost_opening(label, data.placements[i], p, g));
+      open =
+          gpu::ghost_with(open, label.layer, gpu::ghost_opening(label, data.placements[i], p, g));
     }
     for (uint32_t k = 0; k < std::min(layer_count, uint32_t(VR_MAX_LAYERS)); ++k)
       alpha[k] = out[size_t(k) * pixels + q].a;
-    const gpu::GhostKeeps keeps = gpu::ghost_keeps(open_on, alpha, layer_count, g.strength);
+    const gpu::GhostKeeps keeps = gpu::ghost_keeps(open, alpha, layer_count, g.strength);
     for (uint32_t k = 0; k < std::min(layer_count, uint32_t(VR_MAX_LAYERS)); ++k) {
       glm::vec4& c = out[size_t(k) * pixels + q];
       if (keeps.layer[k] < 1.0f) c = to_half_precision(c * keeps.layer[k]);

@@ -159,20 +159,21 @@ std::vector<PickHit> pick_reference(const RenderInputs& inputs, const gpu::Frame
     const glm::vec2 centre = glm::vec2(cast) + 0.5f;
     ReferencePixel walked = walk_reference_pixel(inputs, frame, centre);
     // (as pick.comp: the labels' openings at the pixel, then the keeps from the layers' alphas)
-    float open_on[VR_MAX_LAYERS] = {};
+    gpu::GhostOpenings open = gpu::ghost_no_openings();
     bool any = false;
     for (size_t i = 0; i < label_count && g.strength > 0.0f; ++i) {
       const gpu::LabelGpu& label = labels.labels[i];
       if (label.layer >= layer_count) continue;
-      const float open = gpu::ghost_opening(label, labels.placements[i], glm::vec2(t) + 0.5f, g);
-      open_on[label.layer] = std::max(open_on[label.layer], open);
-      any = any || open > 0.0f;
+      const glm::vec2 opening =
+          gpu::ghost_opening(label, labels.placements[i], glm::vec2(t) + 0.5f, g);
+      open = gpu::ghost_with(open, label.layer, opening);
+      any = any || std::max(opening.x, opening.y) > 0.0f;
     }
     if (any) {
       float alpha[VR_MAX_LAYERS] = {};
       for (uint32_t l = 0; l < layer_count; ++l)
         alpha[l] = gpu::pick_stored_alpha(walked.layers[l].a);
-      const gpu::GhostKeeps keeps = gpu::ghost_keeps(open_on, alpha, layer_count, g.strength);
+      const gpu::GhostKeeps keeps = gpu::ghost_keeps(open, alpha, layer_count, g.strength);
       if (std::any_of(std::begin(keeps.layer), std::end(keeps.layer),
                       [](float k) { return k < 1.0f; })) {
         const gpu::PickStart start = gpu::pick_start(keeps, alpha, layer_count, frame.depth_alpha);

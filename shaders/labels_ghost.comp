@@ -43,8 +43,7 @@ void main() {
   const uvec2 px = gl_GlobalInvocationID.xy;
   if (px.x >= params.width || px.y >= params.height) return;
   const vec2 p = vec2(px) + 0.5;
-  float open_on[VR_MAX_LAYERS];  // the largest opening of the labels on each layer
-  for (uint l = 0u; l < VR_MAX_LAYERS; ++l) open_on[l] = 0.0f;
+  GhostOpenings open = ghost_no_openings();
   bool any = false;
   for (uint w = 0u; w < words; ++w) {
     uint bits = tile_labels[w];
@@ -52,9 +51,9 @@ void main() {
       const uint i = w * 32u + uint(findLSB(bits));
       bits &= bits - 1u;
       const LabelGpu label = labels[i];
-      const float open = ghost_opening(label, placements[i], p, params);
-      open_on[label.layer] = max(open_on[label.layer], open);
-      any = any || open > 0.0f;
+      const vec2 opening = ghost_opening(label, placements[i], p, params);
+      open = ghost_with(open, label.layer, opening);
+      any = any || max(opening.x, opening.y) > 0.0f;
     }
   }
   if (!any) return;
@@ -64,8 +63,10 @@ void main() {
     colour[k] = k < layer_count ? imageLoad(layers, ivec3(px, k)) : vec4(0.0);
     alpha[k] = colour[k].a;
   }
-  const GhostKeeps keeps = ghost_keeps(open_on, alpha, layer_count, params.strength);
+  const GhostKeeps keeps = ghost_keeps(open, alpha, layer_count, params.strength);
   for (uint k = 0u; k < layer_count; ++k) {
-    if (keeps.layer[k] < 1.0) imageStore(layers, ivec3(px, k), colour[k] * keeps.layer[k]);
+    if (keeps.layer[k] < 1.0 && colour[k] != vec4(0.0)) {  // (an empty layer stays empty)
+      imageStore(layers, ivec3(px, k), colour[k] * keeps.layer[k]);
+    }
   }
 }

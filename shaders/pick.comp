@@ -30,8 +30,8 @@ bool walk_stops_at_depth() { return true; }
 #include "shared/resolve_walk.h"
 
 // The largest opening of the labels on each layer at p (labels.ghost's); false where none opens.
-bool open_layers(vec2 p, uint layer_count, out float open_on[VR_MAX_LAYERS]) {
-  for (uint l = 0u; l < VR_MAX_LAYERS; ++l) open_on[l] = 0.0f;
+bool open_layers(vec2 p, uint layer_count, out GhostOpenings open) {
+  open = ghost_no_openings();
   if (params.ghost.strength <= 0.0f) return false;
   const uint count = min(min(params.ghost.label_count, LABEL_MAX),
                          uint(min(labels.length(), placements.length())));
@@ -39,9 +39,9 @@ bool open_layers(vec2 p, uint layer_count, out float open_on[VR_MAX_LAYERS]) {
   for (uint i = 0u; i < count; ++i) {
     const LabelGpu label = labels[i];
     if (label.layer >= layer_count) continue;
-    const float open = ghost_opening(label, placements[i], p, params.ghost);
-    open_on[label.layer] = max(open_on[label.layer], open);
-    any = any || open > 0.0f;
+    const vec2 opening = ghost_opening(label, placements[i], p, params.ghost);
+    open = ghost_with(open, label.layer, opening);
+    any = any || max(opening.x, opening.y) > 0.0f;
   }
   return any;
 }
@@ -52,15 +52,15 @@ void main() {
   const ivec2 t = pick_texel(pixels[i], params.ghost.width, params.ghost.height);
   const ivec2 cast_pixel = pick_cast_pixel(frame, t, params.ghost.width, params.ghost.height);
   const uint layer_count = min(frame.layer_count, uint(VR_MAX_LAYERS));
-  float open_on[VR_MAX_LAYERS];
-  if (!open_layers(vec2(t) + 0.5f, layer_count, open_on)) {
+  GhostOpenings open;
+  if (!open_layers(vec2(t) + 0.5f, layer_count, open)) {
     points[i] = pick_point(frame, cast_pixel, imageLoad(depth_image, t).r);
     return;
   }
   for (uint l = 0u; l < VR_MAX_LAYERS; ++l) {
     layer_alpha[l] = l < layer_count ? imageLoad(layers, ivec3(t, l)).a : 0.0f;
   }
-  const GhostKeeps keeps = ghost_keeps(open_on, layer_alpha, layer_count, params.ghost.strength);
+  const GhostKeeps keeps = ghost_keeps(open, layer_alpha, layer_count, params.ghost.strength);
   for (uint l = 0u; l < VR_MAX_LAYERS; ++l) layer_keeps[l] = keeps.layer[l];
   start = pick_start(keeps, layer_alpha, layer_count, frame.depth_alpha);
   if (start.layer >= layer_count) {

@@ -293,6 +293,31 @@ TEST_SUITE("cli") {
     CHECK(evaluated["per_frame"].size() == frames);
   }
 
+  // A planned video (the default): the path rehearsed first, then every label drawn in at most
+  // one range per stretch of its anchor in view, none shorter than 1 s away from the ends, with
+  // no overlap or cut in any frame; the bound of the stills is at least what the frames read.
+  TEST_CASE("a_planned_video_shows_each_label_in_one_range_per_stretch_none_short_inside") {
+    const std::string dir = empty_folder("video-plan");
+    const auto r = run_strata("--validate video " STRATA_SOURCE_DIR
+                              "/assets/scenes/head.json --orbit 90 --seconds 3 --fps 8 --size 160 "
+                              "-o " +
+                              dir + "/frames --layout-dir " + dir + "/layouts --still-layouts " +
+                              dir + "/stills --report");
+    REQUIRE(r.exit_code == 0);
+    CHECK(r.output.find("validation:") == std::string::npos);
+    CHECK(r.output.find("planned ") != std::string::npos);
+    const nlohmann::json report = bench_report(r.output);
+    const nlohmann::json& sequence = report["sequence"];
+    CHECK(report["frames"] == 25);
+    CHECK(sequence["active_ranges"].get<size_t>() > 0);
+    CHECK(sequence["extra_ranges"] == 0);
+    CHECK(sequence["short_ranges_inside"] == 0);
+    CHECK(report["total"]["overlaps"] == 0);
+    CHECK(report["total"]["cut"] == 0);
+    CHECK(sequence["readable_of_bound"].get<double>() > 0.0);
+    CHECK(sequence["readable_of_bound"].get<double>() <= 1.0);
+  }
+
   // Frames compressed on worker threads are the files of frames written one after another, and
   // the last line says how fast the frames came.
   TEST_CASE("video_frames_written_on_threads_are_the_bytes_of_frames_written_one_by_one") {

@@ -239,8 +239,9 @@ TEST_SUITE("gpu") {
   TEST_CASE_FIXTURE(test::GpuTest, "ghosting_opens_rear_anchors_and_leaves_the_rest_unchanged") {
     // head.json from the front at 192²: with ghosting the layers in front of the shown rear
     // labels' anchors open; the placement is the same, and so is every pixel of every layer
-    // farther than two lens radii from all of those anchors and off their connectors (an anchor
-    // the lens opens is no longer hidden: its connector is drawn solid, not dashed).
+    // farther than two lens radii from all of those anchors, off their connectors (an anchor
+    // the lens opens is no longer hidden: its connector is drawn solid, not dashed) and outside
+    // their boxes' lenses.
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
     const graph::Extent size{192, 192};
     const Camera camera = camera_for(scene, "front");
@@ -253,6 +254,8 @@ TEST_SUITE("gpu") {
     REQUIRE(before.layering.layer_count == after.layering.layer_count);
     std::vector<glm::vec2> rear;
     std::vector<std::array<glm::vec2, 2>> connectors;
+    std::vector<std::array<glm::vec2, 2>> boxes;  // with their lenses
+    const glm::vec2 box_lens(GHOST_BOX_SHARE * ghosted.ghost.radius * float(size.width) + 1.0f);
     size_t seen_before = 0, seen_after = 0;
     for (size_t i = 0; i < before.labels.size(); ++i) {
       const LabelLayout &x = before.labels[i], &y = after.labels[i];
@@ -263,6 +266,7 @@ TEST_SUITE("gpu") {
       rear.push_back(x.anchor);
       connectors.push_back(
           {x.anchor, glm::clamp(x.anchor, x.box_origin, x.box_origin + x.box_size)});
+      boxes.push_back({x.box_origin - box_lens, x.box_origin + x.box_size + box_lens});
       seen_before += x.front_alpha <= 0.3f ? 1 : 0;
       seen_after += y.front_alpha <= 0.3f ? 1 : 0;
       CHECK(y.front_alpha <= x.front_alpha);
@@ -280,8 +284,12 @@ TEST_SUITE("gpu") {
       const glm::vec2 p(float(q % size.width) + 0.5f, float(q / size.width) + 0.5f);
       if (std::any_of(rear.begin(), rear.end(),
                       [&](glm::vec2 anchor) { return glm::length(p - anchor) <= far; }) ||
-          std::any_of(connectors.begin(), connectors.end(), [&](const auto& c) {
-            return gpu::label_segment_distance(p, c[0], c[1]) <= 3.0f;
+          std::any_of(
+              connectors.begin(), connectors.end(),
+              [&](const auto& c) { return gpu::label_segment_distance(p, c[0], c[1]) <= 3.0f; }) ||
+          std::any_of(boxes.begin(), boxes.end(), [&](const auto& box) {
+            return glm::all(glm::greaterThanEqual(p, box[0])) &&
+                   glm::all(glm::lessThanEqual(p, box[1]));
           })) {
         continue;
       }
@@ -295,9 +303,10 @@ TEST_SUITE("gpu") {
 
   TEST_CASE_FIXTURE(test::GpuTest, "a_fading_rear_labels_lens_fades_with_it_frame_by_frame") {
     // head.json from the front at 128², ghosting on, frames of a 20 fps video at rest: a shown
-    // rear label left out of the placement fades out over 0.3 s, and frame by frame the alpha
+    // rear label withheld from the placement fades out over 0.3 s, and frame by frame the alpha
     // in front of its anchor rises as its opacity falls, from open (<= 0.3) to closed, in steps
-    // of about a sixth: no frame pops the lens shut.
+    // of about a sixth: no frame pops the lens shut. (A label whose anchor no other box's lens
+    // reaches: those open the layers too.)
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
     const Camera camera = camera_for(scene, "front");
     LabellingSettings settings;
@@ -309,17 +318,22 @@ TEST_SUITE("gpu") {
     size_t faded = still.labels.size();
     for (size_t i = 0; i < still.labels.size() && faded == still.labels.size(); ++i) {
       const LabelLayout& l = still.labels[i];
-      if (l.placed && l.layer > 0 && l.opacity == 1.0f && l.front_alpha <= 0.3f) faded = i;
+      const float reach = 2.0f * GHOST_BOX_SHARE * settings.ghost.radius * 128.0f;
+      const bool apart = std::none_of(still.labels.begin(), still.labels.end(), [&](const auto& o) {
+        const glm::vec2 lo = o.box_origin - reach, hi = o.box_origin + o.box_size + reach;
+        return o.placed && glm::all(glm::greaterThanEqual(l.anchor, lo)) &&
+               glm::all(glm::lessThanEqual(l.anchor, hi));
+      });
+      if (l.placed && l.layer > 0 && l.opacity == 1.0f && l.front_alpha <= 0.3f && apart) faded = i;
     }
     REQUIRE(faded < still.labels.size());
     CAPTURE(still.labels[faded].text);
-    std::vector<uint32_t> others;
-    for (uint32_t i = 0; i < still.labels.size(); ++i)
-      if (i != faded) others.push_back(i);
+    std::vector<bool> withheld(still.labels.size(), false);
+    withheld[faded] = true;
+    r.set_withheld(withheld);
     std::vector<float> opacity{1.0f}, front{still.labels[faded].front_alpha};
     for (int frame = 0; frame < 8 && opacity.back() > 0.0f; ++frame) {
       r.set_camera(camera);
-      r.set_order(others);
       r.advance(0.05);
       const LabelLayout& l = r.result().labels[faded];
       opacity.push_back(l.opacity);
@@ -335,6 +349,43 @@ TEST_SUITE("gpu") {
       CHECK(front[k] > front[k - 1]);
       CHECK(front[k] - front[k - 1] <= 0.4f * rise);
     }
+  }
+
+  TEST_CASE_FIXTURE(test::GpuTest, "a_withheld_label_is_left_out_of_the_placement_and_fades_out") {
+    // head.json from the front at 128², frames of 0.05 s: a placed label withheld (a planned
+    // video's ranges) has no target from the next frame on and fades out over 0.3 s where it
+    // is; given back, it is placed again.
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    const Camera camera = camera_for(scene, "front");
+    LabellingSettings settings;
+    settings.forces.fade_seconds = 0.3f;
+    LabelledRenderer r(ctx, scene, camera, {128, 128}, settings);
+    r.run();
+    const LabelledFrame still = r.result(false);
+    size_t withheld = 0;
+    while (withheld < still.labels.size() && !still.labels[withheld].placed) ++withheld;
+    REQUIRE(withheld < still.labels.size());
+    const glm::vec2 origin = still.labels[withheld].box_origin;
+    std::vector<bool> out(scene.labels.size(), false);
+    out[withheld] = true;
+    r.set_withheld(out);
+    std::vector<float> opacity{1.0f};
+    for (int frame = 0; frame < 8; ++frame) {
+      r.set_camera(camera);
+      r.advance(0.05);
+      const LabelLayout l = r.result(false).labels[withheld];
+      CHECK_FALSE(l.target_origin);
+      if (l.opacity > 0.0f) CHECK(l.box_origin == origin);  // (fades where it is)
+      CHECK(l.opacity < opacity.back());
+      opacity.push_back(l.opacity);
+      if (l.opacity == 0.0f) break;
+    }
+    CHECK(opacity.back() == 0.0f);
+    CHECK(opacity.size() >= 6);  // (0.3 s in frames of 0.05 s)
+    r.set_withheld({});
+    r.set_camera(camera);
+    r.advance(0.05);
+    CHECK(r.result(false).labels[withheld].target_origin);
   }
 
   // The viewer's own labels: an edit that fits the spare slots keeps the graph (no wait, no new

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "labeling/layout_metrics.h"
+#include "labeling/video_plan.h"
 #include "test_files.h"
 
 namespace strata {
@@ -419,6 +420,7 @@ TEST_SUITE("cpu") {
         if (c == ' ') continue;
         LayoutLabel l = label(int(i) + 1, {c == 'o' ? -10.0 : 50.0, 50}, {60, 40}, {20, 10},
                               c == 'R' || c == 'f');
+        l.placed = l.shown;
         if (c == 'f') l = fading(l, 0.3);
         frames[k].labels.push_back(l);
       }
@@ -517,6 +519,70 @@ TEST_SUITE("cpu") {
     CHECK(*none.ranges.still_readable_label_seconds == 0.0);
     CHECK_FALSE(none.ranges.readable_of_stills);
     CHECK(to_json(none)["sequence"]["readable_of_stills"].is_null());
+  }
+
+  TEST_CASE("the_bound_keeps_each_stretchs_longest_readable_still_run_of_a_second_or_at_an_end") {
+    // 0.25 s a frame. Label 1: runs 0-1, 3-7 (1.25 s) and 9 in one stretch: 1.25 s. Label 2: one
+    // run of 0.75 s inside: nothing. Label 3: out of view at 2 and 8, so three stretches, each
+    // its run: 0.25 (at the start; frame 0 weighs nothing) + 1.25 + 0.25 (at the end).
+    // (Stills have no seconds: they weigh as their frames.)
+    const std::vector<Layout> stills =
+        labelled_frames({"RR-RRRRR-R", "--RRR-----", "RRoRRRRRoR"}, std::nullopt);
+    const std::vector<Layout> frames =
+        labelled_frames({"RRRRRRRRRR", "----------", "----------"}, 0.25);
+    const ActiveRangeMetrics m = sequence_metrics(frames, stills).ranges;
+    REQUIRE(m.bound_label_seconds);
+    CHECK(*m.bound_label_seconds == doctest::Approx(3.0));
+    CHECK(best_consistent_seconds(stills, frame_weights(frames)) == doctest::Approx(3.0));
+    REQUIRE(m.readable_of_bound);
+    CHECK(*m.readable_of_bound == doctest::Approx(2.25 / 3.0));
+    CHECK(to_json(sequence_metrics(
+        labelled_frames({"R--", "---", "---"}, 0.25),
+        labelled_frames({"---", "---", "---"}, std::nullopt)))["sequence"]["readable_of_bound"]
+              .is_null());
+  }
+
+  TEST_CASE("a_first_plan_keeps_each_labels_longest_run_per_stretch_from_its_fade_to_the_end") {
+    // 0.25 s a frame, a lead of 0.3 s (two frames). Label 1: runs 0-1 and 4-9 (1.5 s): from 2 to
+    // the stretch's end. Label 2: runs 0-1 and 3, equally long: the first, from 0. Label 3 is
+    // never drawn, label 4 only 0.5 s inside: neither has a range. Label 5: out of view at 5,
+    // a range in each stretch.
+    const ActiveRanges plan = first_plan(
+        labelled_frames(
+            {"RR--RRRRRR--", "RR-R--------", "------------", "----RR------", "RRRRRoRRRRRR"}, 0.25),
+        0.3);
+    CHECK(plan.size() == 3);
+    CHECK(plan.at(1) == std::vector<FrameRange>{{2, 11}});
+    CHECK(plan.at(2) == std::vector<FrameRange>{{0, 11}});
+    CHECK(plan.at(5) == std::vector<FrameRange>{{0, 4}, {6, 11}});
+  }
+
+  TEST_CASE("drop_short_ranges_removes_the_ranges_a_rehearsal_drew_short_inside") {
+    ActiveRanges plan{{1, {{2, 11}}}, {2, {{0, 11}}}, {3, {{0, 5}, {7, 11}}}};
+    // Label 1 drawn 0.5 s inside its range: dropped. Label 2 drawn 0.25 s from frame 0: at the
+    // start, kept. Label 3: 1.25 s in its first range, 0.5 s up to the last frame: both kept.
+    const size_t dropped = drop_short_ranges(
+        plan, labelled_frames({"----RR------", "RR----------", "RRRRRR-RRRRR"}, 0.25));
+    CHECK(dropped == 1);
+    CHECK_FALSE(plan.contains(1));
+    CHECK(plan.at(2).size() == 1);
+    CHECK(plan.at(3).size() == 2);
+  }
+
+  TEST_CASE("a_plan_follower_withholds_outside_ranges_and_after_a_range_ends_in_its_stretch") {
+    // Label 1 (id 1) may show in frames 0-9; label 2 (id 7) has no range.
+    PlanFollower follower({{1, {{0, 9}}}}, {1, 7});
+    CHECK(follower.withheld(0) == std::vector<bool>{false, true});
+    // Drawn, drawn, then not: withheld from then on while its anchor stays in view; out of view
+    // ends the stretch, and in the next one it may show again.
+    const std::vector<Layout> frames = labelled_frames({"RR-oRR-R--R"}, 0.25);
+    const std::vector<bool> expected{false, false, true, false, false, false,
+                                     true,  true,  true, true};  // (frame 10 is past the range)
+    for (size_t k = 0; k + 1 < frames.size(); ++k) {
+      CAPTURE(k);
+      follower.saw(frames[k]);
+      CHECK(follower.withheld(k + 1)[0] == expected[k]);
+    }
   }
 
   TEST_CASE("read_layout_reads_opacity_target_and_seconds_and_defaults_them_for_older_files") {

@@ -206,7 +206,7 @@ TEST_SUITE("gpu") {
         bool far = true;
         for (size_t i = 0; i < labels.size() && far; ++i) {
           far = glm::distance(p, labels[i].anchor) > ghost.radius + 1.0f &&
-                gpu::ghost_opening(labels[i], drawn[i], p, params) <= 0.0f;
+                gpu::ghost_opening(labels[i], drawn[i], p, params) == glm::vec2(0.0f);
         }
         if (far && pixels.size() < PICK_MAX) pixels.push_back(p);
       }
