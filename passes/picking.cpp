@@ -158,16 +158,17 @@ std::vector<PickHit> pick_reference(const RenderInputs& inputs, const gpu::Frame
     const glm::ivec2 cast = gpu::pick_cast_pixel(frame, t, size.width, size.height);
     const glm::vec2 centre = glm::vec2(cast) + 0.5f;
     ReferencePixel walked = walk_reference_pixel(inputs, frame, centre);
-    // (as pick.comp: the labels' openings at the pixel, then the keeps from the layers' alphas)
+    // (as pick.comp: the labels' lenses at the pixel, not their boxes', then the keeps from the
+    // layers' alphas)
     gpu::GhostOpenings open = gpu::ghost_no_openings();
     bool any = false;
     for (size_t i = 0; i < label_count && g.strength > 0.0f; ++i) {
       const gpu::LabelGpu& label = labels.labels[i];
       if (label.layer >= layer_count) continue;
-      const glm::vec2 opening =
-          gpu::ghost_opening(label, labels.placements[i], glm::vec2(t) + 0.5f, g);
+      const glm::vec2 opening(
+          gpu::ghost_opening(label, labels.placements[i], glm::vec2(t) + 0.5f, g).x, 0.0f);
       open = gpu::ghost_with(open, label.layer, opening);
-      any = any || std::max(opening.x, opening.y) > 0.0f;
+      any = any || opening.x > 0.0f;
     }
     if (any) {
       float alpha[VR_MAX_LAYERS] = {};

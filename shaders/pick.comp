@@ -29,7 +29,8 @@ bool walk_stops_at_depth() { return true; }
 #define VR_RESOLVE_LAYER_KEEP
 #include "shared/resolve_walk.h"
 
-// The largest opening of the labels on each layer at p (labels.ghost's); false where none opens.
+// The largest opening of the labels' lenses on each layer at p (labels.ghost's, without the boxes':
+// under a box the box is what is drawn); false where none opens.
 bool open_layers(vec2 p, uint layer_count, out GhostOpenings open) {
   open = ghost_no_openings();
   if (params.ghost.strength <= 0.0f) return false;
@@ -39,9 +40,9 @@ bool open_layers(vec2 p, uint layer_count, out GhostOpenings open) {
   for (uint i = 0u; i < count; ++i) {
     const LabelGpu label = labels[i];
     if (label.layer >= layer_count) continue;
-    const vec2 opening = ghost_opening(label, placements[i], p, params.ghost);
+    const vec2 opening = vec2(ghost_opening(label, placements[i], p, params.ghost).x, 0.0f);
     open = ghost_with(open, label.layer, opening);
-    any = any || max(opening.x, opening.y) > 0.0f;
+    any = any || opening.x > 0.0f;
   }
   return any;
 }

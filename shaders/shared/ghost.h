@@ -7,12 +7,13 @@
 // its anchor, falling smoothly to 0 at the radius (and, with a leader radius, the same around its
 // connector), and 1 over its drawn box, falling to 0 a box radius (GHOST_BOX_SHARE of the radius)
 // outside it, so that a label is readable wherever it is drawn, also on its way behind content
-// while the camera moves; times the label's opacity (a fading label's lens fades with it), times
-// how much layer L and the layers behind it hold at p (ghost_behind_weight). Layer k keeps 1 -
-// strength * (the largest opening at p) of its colour and alpha; nothing changes beyond every lens.
-// Labels are drawn after, so a box is never made harder to read. The placement counts the lenses
-// too (ghost_placement_opening): a box the lenses let through is legible. Picking (shared/pick.h)
-// walks the picture as drawn, with the same shares kept (ghost_keeps).
+// while the camera moves; times the label's opacity (a fading label's lens fades with it), and a
+// lens (not a box) times how much layer L and the layers behind it hold at p
+// (ghost_behind_weight). Layer k keeps 1 - strength * (the largest opening at p) of its colour
+// and alpha; nothing changes beyond every lens. Labels are drawn after, so a box is never made
+// harder to read. The placement counts the anchors' lenses (ghost_placement_opening): a box they
+// let through is legible. Picking (shared/pick.h) walks the picture as drawn, with the same shares
+// kept (ghost_keeps) but for the boxes' openings: under a box, the box is what is drawn.
 #ifndef STRATA_SHARED_GHOST_H
 #define STRATA_SHARED_GHOST_H
 
