@@ -24,7 +24,14 @@ FrameState frame_state(const LayoutLabel& label, const Layout& frame) {
   return in_image ? State::visible : State::out_of_view;
 }
 
-std::map<int, std::vector<FrameState>> label_timelines(const std::vector<Layout>& frames) {
+namespace {
+
+bool in_view(State s) {
+  return s == State::visible || s == State::readable;
+}
+
+// Each label's state in every frame, by id.
+std::map<int, std::vector<State>> label_timelines(const std::vector<Layout>& frames) {
   std::map<int, std::vector<State>> out;
   for (size_t k = 0; k < frames.size(); ++k) {
     for (const LayoutLabel& l : frames[k].labels) {
@@ -34,6 +41,8 @@ std::map<int, std::vector<FrameState>> label_timelines(const std::vector<Layout>
   }
   return out;
 }
+
+}  // namespace
 
 std::vector<double> frame_weights(const std::vector<Layout>& frames) {
   std::vector<double> weight(frames.size(), 0.0);

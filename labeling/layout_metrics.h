@@ -13,7 +13,6 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
-#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -240,14 +239,9 @@ enum class FrameState : char {
   visible,      // its anchor in view, the label not readable
   readable,
 };
-inline bool in_view(FrameState s) {
-  return s == FrameState::visible || s == FrameState::readable;
-}
 bool readable(const LayoutLabel& label);
 // In view: the anchor in the closed image rectangle, or the label readable.
 FrameState frame_state(const LayoutLabel& label, const Layout& frame);
-// Each label's state in every frame, by id.
-std::map<int, std::vector<FrameState>> label_timelines(const std::vector<Layout>& frames);
 // What each frame weighs in seconds: its time step, frame 0 nothing.
 std::vector<double> frame_weights(const std::vector<Layout>& frames);
 
