@@ -202,22 +202,25 @@ struct PathDrawing {
   const VideoOptions& o;
 };
 
-// Each frame of a drawing with its layout (`visible` NaN and `shown` placed where legibility was
-// not measured).
-using FrameDone = std::function<void(size_t f, LabelledFrame& frame, const Layout& layout)>;
+// Each frame of a drawing with its layout where one was made (`visible` NaN and `shown` placed
+// where legibility was not measured).
+using FrameDone = std::function<void(size_t f, LabelledFrame& frame, const Layout* layout)>;
 
 // The path drawn once by a renderer of its own (so that every drawing starts alike and the same
 // plan gives the same frames). With a plan (`follower`), each frame leaves out the labels it
-// withholds; `measured`: legibility read (the layers downloaded).
-void draw_path(const PathDrawing& d, PlanFollower* follower, bool measured, const FrameDone& done) {
+// withholds; `measured`: legibility read (the layers downloaded) and the layouts made, as they are
+// for a plan.
+void draw_path(const PathDrawing& d, PlanFollower* follower, bool measured, const FrameDone& done,
+               bool layouts = false) {
   LabelledRenderer renderer(d.ctx, d.scene, d.cameras.front(), d.size, d.settings);
   for (size_t f = 0; f < d.cameras.size(); ++f) {
     if (follower) renderer.set_withheld(follower->withheld(f));
     if (f == 0) renderer.run();  // the first frame: the labels settled on their placement
     LabelledFrame frame = next_frame(renderer, d.cameras[f], f, d.o, measured);
-    const Layout layout = measured_layout(frame, f);
-    if (follower) follower->saw(layout);
-    done(f, frame, layout);
+    std::optional<Layout> layout;
+    if (measured || layouts || follower) layout = measured_layout(frame, f);
+    if (follower) follower->saw(*layout);
+    done(f, frame, layout ? &*layout : nullptr);
   }
 }
 
@@ -240,10 +243,13 @@ ActiveRanges plan_video(const PathDrawing& d) {
   const auto rehearse = [&](PlanFollower* follower) {
     std::vector<Layout> layouts;
     const size_t before = size_t(rehearsals++) * d.cameras.size();
-    draw_path(d, follower, false, [&](size_t f, LabelledFrame&, const Layout& layout) {
-      layouts.push_back(layout);
-      progress.step_done(before + f + 1);
-    });
+    draw_path(
+        d, follower, false,
+        [&](size_t f, LabelledFrame&, const Layout* layout) {
+          layouts.push_back(*layout);
+          progress.step_done(before + f + 1);
+        },
+        true);
     return layouts;
   };
   const double lead = d.settings.forces.fade_seconds * opaque_opacity + 1.0 / d.o.fps;
@@ -288,10 +294,10 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   const bool measured = !o.layout_dir.empty() || o.report;
   std::vector<Layout> frame_layouts, still_layouts;  // for the report
   draw_path(drawing, follower ? &*follower : nullptr, measured,
-            [&](size_t f, LabelledFrame& frame, const Layout& layout) {
+            [&](size_t f, LabelledFrame& frame, const Layout* layout) {
               writer.write(std::move(frame.image));  // (the picture is the frame's own copy)
               if (measured)
-                record_layout(o.layout_dir, f, frame, layout, o.report ? &frame_layouts : nullptr);
+                record_layout(o.layout_dir, f, frame, *layout, o.report ? &frame_layouts : nullptr);
               if (still) {
                 still->set_camera(cameras[f]);
                 still->run();
