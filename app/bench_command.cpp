@@ -464,9 +464,7 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   view_cmd->add_option("--degrees", view->degrees, "how far the turntable turns")
       ->check(finite_range(-36000.0, 36000.0))
       ->capture_default_str();
-  view_cmd->add_option("--tidy-rounds", view->tidy_rounds, "rounds of the tidy-up per frame")
-      ->check(whole_range(0, TIDY_ROUNDS_MAX))
-      ->capture_default_str();
+  add_tidy_rounds_option(view_cmd, view->tidy_rounds, "per frame");
   view_cmd->add_flag_callback(
       "--let-overlap", [view] { view->keep_apart = false; },
       "labels on their way may overlap (the forces alone, as `video --let-overlap`)");

@@ -98,6 +98,10 @@ struct LabelLookOptions {
   bool ghost_leaders = false;
 };
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o);
+// --tidy-rounds (render, video, view, bench view): rounds of the tidy-up, run `when`.
+void add_tidy_rounds_option(CLI::App* cmd, uint32_t& rounds, const char* when);
+// --hard (render, video): hard constraints.
+void add_hard_option(CLI::App* cmd, bool& hard);
 // The ghosting asked for: the options, else the scene's settings.
 Ghosting look_ghosting(const LabelLookOptions& o, const Scene& scene);
 

@@ -276,6 +276,16 @@ Ghosting look_ghosting(const LabelLookOptions& o, const Scene& scene) {
   return {o.ghost.value_or(scene.settings.ghost), radius, o.ghost_leaders ? radius / 3.0f : 0.0f};
 }
 
+void add_tidy_rounds_option(CLI::App* cmd, uint32_t& rounds, const char* when) {
+  cmd->add_option("--tidy-rounds", rounds, std::string("rounds of the tidy-up ") + when)
+      ->check(whole_range(0, TIDY_ROUNDS_MAX))
+      ->capture_default_str();
+}
+
+void add_hard_option(CLI::App* cmd, bool& hard) {
+  cmd->add_flag("--hard", hard, "hard constraints: a label with no allowed position is hidden");
+}
+
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {
   cmd->add_option("--label-scale", o.label_scale, "label text and boxes times this (0.25 to 4)")
       ->check(finite_range(0.25, 4.0))

@@ -270,15 +270,12 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_option("--camera", o->camera,
                   "named camera position of the scene, or several (front,left): one image each, "
                   "named after it (out-front.png, out-left.png)");
-  cmd->add_option("--tidy-rounds", o->tidy_rounds,
-                  "rounds of the tidy-up after the placement (0: none)")
-      ->check(whole_range(0, TIDY_ROUNDS_MAX))
-      ->capture_default_str();
+  add_tidy_rounds_option(cmd, o->tidy_rounds, "after the placement (0: none)");
   cmd->add_option("--dump-layers", o->dump_layers,
                   "folder to write each (label-free) layer image to, beside the -o image");
   cmd->add_flag("--no-skipping", o->no_skipping, "turn empty-space skipping off");
   cmd->add_flag("--no-labels", o->no_labels, "render the scene without its labels");
-  cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
+  add_hard_option(cmd, o->hard);
   cmd->add_flag("--internal", o->internal, "internal labelling: labels drawn on their anchors");
   add_label_look_options(cmd, o->look);
   cmd->add_option("--order", o->order,

@@ -346,10 +346,7 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--report", o->report,
                 "print the layout-quality summary of `strata eval` over the frames (stdout, "
                 "JSON) at the end");
-  cmd->add_option("--tidy-rounds", o->tidy_rounds,
-                  "rounds of the tidy-up after the placement (0: none)")
-      ->check(whole_range(0, TIDY_ROUNDS_MAX))
-      ->capture_default_str();
+  add_tidy_rounds_option(cmd, o->tidy_rounds, "after the placement (0: none)");
   cmd->add_flag("--screen-space", o->screen_space,
                 "labels live on screen (the thesis), not as offsets from their anchors");
   cmd->add_flag("--no-forces", o->no_forces, "place every frame from scratch (labels jump)");
@@ -363,7 +360,7 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
          "on: each label's active ranges planned over the whole path before the frames are drawn "
          "(one steady range per stretch in view); off: every frame placed as the viewer would")
       ->default_str("on");
-  cmd->add_flag("--hard", o->hard, "hard constraints: a label with no allowed position is hidden");
+  add_hard_option(cmd, o->hard);
   add_label_look_options(cmd, o->look);
   cmd->add_option("--label-speed", o->forces.speed_widths,
                   "forces: image widths per second a label moves at, at most")

@@ -517,9 +517,7 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
       ->capture_default_str();
   cmd->add_option("--frames", o->frames, "close after this many frames (0: when the window closes)")
       ->check(whole_range(0, 1e9));
-  cmd->add_option("--tidy-rounds", o->tidy_rounds, "rounds of the tidy-up per frame")
-      ->check(whole_range(0, TIDY_ROUNDS_MAX))
-      ->capture_default_str();
+  add_tidy_rounds_option(cmd, o->tidy_rounds, "per frame");
   cmd->add_option("--script", o->script,
                   "input script: events and actions run one by one, each once the view has "
                   "settled (docs/viewer.md)");
