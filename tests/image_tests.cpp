@@ -71,10 +71,10 @@ TEST_SUITE("loaders") {
     const Rgba8Image from_jpeg = strata::read_image(jpeg);
     REQUIRE(from_jpeg.width == 32);
     REQUIRE(from_jpeg.height == 32);
-    for (const auto& [x, y] : {std::pair{8u, 8u}, {24u, 8u}, {8u, 24u}, {24u, 24u}}) {
-      CAPTURE(x);
-      CAPTURE(y);
-      CHECK(difference(pixel(from_jpeg, x, y), pixel(image, x, y)) <= 6);
+    for (const auto& at : {std::pair{8u, 8u}, {24u, 8u}, {8u, 24u}, {24u, 24u}}) {
+      CAPTURE(at.first);
+      CAPTURE(at.second);
+      CHECK(difference(pixel(from_jpeg, at.first, at.second), pixel(image, at.first, at.second)) <= 6);
     }
     const std::vector<uint8_t> grey(16 * 8, 90);
     const fs::path grey_jpeg = folder / "grey.jpg";

@@ -130,9 +130,10 @@ TEST_SUITE("loaders") {
   TEST_CASE("a_preset_for_the_other_modality_warns") {
     strata::Volume mr = ct_block();
     mr.value_range = {0.0f, 255.0f};
-    for (const auto& [volume, preset, warns] :
+    for (const auto& [volume, preset_name, warns] :
          {std::tuple{ct_block(), "ct-bone", false}, std::tuple{ct_block(), "mr-head", true},
           std::tuple{mr, "ct-bone", true}, std::tuple{mr, "mr-brain", false}}) {
+      const std::string preset = preset_name;  // (a lambda cannot capture a structured binding)
       CAPTURE(preset);
       strata::Scene scene;
       scene.volumes.push_back(volume);
