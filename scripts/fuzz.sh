@@ -5,12 +5,19 @@
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]      each target for SECONDS (default 10)
 #   scripts/fuzz.sh --runs N [TARGET...]       each target for N executions (the long run)
+#   scripts/fuzz.sh --scene-tests ...          first the scene and loader tests in the same build
+#                                              (every library there has both sanitizers)
 #
 # New inputs that reach new code are kept in build-fuzz/corpus/<target> for the next run; a
 # finding's input is written to build-fuzz/findings/ and the command to replay it is printed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+scene_tests=0
+if [[ ${1:-} == --scene-tests ]]; then
+  scene_tests=1
+  shift
+fi
 limit=(-max_total_time=10)
 if [[ ${1:-} == --runs ]]; then
   limit=(-runs="$2")
@@ -33,10 +40,16 @@ if [[ ! -f $build/CMakeCache.txt ]]; then
     -DSTRATA_FUZZ=ON -DSTRATA_VIDEO=OFF >/dev/null
 fi
 mkdir -p "$build/findings"
-if ! cmake --build "$build" -j "$(nproc)" --target make_seeds "${targets[@]}" \
+also=()
+((scene_tests)) && also=(strata_scene_tests)
+if ! cmake --build "$build" -j "$(nproc)" --target make_seeds "${targets[@]}" "${also[@]}" \
   >"$build/findings/build.log" 2>&1; then
   tail -40 "$build/findings/build.log"
   exit 1
+fi
+if ((scene_tests)); then
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    "$build"/tests/strata_scene_tests --force-colors=0
 fi
 
 # Seeds: the binary ones generated (fuzz/make_seeds.cpp), the text ones the repository's files.
