@@ -1,4 +1,4 @@
-#include "labeling/placement_beside.h"
+#include "frame/placement_beside.h"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "labeling/labelled_render.h"
+#include "frame/labelled_render.h"
 
 #include <algorithm>
 #include <cmath>
