@@ -12,7 +12,7 @@
 #include <tuple>
 
 #include "app/bench_timings.h"
-#include "labeling/labelled_render.h"
+#include "frame/labelled_render.h"
 #include "shared/placement.h"
 
 namespace strata::app {

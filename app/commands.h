@@ -12,7 +12,7 @@
 #include "engine/scene/scene.h"
 
 namespace strata {
-struct Ghosting;  // labeling/labelled_render.h
+struct Ghosting;  // frame/labelled_render.h
 }
 
 namespace strata::app {

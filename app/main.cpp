@@ -12,8 +12,8 @@
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/volume_loader.h"
 #include "engine/scene/transfer_function_presets.h"
+#include "frame/labelled_render.h"
 #include "labeling/camera_path.h"
-#include "labeling/labelled_render.h"
 #include "labeling/text_layout.h"
 #include "passes/volume_renderer.h"
 

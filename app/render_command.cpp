@@ -9,8 +9,8 @@
 #include "engine/graph/graph_runner.h"
 #include "engine/graph/headless_target.h"
 #include "engine/scene/io/scene_loader.h"
+#include "frame/labelled_render.h"
 #include "labeling/camera_path.h"
-#include "labeling/labelled_render.h"
 #include "passes/test_pattern.h"
 #include "passes/volume_renderer.h"
 
@@ -194,7 +194,7 @@ struct SceneRender {
   }
 };
 
-// strata's main job: the labelled image (labeling/labelled_render.h), once per position.
+// strata's main job: the labelled image (frame/labelled_render.h), once per position.
 void render_labelled_scene(DeviceOptions& device, const RenderOptions& o) {
   SceneRender job(device, o);
   for (const Still& still : job.stills) {

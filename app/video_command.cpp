@@ -19,8 +19,8 @@
 #include "app/progress.h"
 #include "engine/core/frame_writer.h"
 #include "engine/core/text_file.h"
+#include "frame/labelled_render.h"
 #include "labeling/camera_path.h"
-#include "labeling/labelled_render.h"
 #include "labeling/layout_metrics.h"
 #include "labeling/video_plan.h"
 

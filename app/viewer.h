@@ -24,8 +24,8 @@
 #include "engine/graph/frame_slots.h"
 #include "engine/graph/window_target.h"
 #include "engine/scene/io/label_file_writer.h"
+#include "frame/labelled_render.h"
 #include "labeling/camera_control.h"
-#include "labeling/labelled_render.h"
 #include "passes/debug_view.h"
 
 namespace strata::app {

@@ -116,7 +116,7 @@ class LabelForces {
   // leave them out.
   void set_active(uint32_t count) { active_ = std::min(count, label_count_); }
   // The frame's count of labels in the insertion order the forces read (a placement's older than
-  // the frame: labeling/placement_beside.h).
+  // the frame: frame/placement_beside.h).
   void set_order_count(uint32_t count) { params_.order_count = std::min(count, label_count_); }
   // Marks the frame set last as a trial (ForcesParams::trial): labels are drawn where they were
   // and the state is not written, so several trial placements start from the same state.

@@ -1,6 +1,6 @@
 // The runner's side of "declared is used": a pass gets only the resources it declared, and the
 // dependent dispatches of one pass are ordered by the graph's barrier helper (synchronization
-// validation shows that they must be).
+// validation shows that they must be). A graph on the second queue runs where its timelines put it.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -9,7 +9,9 @@
 
 #include "engine/core/error.h"
 #include "engine/gpu/resources.h"
+#include "engine/graph/frame_slots.h"
 #include "engine/graph/graph_runner.h"
+#include "engine/graph/second_queue.h"
 #include "gpu_fixture.h"
 #include "passes/summed_area_table.h"
 #include "shared/summed_area_table.h"
@@ -280,6 +282,73 @@ TEST_SUITE("gpu") {
     CHECK(table(true) == whole);
     const std::vector<double> cpu = summed_area_table_reference(values, size.width, size.height);
     CHECK(whole.back() == doctest::Approx(cpu.back()).epsilon(1e-5));
+    CHECK(ctx.validation_log().count() == 0);
+  }
+
+  // The hand-off of the placement beside the frames: a run on the second queue reads what the
+  // frame that started it wrote, and a later frame that waits for it reads what it wrote; only
+  // the timelines order them (the host waits here only to read the results).
+  TEST_CASE_FIXTURE(test::GpuTest,
+                    "a_second_queue_run_follows_its_frame_and_precedes_the_one_waiting") {
+    constexpr VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                         VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    const auto buffer = [&] { return Buffer(ctx, 4, usage, MemoryKind::device_local, true); };
+    const Buffer fed = buffer(), result = buffer(), seen = buffer();
+    upload(ctx, result, as_bytes(std::vector<uint32_t>{0}));
+
+    graph::Graph run;  // the second queue's: result = fed
+    const auto run_fed = run.import_buffer("fed", {.buffer = fed.handle(), .has_content = true});
+    const auto run_result = run.import_buffer("result", {.buffer = result.handle()});
+    run.add_pass({"copy",
+                  graph::PassKind::transfer,
+                  {{run_fed, graph::Use::transfer_src}, {run_result, graph::Use::transfer_dst}},
+                  [=](graph::PassContext& pc) { pc.copy_buffer(run_fed, run_result, 4); }});
+    graph::GraphRunner second(ctx, std::move(run));
+    second.set_viewport({1, 1});
+
+    uint32_t value = 0;
+    graph::Graph g;  // a frame's: fed = value, seen = result
+    const auto g_fed = g.import_buffer("fed", {.buffer = fed.handle()});
+    const auto g_result =
+        g.import_buffer("result", {.buffer = result.handle(), .has_content = true});
+    const auto g_seen =
+        g.import_buffer("seen", {.buffer = seen.handle(), .final_use = graph::Use::transfer_src});
+    g.add_pass({"write",
+                graph::PassKind::transfer,
+                {{g_fed, graph::Use::transfer_dst}},
+                [&](graph::PassContext& pc) {
+                  record_update(pc.cmd, pc.buffer(g_fed), 0, std::as_bytes(std::span(&value, 1)));
+                }});
+    g.add_pass({"read",
+                graph::PassKind::transfer,
+                {{g_result, graph::Use::transfer_src}, {g_seen, graph::Use::transfer_dst}},
+                [=](graph::PassContext& pc) { pc.copy_buffer(g_result, g_seen, 4); }});
+    graph::GraphRunner frame(ctx, std::move(g));
+    frame.set_viewport({1, 1});
+
+    FrameSlots slots(ctx, 1);
+    graph::SecondQueue queue(ctx);
+    const auto run_frame = [&](uint32_t written, const std::function<void()>& hand_off) {
+      value = written;
+      const uint32_t slot = slots.next();
+      frame.submission() = {};
+      hand_off();
+      frame.record(slots.begin(slot), slot);
+      const graph::FrameSubmission& submission = frame.submission();
+      slots.submit(slot, submission.wait, submission.signal);
+      if (submission.submitted) submission.submitted();
+      slots.wait_all();
+    };
+    run_frame(7, [&] { CHECK(queue.run_after(frame, second) == 1); });
+    CHECK(download_as<uint32_t>(ctx, seen) == std::vector<uint32_t>{0});  // (before the run)
+    queue.wait_idle();
+    CHECK(queue.started() == 1);
+    CHECK(queue.finished(1));
+    CHECK_FALSE(queue.finished(2));
+    run_frame(8, [&] { queue.wait_in(frame, 1); });
+    CHECK(download_as<uint32_t>(ctx, seen) == std::vector<uint32_t>{7});
+    CHECK(download_as<uint32_t>(ctx, result) == std::vector<uint32_t>{7});
     CHECK(ctx.validation_log().count() == 0);
   }
 }

@@ -12,9 +12,9 @@
 #include "engine/core/error.h"
 #include "engine/core/png.h"
 #include "engine/scene/io/scene_loader.h"
+#include "frame/labelled_render.h"
+#include "frame/placement_beside.h"
 #include "gpu_fixture.h"
-#include "labeling/labelled_render.h"
-#include "labeling/placement_beside.h"
 #include "shared/label_drawing.h"
 
 namespace strata {

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "labeling/labelled_render.h"
+#include "frame/labelled_render.h"
 #include "labeling/layout_metrics.h"
 
 namespace strata {

@@ -8,8 +8,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "engine/scene/io/scene_loader.h"
+#include "frame/labelled_render.h"
 #include "gpu_fixture.h"
-#include "labeling/labelled_render.h"
 #include "passes/picking.h"
 #include "passes/volume_render_reference.h"
 #include "passes/volume_renderer.h"

@@ -15,8 +15,8 @@
 
 #include "engine/gpu/resources.h"
 #include "engine/graph/graph_runner.h"
+#include "frame/labelled_render.h"
 #include "gpu_fixture.h"
-#include "labeling/labelled_render.h"
 #include "labeling/layout_metrics.h"
 #include "passes/label_drawing.h"
 #include "passes/label_forces.h"

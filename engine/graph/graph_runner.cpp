@@ -37,6 +37,11 @@ VkImageView PassContext::view(ResourceId id) const {
   return runner_->bound_[id].view;
 }
 
+void PassContext::copy_buffer(ResourceId from, ResourceId to, VkDeviceSize size) {
+  const VkBufferCopy region{0, 0, size};
+  vkCmdCopyBuffer(cmd, buffer(from), buffer(to), 1, &region);
+}
+
 void PassContext::begin_conditional(ResourceId predicate, VkDeviceSize offset) {
   const PassInfo& pass = runner_->graph_.passes()[pass_];
   declared(predicate);

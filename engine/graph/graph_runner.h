@@ -41,6 +41,9 @@ class PassContext {
   // Binds `pipeline` and pushes every resource this pass declared with a binding index (sampled
   // images with the graph's linear clamp-to-edge sampler).
   void bind(const Pipeline& pipeline);
+  // Copies the first `size` bytes of buffer `from` to the start of buffer `to` (a transfer pass
+  // declares them transfer_src and transfer_dst).
+  void copy_buffer(ResourceId from, ResourceId to, VkDeviceSize size);
 
   // Binds `pipeline` (unless this pass bound it last), pushes `push` and dispatches: enough
   // workgroups of the pipeline's reflected size to cover `threads`, exactly `groups`, or the

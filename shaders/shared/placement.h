@@ -20,7 +20,7 @@
 // Legibility: a box pixel is hidden where the layers in front of the label's composite to at
 // least HIDING_ALPHA; a box is legible when at least LEGIBLE_SHARE of its pixels are not hidden.
 // The placement's tables hold each layer's hidden pixels after its integral costs (layer_count +
-// layer); strata's counts (labeling/labelled_render.h) use the same two figures.
+// layer); strata's counts (frame/labelled_render.h) use the same two figures.
 #define HIDING_ALPHA 0.5f
 #define LEGIBLE_SHARE 0.75f
 

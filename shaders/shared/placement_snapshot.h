@@ -1,5 +1,5 @@
 // The frame that starts a placement beside the frames copies its picture and layers for it
-// (labeling/placement_beside.cpp), with a compute pass: a transfer copy of these storage images
+// (frame/placement_beside.cpp), with a compute pass: a transfer copy of these storage images
 // ran at a twentieth of the memory's speed on an NVIDIA H100 (docs/performance.md).
 #ifndef STRATA_SHARED_PLACEMENT_SNAPSHOT_H
 #define STRATA_SHARED_PLACEMENT_SNAPSHOT_H

@@ -1,4 +1,4 @@
-#include "labeling/placement_beside.h"
+#include "frame/placement_beside.h"
 
 #include <algorithm>
 
@@ -6,7 +6,6 @@
 #include "engine/gpu/context.h"
 #include "engine/gpu/resources.h"
 #include "engine/gpu/shader_library.h"
-#include "engine/gpu/vulkan_check.h"
 #include "shared/placement_snapshot.h"
 
 namespace strata {
@@ -24,21 +23,6 @@ Buffer zeroed_buffer(Context& ctx, VkDeviceSize size) {
   Buffer buffer(ctx, size, kCopied, MemoryKind::device_local, true);
   upload(ctx, buffer, std::vector<std::byte>(size));
   return buffer;
-}
-
-VkSemaphore timeline(Context& ctx) {
-  VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
-  type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
-  VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
-  VkSemaphore semaphore = VK_NULL_HANDLE;
-  STRATA_VK(vkCreateSemaphore(ctx.device(), &info, nullptr, &semaphore));
-  return semaphore;
-}
-
-void copy_buffer(const graph::PassContext& pc, graph::ResourceId from, graph::ResourceId to,
-                 VkDeviceSize size) {
-  const VkBufferCopy region{0, 0, size};
-  vkCmdCopyBuffer(pc.cmd, pc.buffer(from), pc.buffer(to), 1, &region);
 }
 
 }  // namespace
@@ -74,24 +58,15 @@ PlacementBeside::PlacementBeside(Context& ctx, Placement& placement, LabelForces
       adopted_targets_(zeroed_buffer(ctx, label_count_ * sizeof(gpu::PlacementGpu))),
       adopted_labels_(zeroed_buffer(ctx, label_count_ * sizeof(gpu::LabelGpu))),
       adopted_order_(zeroed_buffer(ctx, label_count_ * sizeof(uint32_t))),
-      slots_(ctx, 1, ctx.placement_queue(), ctx.placement_family()),
-      fed_(timeline(ctx)),
-      placed_(timeline(ctx)) {}
-
-PlacementBeside::~PlacementBeside() {
-  if (ctx_.drain() || ctx_.may_destroy()) {
-    vkDestroySemaphore(ctx_.device(), fed_, nullptr);
-    vkDestroySemaphore(ctx_.device(), placed_, nullptr);
-  }
-}
+      runs_(ctx) {}
 
 void PlacementBeside::wait_idle() {
-  slots_.wait_all();
+  runs_.wait_idle();
 }
 
 bool PlacementBeside::take_trial(const std::function<void()>& read) {
   if (!trial_finished()) return false;
-  taken_ = started_;
+  taken_ = runs_.started();
   placement_.readback().use_slot(*runner_, started_slot_);
   read();
   placement_.readback().use_slot(*runner_, adopted_slot_);
@@ -100,7 +75,7 @@ bool PlacementBeside::take_trial(const std::function<void()>& read) {
 
 void PlacementBeside::build(uint32_t layer_count, graph::Extent size) {
   wait_idle();
-  if (trial_) taken_ = started_;  // (a trial for the old graph: its results are not read)
+  if (trial_) taken_ = runs_.started();  // (a trial for the old graph: its results are not read)
   layer_count_ = layer_count;
   placement_.readback().set_slots(2);
   adopted_slot_ = 0;
@@ -155,9 +130,9 @@ void PlacementBeside::build(uint32_t layer_count, graph::Extent size) {
                    {labels, Use::transfer_dst},
                    {order, Use::transfer_dst}},
                   [=](graph::PassContext& pc) {
-                    copy_buffer(pc, placed.placements, targets, n * sizeof(gpu::PlacementGpu));
-                    copy_buffer(pc, placed.labels, labels, n * sizeof(gpu::LabelGpu));
-                    copy_buffer(pc, placed.order, order, n * sizeof(uint32_t));
+                    pc.copy_buffer(placed.placements, targets, n * sizeof(gpu::PlacementGpu));
+                    pc.copy_buffer(placed.labels, labels, n * sizeof(gpu::LabelGpu));
+                    pc.copy_buffer(placed.order, order, n * sizeof(uint32_t));
                   },
                   "placement"});
   runner_ = std::make_unique<graph::GraphRunner>(ctx_, std::move(graph));
@@ -199,9 +174,9 @@ PlacementBeside::FrameIds PlacementBeside::add_to_frame(graph::Graph& graph,
                    {order, Use::transfer_dst}},
                   [=, this](graph::PassContext& pc) {
                     if (!adopt_now_) return;
-                    copy_buffer(pc, published_targets, targets, n * sizeof(gpu::PlacementGpu));
-                    copy_buffer(pc, published_labels, placed, n * sizeof(gpu::LabelGpu));
-                    copy_buffer(pc, published_order, order, n * sizeof(uint32_t));
+                    pc.copy_buffer(published_targets, targets, n * sizeof(gpu::PlacementGpu));
+                    pc.copy_buffer(published_labels, placed, n * sizeof(gpu::LabelGpu));
+                    pc.copy_buffer(published_order, order, n * sizeof(uint32_t));
                   },
                   "placement"});
   const graph::ResourceId labels =
@@ -225,49 +200,38 @@ void PlacementBeside::add_state_snapshot(graph::Graph& graph, graph::ResourceId 
                   graph::PassKind::transfer,
                   {{state, Use::transfer_src}, {saved, Use::transfer_dst}},
                   [=, this](graph::PassContext& pc) {
-                    if (start_now_) copy_buffer(pc, state, saved, bytes);
+                    if (start_now_) pc.copy_buffer(state, saved, bytes);
                   },
                   "labels"});
 }
 
 bool PlacementBeside::finished() const {
-  uint64_t value = 0;
-  STRATA_VK(vkGetSemaphoreCounterValue(ctx_.device(), placed_, &value));
-  return value >= started_;
-}
-
-VkSemaphoreSubmitInfo PlacementBeside::at(VkSemaphore semaphore, uint64_t value) const {
-  VkSemaphoreSubmitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-  info.semaphore = semaphore;
-  info.value = value;
-  info.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-  return info;
+  return runs_.finished(runs_.started());
 }
 
 void PlacementBeside::prepare(graph::GraphRunner& frame, const std::vector<gpu::LabelGpu>& labels,
                               bool trial) {
   if (!runner_) throw Error("placement beside the frames: build() before prepare()");
   frame_labels_ = labels;
-  graph::FrameSubmission& submission = frame.submission();
-  submission = {};
+  frame.submission() = {};
   adopt_now_ = start_now_ = false;
-  if (trial_finished()) taken_ = started_;  // (a trial nobody read: dropped)
-  if (started_ > taken_ && !trial_ && finished()) {
+  if (trial_finished()) taken_ = runs_.started();  // (a trial nobody read: dropped)
+  if (runs_.started() > taken_ && !trial_ && finished()) {
     adopt();
-    submission.wait.push_back(at(placed_, taken_));
+    runs_.wait_in(frame, taken_);
   }
   // (the frames write the snapshot of the placement after the one in flight)
-  const Snapshot& next = snapshots_[(started_ + 1) % 2];
+  const Snapshot& next = snapshots_[(runs_.started() + 1) % 2];
   frame.bind_image(frame_snapshot_ids_[0], next.final.handle(), next.final.view(),
                    VK_FORMAT_R8G8B8A8_UNORM);
   frame.bind_image(frame_snapshot_ids_[1], next.layers.handle(), next.layers.view(),
                    VK_FORMAT_R16G16B16A16_SFLOAT);
   frame.bind_buffer(frame_snapshot_ids_[2], next.state.handle());
-  if (started_ == taken_ && !paused_ && (due_ || trial)) start(frame, !due_);
+  if (runs_.started() == taken_ && !paused_ && (due_ || trial)) start(frame, !due_);
 }
 
 void PlacementBeside::adopt() {
-  taken_ = started_;
+  taken_ = runs_.started();
   adopted_slot_ = started_slot_;
   adopt_now_ = true;
   adopted_order_count_ = started_order_count_;
@@ -282,7 +246,7 @@ void PlacementBeside::adopt() {
 // it after the frame, which feeds it. Its results go to the readback slot the adopted placement's
 // are not in.
 void PlacementBeside::start(graph::GraphRunner& frame, bool trial) {
-  const uint64_t k = ++started_;
+  const uint64_t k = runs_.started() + 1;
   start_now_ = true;
   trial_ = trial;
   if (!trial) due_ = false;
@@ -296,18 +260,9 @@ void PlacementBeside::start(graph::GraphRunner& frame, bool trial) {
                       VK_FORMAT_R16G16B16A16_SFLOAT);
   runner_->bind_buffer(runner_snapshot_ids_[2], s.state.handle());
   placement_.readback().use_slot(*runner_, started_slot_);
-  const uint32_t slot = slots_.next();
-  const VkCommandBuffer cmd = slots_.begin(slot);
-  runner_->record(cmd, slot);
+  runs_.run_after(frame, *runner_);
   // (the host reads the adopted placement's results until this one is adopted)
   placement_.readback().use_slot(*runner_, adopted_slot_);
-  graph::FrameSubmission& submission = frame.submission();
-  submission.signal.push_back(at(fed_, k));
-  submission.submitted = [this, slot, k] {
-    const VkSemaphoreSubmitInfo waits[] = {at(fed_, k), at(placed_, k - 1)};
-    const VkSemaphoreSubmitInfo signal = at(placed_, k);
-    slots_.submit(slot, waits, {&signal, 1});
-  };
 }
 
 }  // namespace strata

@@ -15,9 +15,9 @@
 
 #include "engine/core/font.h"
 #include "engine/scene/scene.h"
-#include "labeling/label_slots.h"
+#include "frame/label_slots.h"
+#include "frame/placement_beside.h"
 #include "labeling/layering.h"
-#include "labeling/placement_beside.h"
 #include "labeling/text_layout.h"
 #include "passes/label_forces.h"
 #include "passes/picking.h"
@@ -57,7 +57,7 @@ struct LabellingSettings {
   float wrap_width = 240.0f;
   bool layer_colors = false;  // label borders in their layer's colour (the thesis's depth cue)
   Ghosting ghost;
-  // Label slots kept free beyond the scene's labels (labeling/label_slots.h): labels added later
+  // Label slots kept free beyond the scene's labels (frame/label_slots.h): labels added later
   // (labels_changed) fill them without new buffers or a new graph; the viewer keeps some.
   uint32_t spare_label_slots = 0;
   uint64_t seed = 1;      // k-means++
@@ -197,7 +197,7 @@ class LabelledRenderer {
   // Beside the frames: the total cost (total_cost()) of the trial placement the last frame
   // prepared took up, once; none where it took none.
   std::optional<double> take_trial_cost() { return std::exchange(trial_cost_, std::nullopt); }
-  // The placement beside the frames (labeling/placement_beside.h): the viewer's frames render
+  // The placement beside the frames (frame/placement_beside.h): the viewer's frames render
   // and move the labels toward the newest finished placement without waiting for one; stills,
   // trial frames and run() need it off (the default). Rebuilds the graph.
   void set_placement_beside(bool beside);
@@ -257,7 +257,7 @@ class LabelledRenderer {
   // The last completed frame's (of the current slot) placements and drawn positions, per label.
   std::vector<gpu::PlacementGpu> placement_results() const;
   std::vector<gpu::PlacementGpu> drawn() const;
-  // The per-label buffers' slots (labeling/label_slots.h): the graph was built for count().
+  // The per-label buffers' slots (frame/label_slots.h): the graph was built for count().
   const LabelSlots& label_slots() const { return slots_; }
   // Stein & Decoret's order inside each layer, from the last frame's layers (downloads them:
   // nothing may be in flight).

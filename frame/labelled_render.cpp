@@ -1,4 +1,4 @@
-#include "labeling/labelled_render.h"
+#include "frame/labelled_render.h"
 
 #include <algorithm>
 #include <cmath>
@@ -528,8 +528,7 @@ void LabelledRenderer::add_pick_readback(graph::Graph& graph) {
                   {{points, graph::Use::transfer_src}, {readback, graph::Use::transfer_dst}},
                   [this, points, readback](graph::PassContext& pc) {
                     if (parts_->picking.pixels().empty()) return;
-                    const VkBufferCopy region{0, 0, parts_->pick_points.size()};
-                    vkCmdCopyBuffer(pc.cmd, pc.buffer(points), pc.buffer(readback), 1, &region);
+                    pc.copy_buffer(points, readback, parts_->pick_points.size());
                   },
                   "picking"});
 }

@@ -1,4 +1,4 @@
-#include "labeling/label_slots.h"
+#include "frame/label_slots.h"
 
 #include <algorithm>
 

@@ -21,8 +21,8 @@
 #include <memory>
 #include <vector>
 
-#include "engine/graph/frame_slots.h"
 #include "engine/graph/graph_runner.h"
+#include "engine/graph/second_queue.h"
 #include "passes/label_forces.h"
 #include "passes/placement.h"
 #include "passes/volume_renderer.h"
@@ -43,7 +43,6 @@ void add_snapshot_pass(graph::Graph& graph, const ComputePipeline& pipeline,
 class PlacementBeside {
  public:
   PlacementBeside(Context& ctx, Placement& placement, LabelForces& forces, uint32_t label_count);
-  ~PlacementBeside();
   PlacementBeside(const PlacementBeside&) = delete;
   PlacementBeside& operator=(const PlacementBeside&) = delete;
 
@@ -72,9 +71,9 @@ class PlacementBeside {
                bool trial = false);
   // Whether the next frame may start a trial: no placement due, none in flight but a finished
   // trial, not paused.
-  bool idle() const { return (started_ == taken_ || trial_finished()) && !due_ && !paused_; }
+  bool idle() const { return (runs_.started() == taken_ || trial_finished()) && !due_ && !paused_; }
   // The trial in flight has finished, and take_trial reads it.
-  bool trial_finished() const { return trial_ && started_ > taken_ && finished(); }
+  bool trial_finished() const { return trial_ && runs_.started() > taken_ && finished(); }
   // A finished trial taken up: `read` sees its results (the Placement's readback) and then the
   // readback is the adopted placement's again. False where no trial has finished.
   bool take_trial(const std::function<void()>& read);
@@ -110,7 +109,6 @@ class PlacementBeside {
   bool finished() const;
   void adopt();
   void start(graph::GraphRunner& frame, bool trial);
-  VkSemaphoreSubmitInfo at(VkSemaphore semaphore, uint64_t value) const;
 
   Context& ctx_;
   Placement& placement_;
@@ -123,11 +121,9 @@ class PlacementBeside {
   std::unique_ptr<graph::GraphRunner> runner_;              // the placement's graph
   std::array<graph::ResourceId, 3> runner_snapshot_ids_{};  // final, layers, state
   std::array<graph::ResourceId, 3> frame_snapshot_ids_{};
-  FrameSlots slots_;
-  VkSemaphore fed_ = VK_NULL_HANDLE;     // frame k fed placement k (its snapshot is written)
-  VkSemaphore placed_ = VK_NULL_HANDLE;  // placement k finished
-  // Placements started and taken up (adopted, or read as a trial), counted from 1.
-  uint64_t started_ = 0, taken_ = 0;
+  // Placement k is run k on the second queue, fed by the frame that wrote its snapshot.
+  graph::SecondQueue runs_;
+  uint64_t taken_ = 0;  // placements taken up (adopted, or read as a trial), counted from 1
   bool trial_ = false;  // the last placement started is a trial
   // The Placement's readback slots: the adopted placement's results, and the started one's.
   uint32_t adopted_slot_ = 0, started_slot_ = 0;
