@@ -1,33 +1,23 @@
 // The resolve of one pixel, written once for the GPU (habuffer_resolve.comp) and the CPU
-// reference (passes/volume_render_reference.cpp). The includer provides:
-//   frame                                  FrameGpu
-//   VolumeGpu volume_info(uint v)
-//   vec4 volume_sample(uint v, vec3 tc)    trilinear at tc in [0,1]^3: xyz the gradient (per
-//                                          voxel), w the normalised intensity
-//   vec4 table_entry(uint v, int i)        transfer table entry i of volume v, its alpha
-//                                          corrected for the frame's step (corrected_transfer)
-//   bool brick_empty(uint v, vec3 tc)      transfer function is transparent in tc's brick
-//   bool volume_cut(uint v, vec3 tc)       volume v's cut-aways remove tc (VolumeGpu::cut)
-//   void emit_layer(uint l, vec4 colour)   the pixel's layer l (premultiplied), called for every
-//                                          layer in order, once
-// and the pixel's mesh fragments sorted front to back: their eye depths and payloads. The
-// volumes' boxes are added here, by a ray-box test.
+// reference (passes/volume_render_reference.cpp). What the includer provides (the frame, the
+// volumes' samples, transfer tables, bricks and cut-aways, and emit_layer, which takes the pixel's
+// layers) is resolve_walk_access.h; resolve_pixel's arguments are the pixel's mesh fragments,
+// sorted front to back: their eye depths and payloads. The volumes' boxes are added here, by a
+// ray-box test.
 //
-// With VR_RESOLVE_LAYER_KEEP defined the includer also provides
-//   float layer_keep(uint l)               the share of layer l's colour and alpha the picture
-//                                          keeps (ghosting: shared/ghost.h; 1 without)
-//   uint walk_start_layer()                the first layer the walk samples (below layer_count);
-//                                          those in front are not walked nor emitted
-//   float walk_start_clear()               what the drawn layers in front of it let through
-//   bool walk_stops_at_depth()             the walk ends at the depth (a pick needs no more; the
-//                                          layers from there on are then not whole)
-// and the depth follows the drawn picture instead of the walk's own sum: with A_l(z) layer l's
+// With VR_RESOLVE_LAYER_KEEP defined the includer also provides each layer's keep (ghosting),
+// the layer the walk starts at and whether it stops at the depth (resolve_walk_access.h), and
+// the depth follows the drawn picture instead of the walk's own sum: with A_l(z) layer l's
 // alpha up to z, the picture's alpha at z in layer l is 1 - T * (1 - keep_l * A_l(z)), T the
 // product of (1 - keep_j * A_j) over the layers j in front (their whole alphas). While every
 // layer so far is kept whole that is the walk's own sum, so the depth is exactly the resolve's.
 //
 // The ray is parametrised by eye depth z: point(z) = origin + direction * z. Samples lie on one
 // grid for the whole ray (near + (k + 0.5) * dz), so segments between fragments join seamlessly.
+
+#ifndef __cplusplus
+#include "resolve_walk_access.h"  // (C++: the reference's struct is checked against it)
+#endif
 
 // The frame's volume count; a constant where the includer resolves one volume only
 // (VR_RESOLVE_ONE_VOLUME), so that the compiler drops the general paths.
