@@ -1,24 +1,54 @@
 # Compiles every GLSL shader in a folder to SPIR-V with glslangValidator at build time and embeds
 # the words in a static library. Each shader's #include dependencies come from glslang's depfile,
 # so editing a header in shaders/shared/ rebuilds exactly the shaders that include it.
+# VARIANTS rows "output : source : DEFINE ..." compile one source under several names, each with
+# its own -D defines; a source named in a row is compiled only through its rows, every other
+# shader as itself, with none.
 # The library exposes strata::embedded_shaders() (engine/gpu/shader_library.h reads it by name).
 function(strata_add_shaders target)
-  cmake_parse_arguments(ARG "" "DIRECTORY" "" ${ARGN})
+  cmake_parse_arguments(ARG "" "DIRECTORY" "VARIANTS" ${ARGN})
   file(GLOB sources CONFIGURE_DEPENDS ${ARG_DIRECTORY}/*.comp ${ARG_DIRECTORY}/*.vert
        ${ARG_DIRECTORY}/*.frag)
+  # Each output's source and defines: the table's rows, then every other shader as itself.
+  set(outputs)
+  foreach(row ${ARG_VARIANTS})
+    string(REPLACE ":" ";" fields "${row}")
+    list(LENGTH fields field_count)
+    if(NOT field_count EQUAL 3)
+      message(FATAL_ERROR "shader variant \"${row}\": expected \"output : source : defines\"")
+    endif()
+    list(GET fields 0 output)
+    list(GET fields 1 source)
+    list(GET fields 2 defines)
+    string(STRIP "${output}" output)
+    string(STRIP "${source}" source)
+    separate_arguments(defines UNIX_COMMAND "${defines}")
+    list(TRANSFORM defines PREPEND -D)
+    list(REMOVE_ITEM sources ${ARG_DIRECTORY}/${source})
+    list(APPEND outputs ${output})
+    set(source_of_${output} ${ARG_DIRECTORY}/${source})
+    set(defines_of_${output} ${defines})
+  endforeach()
+  foreach(src ${sources})
+    get_filename_component(file ${src} NAME)
+    list(APPEND outputs ${file})
+    set(source_of_${file} ${src})
+    set(defines_of_${file})
+  endforeach()
+  list(SORT outputs)  # (the registry in name order, as the folder lists them)
   set(out_dir ${CMAKE_BINARY_DIR}/shaders)
   file(MAKE_DIRECTORY ${out_dir})
   set(headers)
   set(includes)
   set(entries)
-  foreach(src ${sources})
-    get_filename_component(file ${src} NAME)
+  foreach(file ${outputs})
+    set(src ${source_of_${file}})
     string(MAKE_C_IDENTIFIER ${file} ident)
     set(header ${out_dir}/${file}.spv.h)
     add_custom_command(
       OUTPUT ${header}
       COMMAND ${GLSLANG_VALIDATOR} --quiet --target-env vulkan1.3 -I${ARG_DIRECTORY}
-              --depfile ${header}.d --vn spv_${ident} -o ${header} ${src}
+              ${defines_of_${file}} --depfile ${header}.d --vn spv_${ident} -o ${header} ${src}
       DEPENDS ${src}
       DEPFILE ${header}.d
       COMMENT "glslang ${file}"

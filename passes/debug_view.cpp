@@ -5,6 +5,7 @@
 #include <string>
 
 #include "engine/core/error.h"
+#include "shared/debug_view_access.h"
 
 namespace strata {
 
@@ -39,6 +40,7 @@ struct DebugViewReference {
 #include "shared/debug_view.h"
 #undef DEBUG_VIEW_PIXEL
 };
+static_assert(DebugViewAccess<DebugViewReference>);
 
 }  // namespace
 }  // namespace gpu

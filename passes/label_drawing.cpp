@@ -6,6 +6,7 @@
 #include <glm/gtc/packing.hpp>
 
 #include "engine/core/error.h"
+#include "shared/label_draw_pixel_access.h"
 #include "shared/volume_shading.h"  // split_depth
 
 namespace strata {
@@ -71,6 +72,7 @@ struct LabelDrawReference {
 
 #include "shared/label_draw_pixel.h"
 };
+static_assert(LabelDrawPixelAccess<LabelDrawReference>);
 
 }  // namespace
 }  // namespace gpu

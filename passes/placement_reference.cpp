@@ -7,7 +7,9 @@
 
 #include "passes/summed_area_table.h"
 #include "shared/ghost.h"
+#include "shared/placement_cost_access.h"
 #include "shared/saliency.h"
+#include "shared/tidy_search_access.h"
 
 namespace strata {
 namespace gpu {
@@ -49,6 +51,7 @@ struct Placer {
 
 #include "shared/placement_cost.h"
 };
+static_assert(PlacementCostAccess<Placer>);
 
 // The tidy-up's rounds (shared/tidy_search.h) one step at a time: each step over
 // every label before the next, as the GPU's barriers separate them.
@@ -131,6 +134,7 @@ struct Tidier {
     return !applied.empty();
   }
 };
+static_assert(TidySearchAccess<Tidier>);
 
 }  // namespace
 }  // namespace gpu

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "shared/resolve_walk_access.h"
 #include "shared/volume_shading.h"
 
 namespace strata {
@@ -81,6 +82,7 @@ struct Reference {
 #include "shared/resolve_walk.h"
 #undef VR_RESOLVE_LAYER_KEEP
 };
+static_assert(ResolveWalkLayerKeepAccess<Reference>);
 static_assert(VR_MAX_LAYERS == 8, "layer_keeps' initialiser");
 
 struct Fragment {

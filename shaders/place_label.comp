@@ -83,8 +83,8 @@ shared uint finish_ends[PLACEMENT_BUCKETS];  // where each bucket's entries end 
 
 // The regions of the label at order position s against the one placed at order position t.
 PairRegionsGpu regions_of(uint s, uint t) { return regions[placement_pair_slot(s, t)]; }
-// What shared/placement_cost.h asks of its includer: the placed labels and anchors the tile's
-// workgroup culled, and the integral-cost tables.
+// What shared/placement_cost.h asks of its includer (placement_cost_access.h): the placed labels
+// and anchors the tile's workgroup culled, and the integral-cost tables.
 uint placed_count() { return tile_placed_count; }
 PairRegionsGpu placed_regions(uint k) { return regions_of(position, tile_placed[k]); }
 uint anchor_count() { return tile_anchor_count; }

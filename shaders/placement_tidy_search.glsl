@@ -1,4 +1,4 @@
-// The tidy-up's search step (placement_tidy_search.comp, placement_tidy_search_large.comp).
+// The tidy-up's search step (TIDY_SEARCH: placement_tidy_search.comp and its _large variant).
 // The pair at position p of (0, 1), (0, 2) ... (0, n - 1), (1, 2) ...: row i starts at
 // i (2n - i - 1) / 2. (The root gives the row to within one or two; integers settle it. A loop
 // over the rows cost an invocation up to n steps.)

@@ -1,4 +1,4 @@
-// What a walk of shared/resolve_walk.h reads on the GPU, for the resolve (habuffer_resolve.glsl)
+// What a walk of shared/resolve_walk.h reads on the GPU, for the resolve (habuffer_resolve.comp)
 // and the pick (pick.comp): the frame, the volumes, the atlas, the transfer table and the
 // occupancy as bindings, the sampling functions the walk asks for, and the gather of a pixel's
 // mesh fragments from the HA-Buffer. The includer includes shared/volume_shading.h first.

@@ -80,18 +80,12 @@ STRATA_END
 #endif
 
 #ifdef DEBUG_VIEW_PIXEL
-// The view's pixel. The includer provides (the shader from its bindings, the CPU reference from
-// spans, as members of the struct it includes this in):
-//   DebugViewParams view
-//   float saliency_at(uint pixel)
-//   float cost_at(uint layer, uint pixel)
-//   vec4 layer_at(uvec2 p, uint layer)            premultiplied
-//   LabelGpu label_at(uint i)
-//   PlacementGpu placement_at(uint i)
-//   uint order_at(uint k)
-//   uvec2 key_at(uint slot)                        an HA-Buffer key: x the low word, y the high
-//   uint table_size()                              the HA-Buffer's slots
-// and calls view_setup() before debug_view_pixel().
+// The view's pixel. What the includer provides (the shader from its bindings, the CPU reference
+// from spans, as members of the struct it includes this in) is debug_view_access.h; it calls
+// view_setup() before debug_view_pixel().
+#ifndef __cplusplus
+#include "debug_view_access.h"  // (C++: the reference's struct is checked against it)
+#endif
 
 // The constraint image is the placement's own code (placement_cost.h) with what that expects of
 // its includer made from the labels, placements and order buffers: the picked label against

@@ -1,14 +1,11 @@
 // One pixel of one depth layer with its labels drawn over it, written once for the GPU
 // (label_draw.comp) and the CPU reference (passes/label_drawing.cpp, which includes this file
-// inside a struct). The includer provides:
-//   uint label_count()                 labels to consider
-//   LabelGpu label_at(uint i)
-//   PlacementGpu placement_at(uint i)
-//   GlyphGpu glyph_at(uint i)
-//   float atlas_coverage(vec2 uv)      the font atlas, bilinear, clamped to its edge
-//   vec4 image_texel(vec2 uv)          the image atlas (premultiplied), bilinear, clamped likewise
-//   bool layer_frames()                borders in their layer's colour
-//   float anchor_hidden_at(uint i)     how hidden label i's anchor is (AnchorCoverGpu::hidden)
+// inside a struct). What the includer provides (the labels, their placements and glyphs, the
+// atlases) is label_draw_pixel_access.h.
+
+#ifndef __cplusplus
+#include "label_draw_pixel_access.h"  // (C++: the reference's struct is checked against it)
+#endif
 
 // Text coverage of a label at p. Glyph quads overlap only in their zero-coverage borders, so the
 // largest coverage is the text's.

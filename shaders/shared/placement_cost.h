@@ -1,17 +1,14 @@
 // Constraints (thesis 3.2.1, 4.1.1) and the cost of eq. 3.1 at one candidate position, written
 // once for the GPU (place_label.comp) and the CPU reference (passes/placement_reference.cpp).
-// The includer provides:
-//   params                         PlacementParams
-//   uint placed_count()            how many placed labels to test against (all placed so far,
-//                                  or the ones a GPU tile's candidates can reach) ...
-//   PairRegionsGpu placed_regions(uint k)   ... and the k-th one's regions (pair_regions below)
-//   uint anchor_count()            how many anchors to test against (shown labels'), ...
-//   vec2 anchor_at(uint k)         ... and where the k-th is
-//   float table_at(uint layer, int x, int y)   summed-area table of the layer's integral costs
+// What the includer provides (params, the placed labels' regions, the anchors, table_at) is
+// placement_cost_access.h.
 //
 // A candidate is a pixel p; the label box then spans pixels [box_origin(p), + size) and its
 // centre is box_origin + size / 2 (box_origin: shared/placement.h).
 
+#ifndef __cplusplus
+#include "placement_cost_access.h"  // (C++: the reference's struct is checked against it)
+#endif
 #include "placement_free_cost.h"
 
 // A placed box or connector B constrains a new label whose anchor is a and whose box (half size

@@ -1,9 +1,11 @@
 // Eq. 3.1 without its constraint terms, and where a label may go at all: written once for the
 // label loop (place_label.comp, through placement_cost.h), the tidy-up
-// (placement_tidy.comp, through tidy.h) and their CPU references. The includer
-// provides params (PlacementParams) and
-//   float table_at(uint layer, int x, int y)   summed-area table of the layer's integral costs
-//                                  (layer < layer_count) or hidden pixels (layer_count + layer)
+// (placement_tidy.comp, through tidy.h) and their CPU references. What the includer provides
+// (params, table_at) is placement_free_cost_access.h.
+
+#ifndef __cplusplus
+#include "placement_free_cost_access.h"  // (C++: the reference's struct is checked against it)
+#endif
 
 // The sum of a table's layer over the box of `size` pixels at `origin`, the part on screen (an
 // internal label's box may reach past the image's right or bottom edge; left of it and above,

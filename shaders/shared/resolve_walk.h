@@ -1,33 +1,23 @@
 // The resolve of one pixel, written once for the GPU (habuffer_resolve.comp) and the CPU
-// reference (passes/volume_render_reference.cpp). The includer provides:
-//   frame                                  FrameGpu
-//   VolumeGpu volume_info(uint v)
-//   vec4 volume_sample(uint v, vec3 tc)    trilinear at tc in [0,1]^3: xyz the gradient (per
-//                                          voxel), w the normalised intensity
-//   vec4 table_entry(uint v, int i)        transfer table entry i of volume v, its alpha
-//                                          corrected for the frame's step (corrected_transfer)
-//   bool brick_empty(uint v, vec3 tc)      transfer function is transparent in tc's brick
-//   bool volume_cut(uint v, vec3 tc)       volume v's cut-aways remove tc (VolumeGpu::cut)
-//   void emit_layer(uint l, vec4 colour)   the pixel's layer l (premultiplied), called for every
-//                                          layer in order, once
-// and the pixel's mesh fragments sorted front to back: their eye depths and payloads. The
-// volumes' boxes are added here, by a ray-box test.
+// reference (passes/volume_render_reference.cpp). What the includer provides (the frame, the
+// volumes' samples, transfer tables, bricks and cut-aways, and emit_layer, which takes the pixel's
+// layers) is resolve_walk_access.h; resolve_pixel's arguments are the pixel's mesh fragments,
+// sorted front to back: their eye depths and payloads. The volumes' boxes are added here, by a
+// ray-box test.
 //
-// With VR_RESOLVE_LAYER_KEEP defined the includer also provides
-//   float layer_keep(uint l)               the share of layer l's colour and alpha the picture
-//                                          keeps (ghosting: shared/ghost.h; 1 without)
-//   uint walk_start_layer()                the first layer the walk samples (below layer_count);
-//                                          those in front are not walked nor emitted
-//   float walk_start_clear()               what the drawn layers in front of it let through
-//   bool walk_stops_at_depth()             the walk ends at the depth (a pick needs no more; the
-//                                          layers from there on are then not whole)
-// and the depth follows the drawn picture instead of the walk's own sum: with A_l(z) layer l's
+// With VR_RESOLVE_LAYER_KEEP defined the includer also provides each layer's keep (ghosting),
+// the layer the walk starts at and whether it stops at the depth (resolve_walk_access.h), and
+// the depth follows the drawn picture instead of the walk's own sum: with A_l(z) layer l's
 // alpha up to z, the picture's alpha at z in layer l is 1 - T * (1 - keep_l * A_l(z)), T the
 // product of (1 - keep_j * A_j) over the layers j in front (their whole alphas). While every
 // layer so far is kept whole that is the walk's own sum, so the depth is exactly the resolve's.
 //
 // The ray is parametrised by eye depth z: point(z) = origin + direction * z. Samples lie on one
 // grid for the whole ray (near + (k + 0.5) * dz), so segments between fragments join seamlessly.
+
+#ifndef __cplusplus
+#include "resolve_walk_access.h"  // (C++: the reference's struct is checked against it)
+#endif
 
 // The frame's volume count; a constant where the includer resolves one volume only
 // (VR_RESOLVE_ONE_VOLUME), so that the compiler drops the general paths.
@@ -191,40 +181,146 @@ float grid_index_at_or_after(float z, float dz) {
   return max(ceil((z - frame.near_depth) / dz - 0.5f), 0.0f);
 }
 
-PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS],
-                          uvec2 payloads[VR_MAX_FRAGMENTS]) {
-  PixelResult r;
-  r.depth = 0.0f;
-  r.samples = 0u;
+// The walk along one ray, shared by its steps below: the ray (with one volume, the common case,
+// that volume's data stay in registers and the ray is stepped in its texture space), the layer it
+// is in, that layer's colour so far (acc) and the eye depth where the next layer starts, the alpha
+// of every layer summed, what it found so far, the live (entered, not yet left) volumes and how
+// far their bricks are known to be occupied. Depth only grows along the ray, so layers are visited
+// in order: the current layer's colour is emitted when the ray moves on (no array of layers: a
+// dynamically indexed one would live in slow local memory on GPUs).
+struct RayWalk {
+  vec3 origin;
+  vec3 direction;
+  vec3 to_eye;
+  float dz;
+  float start_z;  // (samples and mesh fragments in front of the start layer are not walked)
+  bool stops;
+  VolumeGpu first;
+  vec3 first_origin;
+  vec3 first_direction;
+  uint layer;
+  float next_split;
+  vec4 acc;
+  float total;
+  float depth;
+  uint samples;
+  uint live;
+  float checked_until;  // samples before this depth lie in bricks known to be occupied
+};
+RayWalk walk;
+
+// The walk's start at the pixel, before the volumes' boxes are known.
+void walk_start(vec2 pixel) {
   shaded_samples = 0u;
   atlas_fetches = 0u;
 #ifdef VR_RESOLVE_LAYER_KEEP
   const uint start_layer = walk_start_layer();
   drawn_front_clear = start_layer > 0u ? walk_start_clear() : 1.0f;
   drawn_front_whole = start_layer == 0u;
-  const bool stops = walk_stops_at_depth();
+  walk.stops = walk_stops_at_depth();
 #else
   const uint start_layer = 0u;
-  const bool stops = false;
+  walk.stops = false;
 #endif
-  // (samples and mesh fragments in front of the start layer are not walked)
-  const float start_z =
-      start_layer > 0u ? split_depth(frame.splits, start_layer - 1u) : frame.near_depth;
-
+  walk.start_z = start_layer > 0u ? split_depth(frame.splits, start_layer - 1u) : frame.near_depth;
   Ray ray = pixel_ray(pixel);
-  vec3 origin = ray.origin;
-  vec3 direction = ray.direction;
-  vec3 to_eye = -normalize(direction);
-  float dz = frame.step / length(direction);
+  walk.origin = ray.origin;
+  walk.direction = ray.direction;
+  walk.to_eye = -normalize(walk.direction);
+  walk.dz = frame.step / length(walk.direction);
+  walk.first = volume_info(0u);
+  walk.first_origin = vec3(walk.first.world_to_texture * vec4(walk.origin, 1.0f));
+  walk.first_direction = mat3(walk.first.world_to_texture) * walk.direction;
+  walk.layer = start_layer;
+  walk.next_split =
+      start_layer + 1u < frame.layer_count ? split_depth(frame.splits, start_layer) : 3.4e38f;
+  walk.acc = vec4(0.0f);
+  walk.total = 0.0f;
+  walk.depth = 0.0f;
+  walk.samples = 0u;
+  walk.live = 0u;
+  walk.checked_until = -1.0f;
+}
 
+// The ray reaches eye depth z: the layers it leaves are emitted, and z's layer is the walk's.
+void walk_to_layer_of(float z) {
+  uint l = z >= walk.next_split ? layer_of(z) : walk.layer;
+  if (l == walk.layer) return;
+  walk.next_split = l + 1u < frame.layer_count ? split_depth(frame.splits, l) : 3.4e38f;
+  close_layers(walk.layer, l, walk.acc);
+  walk.layer = l;
+  walk.acc = vec4(0.0f);
+}
+
+// Colour c (premultiplied) at eye depth z joins the walk's layer; true where the depth is found.
+bool walk_add(vec4 c, float z) {
+  walk.acc = over(walk.acc, c);
+#ifdef VR_RESOLVE_LAYER_KEEP
+  walk.total = walk.total + (1.0f - walk.total) * c.a;
+  // (the first z: the drawn alpha may step back by a rounding where a layer stops being whole)
+  const bool found =
+      walk.depth <= 0.0f && drawn_alpha(walk.total, walk.acc.a, walk.layer) >= frame.depth_alpha;
+#else
+  float before = walk.total;
+  walk.total = walk.total + (1.0f - walk.total) * c.a;
+  const bool found = before < frame.depth_alpha && walk.total >= frame.depth_alpha;
+#endif
+  if (found) walk.depth = z;
+  return found;
+}
+
+// Where the ray leaves the bricks of the live volumes at eye depth z and whether all of them are
+// empty (brick_state).
+vec2 walk_bricks(float z) {
+  // (one volume: in its texture space, as its samples)
+  vec2 bricks = VR_RESOLVE_VOLUMES == 1u
+                    ? brick_exit(0u, walk.first, walk.first_origin + walk.first_direction * z,
+                                 walk.first_direction, z)
+                    : brick_state(walk.live, walk.origin, walk.direction, z, walk.dz);
+  if (bricks.y > 1.5f) bricks = vec2(z + walk.dz, 1.0f);  // (outside the box: as brick_state)
+  return bricks;
+}
+
+// The walk's samples on the grid from eye depth `from` up to `to`, between two fragments.
+void walk_samples(float from, float to) {
+  float k = grid_index_at_or_after(from, walk.dz);
+  while (walk.live != 0u && grid_depth(k, walk.dz) < to) {
+    float zs = grid_depth(k, walk.dz);
+    walk_to_layer_of(zs);
+    if (walk.acc.a >= frame.termination_alpha) {  // this slab is opaque: go to the next one
+      if (walk.layer + 1u >= frame.layer_count) break;
+      k = max(grid_index_at_or_after(split_depth(frame.splits, walk.layer), walk.dz), k + 1.0f);
+      continue;
+    }
+    // Occupancy is looked up once per brick, not per sample.
+    if (frame.skip_empty != 0u && zs >= walk.checked_until) {
+      vec2 bricks = walk_bricks(zs);
+      if (bricks.y > 0.5f) {
+        k = max(grid_index_at_or_after(bricks.x, walk.dz), k + 1.0f);
+        continue;
+      }
+      walk.checked_until = bricks.x;
+    }
+    vec4 c = VR_RESOLVE_VOLUMES == 1u
+                 ? sample_volume(0u, walk.first, walk.first_origin + walk.first_direction * zs,
+                                 walk.to_eye)
+                 : sample_volumes(walk.live, walk.origin + walk.direction * zs, walk.to_eye);
+    walk.samples += 1u;
+    if (walk_add(c, zs) && walk.stops) break;
+    k += 1.0f;
+  }
+}
+
+PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS],
+                          uvec2 payloads[VR_MAX_FRAGMENTS]) {
+  walk_start(pixel);
   // Each box's faces between the near and far planes join the mesh fragments, in depth order
   // (after fragments at the same depth); a box the near plane cuts is live from the start.
-  uint live = 0u;
   for (uint v = 0u; v < VR_RESOLVE_VOLUMES; ++v) {
-    vec3 tc =
-        vec3(volume_info(v).world_to_texture * vec4(origin + direction * frame.near_depth, 1.0f));
-    if (inside_unit_box(tc)) live |= 1u << v;
-    vec2 box = box_interval(v, origin, direction);
+    vec3 tc = vec3(volume_info(v).world_to_texture *
+                   vec4(walk.origin + walk.direction * frame.near_depth, 1.0f));
+    if (inside_unit_box(tc)) walk.live |= 1u << v;
+    vec2 box = box_interval(v, walk.origin, walk.direction);
     if (box.x > box.y) continue;
     for (uint face = 0u; face < 2u; ++face) {
       float d = face == 0u ? box.x : box.y;
@@ -239,103 +335,30 @@ PixelResult resolve_pixel(vec2 pixel, uint count, float depths[VR_MAX_FRAGMENTS]
     }
   }
 
-  // One volume (the common case): its data stay in registers and the ray is stepped in its
-  // texture space.
-  const bool one_volume = VR_RESOLVE_VOLUMES == 1u;
-  VolumeGpu first = volume_info(0u);
-  vec3 first_origin = vec3(first.world_to_texture * vec4(origin, 1.0f));
-  vec3 first_direction = mat3(first.world_to_texture) * direction;
-
-  float total = 0.0f;
+  // The segments between fragments are sampled; a mesh fragment joins its layer, a box face
+  // makes its volume live or not.
   float z = frame.near_depth;
-  float checked_until = -1.0f;  // samples before this depth lie in bricks known to be occupied
-  // Depth only grows along the ray, so layers are visited in order: the current layer's colour
-  // stays in registers and is emitted when the ray moves on (no array of layers: a dynamically
-  // indexed one would live in slow local memory on GPUs).
-  uint layer = start_layer;
-  float next_split =
-      start_layer + 1u < frame.layer_count ? split_depth(frame.splits, start_layer) : 3.4e38f;
-  vec4 acc = vec4(0.0f);
   for (uint i = 0u; i <= count; ++i) {
-    if (stops && r.depth > 0.0f) break;
+    if (walk.stops && walk.depth > 0.0f) break;
     float z_end = i < count ? depths[i] : frame.far_depth;
-    float k = grid_index_at_or_after(max(z, start_z), dz);
-    while (live != 0u && grid_depth(k, dz) < z_end) {
-      float zs = grid_depth(k, dz);
-      uint l = zs >= next_split ? layer_of(zs) : layer;
-      if (l != layer) {
-        next_split = l + 1u < frame.layer_count ? split_depth(frame.splits, l) : 3.4e38f;
-        close_layers(layer, l, acc);
-        layer = l;
-        acc = vec4(0.0f);
-      }
-      if (acc.a >= frame.termination_alpha) {  // this slab is opaque: go to the next one
-        if (l + 1u >= frame.layer_count) break;
-        k = max(grid_index_at_or_after(split_depth(frame.splits, l), dz), k + 1.0f);
-        continue;
-      }
-      // Occupancy is looked up once per brick, not per sample.
-      if (frame.skip_empty != 0u && zs >= checked_until) {
-        // (one volume: in its texture space, as its samples)
-        vec2 bricks = one_volume ? brick_exit(0u, first, first_origin + first_direction * zs,
-                                              first_direction, zs)
-                                 : brick_state(live, origin, direction, zs, dz);
-        if (bricks.y > 1.5f) bricks = vec2(zs + dz, 1.0f);  // (outside the box: as brick_state)
-        if (bricks.y > 0.5f) {
-          k = max(grid_index_at_or_after(bricks.x, dz), k + 1.0f);
-          continue;
-        }
-        checked_until = bricks.x;
-      }
-      vec4 c = one_volume ? sample_volume(0u, first, first_origin + first_direction * zs, to_eye)
-                          : sample_volumes(live, origin + direction * zs, to_eye);
-      r.samples += 1u;
-      acc = over(acc, c);
-#ifdef VR_RESOLVE_LAYER_KEEP
-      total = total + (1.0f - total) * c.a;
-      // (the first z: the drawn alpha may step back by a rounding where a layer stops being whole)
-      if (r.depth <= 0.0f && drawn_alpha(total, acc.a, layer) >= frame.depth_alpha) {
-        r.depth = zs;
-        if (stops) break;
-      }
-#else
-      float before = total;
-      total = total + (1.0f - total) * c.a;
-      if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = zs;
-#endif
-      k += 1.0f;
-    }
+    walk_samples(max(z, walk.start_z), z_end);
     if (i == count) break;
     uvec2 p = payloads[i];
     uint kind = (p.y >> 8u) & 3u;
-    if (kind == VR_KIND_MESH && z_end >= start_z) {
-      vec4 c = unpackUnorm4x8(p.x);
-      uint l = z_end >= next_split ? layer_of(z_end) : layer;
-      if (l != layer) {
-        next_split = l + 1u < frame.layer_count ? split_depth(frame.splits, l) : 3.4e38f;
-        close_layers(layer, l, acc);
-        layer = l;
-        acc = vec4(0.0f);
-      }
-      acc = over(acc, c);
-#ifdef VR_RESOLVE_LAYER_KEEP
-      total = total + (1.0f - total) * c.a;
-      if (r.depth <= 0.0f && drawn_alpha(total, acc.a, layer) >= frame.depth_alpha) {
-        r.depth = z_end;
-      }
-#else
-      float before = total;
-      total = total + (1.0f - total) * c.a;
-      if (before < frame.depth_alpha && total >= frame.depth_alpha) r.depth = z_end;
-#endif
+    if (kind == VR_KIND_MESH && z_end >= walk.start_z) {
+      walk_to_layer_of(z_end);
+      walk_add(unpackUnorm4x8(p.x), z_end);
     } else if (kind != VR_KIND_MESH) {
       uint bit = 1u << (p.y & 255u);
-      live = ((p.y >> 10u) & 1u) != 0u ? (live | bit) : (live & ~bit);
-      checked_until = -1.0f;
+      walk.live = ((p.y >> 10u) & 1u) != 0u ? (walk.live | bit) : (walk.live & ~bit);
+      walk.checked_until = -1.0f;
     }
     z = z_end;
   }
-  close_layers(layer, frame.layer_count, acc);
+  close_layers(walk.layer, frame.layer_count, walk.acc);
+  PixelResult r;
+  r.depth = walk.depth;
+  r.samples = walk.samples;
   r.shaded = shaded_samples;
   r.fetches = atlas_fetches;
   return r;

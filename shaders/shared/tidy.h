@@ -16,7 +16,7 @@
 // alike. The definitions are those of `strata eval` (labeling/layout_metrics.h).
 //
 // Its constants and TidyLabel are in shared/placement.h. The includer provides params and
-// table_at (placement_free_cost.h).
+// table_at (placement_free_cost_access.h).
 
 #include "placement_free_cost.h"
 

@@ -8,16 +8,12 @@
 //      interacts with it: applying both would change J by more than the sum of their changes
 //      (some pair of their labels conflicts differently). So every applied pair of changes adds
 //      at most its own changes and J falls every round; the best owner is always applied.
-// The includer provides, besides tidy.h's needs:
-//   uint tidy_count()               labels
-//   LabelGpu tidy_input(uint k)     the label as placed
-//   TidyLabel tidy_state(uint k)    its state this round
-//   float tidy_free(uint k)         tidy_free_cost of that state
-//   uint tidy_rank(uint k)          its insertion order position
-//   uint64_t tidy_best(uint k)      step 1's result (steps 2 and 3)
-//   TidyLabel tidy_next(uint k)     its state after its owner's change (itself if none; step 3)
-//   uint tidy_partner(uint k)       an owner's swap partner (TIDY_NO_PARTNER: none; step 3)
-//   ivec4 tidy_conflicts_now(uint k)  tidy_conflicts_of(k, 0, 1) this round (step 1)
+// What the includer provides, besides tidy.h's needs (the labels, their states, the steps'
+// results), is tidy_search_access.h.
+
+#ifndef __cplusplus
+#include "tidy_search_access.h"  // (C++: the reference's struct is checked against it)
+#endif
 
 // Label i's conflicts with the others of first, first + stride, ... (the GPU splits the labels
 // over a workgroup's invocations). (Conflict counts are symmetric: tidy_conflicts(a, b) ==
