@@ -32,7 +32,7 @@ double seconds_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double>(b - a).count();
 }
 
-constexpr double kMaxStep = 0.1;           // a frame's time step at most (slow devices)
+constexpr double kMaxStep = 0.25;          // a frame's time step at most (slow devices)
 constexpr double kPlotSeconds = 5.0;       // the timing plots' span
 constexpr double kAnimationSeconds = 1.0;  // moves to named positions and anatomical views
 // Label slots beyond the scene's: this many labels of one's own are placed without a new graph.
