@@ -228,6 +228,20 @@ void record_update(VkCommandBuffer cmd, VkBuffer buffer, VkDeviceSize offset,
   }
 }
 
+namespace {
+
+// Vulkan's barrier structs share the fields of the two scopes.
+template <class Barrier>
+Barrier scoped(Barrier barrier, SyncScope src, SyncScope dst) {
+  barrier.srcStageMask = src.stage;
+  barrier.srcAccessMask = src.access;
+  barrier.dstStageMask = dst.stage;
+  barrier.dstAccessMask = dst.access;
+  return barrier;
+}
+
+}  // namespace
+
 VkImageSubresourceRange whole_image(VkFormat format, uint32_t layers) {
   return {aspect_of(format), 0, 1, 0, layers};
 }
@@ -235,11 +249,8 @@ VkImageSubresourceRange whole_image(VkFormat format, uint32_t layers) {
 VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange& range,
                                     VkImageLayout from, VkImageLayout to, SyncScope src,
                                     SyncScope dst) {
-  VkImageMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  barrier.srcStageMask = src.stage;
-  barrier.srcAccessMask = src.access;
-  barrier.dstStageMask = dst.stage;
-  barrier.dstAccessMask = dst.access;
+  VkImageMemoryBarrier2 barrier =
+      scoped(VkImageMemoryBarrier2{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2}, src, dst);
   barrier.oldLayout = from;
   barrier.newLayout = to;
   barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
@@ -249,11 +260,8 @@ VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange
 }
 
 VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, SyncScope src, SyncScope dst) {
-  VkBufferMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-  barrier.srcStageMask = src.stage;
-  barrier.srcAccessMask = src.access;
-  barrier.dstStageMask = dst.stage;
-  barrier.dstAccessMask = dst.access;
+  VkBufferMemoryBarrier2 barrier =
+      scoped(VkBufferMemoryBarrier2{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2}, src, dst);
   barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   barrier.buffer = buffer;
   barrier.size = VK_WHOLE_SIZE;
@@ -271,11 +279,7 @@ void record_barriers(VkCommandBuffer cmd, std::span<const VkImageMemoryBarrier2>
 }
 
 void record_memory_barrier(VkCommandBuffer cmd, SyncScope src, SyncScope dst) {
-  VkMemoryBarrier2 memory{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-  memory.srcStageMask = src.stage;
-  memory.srcAccessMask = src.access;
-  memory.dstStageMask = dst.stage;
-  memory.dstAccessMask = dst.access;
+  const VkMemoryBarrier2 memory = scoped(VkMemoryBarrier2{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2}, src, dst);
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.memoryBarrierCount = 1;
   dep.pMemoryBarriers = &memory;
