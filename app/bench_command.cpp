@@ -295,24 +295,74 @@ std::map<std::string, double> group_totals(
   return out;
 }
 
-// The viewer's whole frame (labelled scene, forces, label drawing, the panel), headless, with two
-// frames in flight, along a turntable at 30 frames a second of animation time.
-void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
-  const std::string scene_file = find_data_file(o.scene);
-  const graph::Extent size = parse_size(o.size, "--size");
-  Scene scene = load_scene_reporting(scene_file);
-  scene.labels = resized_labels(scene.labels, o.labels, scene_file);
-  Context ctx(device.context());
-  LabellingSettings settings;
-  settings.placement.weights = scene.settings.weights;
-  settings.placement.tidy_rounds = o.tidy_rounds;
-  settings.forces.keep_apart = o.keep_apart;
-  settings.ghost.strength = o.ghost;
-  settings.ghost.radius = scene.settings.ghost_radius;
-  const double fps = 30.0;
-  const std::vector<Camera> cameras =
-      sample(orbit_path(scene, scene.camera, o.degrees, double(o.frames) / fps), fps);
-  HeadlessOutput output(ctx, size, 2);
+// The path is run three times: with a timestamp around every pass (the time of each), with
+// stamps only where groups begin and end, and only where the frame does (the whole frame,
+// undisturbed).
+enum class Stamps { pass, group, frame };
+
+// One run along the cameras, a frame started `pace` times a second (0: each as soon as the last is
+// submitted), after a frame that puts the stamps in place.
+ViewRun run_path(Viewer& viewer, HeadlessOutput& output, const std::vector<Camera>& cameras,
+                 double fps, double pace, Stamps stamps) {
+  if (stamps == Stamps::frame) {
+    viewer.runner().set_timestamps_per_frame();
+  } else {
+    viewer.runner().set_timestamps_per_pass(stamps == Stamps::pass);
+  }
+  viewer.frame(1.0 / fps);
+  output.wait_idle();
+  ViewRun r{viewer.summary(), {}, 0.0};
+  const auto start = std::chrono::steady_clock::now();
+  for (size_t f = 0; f < cameras.size(); ++f) {
+    if (pace > 0.0) {
+      std::this_thread::sleep_until(start + std::chrono::duration<double>(double(f) / pace));
+    }
+    viewer.set_camera(cameras[f]);
+    viewer.frame(1.0 / fps);
+  }
+  output.wait_idle();
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.after = viewer.summary();
+  return r;
+}
+
+// Each pass's group, from the graph the frames ran (the per-pass run's group totals).
+std::function<std::string(const std::string&)> group_of_passes(Viewer& viewer) {
+  std::map<std::string, std::string> pass_group;
+  for (const auto& pass : viewer.runner().graph().passes()) pass_group[pass.name] = pass.group;
+  return [pass_group](const std::string& pass) {
+    const auto it = pass_group.find(pass);
+    return it == pass_group.end() ? std::string() : it->second;
+  };
+}
+
+// For people: the whole frame and where it goes.
+void print_view_summary(const ordered_json& out, const std::map<std::string, double>& totals,
+                        size_t labels, graph::Extent size, size_t frames) {
+  std::fprintf(stderr,
+               "bench view: %zu labels, %ux%u, %zu frames: GPU frame median %.3f ms (p95 %.3f)",
+               labels, size.width, size.height, frames, out["gpu_frame_ms"]["median"].get<double>(),
+               out["gpu_frame_ms"]["p95"].get<double>());
+  std::fprintf(stderr, "; group means (stamps at group edges):");
+  for (const char* group : {"render", "placement", "labels", "ui"}) {
+    const auto it = totals.find(group);
+    std::fprintf(stderr, " %s %.3f,", group, it == totals.end() ? 0.0 : it->second);
+  }
+  const auto other = totals.find("ungrouped");
+  std::fprintf(stderr, " ungrouped %.3f ms\n", other == totals.end() ? 0.0 : other->second);
+  const ordered_json& placed = out["placement"];
+  std::fprintf(stderr,
+               "bench view: placement %s: %.1f a second, GPU %.3f ms each, latency %.2f frames "
+               "(max %u, %.3f ms); %.1f frames a second\n",
+               placed["mode"].get<std::string>().c_str(), placed["per_second"].get<double>(),
+               placed["gpu_ms_mean"].get<double>(), placed["latency_frames_mean"].get<double>(),
+               placed["latency_frames_max"].get<uint32_t>(),
+               placed["latency_ms_mean"].get<double>(), out["frames_per_second"].get<double>());
+}
+
+// The viewer as the bench runs it: no idle optimization, every frame's spans kept, nothing
+// printed but the report.
+ViewerOptions bench_viewer_options(const ViewBenchOptions& o, const Context& ctx) {
   ViewerOptions options;
   options.scene_path = o.scene;
   options.optimize_on_idle = false;
@@ -321,43 +371,38 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
   options.frame_budget_ms = o.frame_budget_ms;
   // (the viewer keeps the placement beside the frames with interactive rendering)
   options.placement_beside = placement_beside(o.placement, ctx) || o.frame_budget_ms > 0.0;
+  return options;
+}
+
+LabellingSettings bench_view_settings(const ViewBenchOptions& o, const Scene& scene) {
+  LabellingSettings settings;
+  settings.placement.weights = scene.settings.weights;
+  settings.placement.tidy_rounds = o.tidy_rounds;
+  settings.forces.keep_apart = o.keep_apart;
+  settings.ghost.strength = o.ghost;
+  settings.ghost.radius = scene.settings.ghost_radius;
+  return settings;
+}
+
+// The viewer's whole frame (labelled scene, forces, label drawing, the panel), headless, with two
+// frames in flight, along a turntable at 30 frames a second of animation time.
+void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
+  const std::string scene_file = find_data_file(o.scene);
+  const graph::Extent size = parse_size(o.size, "--size");
+  Scene scene = load_scene_reporting(scene_file);
+  scene.labels = resized_labels(scene.labels, o.labels, scene_file);
+  Context ctx(device.context());
+  const double fps = 30.0;
+  const std::vector<Camera> cameras =
+      sample(orbit_path(scene, scene.camera, o.degrees, double(o.frames) / fps), fps);
+  HeadlessOutput output(ctx, size, 2);
+  const ViewerOptions options = bench_viewer_options(o, ctx);
+  const LabellingSettings settings = bench_view_settings(o, scene);
   Viewer viewer(ctx, scene, cameras.front(), settings, options, output, nullptr);
   for (int i = 0; i < 10; ++i) viewer.frame(1.0 / fps);  // warm up: the HA-Buffer grows
-  // The path three times: with a timestamp around every pass (the time of each), with stamps only
-  // where groups begin and end, and only where the frame does (the whole frame, undisturbed).
-  enum class Stamps { pass, group, frame };
-  const auto run = [&](Stamps stamps) {
-    if (stamps == Stamps::frame) {
-      viewer.runner().set_timestamps_per_frame();
-    } else {
-      viewer.runner().set_timestamps_per_pass(stamps == Stamps::pass);
-    }
-    viewer.frame(1.0 / fps);
-    output.wait_idle();
-    ViewRun r{viewer.summary(), {}, 0.0};
-    const auto start = std::chrono::steady_clock::now();
-    for (size_t f = 0; f < cameras.size(); ++f) {
-      if (o.pace > 0.0) {
-        std::this_thread::sleep_until(start + std::chrono::duration<double>(double(f) / o.pace));
-      }
-      viewer.set_camera(cameras[f]);
-      viewer.frame(1.0 / fps);
-    }
-    output.wait_idle();
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    r.after = viewer.summary();
-    return r;
-  };
-  const ViewRun passes = run(Stamps::pass);
-  const ViewRun groups = run(Stamps::group);
-  const ViewRun frames = run(Stamps::frame);
-  // Each pass's group, from the graph the frames ran (the per-pass run's group totals).
-  std::map<std::string, std::string> pass_group;
-  for (const auto& pass : viewer.runner().graph().passes()) pass_group[pass.name] = pass.group;
-  const auto group_of = [&](const std::string& pass) {
-    const auto it = pass_group.find(pass);
-    return it == pass_group.end() ? std::string() : it->second;
-  };
+  const ViewRun passes = run_path(viewer, output, cameras, fps, o.pace, Stamps::pass);
+  const ViewRun groups = run_path(viewer, output, cameras, fps, o.pace, Stamps::group);
+  const ViewRun frames = run_path(viewer, output, cameras, fps, o.pace, Stamps::frame);
   const std::map<std::string, double> group_means = groups.means();
   const std::map<std::string, double> totals = group_totals(group_means, {});
   ordered_json out;
@@ -386,36 +431,19 @@ void bench_view(DeviceOptions& device, const ViewBenchOptions& o) {
                      placement_group == totals.end() ? 0.0 : placement_group->second);
   out["gpu_frame_ms_stamped_per_pass"] = passes.frame_quantiles();
   out["mean_pass_ms"] = means_json(passes.means());
-  out["mean_group_total_ms_stamped_per_pass"] = means_json(group_totals(passes.means(), group_of));
+  out["mean_group_total_ms_stamped_per_pass"] =
+      means_json(group_totals(passes.means(), group_of_passes(viewer)));
   print_report(out);
-  // For people: the whole frame and where it goes.
-  std::fprintf(
-      stderr, "bench view: %zu labels, %ux%u, %zu frames: GPU frame median %.3f ms (p95 %.3f)",
-      scene.labels.size(), size.width, size.height, cameras.size(),
-      out["gpu_frame_ms"]["median"].get<double>(), out["gpu_frame_ms"]["p95"].get<double>());
-  std::fprintf(stderr, "; group means (stamps at group edges):");
-  for (const char* group : {"render", "placement", "labels", "ui"}) {
-    const auto it = totals.find(group);
-    std::fprintf(stderr, " %s %.3f,", group, it == totals.end() ? 0.0 : it->second);
-  }
-  const auto other = totals.find("ungrouped");
-  std::fprintf(stderr, " ungrouped %.3f ms\n", other == totals.end() ? 0.0 : other->second);
-  const ordered_json& placed = out["placement"];
-  std::fprintf(stderr,
-               "bench view: placement %s: %.1f a second, GPU %.3f ms each, latency %.2f frames "
-               "(max %u, %.3f ms); %.1f frames a second\n",
-               placed["mode"].get<std::string>().c_str(), placed["per_second"].get<double>(),
-               placed["gpu_ms_mean"].get<double>(), placed["latency_frames_mean"].get<double>(),
-               placed["latency_frames_max"].get<uint32_t>(),
-               placed["latency_ms_mean"].get<double>(), out["frames_per_second"].get<double>());
+  print_view_summary(out, totals, scene.labels.size(), size, cameras.size());
 }
 
 }  // namespace
 }  // namespace bench
 
-void add_bench_command(CLI::App& app, DeviceOptions& device) {
-  CLI::App* cmd = app.add_subcommand("bench", "GPU timings as JSON (median and min of N runs)");
-  cmd->require_subcommand(1);
+namespace {
+
+// `bench sat`: the summed-area table alone.
+void add_sat_bench(CLI::App* cmd, DeviceOptions& device) {
   struct Options {
     std::string size = "1024";
     uint32_t runs = 50;
@@ -429,7 +457,11 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   sat->callback([&device, options] {
     bench::bench_sat(device, parse_size(options->size, "--size"), options->runs);
   });
+}
 
+// `bench render`: the volume renderer alone.
+void add_render_bench(CLI::App* cmd, DeviceOptions& device) {
+  auto runs = std::make_shared<uint32_t>(50);
   auto render = std::make_shared<bench::RenderBenchOptions>();
   CLI::App* render_cmd = cmd->add_subcommand("render", "HA-Buffer build and resolve of a scene");
   render_cmd->add_option("--scene", render->scene, "scene file")->capture_default_str();
@@ -442,15 +474,14 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   render_cmd
       ->add_option("--step", render->step, "sampling distance in world units (0: half a voxel)")
       ->check(finite_range(0.0, 1000.0));
-  render_cmd->add_option("--runs", options->runs, "timed runs after 3 warm-up runs")
+  render_cmd->add_option("--runs", *runs, "timed runs after 3 warm-up runs")
       ->capture_default_str()
       ->check(whole_range(1, 100000));
-  render_cmd->callback(
-      [&device, render, options] { bench::bench_render(device, *render, options->runs); });
+  render_cmd->callback([&device, render, runs] { bench::bench_render(device, *render, *runs); });
+}
 
-  add_placement_bench(cmd, device);
-  add_encode_bench(cmd);
-
+// `bench view`: the viewer's whole frame.
+void add_view_bench(CLI::App* cmd, DeviceOptions& device) {
   auto view = std::make_shared<bench::ViewBenchOptions>();
   CLI::App* view_cmd = cmd->add_subcommand(
       "view", "the viewer's whole frame (labels, forces, drawing, UI) along a turntable");
@@ -491,7 +522,18 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
       ->check(whole_range(0, 100))
       ->capture_default_str();
   view_cmd->callback([&device, view] { bench::bench_view(device, *view); });
+}
 
+}  // namespace
+
+void add_bench_command(CLI::App& app, DeviceOptions& device) {
+  CLI::App* cmd = app.add_subcommand("bench", "GPU timings as JSON (median and min of N runs)");
+  cmd->require_subcommand(1);
+  add_sat_bench(cmd, device);
+  add_render_bench(cmd, device);
+  add_placement_bench(cmd, device);
+  add_encode_bench(cmd);
+  add_view_bench(cmd, device);
   add_soak_command(cmd, device);
 }
 

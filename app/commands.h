@@ -1,4 +1,7 @@
-// The strata program's subcommands; main.cpp parses the command line and prints errors.
+// The strata program's subcommands and what they share: option values (option_values.cpp,
+// option_range.cpp), options declared alike (shared_options.cpp) and the scene input
+// (scene_input.cpp). main.cpp builds the command line from the add_*_command functions, parses it
+// and prints errors.
 #pragma once
 
 #include <optional>

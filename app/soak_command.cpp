@@ -244,6 +244,227 @@ struct Capacity {
   graph::Extent size;
 };
 
+// When the run does what (see soak()): the warm-up, the measurements and the scheduled changes.
+struct SoakPlan {
+  static constexpr uint32_t plain = 10;  // plain frames before the warm-up's changes
+  uint32_t warmup_changes = 0;
+  uint32_t warmup = 0;
+  uint32_t every = 1;
+  uint32_t interval = 1;
+  uint32_t changes_end = 0;  // the schedule stops here: the last frames run as the warm-up's did
+};
+
+// The warm-up: plain frames (the HA-Buffer grows to what the view needs), then every scheduled
+// change once, applied for a frame and undone for a frame, so that what a setting costs the
+// first time (pipelines, JIT-compiled shader variants, the allocator's working set) is paid
+// before the first measurement; and the camera's whole first round (the run's first half:
+// the HA-Buffer meets the closest zoom there). The second half repeats the round and the
+// changes, so whatever it adds to memory stays for good: a leak.
+SoakPlan plan_soak(const SoakOptions& o, size_t changes) {
+  SoakPlan plan;
+  plan.warmup_changes = uint32_t(changes);
+  plan.warmup = std::max(o.frames / 2, SoakPlan::plain + 2 * plan.warmup_changes);
+  if (o.frames < 2 * plan.warmup) {
+    throw Error("soak: --frames " + std::to_string(o.frames) + " is too few: the warm-up takes " +
+                std::to_string(plan.warmup) + " frames (every scheduled change once), and as " +
+                "many must follow it; at least " + std::to_string(2 * plan.warmup));
+  }
+  plan.every = std::max(1u, o.every);
+  plan.interval = std::max(1u, o.interval);
+  const uint32_t tail = std::max(plan.interval, o.frames / 20);
+  plan.changes_end = o.frames > plan.warmup + tail ? o.frames - tail : plan.warmup;
+  return plan;
+}
+
+// What the frames gave: the measurements, the HA-Buffer's capacity changes and the changes
+// applied.
+struct SoakRecord {
+  std::vector<Sample> samples;
+  std::vector<Capacity> capacity;
+  std::vector<std::pair<uint64_t, std::string>> applied;
+  double seconds = 0.0;
+};
+
+void check_validation(Context& ctx, uint64_t frame) {
+  const size_t count = ctx.validation_log().count();
+  if (count == 0) return;
+  const std::vector<std::string> messages = ctx.validation_log().take();
+  throw Error("soak: " + std::to_string(count) + " validation message(s) by frame " +
+              std::to_string(frame) + ", the first: " + messages.front());
+}
+
+// Frame i's scheduled change: in the warm-up each once, applied then undone; after it one at a
+// time, for `interval` frames each, with as many frames between them.
+struct ChangeSchedule {
+  const std::vector<Change>& changes;
+  const SoakPlan& plan;
+  const Change* pending = nullptr;
+  size_t next = 0;
+
+  void before_frame(uint32_t i, SoakRecord& record) {
+    if (i >= SoakPlan::plain && i < SoakPlan::plain + 2 * plan.warmup_changes) {
+      const Change& c = changes[(i - SoakPlan::plain) / 2];
+      if ((i - SoakPlan::plain) % 2 == 0) {
+        c.apply();
+      } else {
+        c.undo();
+      }
+    }
+    if (i >= plan.warmup && i <= plan.changes_end && (i - plan.warmup) % plan.interval == 0) {
+      if (pending) {
+        pending->undo();
+        pending = nullptr;
+      } else if (i < plan.changes_end && !changes.empty()) {
+        pending = &changes[next++ % changes.size()];
+        pending->apply();
+        record.applied.emplace_back(i, pending->what);
+      }
+    }
+  }
+};
+
+SoakRecord run_frames(Context& ctx, Viewer& viewer, HeadlessOutput& output, const CameraLoop& loop,
+                      const std::vector<Change>& changes, const SoakPlan& plan, uint32_t frames) {
+  SoakRecord record;
+  ChangeSchedule schedule{changes, plan};
+  Progress progress("frame", frames);
+  const auto start = std::chrono::steady_clock::now();
+  for (uint32_t i = 0; i < frames; ++i) {
+    schedule.before_frame(i, record);
+    const auto [camera, zoom] = loop.at(i);
+    viewer.set_camera(camera);
+    viewer.scroll(zoom);
+    viewer.frame(1.0 / kFps);
+    const RenderStats& r = viewer.render_stats();
+    std::vector<Capacity>& capacity = record.capacity;
+    if (capacity.empty() || capacity.back().slots != r.table_size ||
+        !(capacity.back().size == viewer.extent())) {
+      capacity.push_back({i + 1, r.table_size, viewer.extent()});
+    }
+    progress.step_done(i + 1);
+    const bool last = i + 1 == frames;
+    if (last) output.wait_idle();  // (the end: every frame finished)
+    if ((i + 1 >= plan.warmup && (i + 1 - plan.warmup) % plan.every == 0) || last) {
+      record.samples.push_back(measure(i + 1, ctx, viewer));
+      check_validation(ctx, i + 1);
+    }
+  }
+  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (record.samples.empty()) throw Error("soak: no measurements (--frames below the warm-up)");
+  return record;
+}
+
+// One memory series, start to end: reported, and past kAllowedGrowth a failure if judged.
+void judge_series(ordered_json& report, std::vector<std::string>& failures, const std::string& name,
+                  const std::string& key, uint64_t a, uint64_t b, uint64_t peak, bool judged) {
+  const double growth = growth_percent(a, b);
+  report[key] = {{"start", a}, {"end", b}, {"peak", peak}, {"growth_percent", growth}};
+  std::printf("soak: %-38s %14s %14s %14s %+8.2f%%\n", name.c_str(), mib(a).c_str(), mib(b).c_str(),
+              mib(peak).c_str(), growth);
+  if (judged && growth > kAllowedGrowth) {
+    char text[256];
+    std::snprintf(text, sizeof text, "soak: %s grew %.2f%% (start %s, end %s)", name.c_str(),
+                  growth, mib(a).c_str(), mib(b).c_str());
+    failures.emplace_back(text);
+  }
+}
+
+// Memory from the first measurement after the warm-up to the last.
+void judge_memory(ordered_json& report, std::vector<std::string>& failures,
+                  const std::vector<Sample>& samples, const Context& ctx) {
+  const Sample& first = samples.front();
+  const Sample& end = samples.back();
+  const std::string span =
+      "frame " + std::to_string(first.frame) + " to " + std::to_string(end.frame);
+  std::printf("soak: %-38s %14s %14s %14s %9s\n", span.c_str(), "start", "end", "peak", "growth");
+  for (const Series& s : kSeries) {
+    uint64_t peak = 0;
+    for (const Sample& x : samples) peak = std::max(peak, x.*s.field);
+    judge_series(report, failures, s.name, s.key, first.*s.field, end.*s.field, peak, s.judged);
+  }
+  if (first.driver && end.driver) {
+    uint64_t peak = 0;
+    for (const Sample& x : samples) peak = std::max(peak, x.driver.value_or(0));
+    judge_series(report, failures, "device memory (driver's heapUsage)", "driver_heap_usage_bytes",
+                 *first.driver, *end.driver, peak, true);
+  } else {
+    report["driver_heap_usage_bytes"] = nullptr;
+    std::printf(
+        "soak: device memory (driver's heapUsage): not reported (no "
+        "VK_EXT_memory_budget)\n");
+  }
+  report["device_allocations"] = {{"start", first.allocations}, {"end", end.allocations}};
+  std::printf("soak: device allocations %llu -> %llu, peak of strata's device memory %s\n",
+              static_cast<unsigned long long>(first.allocations),
+              static_cast<unsigned long long>(end.allocations), mib(ctx.memory_use().peak).c_str());
+}
+
+// The HA-Buffer's capacity must not grow in the run's second half (at a size it has had before:
+// a resize to a larger picture is not growth).
+void judge_habuffer(ordered_json& report, std::vector<std::string>& failures,
+                    const SoakRecord& record, uint32_t frames) {
+  ordered_json history = ordered_json::array();
+  std::string history_text;
+  uint64_t last_growth = 0;
+  const std::vector<Capacity>& capacity = record.capacity;
+  for (size_t k = 0; k < capacity.size(); ++k) {
+    const Capacity& c = capacity[k];
+    history.push_back(
+        {{"frame", c.frame}, {"slots", c.slots}, {"size", {c.size.width, c.size.height}}});
+    history_text += (k ? ", " : "") + std::to_string(c.slots) + " (frame " +
+                    std::to_string(c.frame) + ", " + std::to_string(c.size.width) + "x" +
+                    std::to_string(c.size.height) + ")";
+    // A resize changes the slots a viewport-sized table has, and a table grown at one size keeps
+    // its slots at the next: only an increase at an unchanged size is growth.
+    const uint32_t before = k > 0 && capacity[k - 1].size == c.size ? capacity[k - 1].slots : 0;
+    if (before == 0 || c.slots <= before) continue;
+    last_growth = c.frame;
+    if (c.frame > frames / 2) {
+      failures.push_back("soak: the HA-Buffer still grows in the run's second half (" +
+                         std::to_string(before) + " -> " + std::to_string(c.slots) +
+                         " slots at frame " + std::to_string(c.frame) + ")");
+    }
+  }
+  const Sample& first = record.samples.front();
+  const Sample& end = record.samples.back();
+  uint32_t peak_slots = 0, peak_overflow = 0;
+  for (const Sample& x : record.samples) {
+    peak_slots = std::max(peak_slots, x.slots);
+    peak_overflow = std::max(peak_overflow, x.overflow);
+  }
+  report["habuffer"] = {
+      {"slots", {{"start", first.slots}, {"end", end.slots}, {"peak", peak_slots}}},
+      {"fragments_end", end.fragments},
+      {"load_end", end.slots ? double(end.fragments) / end.slots : 0.0},
+      {"overflow_after_warmup_max", peak_overflow},
+      {"last_growth_frame", last_growth},
+      {"history", history}};
+  std::printf(
+      "soak: HA-Buffer slots %u -> %u (peak %u, load %.2f at the end, last growth at "
+      "frame %llu); history: %s\n",
+      first.slots, end.slots, peak_slots, end.slots ? double(end.fragments) / end.slots : 0.0,
+      static_cast<unsigned long long>(last_growth), history_text.c_str());
+}
+
+// The changes applied and every measurement, for --json.
+void add_record_json(ordered_json& report, const SoakRecord& record) {
+  ordered_json changes_json = ordered_json::array();
+  for (const auto& [frame, what] : record.applied)
+    changes_json.push_back({{"frame", frame}, {"change", what}});
+  report["changes"] = changes_json;
+  ordered_json samples_json = ordered_json::array();
+  for (const Sample& x : record.samples) {
+    ordered_json entry = {{"frame", x.frame},          {"rss", x.rss},
+                          {"rss_anon", x.rss_anon},    {"heap", x.heap},
+                          {"heap_held", x.heap_held},  {"mappings", x.mappings},
+                          {"device", x.device},        {"allocations", x.allocations},
+                          {"habuffer_slots", x.slots}, {"habuffer_fragments", x.fragments}};
+    entry["driver_heap_usage"] = x.driver ? ordered_json(*x.driver) : ordered_json(nullptr);
+    samples_json.push_back(entry);
+  }
+  report["samples"] = samples_json;
+}
+
 void soak(DeviceOptions& device, const SoakOptions& o) {
   const std::string scene_file = find_data_file(o.scene);
   const graph::Extent size = parse_size(o.size, "--size");
@@ -263,193 +484,28 @@ void soak(DeviceOptions& device, const SoakOptions& o) {
   Viewer viewer(ctx, scene, loop.at(0).first, settings, options, output, nullptr);
   if (o.habuffer_slots) viewer.set_habuffer_slots(o.habuffer_slots);
   const std::vector<Change> changes = schedule(viewer, output, scene, settings, size);
+  const SoakPlan plan = plan_soak(o, changes.size());
+  const SoakRecord record = run_frames(ctx, viewer, output, loop, changes, plan, o.frames);
 
-  // The warm-up: plain frames (the HA-Buffer grows to what the view needs), then every scheduled
-  // change once, applied for a frame and undone for a frame, so that what a setting costs the
-  // first time (pipelines, JIT-compiled shader variants, the allocator's working set) is paid
-  // before the first measurement; and the camera's whole first round (the run's first half:
-  // the HA-Buffer meets the closest zoom there). The second half repeats the round and the
-  // changes, so whatever it adds to memory stays for good: a leak.
-  constexpr uint32_t plain = 10;
-  const auto warmup_changes = uint32_t(changes.size());
-  const uint32_t warmup = std::max(o.frames / 2, plain + 2 * warmup_changes);
-  if (o.frames < 2 * warmup) {
-    throw Error("soak: --frames " + std::to_string(o.frames) + " is too few: the warm-up takes " +
-                std::to_string(warmup) + " frames (every scheduled change once), and as many " +
-                "must follow it; at least " + std::to_string(2 * warmup));
-  }
-  const uint32_t every = std::max(1u, o.every);
-  const uint32_t interval = std::max(1u, o.interval);
-  // The schedule stops a little before the end: the last frames run as the warm-up's did.
-  const uint32_t tail = std::max(interval, o.frames / 20);
-  const uint32_t changes_end = o.frames > warmup + tail ? o.frames - tail : warmup;
-
-  std::vector<Sample> samples;
-  std::vector<Capacity> capacity;
-  std::vector<std::pair<uint64_t, std::string>> applied;
-  const Change* pending = nullptr;
-  size_t next_change = 0;
-  const auto check_validation = [&](uint64_t frame) {
-    const size_t count = ctx.validation_log().count();
-    if (count == 0) return;
-    const std::vector<std::string> messages = ctx.validation_log().take();
-    throw Error("soak: " + std::to_string(count) + " validation message(s) by frame " +
-                std::to_string(frame) + ", the first: " + messages.front());
-  };
-  Progress progress("frame", o.frames);
-  const auto start = std::chrono::steady_clock::now();
-  for (uint32_t i = 0; i < o.frames; ++i) {
-    if (i >= plain && i < plain + 2 * warmup_changes) {
-      const Change& c = changes[(i - plain) / 2];
-      if ((i - plain) % 2 == 0) {
-        c.apply();
-      } else {
-        c.undo();
-      }
-    }
-    if (i >= warmup && i <= changes_end && (i - warmup) % interval == 0) {
-      if (pending) {
-        pending->undo();
-        pending = nullptr;
-      } else if (i < changes_end && !changes.empty()) {
-        pending = &changes[next_change++ % changes.size()];
-        pending->apply();
-        applied.emplace_back(i, pending->what);
-      }
-    }
-    const auto [camera, zoom] = loop.at(i);
-    viewer.set_camera(camera);
-    viewer.scroll(zoom);
-    viewer.frame(1.0 / kFps);
-    const RenderStats& r = viewer.render_stats();
-    if (capacity.empty() || capacity.back().slots != r.table_size ||
-        !(capacity.back().size == viewer.extent())) {
-      capacity.push_back({i + 1, r.table_size, viewer.extent()});
-    }
-    progress.step_done(i + 1);
-    const bool last = i + 1 == o.frames;
-    if (last) output.wait_idle();  // (the end: every frame finished)
-    if ((i + 1 >= warmup && (i + 1 - warmup) % every == 0) || last) {
-      samples.push_back(measure(i + 1, ctx, viewer));
-      check_validation(i + 1);
-    }
-  }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (samples.empty()) throw Error("soak: no measurements (--frames below the warm-up)");
-
-  // Verdicts: memory from the first measurement after the warm-up to the last; the HA-Buffer's
-  // capacity must not grow in the run's second half (at a size it has had before: a resize to a
-  // larger picture is not growth).
-  std::vector<std::string> failures;
-  const Sample& first = samples.front();
-  const Sample& end = samples.back();
+  const double seconds = record.seconds;
   ordered_json report = {{"benchmark", "soak"},
                          {"device", ctx.report().name},
                          {"scene", scene_file},
                          {"size", {size.width, size.height}},
                          {"frames", o.frames},
-                         {"warmup_frames", warmup},
-                         {"measured_every", every},
-                         {"change_interval", interval},
+                         {"warmup_frames", plan.warmup},
+                         {"measured_every", plan.every},
+                         {"change_interval", plan.interval},
                          {"seconds", seconds},
                          {"frames_per_second", double(o.frames) / seconds},
-                         {"changes_applied", applied.size()}};
+                         {"changes_applied", record.applied.size()}};
   std::printf("soak: %s, %u frames at %ux%u on %s, %.1f s (%.2f frames/s), %zu changes\n",
               scene_file.c_str(), o.frames, size.width, size.height, ctx.report().name.c_str(),
-              seconds, double(o.frames) / seconds, applied.size());
-  const std::string span =
-      "frame " + std::to_string(first.frame) + " to " + std::to_string(end.frame);
-  std::printf("soak: %-38s %14s %14s %14s %9s\n", span.c_str(), "start", "end", "peak", "growth");
-  const auto series = [&](const std::string& name, const std::string& key, uint64_t a, uint64_t b,
-                          uint64_t peak, bool judged) {
-    const double growth = growth_percent(a, b);
-    report[key] = {{"start", a}, {"end", b}, {"peak", peak}, {"growth_percent", growth}};
-    std::printf("soak: %-38s %14s %14s %14s %+8.2f%%\n", name.c_str(), mib(a).c_str(),
-                mib(b).c_str(), mib(peak).c_str(), growth);
-    if (judged && growth > kAllowedGrowth) {
-      char text[256];
-      std::snprintf(text, sizeof text, "soak: %s grew %.2f%% (start %s, end %s)", name.c_str(),
-                    growth, mib(a).c_str(), mib(b).c_str());
-      failures.emplace_back(text);
-    }
-  };
-  for (const Series& s : kSeries) {
-    uint64_t peak = 0;
-    for (const Sample& x : samples) peak = std::max(peak, x.*s.field);
-    series(s.name, s.key, first.*s.field, end.*s.field, peak, s.judged);
-  }
-  if (first.driver && end.driver) {
-    uint64_t peak = 0;
-    for (const Sample& x : samples) peak = std::max(peak, x.driver.value_or(0));
-    series("device memory (driver's heapUsage)", "driver_heap_usage_bytes", *first.driver,
-           *end.driver, peak, true);
-  } else {
-    report["driver_heap_usage_bytes"] = nullptr;
-    std::printf(
-        "soak: device memory (driver's heapUsage): not reported (no "
-        "VK_EXT_memory_budget)\n");
-  }
-  report["device_allocations"] = {{"start", first.allocations}, {"end", end.allocations}};
-  std::printf("soak: device allocations %llu -> %llu, peak of strata's device memory %s\n",
-              static_cast<unsigned long long>(first.allocations),
-              static_cast<unsigned long long>(end.allocations), mib(ctx.memory_use().peak).c_str());
-
-  // (growth: more slots than the entry before, at the same picture size)
-  ordered_json history = ordered_json::array();
-  std::string history_text;
-  uint64_t last_growth = 0;
-  for (size_t k = 0; k < capacity.size(); ++k) {
-    const Capacity& c = capacity[k];
-    history.push_back(
-        {{"frame", c.frame}, {"slots", c.slots}, {"size", {c.size.width, c.size.height}}});
-    history_text += (k ? ", " : "") + std::to_string(c.slots) + " (frame " +
-                    std::to_string(c.frame) + ", " + std::to_string(c.size.width) + "x" +
-                    std::to_string(c.size.height) + ")";
-    // A resize changes the slots a viewport-sized table has, and a table grown at one size keeps
-    // its slots at the next: only an increase at an unchanged size is growth.
-    const uint32_t before = k > 0 && capacity[k - 1].size == c.size ? capacity[k - 1].slots : 0;
-    if (before == 0 || c.slots <= before) continue;
-    last_growth = c.frame;
-    if (c.frame > o.frames / 2) {
-      failures.push_back("soak: the HA-Buffer still grows in the run's second half (" +
-                         std::to_string(before) + " -> " + std::to_string(c.slots) +
-                         " slots at frame " + std::to_string(c.frame) + ")");
-    }
-  }
-  uint32_t peak_slots = 0, peak_overflow = 0;
-  for (const Sample& x : samples) {
-    peak_slots = std::max(peak_slots, x.slots);
-    peak_overflow = std::max(peak_overflow, x.overflow);
-  }
-  report["habuffer"] = {
-      {"slots", {{"start", first.slots}, {"end", end.slots}, {"peak", peak_slots}}},
-      {"fragments_end", end.fragments},
-      {"load_end", end.slots ? double(end.fragments) / end.slots : 0.0},
-      {"overflow_after_warmup_max", peak_overflow},
-      {"last_growth_frame", last_growth},
-      {"history", history}};
-  std::printf(
-      "soak: HA-Buffer slots %u -> %u (peak %u, load %.2f at the end, last growth at "
-      "frame %llu); history: %s\n",
-      first.slots, end.slots, peak_slots, end.slots ? double(end.fragments) / end.slots : 0.0,
-      static_cast<unsigned long long>(last_growth), history_text.c_str());
-
-  ordered_json changes_json = ordered_json::array();
-  for (const auto& [frame, what] : applied)
-    changes_json.push_back({{"frame", frame}, {"change", what}});
-  report["changes"] = changes_json;
-  ordered_json samples_json = ordered_json::array();
-  for (const Sample& x : samples) {
-    ordered_json entry = {{"frame", x.frame},          {"rss", x.rss},
-                          {"rss_anon", x.rss_anon},    {"heap", x.heap},
-                          {"heap_held", x.heap_held},  {"mappings", x.mappings},
-                          {"device", x.device},        {"allocations", x.allocations},
-                          {"habuffer_slots", x.slots}, {"habuffer_fragments", x.fragments}};
-    entry["driver_heap_usage"] = x.driver ? ordered_json(*x.driver) : ordered_json(nullptr);
-    samples_json.push_back(entry);
-  }
-  report["samples"] = samples_json;
+              seconds, double(o.frames) / seconds, record.applied.size());
+  std::vector<std::string> failures;
+  judge_memory(report, failures, record.samples, ctx);
+  judge_habuffer(report, failures, record, o.frames);
+  add_record_json(report, record);
   report["validation_messages"] = ctx.validation_log().count();
   report["failures"] = failures;
   report["ok"] = failures.empty();
@@ -457,7 +513,7 @@ void soak(DeviceOptions& device, const SoakOptions& o) {
     write_text_file(o.json,
                     report.dump(2, ' ', false, ordered_json::error_handler_t::replace) + "\n");
   }
-  check_validation(o.frames);
+  check_validation(ctx, o.frames);
   if (!failures.empty()) {
     std::string all;
     for (const std::string& f : failures) all += (all.empty() ? "" : "; ") + f;

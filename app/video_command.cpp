@@ -317,15 +317,9 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   }
 }
 
-}  // namespace
-
-void add_video_command(CLI::App& app, DeviceOptions& device) {
-  CLI::App* cmd = app.add_subcommand(
-      "video", "Render the labelled scene along a camera path or a turntable, frame by frame");
-  auto o = std::make_shared<VideoOptions>();
-  cmd->add_option("scene", o->scene.file, "scene file, or a volume file or DICOM folder")
-      ->required();
-  add_scene_input_options(cmd, o->scene);
+// The camera's way and what is written: the path or turntable, the frame rate and size, the
+// video and the layouts.
+void add_path_and_output_options(CLI::App* cmd, const std::shared_ptr<VideoOptions>& o) {
   cmd->add_option("--path", o->path, "camera path: front,left_2,top_3 (docs/scene-format.md)");
   cmd->add_option("--orbit", o->orbit, "turntable: degrees about the scene's centre")
       ->check(finite_range(-36000.0, 36000.0));
@@ -346,6 +340,10 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--report", o->report,
                 "print the layout-quality summary of `strata eval` over the frames (stdout, "
                 "JSON) at the end");
+}
+
+// How the labels are placed in each frame.
+void add_placement_options(CLI::App* cmd, const std::shared_ptr<VideoOptions>& o) {
   add_tidy_rounds_option(cmd, o->tidy_rounds, "after the placement (0: none)");
   cmd->add_flag("--screen-space", o->screen_space,
                 "labels live on screen (the thesis), not as offsets from their anchors");
@@ -362,6 +360,10 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
       ->default_str("on");
   add_hard_option(cmd, o->hard);
   add_label_look_options(cmd, o->look);
+}
+
+// How the labels move from frame to frame (labeling/forces.h).
+void add_force_options(CLI::App* cmd, const std::shared_ptr<VideoOptions>& o) {
   cmd->add_option("--label-speed", o->forces.speed_widths,
                   "forces: image widths per second a label moves at, at most")
       ->capture_default_str()
@@ -409,6 +411,20 @@ void add_video_command(CLI::App& app, DeviceOptions& device) {
                   "changes layer, as a share of the distance to the next plane")
       ->capture_default_str()
       ->check(finite_range(0.0, 100.0));
+}
+
+}  // namespace
+
+void add_video_command(CLI::App& app, DeviceOptions& device) {
+  CLI::App* cmd = app.add_subcommand(
+      "video", "Render the labelled scene along a camera path or a turntable, frame by frame");
+  auto o = std::make_shared<VideoOptions>();
+  cmd->add_option("scene", o->scene.file, "scene file, or a volume file or DICOM folder")
+      ->required();
+  add_scene_input_options(cmd, o->scene);
+  add_path_and_output_options(cmd, o);
+  add_placement_options(cmd, o);
+  add_force_options(cmd, o);
   cmd->add_option("--threads", o->threads,
                   "threads compressing frames (default: one per core; 1 on a CPU device, where "
                   "rendering takes every core)")

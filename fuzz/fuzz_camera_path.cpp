@@ -9,20 +9,13 @@
 
 #include "fuzz/fuzz_input.h"
 #include "labeling/camera_path.h"
+#include "tests/test_scenes.h"
 
 namespace {
 
+// tests/test_scenes.h's box, with named positions around it.
 strata::Scene box_scene() {
-  strata::Scene scene;
-  strata::Mesh box;
-  for (int corner = 0; corner < 8; ++corner) {
-    box.positions.push_back(glm::vec3(10, 20, 30) + 10.0f * glm::vec3((corner & 1) ? 1 : -1,
-                                                                      (corner & 2) ? 1 : -1,
-                                                                      (corner & 4) ? 1 : -1));
-  }
-  scene.meshes.push_back(box);
-  scene.camera = {glm::lookAt(glm::vec3(-60, -60, 80), glm::vec3(10, 20, 30), glm::vec3(0, 0, 1)),
-                  30.0f, 1.0f, 500.0f};
+  strata::Scene scene = strata::test::box_scene();
   const auto pose = [](const char* name, glm::vec3 eye, glm::vec3 target, glm::vec3 up) {
     return strata::CameraPose{name, glm::lookAt(eye, target, up)};
   };

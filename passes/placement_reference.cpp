@@ -167,15 +167,12 @@ std::vector<gpu::PlacementGpu> tidy_reference(std::span<const gpu::LabelGpu> lab
   return placements;
 }
 
-ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
-                                   std::span<const glm::vec4> layers, uint32_t layer_count,
-                                   std::span<const gpu::LabelGpu> labels,
-                                   std::span<const uint32_t> order,
-                                   const PlacementSettings& settings, graph::Extent size) {
+namespace {
+
+// Saliency: CIELAB of each pixel, Sobel with clamp-to-edge neighbours.
+std::vector<float> saliency_reference(std::span<const uint8_t> final_rgba8, graph::Extent size) {
   const uint32_t w = size.width, h = size.height;
   const size_t pixels = size_t{w} * h;
-  ReferencePlacement out;
-  // Saliency: CIELAB of each pixel, Sobel with clamp-to-edge neighbours.
   std::vector<glm::vec3> lab(pixels);
   for (size_t p = 0; p < pixels; ++p) {
     lab[p] = gpu::rgb_to_lab(
@@ -184,17 +181,24 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
   const auto at = [&](int x, int y) {
     return lab[size_t(std::clamp(y, 0, int(h) - 1)) * w + size_t(std::clamp(x, 0, int(w) - 1))];
   };
-  out.saliency.resize(pixels);
+  std::vector<float> saliency(pixels);
   for (int y = 0; y < int(h); ++y) {
     for (int x = 0; x < int(w); ++x) {
-      out.saliency[size_t(y) * w + size_t(x)] =
+      saliency[size_t(y) * w + size_t(x)] =
           gpu::sobel_saliency(at(x - 1, y - 1), at(x, y - 1), at(x + 1, y - 1), at(x - 1, y),
                               at(x + 1, y), at(x - 1, y + 1), at(x, y + 1), at(x + 1, y + 1));
     }
   }
-  // Integral costs per layer, hidden pixels per layer (after them), and their tables.
+  return saliency;
+}
+
+// Integral costs per layer, then hidden pixels per layer (after them), into out.costs.
+void costs_reference(ReferencePlacement& out, std::span<const glm::vec4> layers,
+                     uint32_t layer_count, std::span<const gpu::LabelGpu> labels,
+                     const PlacementSettings& settings, graph::Extent size) {
+  const uint32_t w = size.width;
+  const size_t pixels = size_t{w} * size.height;
   out.costs.resize(pixels * layer_count * 2);
-  out.tables.resize(out.costs.size());
   std::vector<float> open_on(layer_count), kept(layer_count);
   for (size_t p = 0; p < pixels; ++p) {
     float all = 0.0f;
@@ -229,12 +233,16 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
           settings.occlusion_weight, settings.single_saliency_weight);
     }
   }
-  for (uint32_t l = 0; l < 2 * layer_count; ++l) {
-    const std::vector<double> table =
-        summed_area_table_reference(std::span(out.costs).subspan(l * pixels, pixels), w, h);
-    for (size_t p = 0; p < pixels; ++p) out.tables[l * pixels + p] = float(table[p]);
-  }
-  // The greedy loop: each label's argmin over every pixel (ties: the lowest pixel index).
+}
+
+// The greedy loop: each label's argmin over every pixel (ties: the lowest pixel index), as
+// (cost bits << 32 | pixel); out.constraints gets the constraint bits.
+std::vector<uint64_t> greedy_reference(ReferencePlacement& out,
+                                       std::span<const gpu::LabelGpu> labels,
+                                       std::span<const uint32_t> order,
+                                       const PlacementSettings& settings, graph::Extent size,
+                                       uint32_t layer_count) {
+  const uint32_t w = size.width, h = size.height;
   gpu::Placer placer{placement_params(settings, size, layer_count, uint32_t(labels.size()), 0),
                      labels,
                      order,
@@ -245,7 +253,7 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
   for (const gpu::LabelGpu& l : labels) {
     if ((l.flags & LABEL_ENABLED) != 0u) placer.anchors.push_back(l.anchor);
   }
-  out.constraints.assign(pixels, 0u);
+  out.constraints.assign(size_t{w} * h, 0u);
   for (uint32_t step = 0; step < order.size(); ++step) {
     placer.params.step = step;
     const uint32_t label = order[step];
@@ -274,8 +282,30 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
       }
     }
   }
-  out.placements =
-      tidy_reference(labels, order, placer.results, out.tables, settings, size, layer_count);
+  return std::move(placer.results);
+}
+
+}  // namespace
+
+ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
+                                   std::span<const glm::vec4> layers, uint32_t layer_count,
+                                   std::span<const gpu::LabelGpu> labels,
+                                   std::span<const uint32_t> order,
+                                   const PlacementSettings& settings, graph::Extent size) {
+  const uint32_t w = size.width, h = size.height;
+  const size_t pixels = size_t{w} * h;
+  ReferencePlacement out;
+  out.saliency = saliency_reference(final_rgba8, size);
+  costs_reference(out, layers, layer_count, labels, settings, size);
+  out.tables.resize(out.costs.size());
+  for (uint32_t l = 0; l < 2 * layer_count; ++l) {
+    const std::vector<double> table =
+        summed_area_table_reference(std::span(out.costs).subspan(l * pixels, pixels), w, h);
+    for (size_t p = 0; p < pixels; ++p) out.tables[l * pixels + p] = float(table[p]);
+  }
+  const std::vector<uint64_t> results =
+      greedy_reference(out, labels, order, settings, size, layer_count);
+  out.placements = tidy_reference(labels, order, results, out.tables, settings, size, layer_count);
   return out;
 }
 

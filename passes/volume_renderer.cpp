@@ -151,22 +151,17 @@ VolumeLimits device_volume_limits(const Context& ctx) {
           .device = properties.properties.deviceName};
 }
 
-RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d,
-                                   uint64_t max_bytes) {
-  if (scene.volumes.size() > VR_MAX_VOLUMES) {
-    throw Error(scene.source.string() + ": " + std::to_string(scene.volumes.size()) +
-                " volumes; strata renders at most " + std::to_string(VR_MAX_VOLUMES));
-  }
-  RenderInputs in;
-  in.scene_min = glm::vec3(3.4e38f);
-  in.scene_max = glm::vec3(-3.4e38f);
-  in.finest_spacing = 3.4e38f;
-  const auto extend = [&](const glm::vec3& p) {
-    in.scene_min = glm::min(in.scene_min, p);
-    in.scene_max = glm::max(in.scene_max, p);
-  };
+namespace {
 
-  // The atlas: every volume stacked along z with a border of replicated edge voxels.
+void extend_bounds(RenderInputs& in, const glm::vec3& p) {
+  in.scene_min = glm::min(in.scene_min, p);
+  in.scene_max = glm::max(in.scene_max, p);
+}
+
+// The atlas: every volume stacked along z with a border of replicated edge voxels; its size
+// checked against the device's.
+glm::uvec3 checked_atlas_dims(const Scene& scene, uint32_t max_image_dimension_3d,
+                              uint64_t max_bytes) {
   glm::uvec3 dims(1, 1, 0);
   for (const Volume& v : scene.volumes) {
     dims.x = std::max(dims.x, v.dims.x + 2 * VR_ATLAS_BORDER);
@@ -188,80 +183,121 @@ RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimens
                 std::to_string(atlas_bytes >> 20) + " MiB; this device takes at most " +
                 std::to_string(max_bytes >> 20) + " MiB in one allocation");
   }
-  in.atlas_dims = dims;
-  in.atlas.assign(4 * size_t(dims.x) * dims.y * dims.z, 0);
+  return dims;
+}
+
+// One volume's slab of the atlas from slice z0 on: per voxel the central-difference gradient and
+// the normalised value `t`, the border replicating the edge.
+void fill_atlas_slab(const Volume& v, const std::vector<int16_t>& t, glm::uvec3 dims, uint32_t z0,
+                     std::vector<int16_t>& atlas) {
+  const glm::ivec3 vd(v.dims);
+  over_slices(v.dims.z + 2 * VR_ATLAS_BORDER, [&](uint32_t first, uint32_t last) {
+    for (uint32_t az = first; az < last; ++az) {
+      const int k = std::clamp(int(az) - int(VR_ATLAS_BORDER), 0, vd.z - 1);
+      for (uint32_t ay = 0; ay < dims.y; ++ay) {
+        const int j = std::clamp(int(ay) - int(VR_ATLAS_BORDER), 0, vd.y - 1);
+        int16_t* row = &atlas[4 * (size_t(z0 + az) * dims.y + ay) * dims.x];
+        for (uint32_t ax = 0; ax < dims.x; ++ax) {
+          const int i = std::clamp(int(ax) - int(VR_ATLAS_BORDER), 0, vd.x - 1);
+          const auto at = [&](int x, int y, int z) {  // clamped to the volume's edge
+            const size_t cz = size_t(std::clamp(z, 0, vd.z - 1));
+            const size_t cy = size_t(std::clamp(y, 0, vd.y - 1));
+            const size_t cx = size_t(std::clamp(x, 0, vd.x - 1));
+            return int(t[(cz * vd.y + cy) * vd.x + cx]);
+          };
+          row[4 * ax + 0] = int16_t((at(i + 1, j, k) - at(i - 1, j, k)) / 2);
+          row[4 * ax + 1] = int16_t((at(i, j + 1, k) - at(i, j - 1, k)) / 2);
+          row[4 * ax + 2] = int16_t((at(i, j, k + 1) - at(i, j, k - 1)) / 2);
+          row[4 * ax + 3] = t[(size_t(k) * vd.y + j) * vd.x + i];
+        }
+      }
+    }
+  });
+}
+
+// What the shaders know of volume `index` (of `count`) whose slab starts at atlas slice z0: its
+// maps to and from world space, its place in the atlas and its cut planes (its bricks are the
+// caller's).
+gpu::VolumeGpu volume_info(const Volume& v, const glm::mat4& to_world, uint32_t index, size_t count,
+                           glm::uvec3 dims, uint32_t z0) {
+  gpu::VolumeGpu info{};
+  info.world_to_texture = glm::inverse(to_world);
+  // Per voxel to per texture unit (× dims), then world: gradients transform with the transpose
+  // of the world-to-texture map.
+  const glm::mat3 gradient =
+      glm::transpose(glm::mat3(info.world_to_texture)) *
+      glm::mat3(glm::vec3(v.dims.x, 0, 0), glm::vec3(0, v.dims.y, 0), glm::vec3(0, 0, v.dims.z));
+  info.gradient_to_world = glm::mat4(gradient);
+  const glm::vec3 atlas_size(dims);
+  info.atlas_offset =
+      glm::vec4(glm::vec3(VR_ATLAS_BORDER, VR_ATLAS_BORDER, z0 + VR_ATLAS_BORDER) / atlas_size,
+                (float(index) + 0.5f) / float(count));
+  const float spacing = finest_world_spacing(to_world, v.dims);
+  info.atlas_scale = glm::vec4(glm::vec3(v.dims) / atlas_size, spacing);
+  info.texel = glm::vec4(1.0f / glm::vec3(v.dims), 0.0f);
+  set_cut_planes(v, v.cut, info);
+  return info;
+}
+
+// Every volume into the atlas, with its VolumeGpu, bricks, bounds and transfer function.
+void add_volumes(const Scene& scene, RenderInputs& in) {
+  const glm::uvec3 dims = in.atlas_dims;
   uint32_t z0 = 0, first_brick = 0;
   for (uint32_t index = 0; index < scene.volumes.size(); ++index) {
     const Volume& v = scene.volumes[index];
     const std::vector<int16_t> t = normalised(v);
-    const glm::ivec3 vd(v.dims);
-    over_slices(v.dims.z + 2 * VR_ATLAS_BORDER, [&](uint32_t first, uint32_t last) {
-      for (uint32_t az = first; az < last; ++az) {
-        const int k = std::clamp(int(az) - int(VR_ATLAS_BORDER), 0, vd.z - 1);
-        for (uint32_t ay = 0; ay < dims.y; ++ay) {
-          const int j = std::clamp(int(ay) - int(VR_ATLAS_BORDER), 0, vd.y - 1);
-          int16_t* row = &in.atlas[4 * (size_t(z0 + az) * dims.y + ay) * dims.x];
-          for (uint32_t ax = 0; ax < dims.x; ++ax) {
-            const int i = std::clamp(int(ax) - int(VR_ATLAS_BORDER), 0, vd.x - 1);
-            const auto at = [&](int x, int y, int z) {  // clamped to the volume's edge
-              const size_t cz = size_t(std::clamp(z, 0, vd.z - 1));
-              const size_t cy = size_t(std::clamp(y, 0, vd.y - 1));
-              const size_t cx = size_t(std::clamp(x, 0, vd.x - 1));
-              return int(t[(cz * vd.y + cy) * vd.x + cx]);
-            };
-            row[4 * ax + 0] = int16_t((at(i + 1, j, k) - at(i - 1, j, k)) / 2);
-            row[4 * ax + 1] = int16_t((at(i, j + 1, k) - at(i, j - 1, k)) / 2);
-            row[4 * ax + 2] = int16_t((at(i, j, k + 1) - at(i, j, k - 1)) / 2);
-            row[4 * ax + 3] = t[(size_t(k) * vd.y + j) * vd.x + i];
-          }
-        }
-      }
-    });
-    gpu::VolumeGpu info{};
+    fill_atlas_slab(v, t, dims, z0, in.atlas);
     const glm::mat4 to_world = texture_to_world(v);
-    info.world_to_texture = glm::inverse(to_world);
-    // Per voxel to per texture unit (× dims), then world: gradients transform with the transpose
-    // of the world-to-texture map.
-    const glm::mat3 gradient =
-        glm::transpose(glm::mat3(info.world_to_texture)) *
-        glm::mat3(glm::vec3(v.dims.x, 0, 0), glm::vec3(0, v.dims.y, 0), glm::vec3(0, 0, v.dims.z));
-    info.gradient_to_world = glm::mat4(gradient);
-    const glm::vec3 atlas_size(dims);
-    info.atlas_offset =
-        glm::vec4(glm::vec3(VR_ATLAS_BORDER, VR_ATLAS_BORDER, z0 + VR_ATLAS_BORDER) / atlas_size,
-                  (float(index) + 0.5f) / float(scene.volumes.size()));
-    const float spacing = finest_world_spacing(to_world, v.dims);
-    info.atlas_scale = glm::vec4(glm::vec3(v.dims) / atlas_size, spacing);
-    info.texel = glm::vec4(1.0f / glm::vec3(v.dims), 0.0f);
-    set_cut_planes(v, v.cut, info);
+    gpu::VolumeGpu info = volume_info(v, to_world, index, scene.volumes.size(), dims, z0);
     const glm::uvec3 bricks = (v.dims + uint32_t(VR_BRICK - 1)) / uint32_t(VR_BRICK);
     info.bricks = glm::uvec4(bricks, first_brick);
     brick_ranges(t, v.dims, bricks, in.brick_ranges);
     first_brick += bricks.x * bricks.y * bricks.z;
     in.volumes.push_back(info);
-    in.finest_spacing = std::min(in.finest_spacing, spacing);
+    in.finest_spacing = std::min(in.finest_spacing, info.atlas_scale.w);  // (its finest spacing)
     for (int c = 0; c < 8; ++c) {
-      extend(glm::vec3(to_world * glm::vec4(c & 1, (c >> 1) & 1, (c >> 2) & 1, 1.0f)));
+      extend_bounds(in, glm::vec3(to_world * glm::vec4(c & 1, (c >> 1) & 1, (c >> 2) & 1, 1.0f)));
     }
     in.transfer_functions.push_back(v.transfer_function >= 0
                                         ? scene.transfer_functions.at(size_t(v.transfer_function))
                                         : TransferFunction{});
     z0 += v.dims.z + 2 * VR_ATLAS_BORDER;
   }
+}
 
-  // Meshes: one vertex buffer (position, normal as vec4 pairs) and one index buffer.
+// Meshes: one vertex buffer (position, normal as vec4 pairs) and one index buffer.
+void add_meshes(const Scene& scene, RenderInputs& in) {
   for (const Mesh& mesh : scene.meshes) {
     const uint32_t base = static_cast<uint32_t>(in.vertices.size() / 2);
     for (size_t i = 0; i < mesh.positions.size(); ++i) {
       in.vertices.emplace_back(mesh.positions[i], 1.0f);
       in.vertices.emplace_back(
           i < mesh.normals.size() ? mesh.normals[i] : glm::vec3(0.0f, 0.0f, 1.0f), 0.0f);
-      extend(glm::vec3(mesh.transform * glm::vec4(mesh.positions[i], 1.0f)));
+      extend_bounds(in, glm::vec3(mesh.transform * glm::vec4(mesh.positions[i], 1.0f)));
     }
     in.meshes.push_back({static_cast<uint32_t>(in.indices.size()),
                          static_cast<uint32_t>(mesh.indices.size()), mesh.color, mesh.transform});
     for (uint32_t index : mesh.indices) in.indices.push_back(base + index);
   }
+}
+
+}  // namespace
+
+RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d,
+                                   uint64_t max_bytes) {
+  if (scene.volumes.size() > VR_MAX_VOLUMES) {
+    throw Error(scene.source.string() + ": " + std::to_string(scene.volumes.size()) +
+                " volumes; strata renders at most " + std::to_string(VR_MAX_VOLUMES));
+  }
+  RenderInputs in;
+  in.scene_min = glm::vec3(3.4e38f);
+  in.scene_max = glm::vec3(-3.4e38f);
+  in.finest_spacing = 3.4e38f;
+  in.atlas_dims = checked_atlas_dims(scene, max_image_dimension_3d, max_bytes);
+  const glm::uvec3 dims = in.atlas_dims;
+  in.atlas.assign(4 * size_t(dims.x) * dims.y * dims.z, 0);
+  add_volumes(scene, in);
+  add_meshes(scene, in);
   if (in.finest_spacing > 1e30f)
     in.finest_spacing = glm::length(in.scene_max - in.scene_min) / 256.0f;
   in.update_transfer();
@@ -449,35 +485,36 @@ uint32_t VolumeRenderer::slots_for(graph::Extent e) const {
   return static_cast<uint32_t>(std::min(std::ceil(wanted), 4.0e9));
 }
 
-VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
+VolumeRenderer::Transients VolumeRenderer::add_transients(graph::Graph& graph) const {
   const auto slots = [this](graph::Extent e) { return VkDeviceSize{slots_for(e)} * 8; };
-  const ResourceId frame = graph.add_buffer(
-      "render.frame", {[](graph::Extent) { return VkDeviceSize{sizeof(gpu::FrameGpu)}; }});
-  const ResourceId keys = graph.add_buffer("render.keys", {slots});
-  const ResourceId payload = graph.add_buffer("render.payload", {slots});
+  Transients t;
+  t.frame = graph.add_buffer("render.frame",
+                             {[](graph::Extent) { return VkDeviceSize{sizeof(gpu::FrameGpu)}; }});
+  t.keys = graph.add_buffer("render.keys", {slots});
+  t.payload = graph.add_buffer("render.payload", {slots});
   // (written each frame: corrected for the frame's step, which the viewer may change any time)
   const VkDeviceSize table_bytes = inputs_.transfer_table.size() * sizeof(glm::vec4);
-  const ResourceId transfer =
+  t.transfer =
       graph.add_buffer("render.transfer", {[table_bytes](graph::Extent) { return table_bytes; }});
-  const ResourceId counters = graph.add_buffer(
-      "render.counters",
-      {[](graph::Extent) { return VkDeviceSize{VR_COUNTER_COUNT * sizeof(uint32_t)}; }});
-  const auto images = [&graph, this](const std::string& suffix, bool keep) {
-    Outputs o;
-    o.layers =
-        graph.add_image("render.layers" + suffix,
-                        {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count, true, keep});
-    o.final =
-        graph.add_image("render.final" + suffix, {VK_FORMAT_R8G8B8A8_UNORM, {}, 1, false, keep});
-    o.depth = graph.add_image("render.depth" + suffix, {VK_FORMAT_R32_SFLOAT, {}, 1, false, keep});
-    return o;
-  };
-  Outputs out = images("", false);
-  out.frame = frame;
-  out.keys = keys;
-  // (interactive: the resolve writes the cast pixels, the upscale the images everyone reads)
-  last_cast_.reset();  // (a new graph: new images)
-  const Outputs cast = settings_.interactive ? images(".cast", true) : out;
+  t.counters = graph.add_buffer("render.counters", {[](graph::Extent) {
+                                  return VkDeviceSize{VR_COUNTER_COUNT * sizeof(uint32_t)};
+                                }});
+  return t;
+}
+
+VolumeRenderer::Outputs VolumeRenderer::add_images(graph::Graph& graph, const std::string& suffix,
+                                                   bool keep) const {
+  Outputs o;
+  o.layers =
+      graph.add_image("render.layers" + suffix,
+                      {VK_FORMAT_R16G16B16A16_SFLOAT, {}, settings_.layer_count, true, keep});
+  o.final =
+      graph.add_image("render.final" + suffix, {VK_FORMAT_R8G8B8A8_UNORM, {}, 1, false, keep});
+  o.depth = graph.add_image("render.depth" + suffix, {VK_FORMAT_R32_SFLOAT, {}, 1, false, keep});
+  return o;
+}
+
+void VolumeRenderer::import_scene(graph::Graph& graph) {
   const auto uploaded = [&graph](const char* name, const Buffer& buffer) {
     return graph.import_buffer(name, {.buffer = buffer.handle(), .has_content = true});
   };
@@ -492,55 +529,59 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
   ids_.vertices = uploaded("render.vertices", vertices_);
   ids_.indices = uploaded("render.indices", indices_);
   ids_.readback = counters_readback_.import(graph, "render.counters_readback");
-  out.payload = payload;
-  out.volumes = ids_.volumes;
-  out.atlas = ids_.atlas;
-  out.transfer = transfer;
-  out.occupancy = ids_.occupancy;
+}
 
+// The frame's data and transfer table written, the counters and the HA-Buffer's keys cleared;
+// nothing but the counters when the frame casts the same rays as the last (interactive, at rest).
+void VolumeRenderer::add_clear_pass(graph::Graph& graph, const Transients& t) {
   graph.add_pass({"render.clear",
                   graph::PassKind::transfer,
-                  {{frame, Use::transfer_dst},
-                   {transfer, Use::transfer_dst},
-                   {keys, Use::transfer_dst},
-                   {counters, Use::transfer_dst}},
-                  [this, frame, transfer, keys, counters](graph::PassContext& pc) {
+                  {{t.frame, Use::transfer_dst},
+                   {t.transfer, Use::transfer_dst},
+                   {t.keys, Use::transfer_dst},
+                   {t.counters, Use::transfer_dst}},
+                  [this, t](graph::PassContext& pc) {
                     gpu::FrameGpu data = frame_data(inputs_, camera_, settings_,
                                                     cast_size(pc.viewport), slots_for(pc.viewport));
                     data.group_order = group_order_;
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(counters), 0, VK_WHOLE_SIZE, 0);
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(t.counters), 0, VK_WHOLE_SIZE, 0);
                     const Cast now{data, transfer_version_, pc.allocation()};
                     reuse_cast_ = settings_.interactive && same_cast(now);
                     if (reuse_cast_) return;
                     if (settings_.interactive) last_cast_ = now;
-                    vkCmdUpdateBuffer(pc.cmd, pc.buffer(frame), 0, sizeof data, &data);
+                    vkCmdUpdateBuffer(pc.cmd, pc.buffer(t.frame), 0, sizeof data, &data);
                     const std::vector<glm::vec4> table = corrected_transfer(inputs_, data.step);
-                    vkCmdUpdateBuffer(pc.cmd, pc.buffer(transfer), 0,
+                    vkCmdUpdateBuffer(pc.cmd, pc.buffer(t.transfer), 0,
                                       table.size() * sizeof(glm::vec4), table.data());
-                    vkCmdFillBuffer(pc.cmd, pc.buffer(keys), 0, VK_WHOLE_SIZE, 0);
+                    vkCmdFillBuffer(pc.cmd, pc.buffer(t.keys), 0, VK_WHOLE_SIZE, 0);
                   },
                   "render"});
+}
+
+// The HA-Buffer built from the meshes, then resolved with the volumes into the `cast` images.
+void VolumeRenderer::add_cast_passes(graph::Graph& graph, const Transients& t,
+                                     const Outputs& cast) {
   graph.add_pass({"render.habuffer_build",
                   graph::PassKind::graphics,
-                  {{frame, Use::uniform, VR_BINDING_FRAME},
+                  {{t.frame, Use::uniform, VR_BINDING_FRAME},
                    {ids_.vertices, Use::storage_read, VR_BINDING_VERTICES},
                    {ids_.indices, Use::storage_read, VR_BINDING_INDICES},
-                   {keys, Use::storage_read_write, VR_BINDING_KEYS},
-                   {payload, Use::storage_write, VR_BINDING_PAYLOAD},
-                   {counters, Use::storage_read_write, VR_BINDING_COUNTERS}},
+                   {t.keys, Use::storage_read_write, VR_BINDING_KEYS},
+                   {t.payload, Use::storage_write, VR_BINDING_PAYLOAD},
+                   {t.counters, Use::storage_read_write, VR_BINDING_COUNTERS}},
                   [this](graph::PassContext& pc) {
                     if (!reuse_cast_) record_build(pc);
                   },
                   "render"});
   graph.add_pass({"render.resolve",
                   graph::PassKind::compute,
-                  {{frame, Use::uniform, VR_BINDING_FRAME},
+                  {{t.frame, Use::uniform, VR_BINDING_FRAME},
                    {ids_.volumes, Use::uniform, VR_BINDING_VOLUMES},
-                   {keys, Use::storage_read, VR_BINDING_KEYS},
-                   {payload, Use::storage_read, VR_BINDING_PAYLOAD},
-                   {counters, Use::storage_read_write, VR_BINDING_COUNTERS},
+                   {t.keys, Use::storage_read, VR_BINDING_KEYS},
+                   {t.payload, Use::storage_read, VR_BINDING_PAYLOAD},
+                   {t.counters, Use::storage_read_write, VR_BINDING_COUNTERS},
                    {ids_.atlas, Use::sampled, VR_BINDING_ATLAS},
-                   {transfer, Use::storage_read, VR_BINDING_TRANSFER},
+                   {t.transfer, Use::storage_read, VR_BINDING_TRANSFER},
                    {ids_.occupancy, Use::storage_read, VR_BINDING_OCCUPANCY},
                    {cast.layers, Use::storage_write, VR_BINDING_LAYERS},
                    {cast.final, Use::storage_write, VR_BINDING_FINAL},
@@ -551,8 +592,27 @@ VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
                     pc.dispatch(resolve_, {e.width, e.height, 1});
                   },
                   "render"});
+}
+
+VolumeRenderer::Outputs VolumeRenderer::add_to(graph::Graph& graph) {
+  const Transients t = add_transients(graph);
+  Outputs out = add_images(graph, "", false);
+  out.frame = t.frame;
+  out.keys = t.keys;
+  // (interactive: the resolve writes the cast pixels, the upscale the images everyone reads)
+  last_cast_.reset();  // (a new graph: new images)
+  const Outputs cast = settings_.interactive ? add_images(graph, ".cast", true) : out;
+  import_scene(graph);
+  out.payload = t.payload;
+  out.volumes = ids_.volumes;
+  out.atlas = ids_.atlas;
+  out.transfer = t.transfer;
+  out.occupancy = ids_.occupancy;
+
+  add_clear_pass(graph, t);
+  add_cast_passes(graph, t, cast);
   if (settings_.interactive) add_upscale(graph, cast, out);
-  const ResourceId readback = ids_.readback;
+  const ResourceId counters = t.counters, readback = ids_.readback;
   graph.add_pass({"render.counters",
                   graph::PassKind::transfer,
                   {{counters, Use::transfer_src}, {readback, Use::transfer_dst}},

@@ -9,6 +9,7 @@
 #include <functional>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "engine/gpu/resources.h"
@@ -191,6 +192,16 @@ class VolumeRenderer {
   GraphicsPipeline build_;
   ComputePipeline resolve_;
   ComputePipeline upscale_;
+  // add_to's pieces: the frame's buffers, the images (".cast" ones kept for interactive
+  // rendering), the uploaded scene imported, and the passes.
+  struct Transients {
+    graph::ResourceId frame, keys, payload, transfer, counters;
+  };
+  Transients add_transients(graph::Graph& graph) const;
+  Outputs add_images(graph::Graph& graph, const std::string& suffix, bool keep) const;
+  void import_scene(graph::Graph& graph);
+  void add_clear_pass(graph::Graph& graph, const Transients& t);
+  void add_cast_passes(graph::Graph& graph, const Transients& t, const Outputs& cast);
   void add_upscale(graph::Graph& graph, const Outputs& cast, const Outputs& out);
   graph::Extent cast_size(graph::Extent viewport) const;
   struct Ids {

@@ -218,6 +218,140 @@ bool real_script(hb_script_t s) {
          s != HB_SCRIPT_INVALID;
 }
 
+// The face of each character: the first that has it; a combining mark stays with its base's
+// face when that face has the mark too; none has it: the main face (its missing-glyph box).
+std::vector<uint32_t> faces_of(const std::u32string& text, const std::vector<FT_Face>& faces) {
+  hb_unicode_funcs_t* unicode = hb_unicode_funcs_get_default();
+  const size_t n = text.size();
+  std::vector<uint32_t> face_of(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    const bool mark = hb_unicode_general_category(unicode, text[i]) ==
+                      HB_UNICODE_GENERAL_CATEGORY_NON_SPACING_MARK;
+    if (mark && i > 0 && FT_Get_Char_Index(faces[face_of[i - 1]], text[i]) != 0) {
+      face_of[i] = face_of[i - 1];
+      continue;
+    }
+    for (uint32_t f = 0; f < faces.size(); ++f) {
+      if (FT_Get_Char_Index(faces[f], text[i]) != 0) {
+        face_of[i] = f;
+        break;
+      }
+    }
+  }
+  return face_of;
+}
+
+// The script of each character: spaces, digits, punctuation and marks (common, inherited) take
+// the script before them, else the one after.
+std::vector<hb_script_t> scripts_of(const std::u32string& text) {
+  hb_unicode_funcs_t* unicode = hb_unicode_funcs_get_default();
+  const size_t n = text.size();
+  std::vector<hb_script_t> script(n, HB_SCRIPT_INVALID);
+  for (size_t i = 0; i < n; ++i) {
+    const hb_script_t s = hb_unicode_script(unicode, text[i]);
+    script[i] = real_script(s) ? s : i > 0 ? script[i - 1] : HB_SCRIPT_INVALID;
+  }
+  for (size_t i = n; i-- > 0;) {
+    if (script[i] == HB_SCRIPT_INVALID) script[i] = i + 1 < n ? script[i + 1] : HB_SCRIPT_COMMON;
+  }
+  return script;
+}
+
+struct VisualOrder {
+  std::vector<FriBidiLevel> levels;  // each character's embedding level
+  std::vector<FriBidiStrIndex> map;  // map[visual] = logical
+  FriBidiParType base = FRIBIDI_PAR_LTR;
+};
+
+// The bidirectional algorithm: embedding levels for the line as a paragraph of its own in
+// `direction`, then the visual order (trailing spaces at the paragraph's level). Marks are not
+// moved after their bases (no FRIBIDI_FLAG_REORDER_NSM): HarfBuzz places them, shaping each
+// right-to-left run in its own direction.
+VisualOrder visual_order(const std::u32string& text, TextDirection direction) {
+  const size_t n = text.size();
+  const auto length = static_cast<FriBidiStrIndex>(n);
+  const auto* chars = reinterpret_cast<const FriBidiChar*>(text.data());
+  std::vector<FriBidiCharType> types(n);
+  std::vector<FriBidiBracketType> brackets(n);
+  VisualOrder order{std::vector<FriBidiLevel>(n, 0), std::vector<FriBidiStrIndex>(n)};
+  std::iota(order.map.begin(), order.map.end(), FriBidiStrIndex{0});
+  order.base = direction == TextDirection::left_to_right   ? FRIBIDI_PAR_LTR
+               : direction == TextDirection::right_to_left ? FRIBIDI_PAR_RTL
+                                                           : FRIBIDI_PAR_ON;
+  if (n > 0) {
+    fribidi_get_bidi_types(chars, length, types.data());
+    fribidi_get_bracket_types(chars, length, types.data(), brackets.data());
+    if (fribidi_get_par_embedding_levels_ex(types.data(), brackets.data(), length, &order.base,
+                                            order.levels.data()) == 0 ||
+        fribidi_reorder_line(0, types.data(), length, 0, order.base, order.levels.data(), nullptr,
+                             order.map.data()) == 0) {
+      throw Error("font: FriBiDi could not order a label line of " + std::to_string(n) +
+                  " characters");
+    }
+  } else if (order.base == FRIBIDI_PAR_ON) {
+    order.base = FRIBIDI_PAR_LTR;
+  }
+  return order;
+}
+
+// A run: characters next to each other in both orders, of one level, face and script.
+struct Run {
+  size_t start = 0;  // its first character in logical order
+  size_t count = 0;
+  bool rtl = false;
+  uint32_t face = 0;
+  hb_script_t script = HB_SCRIPT_COMMON;
+};
+
+// The run that starts at visual position v.
+Run run_at(size_t v, const VisualOrder& order, const std::vector<uint32_t>& face_of,
+           const std::vector<hb_script_t>& script) {
+  const std::vector<FriBidiStrIndex>& map = order.map;
+  const size_t n = map.size();
+  const auto first = size_t(map[v]);
+  const FriBidiLevel level = order.levels[first];
+  const bool rtl = (level & 1) != 0;
+  size_t w = v + 1;
+  for (; w < n; ++w) {
+    const auto logical = size_t(map[w]);
+    const size_t expected = rtl ? size_t(map[w - 1]) - 1 : size_t(map[w - 1]) + 1;
+    if (logical != expected || order.levels[logical] != level ||
+        face_of[logical] != face_of[first] || script[logical] != script[first]) {
+      break;
+    }
+  }
+  return {rtl ? size_t(map[w - 1]) : first, w - v, rtl, face_of[first], script[first]};
+}
+
+// Shapes one run with HarfBuzz and appends its glyphs at `pen` (moved past them); characters no
+// face draws (glyph 0) are added to out.missing.
+void shape_run(hb_buffer_t* buffer, hb_font_t* font, const std::u32string& text, const Run& run,
+               glm::vec2& pen, ShapedLine& out) {
+  const size_t n = text.size();
+  hb_buffer_clear_contents(buffer);
+  // (the whole line is the context: shaping at a run's edge sees its neighbours)
+  hb_buffer_add_utf32(buffer, reinterpret_cast<const uint32_t*>(text.data()), int(n),
+                      unsigned(run.start), int(run.count));
+  hb_buffer_set_direction(buffer, run.rtl ? HB_DIRECTION_RTL : HB_DIRECTION_LTR);
+  hb_buffer_set_script(buffer, run.script);
+  hb_buffer_guess_segment_properties(buffer);  // (the language)
+  hb_shape(font, buffer, nullptr, 0);
+  unsigned glyphs = 0;
+  const hb_glyph_info_t* info = hb_buffer_get_glyph_infos(buffer, &glyphs);
+  const hb_glyph_position_t* position = hb_buffer_get_glyph_positions(buffer, &glyphs);
+  for (unsigned g = 0; g < glyphs; ++g) {
+    const glm::vec2 offset(float(position[g].x_offset) / 64.0f,
+                           -float(position[g].y_offset) / 64.0f);
+    out.glyphs.push_back({{run.face, info[g].codepoint}, pen + offset, info[g].cluster});
+    pen += glm::vec2(float(position[g].x_advance), -float(position[g].y_advance)) / 64.0f;
+    const char32_t c = info[g].cluster < n ? text[info[g].cluster] : kReplacement;
+    if (info[g].codepoint == 0 &&
+        std::find(out.missing.begin(), out.missing.end(), c) == out.missing.end()) {
+      out.missing.push_back(c);
+    }
+  }
+}
+
 }  // namespace
 
 ShapedLine Font::shape(std::string_view line, TextDirection direction) const {
@@ -227,108 +361,18 @@ ShapedLine Font::shape(std::string_view line, TextDirection direction) const {
     throw Error("font: a label line of " + std::to_string(n) + " characters (at most " +
                 std::to_string(kMaxLineCharacters) + ")");
   }
-  // The face of each character: the first that has it; a combining mark stays with its base's
-  // face when that face has the mark too; none has it: the main face (its missing-glyph box).
-  hb_unicode_funcs_t* unicode = hb_unicode_funcs_get_default();
-  std::vector<uint32_t> face_of(n, 0);
-  for (size_t i = 0; i < n; ++i) {
-    const bool mark = hb_unicode_general_category(unicode, text[i]) ==
-                      HB_UNICODE_GENERAL_CATEGORY_NON_SPACING_MARK;
-    if (mark && i > 0 && FT_Get_Char_Index(faces_->faces[face_of[i - 1]], text[i]) != 0) {
-      face_of[i] = face_of[i - 1];
-      continue;
-    }
-    for (uint32_t f = 0; f < faces_->faces.size(); ++f) {
-      if (FT_Get_Char_Index(faces_->faces[f], text[i]) != 0) {
-        face_of[i] = f;
-        break;
-      }
-    }
-  }
-  // The script of each character: spaces, digits, punctuation and marks (common, inherited) take
-  // the script before them, else the one after.
-  std::vector<hb_script_t> script(n, HB_SCRIPT_INVALID);
-  for (size_t i = 0; i < n; ++i) {
-    const hb_script_t s = hb_unicode_script(unicode, text[i]);
-    script[i] = real_script(s) ? s : i > 0 ? script[i - 1] : HB_SCRIPT_INVALID;
-  }
-  for (size_t i = n; i-- > 0;) {
-    if (script[i] == HB_SCRIPT_INVALID) script[i] = i + 1 < n ? script[i + 1] : HB_SCRIPT_COMMON;
-  }
-
-  // The bidirectional algorithm: embedding levels for the line as a paragraph of its own in
-  // `direction`, then the visual order (map[visual] = logical, trailing spaces at the
-  // paragraph's level). Marks are not moved after their bases (no FRIBIDI_FLAG_REORDER_NSM):
-  // HarfBuzz places them, shaping each right-to-left run in its own direction.
-  const auto length = static_cast<FriBidiStrIndex>(n);
-  const auto* chars = reinterpret_cast<const FriBidiChar*>(text.data());
-  std::vector<FriBidiCharType> types(n);
-  std::vector<FriBidiBracketType> brackets(n);
-  std::vector<FriBidiLevel> levels(n, 0);
-  std::vector<FriBidiStrIndex> map(n);
-  std::iota(map.begin(), map.end(), FriBidiStrIndex{0});
-  FriBidiParType base = direction == TextDirection::left_to_right   ? FRIBIDI_PAR_LTR
-                        : direction == TextDirection::right_to_left ? FRIBIDI_PAR_RTL
-                                                                    : FRIBIDI_PAR_ON;
-  if (n > 0) {
-    fribidi_get_bidi_types(chars, length, types.data());
-    fribidi_get_bracket_types(chars, length, types.data(), brackets.data());
-    if (fribidi_get_par_embedding_levels_ex(types.data(), brackets.data(), length, &base,
-                                            levels.data()) == 0 ||
-        fribidi_reorder_line(0, types.data(), length, 0, base, levels.data(), nullptr,
-                             map.data()) == 0) {
-      throw Error("font: FriBiDi could not order a label line of " + std::to_string(n) +
-                  " characters");
-    }
-  } else if (base == FRIBIDI_PAR_ON) {
-    base = FRIBIDI_PAR_LTR;
-  }
+  const std::vector<uint32_t> face_of = faces_of(text, faces_->faces);
+  const std::vector<hb_script_t> script = scripts_of(text);
+  const VisualOrder order = visual_order(text, direction);
 
   ShapedLine out;
-  out.right_to_left = FRIBIDI_IS_RTL(base);
+  out.right_to_left = FRIBIDI_IS_RTL(order.base);
   glm::vec2 pen(0.0f);
   hb_buffer_t* buffer = hb_buffer_create();
-  // Runs in visual order: characters next to each other in both orders, of one level, face and
-  // script.
-  for (size_t v = 0; v < n;) {
-    const auto first = size_t(map[v]);
-    const FriBidiLevel level = levels[first];
-    const bool rtl = (level & 1) != 0;
-    size_t w = v + 1;
-    for (; w < n; ++w) {
-      const auto logical = size_t(map[w]);
-      const size_t expected = rtl ? size_t(map[w - 1]) - 1 : size_t(map[w - 1]) + 1;
-      if (logical != expected || levels[logical] != level || face_of[logical] != face_of[first] ||
-          script[logical] != script[first]) {
-        break;
-      }
-    }
-    const size_t start = rtl ? size_t(map[w - 1]) : first;
-    const size_t count = w - v;
-    v = w;
-    const uint32_t face = face_of[first];
-    hb_buffer_clear_contents(buffer);
-    // (the whole line is the context: shaping at a run's edge sees its neighbours)
-    hb_buffer_add_utf32(buffer, reinterpret_cast<const uint32_t*>(text.data()), int(n),
-                        unsigned(start), int(count));
-    hb_buffer_set_direction(buffer, rtl ? HB_DIRECTION_RTL : HB_DIRECTION_LTR);
-    hb_buffer_set_script(buffer, script[first]);
-    hb_buffer_guess_segment_properties(buffer);  // (the language)
-    hb_shape(faces_->fonts[face], buffer, nullptr, 0);
-    unsigned glyphs = 0;
-    const hb_glyph_info_t* info = hb_buffer_get_glyph_infos(buffer, &glyphs);
-    const hb_glyph_position_t* position = hb_buffer_get_glyph_positions(buffer, &glyphs);
-    for (unsigned g = 0; g < glyphs; ++g) {
-      const glm::vec2 offset(float(position[g].x_offset) / 64.0f,
-                             -float(position[g].y_offset) / 64.0f);
-      out.glyphs.push_back({{face, info[g].codepoint}, pen + offset, info[g].cluster});
-      pen += glm::vec2(float(position[g].x_advance), -float(position[g].y_advance)) / 64.0f;
-      const char32_t c = info[g].cluster < n ? text[info[g].cluster] : kReplacement;
-      if (info[g].codepoint == 0 &&
-          std::find(out.missing.begin(), out.missing.end(), c) == out.missing.end()) {
-        out.missing.push_back(c);
-      }
-    }
+  for (size_t v = 0; v < n;) {  // (runs in visual order)
+    const Run run = run_at(v, order, face_of, script);
+    v += run.count;
+    shape_run(buffer, faces_->fonts[run.face], text, run, pen, out);
   }
   hb_buffer_destroy(buffer);
   // (the runs were visited in visual order; the missing characters are listed in logical order)

@@ -338,6 +338,104 @@ std::vector<DeviceReport> Instance::devices() const {
   return reports;
 }
 
+namespace {
+
+VkPhysicalDevice physical_device_at(VkInstance instance, uint32_t index) {
+  uint32_t count = 0;
+  vkEnumeratePhysicalDevices(instance, &count, nullptr);
+  std::vector<VkPhysicalDevice> handles(count);
+  vkEnumeratePhysicalDevices(instance, &count, handles.data());
+  return handles[index];
+}
+
+// The features strata needs, chained from `features`, with those of the optional extensions the
+// device has; the extensions to enable with them. Not copied: the chain points into it.
+struct DeviceFeatures {
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executables{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+  VkPhysicalDeviceConditionalRenderingFeaturesEXT conditional{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONDITIONAL_RENDERING_FEATURES_EXT};
+  std::vector<const char*> extensions = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+
+  DeviceFeatures(const DeviceCapabilities& caps, bool presentation, bool memory_budget) {
+    f13.synchronization2 = VK_TRUE;
+    f13.dynamicRendering = VK_TRUE;
+    f13.maintenance4 =
+        VK_TRUE;  // core in 1.3; SPIR-V 1.6 declares workgroup sizes with LocalSizeId
+    f12.pNext = &f13;
+    f12.shaderBufferInt64Atomics = VK_TRUE;
+    f12.shaderSharedInt64Atomics = VK_TRUE;
+    f12.timelineSemaphore = VK_TRUE;
+    features.pNext = &f12;
+    features.features.shaderInt64 = VK_TRUE;
+    features.features.fragmentStoresAndAtomics = VK_TRUE;
+    if (presentation) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+    if (memory_budget) extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    executables.pipelineExecutableInfo = VK_TRUE;
+    if (caps.pipeline_statistics) {
+      enable(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME, executables);
+    }
+    conditional.conditionalRendering = VK_TRUE;
+    if (caps.conditional_rendering)
+      enable(VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME, conditional);
+  }
+  DeviceFeatures(const DeviceFeatures&) = delete;
+  DeviceFeatures& operator=(const DeviceFeatures&) = delete;
+
+  // An optional extension the device has, its feature struct chained in.
+  template <class Feature>
+  void enable(const char* extension, Feature& feature) {
+    extensions.push_back(extension);
+    feature.pNext = f13.pNext;
+    f13.pNext = &feature;
+  }
+};
+
+struct DeviceQueues {
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;            // the frames'
+  VkQueue placement_queue = VK_NULL_HANDLE;  // the placement's beside them (or the frames')
+  uint32_t placement_family = 0;
+};
+
+// The placement beside the frames gets a queue of a compute-only family (asynchronous compute)
+// or else a second one of the frames' family, where the device has either (the frames' queue
+// first: the placement may wait, the picture not).
+DeviceQueues create_device(VkPhysicalDevice physical, uint32_t family,
+                           const DeviceFeatures& features) {
+  DeviceQueues out;
+  const float priorities[] = {1.0f, 0.5f};
+  const int compute = compute_only_family(physical);
+  out.placement_family = compute >= 0 ? uint32_t(compute) : family;
+  VkDeviceQueueCreateInfo queues[2] = {{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO},
+                                       {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO}};
+  queues[0].queueFamilyIndex = family;
+  queues[0].queueCount = compute < 0 && queue_count(physical, family) >= 2 ? 2 : 1;
+  queues[0].pQueuePriorities = priorities;
+  queues[1].queueFamilyIndex = out.placement_family;
+  queues[1].queueCount = 1;
+  queues[1].pQueuePriorities = priorities + 1;
+  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features.features};
+  info.queueCreateInfoCount = compute >= 0 ? 2 : 1;
+  info.pQueueCreateInfos = queues;
+  info.enabledExtensionCount = static_cast<uint32_t>(features.extensions.size());
+  info.ppEnabledExtensionNames = features.extensions.data();
+  STRATA_VK(vkCreateDevice(physical, &info, nullptr, &out.device));
+  vkGetDeviceQueue(out.device, family, 0, &out.queue);
+  out.placement_queue = out.queue;
+  if (compute >= 0) {
+    vkGetDeviceQueue(out.device, out.placement_family, 0, &out.placement_queue);
+  } else if (queues[0].queueCount == 2) {
+    vkGetDeviceQueue(out.device, family, 1, &out.placement_queue);
+  }
+  return out;
+}
+
+}  // namespace
+
 Context::Context(const ContextOptions& options)
     : instance_(options.validation, options.instance_extensions) {
   std::string selector = options.device_selector;
@@ -347,11 +445,7 @@ Context::Context(const ContextOptions& options)
   const std::vector<DeviceReport> reports = instance_.devices();
   const uint32_t index = choose_device(reports, selector);
   report_ = reports[index];
-  uint32_t count = 0;
-  vkEnumeratePhysicalDevices(instance_.handle(), &count, nullptr);
-  std::vector<VkPhysicalDevice> handles(count);
-  vkEnumeratePhysicalDevices(instance_.handle(), &count, handles.data());
-  physical_ = handles[index];
+  physical_ = physical_device_at(instance_.handle(), index);
   VkPhysicalDeviceVulkan13Properties p13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES};
   VkPhysicalDeviceVulkan11Properties p11{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES,
                                          &p13};
@@ -369,68 +463,13 @@ Context::Context(const ContextOptions& options)
                  to_string(report_.type));
   }
 
-  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
-  f13.synchronization2 = VK_TRUE;
-  f13.dynamicRendering = VK_TRUE;
-  f13.maintenance4 = VK_TRUE;  // core in 1.3; SPIR-V 1.6 declares workgroup sizes with LocalSizeId
-  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
-  f12.shaderBufferInt64Atomics = VK_TRUE;
-  f12.shaderSharedInt64Atomics = VK_TRUE;
-  f12.timelineSemaphore = VK_TRUE;
-  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
-  features.features.shaderInt64 = VK_TRUE;
-  features.features.fragmentStoresAndAtomics = VK_TRUE;
-
-  std::vector<const char*> extensions = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
-  if (options.presentation) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
   memory_budget_ = has_device_extension(physical_, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
-  if (memory_budget_) extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
-  // Optional extensions the device has: each with its feature struct chained in.
-  const auto enable = [&](const char* extension, auto& feature) {
-    extensions.push_back(extension);
-    feature.pNext = f13.pNext;
-    f13.pNext = &feature;
-  };
-  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR executables{
-      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
-  executables.pipelineExecutableInfo = VK_TRUE;
-  if (report_.caps.pipeline_statistics) {
-    enable(VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME, executables);
-  }
-  VkPhysicalDeviceConditionalRenderingFeaturesEXT conditional{
-      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_CONDITIONAL_RENDERING_FEATURES_EXT};
-  conditional.conditionalRendering = VK_TRUE;
-  if (report_.caps.conditional_rendering) {
-    enable(VK_EXT_CONDITIONAL_RENDERING_EXTENSION_NAME, conditional);
-  }
-
-  // The placement beside the frames gets a queue of a compute-only family (asynchronous compute)
-  // or else a second one of the frames' family, where the device has either (the frames' queue
-  // first: the placement may wait, the picture not).
-  const float priorities[] = {1.0f, 0.5f};
-  const int compute = compute_only_family(physical_);
-  placement_family_ = compute >= 0 ? uint32_t(compute) : queue_family_;
-  VkDeviceQueueCreateInfo queues[2] = {{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO},
-                                       {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO}};
-  queues[0].queueFamilyIndex = queue_family_;
-  queues[0].queueCount = compute < 0 && queue_count(physical_, queue_family_) >= 2 ? 2 : 1;
-  queues[0].pQueuePriorities = priorities;
-  queues[1].queueFamilyIndex = placement_family_;
-  queues[1].queueCount = 1;
-  queues[1].pQueuePriorities = priorities + 1;
-  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features};
-  info.queueCreateInfoCount = compute >= 0 ? 2 : 1;
-  info.pQueueCreateInfos = queues;
-  info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
-  info.ppEnabledExtensionNames = extensions.data();
-  STRATA_VK(vkCreateDevice(physical_, &info, nullptr, &device_));
-  vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
-  placement_queue_ = queue_;
-  if (compute >= 0) {
-    vkGetDeviceQueue(device_, placement_family_, 0, &placement_queue_);
-  } else if (queues[0].queueCount == 2) {
-    vkGetDeviceQueue(device_, queue_family_, 1, &placement_queue_);
-  }
+  const DeviceFeatures features(report_.caps, options.presentation, memory_budget_);
+  const DeviceQueues queues = create_device(physical_, queue_family_, features);
+  device_ = queues.device;
+  queue_ = queues.queue;
+  placement_queue_ = queues.placement_queue;
+  placement_family_ = queues.placement_family;
 
   VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   pool.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;

@@ -58,22 +58,14 @@ VkDeviceSize image_bytes(const ImageDesc& d) {
          texel_size(d.format);
 }
 
-// Makes the copies' writes so far visible to `stage`'s `access`.
-void copied_barrier(VkCommandBuffer cmd, VkPipelineStageFlags2 stage, VkAccessFlags2 access) {
-  VkMemoryBarrier2 copied{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-  copied.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-  copied.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-  copied.dstStageMask = stage;
-  copied.dstAccessMask = access;
-  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dep.memoryBarrierCount = 1;
-  dep.pMemoryBarriers = &copied;
-  vkCmdPipelineBarrier2(cmd, &dep);
+// Makes the copies' writes so far visible to `dst`.
+void copied_barrier(VkCommandBuffer cmd, SyncScope dst) {
+  record_memory_barrier(cmd, {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT}, dst);
 }
 
 // Makes a copy's writes visible to the host that reads the staging buffer after the fence.
 void copy_to_host_barrier(VkCommandBuffer cmd) {
-  copied_barrier(cmd, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+  copied_barrier(cmd, {VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT});
 }
 
 }  // namespace
@@ -236,6 +228,64 @@ void record_update(VkCommandBuffer cmd, VkBuffer buffer, VkDeviceSize offset,
   }
 }
 
+namespace {
+
+// Vulkan's barrier structs share the fields of the two scopes.
+template <class Barrier>
+Barrier scoped(Barrier barrier, SyncScope src, SyncScope dst) {
+  barrier.srcStageMask = src.stage;
+  barrier.srcAccessMask = src.access;
+  barrier.dstStageMask = dst.stage;
+  barrier.dstAccessMask = dst.access;
+  return barrier;
+}
+
+}  // namespace
+
+VkImageSubresourceRange whole_image(VkFormat format, uint32_t layers) {
+  return {aspect_of(format), 0, 1, 0, layers};
+}
+
+VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange& range,
+                                    VkImageLayout from, VkImageLayout to, SyncScope src,
+                                    SyncScope dst) {
+  VkImageMemoryBarrier2 barrier =
+      scoped(VkImageMemoryBarrier2{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2}, src, dst);
+  barrier.oldLayout = from;
+  barrier.newLayout = to;
+  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.image = image;
+  barrier.subresourceRange = range;
+  return barrier;
+}
+
+VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, SyncScope src, SyncScope dst) {
+  VkBufferMemoryBarrier2 barrier =
+      scoped(VkBufferMemoryBarrier2{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2}, src, dst);
+  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.buffer = buffer;
+  barrier.size = VK_WHOLE_SIZE;
+  return barrier;
+}
+
+void record_barriers(VkCommandBuffer cmd, std::span<const VkImageMemoryBarrier2> images,
+                     std::span<const VkBufferMemoryBarrier2> buffers) {
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.bufferMemoryBarrierCount = static_cast<uint32_t>(buffers.size());
+  dep.pBufferMemoryBarriers = buffers.data();
+  dep.imageMemoryBarrierCount = static_cast<uint32_t>(images.size());
+  dep.pImageMemoryBarriers = images.data();
+  vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+void record_memory_barrier(VkCommandBuffer cmd, SyncScope src, SyncScope dst) {
+  const VkMemoryBarrier2 memory = scoped(VkMemoryBarrier2{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2}, src, dst);
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.memoryBarrierCount = 1;
+  dep.pMemoryBarriers = &memory;
+  vkCmdPipelineBarrier2(cmd, &dep);
+}
+
 uint32_t texel_size(VkFormat format) {
   switch (format) {
     case VK_FORMAT_R8G8B8A8_UNORM:
@@ -264,22 +314,10 @@ uint32_t texel_size(VkFormat format) {
 namespace {
 
 void transition(VkCommandBuffer cmd, VkImage image, const ImageDesc& desc, VkImageLayout from,
-                VkImageLayout to, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) {
-  VkImageMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  barrier.srcStageMask = src_stage;
-  barrier.srcAccessMask = src_access;
-  barrier.dstStageMask = dst_stage;
-  barrier.dstAccessMask = dst_access;
-  barrier.oldLayout = from;
-  barrier.newLayout = to;
-  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  barrier.image = image;
-  barrier.subresourceRange = {aspect_of(desc.format), 0, 1, 0, desc.layers};
-  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dep.imageMemoryBarrierCount = 1;
-  dep.pImageMemoryBarriers = &barrier;
-  vkCmdPipelineBarrier2(cmd, &dep);
+                VkImageLayout to, SyncScope src, SyncScope dst) {
+  const VkImageMemoryBarrier2 barrier =
+      image_barrier(image, whole_image(desc.format, desc.layers), from, to, src, dst);
+  record_barriers(cmd, {&barrier, 1});
 }
 
 Buffer staged(Context& ctx, std::span<const std::byte> data) {
@@ -321,18 +359,18 @@ void Uploads::record(VkCommandBuffer cmd) const {
     }
     // (a new image: it starts undefined, and is handed to every later stage in final_layout)
     transition(cmd, item.image, item.desc, VK_IMAGE_LAYOUT_UNDEFINED,
-               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
-               VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, {},
+               {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT});
     VkBufferImageCopy region{};
     region.imageSubresource = {aspect_of(item.desc.format), 0, 0, item.desc.layers};
     region.imageExtent = item.desc.extent;
     vkCmdCopyBufferToImage(cmd, item.staging.handle(), item.image,
                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
     transition(cmd, item.image, item.desc, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, item.final_layout,
-               VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-               VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+               {VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT},
+               {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT});
   }
-  copied_barrier(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+  copied_barrier(cmd, {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT});
 }
 
 void upload(Context& ctx, const Buffer& dst, std::span<const std::byte> data) {

@@ -80,6 +80,28 @@ class Image {
   ImageDesc desc_;
 };
 
+// ---- barriers: the one place where a dependency becomes Vulkan's (the render graph's and the
+// uploads' alike)
+
+// One side of a dependency: the stages and the accesses of them.
+struct SyncScope {
+  VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
+  VkAccessFlags2 access = VK_ACCESS_2_NONE;
+};
+
+// The first mip's `layers` layers of an image of this format, depth or colour.
+VkImageSubresourceRange whole_image(VkFormat format, uint32_t layers);
+VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange& range,
+                                    VkImageLayout from, VkImageLayout to, SyncScope src,
+                                    SyncScope dst);
+// The whole buffer.
+VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, SyncScope src, SyncScope dst);
+// Records the barriers as one vkCmdPipelineBarrier2.
+void record_barriers(VkCommandBuffer cmd, std::span<const VkImageMemoryBarrier2> images,
+                     std::span<const VkBufferMemoryBarrier2> buffers = {});
+// Records a global memory barrier.
+void record_memory_barrier(VkCommandBuffer cmd, SyncScope src, SyncScope dst);
+
 // Bytes per texel of the colour formats strata uses; throws for others.
 uint32_t texel_size(VkFormat format);
 

@@ -272,6 +272,35 @@ std::vector<ComputePipeline> create_compute_pipelines(Context& ctx,
   return out;
 }
 
+namespace {
+
+VkPipelineShaderStageCreateInfo shader_stage(VkShaderStageFlagBits stage, VkShaderModule module) {
+  VkPipelineShaderStageCreateInfo info{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  info.stage = stage;
+  info.module = module;
+  info.pName = "main";
+  return info;
+}
+
+// Every colour attachment written whole; with state.blend, premultiplied "over".
+std::vector<VkPipelineColorBlendAttachmentState> blend_attachments(const GraphicsState& state) {
+  std::vector<VkPipelineColorBlendAttachmentState> attachments(state.color_formats.size());
+  for (auto& a : attachments) {
+    a.blendEnable = state.blend;
+    a.srcColorBlendFactor = VK_BLEND_FACTOR_ONE;
+    a.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    a.colorBlendOp = VK_BLEND_OP_ADD;
+    a.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    a.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+    a.alphaBlendOp = VK_BLEND_OP_ADD;
+    a.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                       VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+  }
+  return attachments;
+}
+
+}  // namespace
+
 GraphicsPipeline::GraphicsPipeline(Context& ctx, std::string_view vertex_shader,
                                    std::string_view fragment_shader, const GraphicsState& state)
     : Pipeline(ctx, std::string(vertex_shader) + "+" + std::string(fragment_shader),
@@ -283,15 +312,9 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, std::string_view vertex_shader,
                VK_PIPELINE_BIND_POINT_GRAPHICS) {
   VkShaderModule vertex = create_module(shader_code(vertex_shader));
   VkShaderModule fragment = create_module(shader_code(fragment_shader));
-  VkPipelineShaderStageCreateInfo stages[2] = {
-      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
-      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
-  stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
-  stages[0].module = vertex;
-  stages[0].pName = "main";
-  stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
-  stages[1].module = fragment;
-  stages[1].pName = "main";
+  const VkPipelineShaderStageCreateInfo stages[2] = {
+      shader_stage(VK_SHADER_STAGE_VERTEX_BIT, vertex),
+      shader_stage(VK_SHADER_STAGE_FRAGMENT_BIT, fragment)};
 
   VkPipelineVertexInputStateCreateInfo vertex_input{
       VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
@@ -312,18 +335,7 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, std::string_view vertex_shader,
   multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
   VkPipelineDepthStencilStateCreateInfo depth{
       VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
-  std::vector<VkPipelineColorBlendAttachmentState> attachments(state.color_formats.size());
-  for (auto& a : attachments) {
-    a.blendEnable = state.blend;
-    a.srcColorBlendFactor = VK_BLEND_FACTOR_ONE;
-    a.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
-    a.colorBlendOp = VK_BLEND_OP_ADD;
-    a.srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
-    a.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
-    a.alphaBlendOp = VK_BLEND_OP_ADD;
-    a.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
-                       VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
-  }
+  const std::vector<VkPipelineColorBlendAttachmentState> attachments = blend_attachments(state);
   VkPipelineColorBlendStateCreateInfo blend{
       VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
   blend.attachmentCount = static_cast<uint32_t>(attachments.size());

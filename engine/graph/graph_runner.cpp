@@ -108,36 +108,32 @@ void PassContext::record_barrier(bool predicates) {
     throw GraphError("pass '" + pass.name +
                      "' asks for a barrier between its commands, but it is " + "a graphics pass");
   }
-  VkMemoryBarrier2 memory{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+  SyncScope src, dst;
   if (pass.kind == PassKind::compute) {
-    memory.srcStageMask = memory.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-    memory.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-    memory.dstAccessMask =
-        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+    src = {VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT};
+    dst = {VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+           VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT};
   } else {  // transfer: copies and fills that overwrite or read what the pass wrote before
-    memory.srcStageMask = memory.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
-    memory.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    memory.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    src = {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};
+    dst = {VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+           VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT};
   }
   bool declared_predicates = false;
   for (const ResourceUse& u : pass.uses) {
     declared_predicates = declared_predicates || u.use == Use::conditional;
     if (u.use != Use::indirect) continue;
-    memory.dstStageMask |= VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
-    memory.dstAccessMask |= VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT;
+    dst.stage |= VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
+    dst.access |= VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT;
   }
   if (predicates) {
     if (!declared_predicates) {
       throw GraphError("pass '" + pass.name +
                        "' asks for a barrier before predicates, but declared none conditional");
     }
-    memory.dstStageMask |= VK_PIPELINE_STAGE_2_CONDITIONAL_RENDERING_BIT_EXT;
-    memory.dstAccessMask |= VK_ACCESS_2_CONDITIONAL_RENDERING_READ_BIT_EXT;
+    dst.stage |= VK_PIPELINE_STAGE_2_CONDITIONAL_RENDERING_BIT_EXT;
+    dst.access |= VK_ACCESS_2_CONDITIONAL_RENDERING_READ_BIT_EXT;
   }
-  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dep.memoryBarrierCount = 1;
-  dep.pMemoryBarriers = &memory;
-  vkCmdPipelineBarrier2(cmd, &dep);
+  record_memory_barrier(cmd, src, dst);
 }
 
 void PassContext::bind(const Pipeline& pipeline) {
@@ -245,18 +241,12 @@ void GraphRunner::set_viewport(Extent viewport) {
 // A new kept image, empty, in the layout every run expects it in.
 void GraphRunner::put_in_layout(const Image& image, VkImageLayout layout) {
   ctx_.run_now([&](VkCommandBuffer cmd) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-    b.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    b.newLayout = layout;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image.handle();
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, VK_REMAINING_ARRAY_LAYERS};
-    VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dependency.imageMemoryBarrierCount = 1;
-    dependency.pImageMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dependency);
+    const VkImageMemoryBarrier2 b =
+        image_barrier(image.handle(), whole_image(image.desc().format, VK_REMAINING_ARRAY_LAYERS),
+                      VK_IMAGE_LAYOUT_UNDEFINED, layout, {},
+                      {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                       VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT});
+    record_barriers(cmd, {&b, 1});
   });
 }
 
@@ -302,38 +292,15 @@ void GraphRunner::emit(VkCommandBuffer cmd, std::span<const Barrier> barriers) c
   std::vector<VkImageMemoryBarrier2> images;
   for (const Barrier& b : barriers) {
     const Bound& r = bound_[b.resource];
+    const SyncScope src{b.src_stage, b.src_access}, dst{b.dst_stage, b.dst_access};
     if (b.is_image) {
-      VkImageMemoryBarrier2 ib{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-      ib.srcStageMask = b.src_stage;
-      ib.srcAccessMask = b.src_access;
-      ib.dstStageMask = b.dst_stage;
-      ib.dstAccessMask = b.dst_access;
-      ib.oldLayout = b.old_layout;
-      ib.newLayout = b.new_layout;
-      ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      ib.image = r.image;
-      const VkImageAspectFlags aspect =
-          r.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
-      ib.subresourceRange = {aspect, 0, 1, 0, VK_REMAINING_ARRAY_LAYERS};
-      images.push_back(ib);
+      images.push_back(image_barrier(r.image, whole_image(r.format, VK_REMAINING_ARRAY_LAYERS),
+                                     b.old_layout, b.new_layout, src, dst));
     } else {
-      VkBufferMemoryBarrier2 bb{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-      bb.srcStageMask = b.src_stage;
-      bb.srcAccessMask = b.src_access;
-      bb.dstStageMask = b.dst_stage;
-      bb.dstAccessMask = b.dst_access;
-      bb.srcQueueFamilyIndex = bb.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      bb.buffer = r.buffer;
-      bb.size = VK_WHOLE_SIZE;
-      buffers.push_back(bb);
+      buffers.push_back(buffer_barrier(r.buffer, src, dst));
     }
   }
-  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dep.bufferMemoryBarrierCount = static_cast<uint32_t>(buffers.size());
-  dep.pBufferMemoryBarriers = buffers.data();
-  dep.imageMemoryBarrierCount = static_cast<uint32_t>(images.size());
-  dep.pImageMemoryBarriers = images.data();
-  vkCmdPipelineBarrier2(cmd, &dep);
+  record_barriers(cmd, images, buffers);
 }
 
 void GraphRunner::check_bound() const {
@@ -404,14 +371,9 @@ void GraphRunner::record_passes(VkCommandBuffer cmd, PassId first, PassId end, u
     // Frames share the transient resources and follow each other on the queue: everything the
     // earlier frames did is done and visible before this one starts (compile() orders the passes
     // inside one frame only).
-    VkMemoryBarrier2 all{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-    all.srcStageMask = all.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-    all.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
-    all.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.memoryBarrierCount = 1;
-    dep.pMemoryBarriers = &all;
-    vkCmdPipelineBarrier2(cmd, &dep);
+    record_memory_barrier(cmd, {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT},
+                          {VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                           VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT});
   }
   if (first == 0) {
     slot_uploads_.resize(queries_.size());

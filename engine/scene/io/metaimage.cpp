@@ -20,38 +20,13 @@ namespace {
 using namespace volume_io;
 namespace fs = std::filesystem;
 
-// Headers are a few hundred bytes; a megabyte without ElementDataFile is not a header.
-constexpr size_t max_header_bytes = 1 << 20;
-
-struct MetaHeader {
-  fs::path path;
-  std::vector<std::pair<std::string, std::string>> fields;  // lowercase key, value
-  uint64_t data_offset = 0;  // where LOCAL data starts: after the ElementDataFile line
-
-  // The value of the first of the given keys (MetaIO's synonyms) that is present.
-  std::optional<std::string_view> get(std::initializer_list<std::string_view> keys) const {
-    for (std::string_view key : keys)
-      for (const auto& [name, value] : fields)
-        if (name == lowercase(key)) return value;
-    return std::nullopt;
-  }
-  std::string_view require(std::string_view key) const {
-    const auto value = get({key});
-    if (!value) fail(path, concat("no ", key, " field"));
-    return *value;
-  }
-};
-
-MetaHeader parse_header(const fs::path& path) {
-  MetaHeader header{.path = path};
-  const std::string text = read_prefix(path, max_header_bytes);
+TextHeader parse_header(const fs::path& path) {
+  TextHeader header{.path = path};
+  const std::string text = read_prefix(path, max_text_header_bytes);
   size_t pos = 0;
   for (int line_number = 1; pos < text.size(); ++line_number) {
-    size_t end = text.find('\n', pos);
-    const bool complete = end != std::string::npos;
-    if (!complete) end = text.size();
-    const std::string_view line = trim(std::string_view(text).substr(pos, end - pos));
-    pos = complete ? end + 1 : end;
+    const auto [raw, complete] = next_line(text, pos);
+    const std::string_view line = trim(raw);
     for (char c : line)
       if ((static_cast<unsigned char>(c) < 32 && c != '\t') || c == 127)
         fail(path, concat("not a MetaImage header: line ", line_number, " holds binary data"));
@@ -81,18 +56,18 @@ bool parse_bool(const fs::path& path, std::string_view field, std::string_view v
   fail(path, concat(field, " = ", value, ": expected True or False"));
 }
 
-void check_image_kind(const MetaHeader& header) {
+void check_image_kind(const TextHeader& header) {
   const fs::path& path = header.path;
-  if (const auto type = header.get({"ObjectType"}); type && lowercase(*type) != "image")
+  if (const auto type = header.get("ObjectType"); type && lowercase(*type) != "image")
     fail(path, concat("ObjectType = ", *type, ": only Image is supported"));
-  if (const auto channels = header.get({"ElementNumberOfChannels"}); channels && *channels != "1")
+  if (const auto channels = header.get("ElementNumberOfChannels"); channels && *channels != "1")
     fail(path, concat("ElementNumberOfChannels = ", *channels, ": only 1 is supported"));
-  if (const auto binary = header.get({"BinaryData"});
+  if (const auto binary = header.get("BinaryData");
       binary && !parse_bool(path, "BinaryData", *binary))
     fail(path, "BinaryData = False: ASCII data is not supported");
 }
 
-StoredType element_type(const MetaHeader& header) {
+StoredType element_type(const TextHeader& header) {
   const std::string_view name = header.require("ElementType");
   if (name == "MET_UCHAR") return StoredType::uint8;
   if (name == "MET_SHORT") return StoredType::int16;
@@ -103,7 +78,7 @@ StoredType element_type(const MetaHeader& header) {
                            "MET_FLOAT)"));
 }
 
-int dimensions(const MetaHeader& header) {
+int dimensions(const TextHeader& header) {
   const std::string_view ndims = trim(header.require("NDims"));
   if (ndims != "2" && ndims != "3" && ndims != "4")
     fail(header.path, concat("NDims = ", ndims, ": expected 2, 3 or 4 (a 2-D, 3-D or 4-D image)"));
@@ -111,7 +86,7 @@ int dimensions(const MetaHeader& header) {
 }
 
 // A per-axis field's n numbers (n = NDims, or NDims² for the matrix).
-std::vector<float> numbers_of(const MetaHeader& header, std::string_view field,
+std::vector<float> numbers_of(const TextHeader& header, std::string_view field,
                               std::string_view text, size_t n) {
   std::vector<float> values = parse_numbers<float>(header.path, field, text);
   if (values.size() != n)
@@ -120,20 +95,20 @@ std::vector<float> numbers_of(const MetaHeader& header, std::string_view field,
   return values;
 }
 
-void set_geometry(Volume& volume, const MetaHeader& header, int ndims) {
+void set_geometry(Volume& volume, const TextHeader& header, int ndims) {
   const fs::path& path = header.path;
   const size_t n = size_t(ndims), spatial = std::min<size_t>(n, 3);
-  if (const auto text = header.get({"ElementSpacing", "ElementSize"})) {
+  if (const auto text = header.first_of({"ElementSpacing", "ElementSize"})) {
     const auto s = numbers_of(header, "ElementSpacing", *text, n);
     for (size_t axis = 0; axis < spatial; ++axis) volume.spacing[int(axis)] = s[axis];
     check_spacing(path, "ElementSpacing", {volume.spacing.x, volume.spacing.y, volume.spacing.z},
                   "ElementSpacing", 0);
   }
-  if (const auto text = header.get({"Offset", "Position", "Origin"})) {
+  if (const auto text = header.first_of({"Offset", "Position", "Origin"})) {
     const auto o = numbers_of(header, "Offset", *text, n);
     for (size_t axis = 0; axis < spatial; ++axis) volume.origin[int(axis)] = o[axis];
   }
-  if (const auto text = header.get({"TransformMatrix", "Rotation", "Orientation"})) {
+  if (const auto text = header.first_of({"TransformMatrix", "Rotation", "Orientation"})) {
     const auto m = numbers_of(header, "TransformMatrix", *text, n * n);
     for (size_t axis = 0; axis < spatial; ++axis)
       for (size_t row = 0; row < spatial; ++row)
@@ -141,12 +116,12 @@ void set_geometry(Volume& volume, const MetaHeader& header, int ndims) {
   }
 }
 
-InputFile::Source data_source(const MetaHeader& header, uint64_t bytes) {
+InputFile::Source data_source(const TextHeader& header, uint64_t bytes) {
   const fs::path& path = header.path;
   InputFile::Source source{.file = path, .report_as = path};
-  if (const auto text = header.get({"CompressedData"}))
+  if (const auto text = header.get("CompressedData"))
     source.compressed = parse_bool(path, "CompressedData", *text);
-  if (const auto text = header.get({"CompressedDataSize"}); text && source.compressed)
+  if (const auto text = header.get("CompressedDataSize"); text && source.compressed)
     source.compressed_size = parse_exactly<uint64_t, 1>(path, "CompressedDataSize", *text)[0];
 
   const std::string name(header.require("ElementDataFile"));
@@ -160,7 +135,7 @@ InputFile::Source data_source(const MetaHeader& header, uint64_t bytes) {
   source.file = path.parent_path() / name;
   source.what = concat("ElementDataFile '", name, "'");
   const uint64_t size = data_file_size(path, source.what, source.file);
-  if (const auto text = header.get({"HeaderSize"})) {
+  if (const auto text = header.get("HeaderSize")) {
     const int64_t skip = parse_exactly<int64_t, 1>(path, "HeaderSize", *text)[0];
     // -1 means "the data is at the end of the file, after a header of unknown size".
     if (skip == -1 && !source.compressed) source.offset = size >= bytes ? size - bytes : 0;
@@ -248,7 +223,7 @@ void write_data(AtomicFile& out, const Volume& volume, bool compress, const fs::
 Volume load_metaimage(const std::filesystem::path& path, const VolumeReadOptions& options,
                       std::vector<std::string>& warnings) {
   existing_file_size(path);
-  const MetaHeader header = parse_header(path);
+  const TextHeader header = parse_header(path);
   check_image_kind(header);
   const int ndims = dimensions(header);
   const StoredType stored = element_type(header);
@@ -276,7 +251,7 @@ Volume load_metaimage(const std::filesystem::path& path, const VolumeReadOptions
     volume.direction[2] = glm::normalize(glm::cross(volume.direction[0], volume.direction[1]));
   check_geometry(path, "Offset", "TransformMatrix", volume);
   bool big_endian = false;
-  if (const auto msb = header.get({"BinaryDataByteOrderMSB", "ElementByteOrderMSB"}))
+  if (const auto msb = header.first_of({"BinaryDataByteOrderMSB", "ElementByteOrderMSB"}))
     big_endian = parse_bool(path, "BinaryDataByteOrderMSB", *msb);
 
   InputFile in(data_source(header, all_frames_bytes));

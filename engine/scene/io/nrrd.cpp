@@ -16,29 +16,9 @@ namespace {
 using namespace volume_io;
 namespace fs = std::filesystem;
 
-constexpr size_t max_header_bytes = 1 << 20;
-
-struct NrrdHeader {
-  fs::path path;
-  std::vector<std::pair<std::string, std::string>> fields;  // lowercase field name, value
-  bool attached = false;     // a blank line ended the header: the data follows it
-  uint64_t data_offset = 0;  // just after that blank line
-
-  std::optional<std::string_view> get(std::string_view field) const {
-    for (const auto& [name, value] : fields)
-      if (name == field) return value;
-    return std::nullopt;
-  }
-  std::string_view require(std::string_view field) const {
-    const auto value = get(field);
-    if (!value) fail(path, concat("no '", field, "' field"));
-    return *value;
-  }
-  std::optional<std::string_view> data_file() const {
-    if (auto name = get("data file")) return name;
-    return get("datafile");
-  }
-};
+std::optional<std::string_view> data_file(const TextHeader& header) {
+  return header.first_of({"data file", "datafile"});
+}
 
 void check_magic(const fs::path& path, const std::string& text) {
   const std::string_view first = std::string_view(text).substr(0, text.find('\n'));
@@ -49,21 +29,17 @@ void check_magic(const fs::path& path, const std::string& text) {
                       "' (expected NRRD0001 to NRRD0005)"));
 }
 
-NrrdHeader parse_header(const fs::path& path) {
-  NrrdHeader header{.path = path};
-  const std::string text = read_prefix(path, max_header_bytes);
+TextHeader parse_header(const fs::path& path) {
+  TextHeader header{.path = path, .quote_names = true};
+  const std::string text = read_prefix(path, max_text_header_bytes);
   check_magic(path, text);
   size_t pos = text.find('\n') + 1;
+  bool attached = false;      // a blank line ended the header: the data follows it
   std::string bad_last_line;  // an unfinished last line that is not a field: cut off?
   for (int line_number = 2; pos < text.size(); ++line_number) {
-    size_t end = text.find('\n', pos);
-    const bool complete = end != std::string::npos;
-    if (!complete) end = text.size();
-    std::string_view line = std::string_view(text).substr(pos, end - pos);
-    if (line.ends_with('\r')) line.remove_suffix(1);
-    pos = complete ? end + 1 : end;
+    const auto [line, complete] = next_line(text, pos);
     if (line.empty()) {
-      header.attached = true;
+      attached = true;
       header.data_offset = pos;
       break;
     }
@@ -79,15 +55,16 @@ NrrdHeader parse_header(const fs::path& path) {
     header.fields.emplace_back(lowercase(trim(line.substr(0, colon))),
                                std::string(trim(line.substr(colon + 2))));
   }
-  if (!header.attached && !header.data_file()) {
-    if (text.size() == max_header_bytes) fail(path, "no blank line ends the header in its 1 MiB");
+  if (!attached && !data_file(header)) {
+    if (text.size() == max_text_header_bytes)
+      fail(path, "no blank line ends the header in its 1 MiB");
     fail(path, "header is truncated: no blank line ends it and it names no data file");
   }
   if (!bad_last_line.empty()) fail(path, bad_last_line);
   return header;
 }
 
-StoredType element_type(const NrrdHeader& header) {
+StoredType element_type(const TextHeader& header) {
   const std::string type = lowercase(header.require("type"));
   for (const char* name : {"uchar", "unsigned char", "uint8", "uint8_t"})
     if (type == name) return StoredType::uint8;
@@ -135,7 +112,7 @@ glm::dvec3 vector_in_space(const fs::path& path, std::string_view field, std::st
 
 // How many numbers a vector has: "space dimension", or 3 for a named space (all of NRRD's named
 // spaces are 3-D). A 2-D space (ITK writes one for 2-D images) holds only a 2-D image.
-int space_dimension(const NrrdHeader& header, int rank) {
+int space_dimension(const TextHeader& header, int rank) {
   const fs::path& path = header.path;
   const auto text = header.get("space dimension");
   if (!text) return 3;
@@ -152,7 +129,7 @@ int space_dimension(const NrrdHeader& header, int rank) {
 }
 
 // Signs that take coordinates of the header's "space" to LPS+.
-glm::dvec3 to_lps(const NrrdHeader& header) {
+glm::dvec3 to_lps(const TextHeader& header) {
   const auto space = header.get("space");
   if (!space) return glm::dvec3(1.0);
   const std::string name = lowercase(*space);
@@ -174,7 +151,7 @@ struct Extent {
 
 // A 4-D image is read a frame at a time only when its frames are stored one after the other: the
 // non-spatial axis ("none" in space directions, a kind other than domain or space) must be last.
-void check_frames_last(const NrrdHeader& header) {
+void check_frames_last(const TextHeader& header) {
   const auto kinds = header.get("kinds");
   if (!kinds) return;
   std::istringstream words{std::string(*kinds)};
@@ -187,7 +164,7 @@ void check_frames_last(const NrrdHeader& header) {
                                "one (time)"));
 }
 
-Extent image_extent(const NrrdHeader& header) {
+Extent image_extent(const TextHeader& header) {
   const fs::path& path = header.path;
   const std::string_view dimension = trim(header.require("dimension"));
   Extent e;
@@ -212,7 +189,7 @@ Extent image_extent(const NrrdHeader& header) {
   return e;
 }
 
-void set_direction(Volume& volume, const NrrdHeader& header, int rank, std::string_view text) {
+void set_direction(Volume& volume, const TextHeader& header, int rank, std::string_view text) {
   const fs::path& path = header.path;
   const glm::dvec3 signs = to_lps(header);
   const int space = space_dimension(header, rank);
@@ -240,7 +217,7 @@ void set_direction(Volume& volume, const NrrdHeader& header, int rank, std::stri
     volume.direction[2] = glm::normalize(glm::cross(volume.direction[0], volume.direction[1]));
 }
 
-void set_geometry(Volume& volume, const NrrdHeader& header, int rank) {
+void set_geometry(Volume& volume, const TextHeader& header, int rank) {
   const fs::path& path = header.path;
   if (const auto text = header.get("space directions")) {
     set_direction(volume, header, rank, *text);
@@ -262,30 +239,30 @@ void set_geometry(Volume& volume, const NrrdHeader& header, int rank) {
   check_geometry(path, "space origin", "space directions", volume);
 }
 
-bool is_gzip_encoding(const NrrdHeader& header) {
+bool is_gzip_encoding(const TextHeader& header) {
   const std::string encoding = lowercase(header.require("encoding"));
   if (encoding == "raw") return false;
   if (encoding == "gzip" || encoding == "gz") return true;
   fail(header.path, concat("encoding '", encoding, "' is not supported (raw, gzip)"));
 }
 
-bool is_big_endian(const NrrdHeader& header) {
+bool is_big_endian(const TextHeader& header) {
   const auto endian = header.get("endian");
   if (!endian || lowercase(*endian) == "little") return false;
   if (lowercase(*endian) == "big") return true;
   fail(header.path, concat("endian '", *endian, "': expected little or big"));
 }
 
-int64_t skip_field(const NrrdHeader& header, std::string_view field) {
+int64_t skip_field(const TextHeader& header, std::string_view field) {
   const auto text = header.get(field);
   return text ? parse_exactly<int64_t, 1>(header.path, field, *text)[0] : 0;
 }
 
 // Where the data starts in its file, before "byte skip" (which, for gzip, counts inflated bytes).
-InputFile::Source data_source(const NrrdHeader& header, bool gzip) {
+InputFile::Source data_source(const TextHeader& header, bool gzip) {
   const fs::path& path = header.path;
   InputFile::Source source{.file = path, .report_as = path, .compressed = gzip};
-  if (const auto name = header.data_file()) {
+  if (const auto name = data_file(header)) {
     if (name->starts_with("LIST") || name->find_first_of("% ") != std::string_view::npos)
       fail(path, concat("data file: '", *name, "': file lists and patterns are not supported"));
     source.file = path.parent_path() / *name;
@@ -312,7 +289,7 @@ InputFile::Source data_source(const NrrdHeader& header, bool gzip) {
 Volume load_nrrd(const std::filesystem::path& path, const VolumeReadOptions& options,
                  std::vector<std::string>& warnings) {
   existing_file_size(path);
-  const NrrdHeader header = parse_header(path);
+  const TextHeader header = parse_header(path);
   const Extent extent = image_extent(header);
   const StoredType stored = element_type(header);
   const size_t bytes =

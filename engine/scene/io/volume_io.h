@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -200,6 +201,33 @@ std::string_view trim(std::string_view text);
 std::string lowercase(std::string_view text);
 // At most max_length characters of text for an error message, bytes outside ASCII shown as '?'.
 std::string printable(std::string_view text, size_t max_length = 40);
+
+// Text headers are a few hundred bytes; a megabyte without the header's end is not a header.
+inline constexpr size_t max_text_header_bytes = 1 << 20;
+
+// A text header's fields in file order, names lowercased: MetaImage's "Key = Value" lines and
+// NRRD's "field: value" lines.
+struct TextHeader {
+  std::filesystem::path path;
+  std::vector<std::pair<std::string, std::string>> fields;  // lowercase name, value
+  uint64_t data_offset = 0;  // where data that follows the header starts
+  bool quote_names = false;  // NRRD's names hold spaces: errors quote them
+
+  // The value of a field, its name in any case.
+  std::optional<std::string_view> get(std::string_view name) const;
+  // The value of the first of the names (a format's synonyms) that is present.
+  std::optional<std::string_view> first_of(std::initializer_list<std::string_view> names) const;
+  // The value of a field; "no <name> field" otherwise.
+  std::string_view require(std::string_view name) const;
+};
+
+// The line of `text` that starts at `pos`, without its '\n' (nor a '\r' before it); `pos` moves
+// past it. `complete`: a '\n' ended it (else the text did: a header cut there?).
+struct TextLine {
+  std::string_view text;
+  bool complete = false;
+};
+TextLine next_line(std::string_view text, size_t& pos);
 
 // Whitespace-separated numbers; "<file>: <field>: '<text>' is not a list of numbers" otherwise.
 template <class T>

@@ -751,4 +751,35 @@ std::string printable(std::string_view text, size_t max_length) {
   return shown;
 }
 
+std::optional<std::string_view> TextHeader::get(std::string_view name) const {
+  const std::string key = lowercase(name);
+  for (const auto& [field, value] : fields)
+    if (field == key) return value;
+  return std::nullopt;
+}
+
+std::optional<std::string_view> TextHeader::first_of(
+    std::initializer_list<std::string_view> names) const {
+  for (std::string_view name : names)
+    if (const auto value = get(name)) return value;
+  return std::nullopt;
+}
+
+std::string_view TextHeader::require(std::string_view name) const {
+  const auto value = get(name);
+  if (!value)
+    fail(path, quote_names ? concat("no '", name, "' field") : concat("no ", name, " field"));
+  return *value;
+}
+
+TextLine next_line(std::string_view text, size_t& pos) {
+  size_t end = text.find('\n', pos);
+  const bool complete = end != std::string_view::npos;
+  if (!complete) end = text.size();
+  std::string_view line = text.substr(pos, end - pos);
+  if (line.ends_with('\r')) line.remove_suffix(1);
+  pos = complete ? end + 1 : end;
+  return {line, complete};
+}
+
 }  // namespace strata::volume_io
