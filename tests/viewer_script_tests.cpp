@@ -145,6 +145,20 @@ TEST_SUITE("cpu") {
     CHECK(clip_normal_usable({1e-5f, 0.0f, 0.0f}));
   }
 
+  // A command is one entry of the table (app/viewer/script_commands.inc): `report camera` and
+  // `report FILE` share a name, the first entry whose words fit reads the line.
+  TEST_CASE("viewer_script_report_camera_is_one_entry_of_the_command_table") {
+    const auto c = parse_viewer_script("report camera\nreport r.json\n", "demo.txt");
+    REQUIRE(c.size() == 2);
+    CHECK(c[0].name == "report");
+    CHECK(c[0].word.empty());
+    CHECK(c[0].spec().writes == nullptr);
+    CHECK(c[1].word == "r.json");
+    CHECK(c[1].spec().writes != nullptr);
+    CHECK(parse_error("report").find("demo.txt:2: 'report' takes the form: report camera | report "
+                                     "FILE.json") == 0);
+  }
+
   // docs/viewer.md lists every command of the table with its form.
   TEST_CASE("viewer_script_commands_are_each_in_the_viewer_docs") {
     const std::string docs = test::read_file(STRATA_SOURCE_DIR "/docs/viewer.md");

@@ -420,7 +420,7 @@ TEST_SUITE("window") {
             "\ndrag left 80 60 110 60\nlayout " + d("rotated.json") + "\nscreenshot " +
             d("rotated.png") + "\nscroll -2\nlayout " + d("zoomed.json") +
             "\ndrag middle 80 60 92 52\nlayout " + d("panned.json") +
-            "\nkey 2\nlayout " + d("left.json") + "\nscreenshot " + d("left.png") +
+            "\nkey 2\nreport camera\nlayout " + d("left.json") + "\nscreenshot " + d("left.png") +
             "\nhide 3\nlayout " + d("hidden.json") + "\nscreenshot " + d("hidden.png") +
             "\nset forces.keep_apart off\nhide 60\nhide 52\nhide 81\nhide 29\nhide 31\nhide 37"
             "\nlayout " +
@@ -435,6 +435,9 @@ TEST_SUITE("window") {
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     CHECK(r.output.find("validation") == std::string::npos);
+    // `report camera` prints the camera of the scene's second position.
+    CHECK(r.output.find("view: camera eye ") != std::string::npos);
+    CHECK(r.output.find(", fov ") != std::string::npos);
 
     // Left drag: the scene turns (anchors move, the picture changes).
     const auto base = read_layout(d("base.json")), rotated = read_layout(d("rotated.json"));
