@@ -1,4 +1,4 @@
-// `strata view`: the interactive viewer in a GLFW window (app/viewer.h), driven by the mouse and
+// `strata view`: the interactive viewer in a GLFW window (app/viewer/viewer.h), driven by the mouse and
 // keys or by an input script that feeds it the same events (tests, demos).
 #include <cstdio>
 #include <fstream>

@@ -53,7 +53,7 @@ struct SettingsRef {
 
 // A parameter: a number in [lo, hi] or (with `flag`) on or off. The ranges keep a frame's work
 // bounded (render.step has a lower bound from the volumes too: Viewer::set_number) and hold the
-// panel's slider ranges (app/viewer_panel.cpp).
+// panel's slider ranges (app/viewer/panel.cpp).
 struct Parameter {
   const char* name;
   const char* what;

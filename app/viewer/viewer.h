@@ -223,7 +223,7 @@ class Viewer {
   // after the atlas region there, else "Label ID"; returns its id. An Error where the ray meets
   // only background (move_label too) or no label has the id.
   int place_label(glm::vec2 at);
-  // The viewer's own cut-aways on every volume, besides its scene's (app/viewer_cut.cpp): a crop
+  // The viewer's own cut-aways on every volume, besides its scene's (app/viewer/cut_aways.cpp): a crop
   // box (world mm, LPS) and up to six clipping planes; none: only the scene's. The panel's
   // Cut-aways section sets them; while on they are drawn over the picture with a handle on each
   // box face and each plane, which a left drag moves.
