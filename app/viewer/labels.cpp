@@ -103,10 +103,7 @@ size_t Viewer::label_index(int id) const {
 void Viewer::edit_labels(const std::function<void(std::vector<Label>&)>& edit, bool undoable) {
   std::vector<Label> before = scene_.labels;
   edit(scene_.labels);
-  if (undoable) {
-    undo_.push_back(std::move(before));
-    redo_.clear();
-  }
+  if (undoable) history_.edited(std::move(before));
   labelled_->labels_changed();
   moving_labels_.clear();
   if (picked_label_ >= int(scene_.labels.size())) picked_label_ = -1;
@@ -154,13 +151,9 @@ void Viewer::delete_label(int id) {
   edit_labels([&](std::vector<Label>& labels) { labels.erase(labels.begin() + ptrdiff_t(i)); });
 }
 
-// Undo and redo: the labels on top of `from` come back, the ones they replace go onto `to`.
-bool Viewer::restore_labels(std::vector<std::vector<Label>>& from,
-                            std::vector<std::vector<Label>>& to) {
-  if (from.empty()) return false;
-  to.push_back(scene_.labels);
-  scene_.labels = std::move(from.back());
-  from.pop_back();
+// After an undo or redo: the labels came back.
+bool Viewer::restored_labels(bool done) {
+  if (!done) return false;
   if (picked_label_ >= int(scene_.labels.size())) picked_label_ = -1;
   labelled_->labels_changed();
   changed();
@@ -168,11 +161,11 @@ bool Viewer::restore_labels(std::vector<std::vector<Label>>& from,
 }
 
 bool Viewer::undo_labels() {
-  return restore_labels(undo_, redo_);
+  return restored_labels(history_.undo(scene_.labels));
 }
 
 bool Viewer::redo_labels() {
-  return restore_labels(redo_, undo_);
+  return restored_labels(history_.redo(scene_.labels));
 }
 
 void Viewer::save_labels(const std::filesystem::path& path, LabelAxes axes) {

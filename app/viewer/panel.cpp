@@ -236,11 +236,11 @@ void Viewer::panel_labels() {
     }
     ImGui::SameLine();
   }
-  ImGui::BeginDisabled(undo_.empty());
+  ImGui::BeginDisabled(!history_.can_undo());
   if (ImGui::Button("Undo")) panel_command(*this, {"undo"});
   ImGui::EndDisabled();
   ImGui::SameLine();
-  ImGui::BeginDisabled(redo_.empty());
+  ImGui::BeginDisabled(!history_.can_redo());
   if (ImGui::Button("Redo")) panel_command(*this, {"redo"});
   ImGui::EndDisabled();
   ImGui::SameLine();

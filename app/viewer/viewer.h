@@ -24,6 +24,7 @@
 
 #include "app/viewer/camera_control.h"
 #include "app/viewer/idle_optimisation.h"
+#include "app/viewer/label_history.h"
 #include "app/viewer/recorder.h"
 #include "app/viewer/script.h"
 #include "app/viewer/ui_layer.h"
@@ -223,8 +224,8 @@ class Viewer {
   // after the atlas region there, else "Label ID"; returns its id. An Error where the ray meets
   // only background (move_label too) or no label has the id.
   int place_label(glm::vec2 at);
-  // The viewer's own cut-aways on every volume, besides its scene's (app/viewer/cut_aways.cpp): a crop
-  // box (world mm, LPS) and up to six clipping planes; none: only the scene's. The panel's
+  // The viewer's own cut-aways on every volume, besides its scene's (app/viewer/cut_aways.cpp): a
+  // crop box (world mm, LPS) and up to six clipping planes; none: only the scene's. The panel's
   // Cut-aways section sets them; while on they are drawn over the picture with a handle on each
   // box face and each plane, which a left drag moves.
   void set_crop(std::optional<std::array<glm::vec3, 2>> box);
@@ -286,7 +287,7 @@ class Viewer {
   // A label edit: the labels before it kept for undo, the scene's labels changed by `edit`, the
   // renderer made again for them.
   void edit_labels(const std::function<void(std::vector<Label>&)>& edit, bool undoable = true);
-  bool restore_labels(std::vector<std::vector<Label>>& from, std::vector<std::vector<Label>>& to);
+  bool restored_labels(bool done);
   graph::GraphRunner& prepare(uint32_t slot, graph::Extent extent, double seconds);
   void read_slot(uint32_t slot);
   int next_trial();
@@ -410,7 +411,7 @@ class Viewer {
   glm::vec2 press_at_{0.0f};  // where the last button press was (a click selects a label)
   char edit_text_[256] = "";  // the panel's text of the selected label
   std::filesystem::path default_labels_path() const;  // Ctrl+S: SCENE-labels.mrk.json beside it
-  std::vector<std::vector<Label>> undo_, redo_;       // the scene's labels before each edit
+  LabelHistory history_;
   std::vector<Label> scene_labels_;  // the scene file's own labels (id, text and anchor)
 
   // Output.
