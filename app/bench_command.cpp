@@ -17,7 +17,7 @@
 #include "app/bench_timings.h"
 #include "app/commands.h"
 #include "app/soak_command.h"
-#include "app/viewer.h"
+#include "app/viewer/viewer.h"
 #include "engine/core/json_field.h"
 #include "engine/gpu/resources.h"
 #include "engine/graph/graph_runner.h"

@@ -105,19 +105,14 @@ void FrameFolder::remove_earlier_frames() const {
 
 void check_script_outputs(const std::string& script, const std::vector<ScriptCommand>& commands,
                           const std::string& labels) {
-  static constexpr std::pair<ScriptOp, const char*> kWriting[] = {
-      {ScriptOp::screenshot, "screenshot"}, {ScriptOp::capture, "capture"},
-      {ScriptOp::layout, "layout"},         {ScriptOp::record_start, "record start"},
-      {ScriptOp::report, "report"},         {ScriptOp::save_labels, "save"}};
   for (const ScriptCommand& c : commands) {
-    const auto* writing = std::find_if(std::begin(kWriting), std::end(kWriting),
-                                       [&](const auto& w) { return w.first == c.op; });
+    const char* writing = c.spec().writes;
     // (a screenshot without a name gets a new one; save may write the label file opened)
     std::error_code error;
-    if (writing == std::end(kWriting) || c.word.empty() ||
-        (c.op == ScriptOp::save_labels && !labels.empty() && fs::equivalent(c.word, labels, error)))
+    if (!writing || c.word.empty() ||
+        (c.name == "save" && !labels.empty() && fs::equivalent(c.word, labels, error)))
       continue;
-    check_output_file(script + ":" + std::to_string(c.line) + ": " + writing->second, c.word);
+    check_output_file(script + ":" + std::to_string(c.line) + ": " + writing, c.word);
   }
 }
 

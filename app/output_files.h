@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "app/viewer_script.h"
+#include "app/viewer/script.h"
 
 namespace strata::app {
 

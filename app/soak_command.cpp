@@ -24,7 +24,7 @@
 
 #include "app/output_files.h"
 #include "app/progress.h"
-#include "app/viewer.h"
+#include "app/viewer/viewer.h"
 #include "engine/core/text_file.h"
 #include "engine/gpu/context.h"
 #include "engine/scene/transfer_function_presets.h"

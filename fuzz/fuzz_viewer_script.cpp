@@ -1,10 +1,10 @@
-// The viewer's input scripts (`strata view --script`, app/viewer_script.cpp) through
+// The viewer's input scripts (`strata view --script`, app/viewer/script.cpp) through
 // parse_viewer_script: every command it returns must carry numbers that are finite and within the
 // script limits, or the parse gives an Error.
 #include <cmath>
 #include <string>
 
-#include "app/viewer_script.h"
+#include "app/viewer/script.h"
 #include "fuzz/fuzz_input.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -17,11 +17,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
           std::abort();
         }
       }
-      if (c.op == strata::app::ScriptOp::frames && c.numbers[0] > strata::app::kScriptMaxFrames) {
+      if (c.name == "frames" && c.numbers[0] > strata::app::kScriptMaxFrames) {
         std::fprintf(stderr, "fuzz: line %zu: frames %g\n", c.line, c.numbers[0]);
         std::abort();
       }
-      if (c.op == strata::app::ScriptOp::sleep && !(c.numbers[0] <= strata::app::kScriptMaxSleep)) {
+      if (c.name == "sleep" && !(c.numbers[0] <= strata::app::kScriptMaxSleep)) {
         std::fprintf(stderr, "fuzz: line %zu: sleep %g\n", c.line, c.numbers[0]);
         std::abort();
       }

@@ -9,7 +9,7 @@
 
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/scene_bounds.h"
-#include "labeling/camera_control.h"
+#include "app/viewer/camera_control.h"
 #include "test_scenes.h"
 
 namespace strata {

@@ -1,4 +1,4 @@
-// The viewer's input scripts are checked: the parser (app/viewer_script.h) refuses NaN,
+// The viewer's input scripts are checked: the parser (app/viewer/script.h) refuses NaN,
 // infinities and numbers outside each command's range with FILE:LINE, and `strata view` stops on
 // such a line with that error in bounded time instead of hanging.
 #include <doctest/doctest.h>
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "app/viewer_script.h"
+#include "app/viewer/script.h"
 #include "engine/core/error.h"
 #include "engine/scene/scene.h"
 #include "gpu_fixture.h"
@@ -70,16 +70,16 @@ TEST_SUITE("cpu") {
         "s.txt");
     REQUIRE(commands.size() == 6);
     CHECK(commands[0].line == 2);
-    CHECK(commands[0].op == app::ScriptOp::drag);
+    CHECK(commands[0].name == "drag");
     CHECK(commands[0].word == "middle");
     CHECK(commands[0].numbers == std::vector<double>{1, 2, 3.5, 4});
-    CHECK(commands[0].shift);
+    CHECK(commands[0].flag);
     CHECK(commands[1].line == 4);
     CHECK(commands[1].numbers == std::vector<double>{12});
     CHECK(commands[2].numbers == std::vector<double>{0.25});
     CHECK(commands[3].word == "weights.label_shadow");
     CHECK(commands[3].value == "50");
-    CHECK(commands[5].op == app::ScriptOp::quit);
+    CHECK(commands[5].name == "quit");
   }
 
   // The label commands: place, move, text (one quoted word with spaces, '#', escaped quotes and
@@ -90,16 +90,16 @@ TEST_SUITE("cpu") {
         "comment\ndelete 103\nundo\nredo\nsave a.mrk.json ras\nsave b.fcsv\n",
         "demo.txt");
     REQUIRE(c.size() == 8);
-    CHECK(c[0].op == app::ScriptOp::place);
+    CHECK(c[0].name == "place");
     CHECK(c[0].numbers == std::vector<double>{80.0, 40.0});
-    CHECK(c[1].op == app::ScriptOp::move);
+    CHECK(c[1].name == "move");
     CHECK(c[1].numbers == std::vector<double>{101.0, 90.5, 45.0});
-    CHECK(c[2].op == app::ScriptOp::text);
+    CHECK(c[2].name == "text");
     CHECK(c[2].value == "Thalamus R – Ödem # \"rechts\"");
-    CHECK(c[3].op == app::ScriptOp::delete_label);
-    CHECK(c[4].op == app::ScriptOp::undo);
-    CHECK(c[5].op == app::ScriptOp::redo);
-    CHECK(c[6].op == app::ScriptOp::save_labels);
+    CHECK(c[3].name == "delete");
+    CHECK(c[4].name == "undo");
+    CHECK(c[5].name == "redo");
+    CHECK(c[6].name == "save");
     CHECK(c[6].word == "a.mrk.json");
     CHECK(c[6].value == "ras");
     CHECK(c[7].value == "lps");
@@ -114,9 +114,9 @@ TEST_SUITE("cpu") {
   TEST_CASE("viewer_script_parser_reads_the_crop_box") {
     const auto c = parse_viewer_script("crop -100 -120 -60 100 120 40.5\ncrop off\n", "demo.txt");
     REQUIRE(c.size() == 2);
-    CHECK(c[0].op == app::ScriptOp::crop);
+    CHECK(c[0].name == "crop");
     CHECK(c[0].numbers == std::vector<double>{-100, -120, -60, 100, 120, 40.5});
-    CHECK(c[1].op == app::ScriptOp::crop);
+    CHECK(c[1].name == "crop");
     CHECK(c[1].numbers.empty());
     CHECK(parse_error("crop 0 0 0 1 1").find("demo.txt:2: 'crop' takes the form") == 0);
     CHECK(parse_error("crop 0 0 5 1 1 4").find("demo.txt:2: 'crop': each low corner") == 0);
@@ -126,9 +126,9 @@ TEST_SUITE("cpu") {
   TEST_CASE("viewer_script_parser_reads_the_clipping_plane") {
     const auto c = parse_viewer_script("clip 0 -15 2.5 0 0 -1\nclip off\n", "demo.txt");
     REQUIRE(c.size() == 2);
-    CHECK(c[0].op == app::ScriptOp::clip);
+    CHECK(c[0].name == "clip");
     CHECK(c[0].numbers == std::vector<double>{0, -15, 2.5, 0, 0, -1});
-    CHECK(c[1].op == app::ScriptOp::clip);
+    CHECK(c[1].name == "clip");
     CHECK(c[1].numbers.empty());
     CHECK(parse_error("clip 0 0 0 1").find("demo.txt:2: 'clip' takes the form") == 0);
     CHECK(parse_error("clip 0 0 0 0 0 0").find("demo.txt:2: 'clip': the normal") == 0);
@@ -143,6 +143,32 @@ TEST_SUITE("cpu") {
     CHECK(parse_viewer_script("clip 0 0 0 1e-5 0 0\n", "demo.txt").size() == 1);
     CHECK(!clip_normal_usable({1e-7f, 0.0f, 0.0f}));
     CHECK(clip_normal_usable({1e-5f, 0.0f, 0.0f}));
+  }
+
+  // A command is one entry of the table (app/viewer/script_commands.inc): `report camera` and
+  // `report FILE` share a name, the first entry whose words fit reads the line.
+  TEST_CASE("viewer_script_report_camera_is_one_entry_of_the_command_table") {
+    const auto c = parse_viewer_script("report camera\nreport r.json\n", "demo.txt");
+    REQUIRE(c.size() == 2);
+    CHECK(c[0].name == "report");
+    CHECK(c[0].word.empty());
+    CHECK(c[0].spec().writes == nullptr);
+    CHECK(c[1].word == "r.json");
+    CHECK(c[1].spec().writes != nullptr);
+    CHECK(parse_error("report").find("demo.txt:2: 'report' takes the form: report camera | report "
+                                     "FILE.json") == 0);
+  }
+
+  // docs/viewer.md lists every command of the table with its form.
+  TEST_CASE("viewer_script_commands_are_each_in_the_viewer_docs") {
+    const std::string docs = test::read_file(STRATA_SOURCE_DIR "/docs/viewer.md");
+    for (const app::ScriptCommandSpec& spec : app::viewer_script_commands()) {
+      CAPTURE(spec.name);
+      std::string form;  // (a table cell writes '|' as '\|')
+      for (const char ch : app::script_form(spec))
+        form += ch == '|' ? std::string("\\|") : std::string(1, ch);
+      CHECK(docs.find("`" + form + "`") != std::string::npos);
+    }
   }
 
   TEST_CASE("viewer_script_parser_refuses_unknown_names_before_anything_runs") {

@@ -414,27 +414,30 @@ TEST_SUITE("window") {
   TEST_CASE("viewer_script_rotates_zooms_pans_jumps_reweights_and_hides") {
     const auto dir = test::fresh_folder("viewer", "script");
     const auto d = [&](const char* name) { return (dir / name).string(); };
-    const auto r =
-        view(dir,
-             "layout " + d("base.json") + "\nscreenshot " + d("base.png") +
-                 "\ndrag left 80 60 110 60\nlayout " + d("rotated.json") + "\nscreenshot " +
-                 d("rotated.png") + "\nscroll -2\nlayout " + d("zoomed.json") +
-                 "\ndrag middle 80 60 92 52\nlayout " + d("panned.json") + "\nkey 2\nlayout " +
-                 d("left.json") + "\nscreenshot " + d("left.png") + "\nhide 3\nlayout " +
-                 d("hidden.json") + "\nscreenshot " + d("hidden.png") +
-                 "\nset forces.keep_apart off\nhide 60\nhide 52\nhide 81\nhide 29\nhide 31\nhide 37"
-                 "\nlayout " +
-                 d("few.json") +
-                 "\nset weights.anchor_constraint 0\nset weights.distance_to_anchor 1\n"
-                 "set weights.leader_crossing 0\nlayout " +
-                 d("weighted.json") + "\nquit\n",
-             // (the layouts this test expects are those of the placement in each frame, in the
-             // scene's insertion order: the optimisation on idle's orders would blur what the
-             // weights change)
-             "--no-optimize --no-panel --frame-budget 0");
+    const auto r = view(
+        dir,
+        "layout " + d("base.json") + "\nscreenshot " + d("base.png") +
+            "\ndrag left 80 60 110 60\nlayout " + d("rotated.json") + "\nscreenshot " +
+            d("rotated.png") + "\nscroll -2\nlayout " + d("zoomed.json") +
+            "\ndrag middle 80 60 92 52\nlayout " + d("panned.json") +
+            "\nkey 2\nreport camera\nlayout " + d("left.json") + "\nscreenshot " + d("left.png") +
+            "\nhide 3\nlayout " + d("hidden.json") + "\nscreenshot " + d("hidden.png") +
+            "\nset forces.keep_apart off\nhide 60\nhide 52\nhide 81\nhide 29\nhide 31\nhide 37"
+            "\nlayout " +
+            d("few.json") +
+            "\nset weights.anchor_constraint 0\nset weights.distance_to_anchor 1\n"
+            "set weights.leader_crossing 0\nlayout " +
+            d("weighted.json") + "\nquit\n",
+        // (the layouts this test expects are those of the placement in each frame, in the
+        // scene's insertion order: the optimisation on idle's orders would blur what the
+        // weights change)
+        "--no-optimize --no-panel --frame-budget 0");
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     CHECK(r.output.find("validation") == std::string::npos);
+    // `report camera` prints the camera of the scene's second position.
+    CHECK(r.output.find("view: camera eye ") != std::string::npos);
+    CHECK(r.output.find(", fov ") != std::string::npos);
 
     // Left drag: the scene turns (anchors move, the picture changes).
     const auto base = read_layout(d("base.json")), rotated = read_layout(d("rotated.json"));

@@ -1,4 +1,4 @@
-#include "labeling/camera_control.h"
+#include "app/viewer/camera_control.h"
 
 #include <algorithm>
 #include <cmath>

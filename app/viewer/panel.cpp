@@ -7,7 +7,7 @@
 
 #include <imgui.h>
 
-#include "app/viewer.h"
+#include "app/viewer/viewer.h"
 #include "engine/core/error.h"
 #include "engine/scene/scene_bounds.h"
 #include "engine/scene/transfer_function_presets.h"
@@ -16,18 +16,28 @@
 namespace strata::app {
 namespace {
 
-// A float slider whose change is applied through set_number (one path for the panel and for
-// input scripts).
+// The panel's changes are the commands scripts write (`set NAME VALUE`, `hide ID`, ...), applied
+// before the frame is drawn (Viewer::submit).
+void panel_command(Viewer& viewer, const std::vector<std::string>& words) {
+  viewer.submit(viewer_command(words));
+}
+
+void submit_number(Viewer& viewer, const char* parameter, float value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", double(value));  // (a float's every digit)
+  panel_command(viewer, {"set", parameter, text});
+}
+
 bool slider(Viewer& viewer, const char* label, const char* parameter, float value, float lo,
             float hi, const char* format = "%.3g", ImGuiSliderFlags flags = 0) {
   if (!ImGui::SliderFloat(label, &value, lo, hi, format, flags)) return false;
-  viewer.set_number(parameter, value);
+  submit_number(viewer, parameter, value);
   return true;
 }
 
 bool checkbox(Viewer& viewer, const char* label, const char* parameter, bool value) {
   if (!ImGui::Checkbox(label, &value)) return false;
-  viewer.set_flag(parameter, value);
+  panel_command(viewer, {"set", parameter, value ? "on" : "off"});
   return true;
 }
 
@@ -51,7 +61,7 @@ void Viewer::build_panel() {
   try {
     if (ImGui::Button("Screenshot (F12)")) screenshot();
     ImGui::SameLine();
-    if (!video_) {
+    if (!recording()) {
       if (ImGui::Button("Record")) {
         const std::string stem = scene_.source.empty() ? "strata" : scene_.source.stem().string();
         std::filesystem::path path;
@@ -92,9 +102,10 @@ void Viewer::panel_camera() {
   }
   for (int v = 0; v < 6; ++v) {
     if (v % 3 != 0) ImGui::SameLine();
-    if (ImGui::Button(kAnatomicalViewNames[v])) view_from(AnatomicalView(v));
+    if (ImGui::Button(kAnatomicalViewNames[v]))
+      panel_command(*this, {"view", kAnatomicalViewNames[v]});
   }
-  if (ImGui::Button("Reset (r)")) reset_camera();
+  if (ImGui::Button("Reset (r)")) panel_command(*this, {"key", "r"});
   ImGui::SetNextItemWidth(140.0f * ui_.scale());
   ImGui::InputTextWithHint("##name", "position name", position_name_, sizeof position_name_);
   ImGui::SameLine();
@@ -134,11 +145,11 @@ void Viewer::panel_labelling() {
   ImGui::Separator();
   slider(*this, "margin (text sizes)", "margin_em", s.placement.margin_em, 0.0f, 2.0f, "%.2f");
   int layers = int(s.layer_count);
-  if (ImGui::SliderInt("layers", &layers, 1, 8)) set_number("layers", float(layers));
+  if (ImGui::SliderInt("layers", &layers, 1, 8)) submit_number(*this, "layers", float(layers));
   ImGui::Text("layers used: %u", labelled_->layering().layer_count);
   int tidy_rounds = int(s.placement.tidy_rounds);
   if (ImGui::SliderInt("tidy-up rounds", &tidy_rounds, 0, 64)) {
-    set_number("tidy_rounds", float(tidy_rounds));
+    submit_number(*this, "tidy_rounds", float(tidy_rounds));
   }
   const char* orders[] = {"scene", "Apollonius (when the camera rests)"};
   if (ImGui::Combo("insertion order", &insertion_order_, orders, 2)) {
@@ -153,17 +164,17 @@ void Viewer::panel_labelling() {
   checkbox(*this, "borders in layer colours", "layer_colors", s.layer_colors);
   float ghost = s.ghost.strength;
   ImGui::SliderFloat("ghosting", &ghost, 0.0f, 1.0f, "%.2f");
-  if (ImGui::IsItemDeactivatedAfterEdit()) set_number("ghost", ghost);
+  if (ImGui::IsItemDeactivatedAfterEdit()) submit_number(*this, "ghost", ghost);
   float lens = s.ghost.radius;
   ImGui::SliderFloat("ghosting lens", &lens, kGhostRadiusMin, kGhostRadiusMax, "%.3f");
-  if (ImGui::IsItemDeactivatedAfterEdit()) set_number("ghost.radius", lens);
+  if (ImGui::IsItemDeactivatedAfterEdit()) submit_number(*this, "ghost.radius", lens);
   // (applied when the slider is let go: the glyphs and the graph are rebuilt)
   float font = s.font_pixels;
   ImGui::SliderFloat("font size (px)", &font, 8.0f, 40.0f, "%.0f");
-  if (ImGui::IsItemDeactivatedAfterEdit()) set_number("font", font);
+  if (ImGui::IsItemDeactivatedAfterEdit()) submit_number(*this, "font", font);
   float scale = s.label_scale;
   ImGui::SliderFloat("label scale", &scale, 0.25f, 4.0f, "%.2f");
-  if (ImGui::IsItemDeactivatedAfterEdit()) set_number("label_scale", scale);
+  if (ImGui::IsItemDeactivatedAfterEdit()) submit_number(*this, "label_scale", scale);
 }
 
 void Viewer::panel_forces() {
@@ -195,7 +206,8 @@ void Viewer::panel_labels() {
       if (!filter.empty() && text.find(filter) == std::string::npos) continue;
       ImGui::PushID(int(i));
       bool shown = !labelled_->label_hidden(i);
-      if (ImGui::Checkbox("##shown", &shown)) set_label_hidden(l.id, !shown);
+      if (ImGui::Checkbox("##shown", &shown))
+        panel_command(*this, {shown ? "show" : "hide", std::to_string(l.id)});
       ImGui::SameLine();
       if (ImGui::Selectable(l.text.c_str(), picked_label_ == int(i))) {
         picked_label_ = int(i);
@@ -206,7 +218,7 @@ void Viewer::panel_labels() {
   }
   ImGui::EndChild();
   if (ImGui::Button("Show all")) {
-    for (const Label& l : scene_.labels) set_label_hidden(l.id, false);
+    for (const Label& l : scene_.labels) panel_command(*this, {"show", std::to_string(l.id)});
   }
   // Labels of one's own: place mode, the selected label's text, delete, undo, redo, save.
   bool placing = place_mode_;
@@ -216,23 +228,24 @@ void Viewer::panel_labels() {
     if (ImGui::InputText("text", edit_text_, sizeof edit_text_,
                          ImGuiInputTextFlags_EnterReturnsTrue) &&
         edit_text_[0] != '\0') {
-      set_label_text(id, edit_text_);
+      panel_command(*this, {"text", std::to_string(id), edit_text_});
     }
     if (ImGui::Button("Delete")) {
-      delete_label(id);
+      panel_command(*this, {"delete", std::to_string(id)});
       picked_label_ = -1;
     }
     ImGui::SameLine();
   }
-  ImGui::BeginDisabled(undo_.empty());
-  if (ImGui::Button("Undo")) undo_labels();
+  ImGui::BeginDisabled(!history_.can_undo());
+  if (ImGui::Button("Undo")) panel_command(*this, {"undo"});
   ImGui::EndDisabled();
   ImGui::SameLine();
-  ImGui::BeginDisabled(redo_.empty());
-  if (ImGui::Button("Redo")) redo_labels();
+  ImGui::BeginDisabled(!history_.can_redo());
+  if (ImGui::Button("Redo")) panel_command(*this, {"redo"});
   ImGui::EndDisabled();
   ImGui::SameLine();
-  if (ImGui::Button("Save labels (Ctrl+S)")) save_labels(default_labels_path());
+  if (ImGui::Button("Save labels (Ctrl+S)"))
+    panel_command(*this, {"save", default_labels_path().string()});
 }
 
 void Viewer::panel_rendering() {
@@ -243,7 +256,7 @@ void Viewer::panel_rendering() {
     if (ImGui::BeginCombo("preset", original_tfs_[v].name.c_str())) {
       for (const TransferFunctionPreset& p : transfer_function_presets()) {
         if (ImGui::Selectable(p.name, original_tfs_[v].name == p.name))
-          set_preset(uint32_t(v), p.name);
+          panel_command(*this, {"preset", p.name, std::to_string(v)});
         if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", p.description);
       }
       ImGui::EndCombo();

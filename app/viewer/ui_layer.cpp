@@ -1,4 +1,4 @@
-#include "app/ui_layer.h"
+#include "app/viewer/ui_layer.h"
 
 #include <imgui.h>
 

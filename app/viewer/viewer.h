@@ -4,6 +4,9 @@
 // Frames are recorded while earlier ones still run; what the GPU reports (layouts, costs,
 // counters, timings) is read when a frame slot comes round again, a frame or two later. With
 // nothing to do (camera still, labels settled, no input) the viewer asks for no frames.
+// A job a file in app/viewer/: the frame here (viewer.cpp), input.cpp, panel.cpp, parameters.cpp,
+// labels.cpp, cut_aways.cpp, settling.cpp (with idle_optimisation.h), recording.cpp (with
+// recorder.h); the commands of scripts, keys and panel in script_commands.inc.
 #pragma once
 
 #include <array>
@@ -19,13 +22,16 @@
 
 #include <glm/glm.hpp>
 
-#include "app/ui_layer.h"
-#include "engine/core/video_file.h"
+#include "app/viewer/camera_control.h"
+#include "app/viewer/idle_optimisation.h"
+#include "app/viewer/label_history.h"
+#include "app/viewer/recorder.h"
+#include "app/viewer/script.h"
+#include "app/viewer/ui_layer.h"
 #include "engine/graph/frame_slots.h"
 #include "engine/graph/window_target.h"
 #include "engine/scene/io/label_file_writer.h"
 #include "frame/labelled_render.h"
-#include "labeling/camera_control.h"
 #include "passes/debug_view.h"
 
 namespace strata::app {
@@ -152,6 +158,12 @@ class Viewer {
   void cursor(glm::vec2 position);
   void scroll(double ticks);
   void key(int key, int mods);
+  // A command of the viewer's table (app/viewer/script_commands.inc, the commands scripts write),
+  // applied once the next frame's UI is built, before the frame is drawn: what the keys and the
+  // panel do. An Error it gives is shown in the panel.
+  void submit(ScriptCommand command) { submitted_.push_back(std::move(command)); }
+  // What a key does (the `key` command; GLFW_KEY_*).
+  void press_key(int key);
   // Any event the UI took (it needs a frame or two to show its answer).
   void ui_event() { ui_frames_ = 3; }
   bool ui_wants_mouse() const { return ui_.wants_mouse(); }
@@ -197,7 +209,7 @@ class Viewer {
   // time step of 1 / fps, until stop_recording().
   void start_recording(const std::filesystem::path& path);
   void stop_recording();
-  bool recording() const { return video_ != nullptr; }
+  bool recording() const { return recorder_.on(); }
   // Sets a parameter by the name the panel and input scripts use (`viewer_parameters()`): from
   // text (scripts), a number or a flag (the panel). A bad name or value changes nothing.
   void set_parameter(const std::string& name, const std::string& value);
@@ -212,8 +224,8 @@ class Viewer {
   // after the atlas region there, else "Label ID"; returns its id. An Error where the ray meets
   // only background (move_label too) or no label has the id.
   int place_label(glm::vec2 at);
-  // The viewer's own cut-aways on every volume, besides its scene's (app/viewer_cut.cpp): a crop
-  // box (world mm, LPS) and up to six clipping planes; none: only the scene's. The panel's
+  // The viewer's own cut-aways on every volume, besides its scene's (app/viewer/cut_aways.cpp): a
+  // crop box (world mm, LPS) and up to six clipping planes; none: only the scene's. The panel's
   // Cut-aways section sets them; while on they are drawn over the picture with a handle on each
   // box face and each plane, which a left drag moves.
   void set_crop(std::optional<std::array<glm::vec3, 2>> box);
@@ -275,7 +287,7 @@ class Viewer {
   // A label edit: the labels before it kept for undo, the scene's labels changed by `edit`, the
   // renderer made again for them.
   void edit_labels(const std::function<void(std::vector<Label>&)>& edit, bool undoable = true);
-  bool restore_labels(std::vector<std::vector<Label>>& from, std::vector<std::vector<Label>>& to);
+  bool restored_labels(bool done);
   graph::GraphRunner& prepare(uint32_t slot, graph::Extent extent, double seconds);
   void read_slot(uint32_t slot);
   int next_trial();
@@ -302,6 +314,7 @@ class Viewer {
   void extend_graph(graph::Graph& graph, const LabelledRenderer::GraphIds& ids);
   void read_latest();
   void draw_frame(std::optional<double> seconds);
+  void apply_submitted();
   std::vector<uint8_t> download(graph::ResourceId image);
 
   Context& ctx_;
@@ -321,7 +334,8 @@ class Viewer {
   bool drag_pan_ = false;
   glm::vec2 mouse_{0.0f};
   bool quit_ = false;
-  int ui_frames_ = 3;     // frames the UI still needs
+  std::vector<ScriptCommand> submitted_;  // commands from the keys and the panel (submit)
+  int ui_frames_ = 3;                     // frames the UI still needs
   glm::uvec4 panel_{0u};  // the panel's rectangle this frame, x0 y0 x1 y1 (none: hidden)
   std::vector<uint32_t> moving_labels_;  // labels not yet on their targets (the last frame's)
   uint64_t checked_serial_ = ~0ull;      // the serial of that frame
@@ -350,14 +364,7 @@ class Viewer {
 
   // Optimisation on idle: random orders tried in trial frames (beside the frames: trial
   // placements, one at a time), the cheapest kept.
-  struct Optimisation {
-    std::vector<std::vector<uint32_t>> orders;
-    std::vector<double> costs;  // NaN until read back
-    uint32_t submitted = 0;
-    int in_flight = -1;      // beside the frames: the trial whose placement runs
-    double baseline = -1.0;  // the kept order's cost (a normal frame's)
-    bool done = false;
-  } optimisation_;
+  IdleOptimisation optimisation_;
   bool trials_beside_ = false;  // the placement was beside the frames in the last frame
 
   // Panel state.
@@ -404,25 +411,16 @@ class Viewer {
   glm::vec2 press_at_{0.0f};  // where the last button press was (a click selects a label)
   char edit_text_[256] = "";  // the panel's text of the selected label
   std::filesystem::path default_labels_path() const;  // Ctrl+S: SCENE-labels.mrk.json beside it
-  std::vector<std::vector<Label>> undo_, redo_;       // the scene's labels before each edit
+  LabelHistory history_;
   std::vector<Label> scene_labels_;  // the scene file's own labels (id, text and anchor)
 
   // Output.
-  std::unique_ptr<VideoFile> video_;
-  std::filesystem::path video_path_;
+  Recorder recorder_;
   // Where "save position" wrote the scene: the opened .json, or the new file made for a scene
   // from elsewhere (a volume, a thesis .xml); later saves go there too.
   std::filesystem::path saved_scene_path_;
-  uint64_t video_frames_ = 0;
   uint32_t screenshots_ = 0;
   ViewerSummary summary_;
 };
-
-// The names set_parameter() takes, with what each sets.
-std::vector<std::pair<std::string, std::string>> viewer_parameters();
-// An Error unless `name` is a parameter and `value` is on or off for a flag, a number in the
-// parameter's range otherwise (what set_parameter checks, without a viewer; render.step's lower
-// bound from the volumes is checked by set_number alone).
-void check_viewer_parameter(const std::string& name, const std::string& value);
 
 }  // namespace strata::app

@@ -6,7 +6,7 @@
 #include <GLFW/glfw3.h>
 #include <imgui.h>
 
-#include "app/viewer.h"
+#include "app/viewer/viewer.h"
 #include "engine/core/error.h"
 #include "engine/scene/scene_bounds.h"
 
