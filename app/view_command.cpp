@@ -1,5 +1,6 @@
 // `strata view`: the interactive viewer in a GLFW window (app/viewer/viewer.h), driven by the mouse and
 // keys or by an input script that feeds it the same events (tests, demos).
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -116,6 +117,14 @@ double default_frame_budget_ms(const Context& ctx) {
   return ctx.report().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 125.0 : 0.0;
 }
 
+// Seconds between two pictures of the display (60 Hz where it does not say). FIFO presentation
+// waits for them on a real display; a virtual one (Xvfb, a remote X server) takes pictures as
+// fast as they come, and frames drawn faster than a display shows them are never seen.
+double display_period() {
+  const GLFWvidmode* mode = glfwGetVideoMode(glfwGetPrimaryMonitor());
+  return 1.0 / double(mode && mode->refreshRate > 0 ? mode->refreshRate : 60);
+}
+
 void print_summary(const Viewer& viewer, const std::string& scene) {
   const ViewerSummary& s = viewer.summary();
   const graph::Extent e = viewer.extent();
@@ -208,6 +217,8 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   glfwSetWindowCloseCallback(window.handle, on_close);
   glfwSetWindowRefreshCallback(window.handle, on_refresh);
 
+  const double period = display_period();
+  auto last_drawn = std::chrono::steady_clock::now() - std::chrono::hours(1);
   while (!viewer.quit_requested()) {
     glfwPollEvents();
     if (script && script->frames_due() == 0 && !script->sleeping()) {
@@ -222,6 +233,13 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
     // script asks for, so that its frame count is known)
     const bool due = viewer.busy() || (script ? script->frames_due() > 0 : viewer.recording());
     if (due) {
+      const auto now = std::chrono::steady_clock::now();
+      const double early = period - std::chrono::duration<double>(now - last_drawn).count();
+      if (early > 0.001) {  // (not before the display shows the last frame; events meanwhile)
+        glfwWaitEventsTimeout(early);
+        continue;
+      }
+      last_drawn = now;
       viewer.frame();
       if (script) script->frame_drawn();
       if (o.frames > 0 && viewer.summary().frames >= o.frames) break;

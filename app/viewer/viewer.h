@@ -186,7 +186,7 @@ class Viewer {
     return {panel_.x, panel_.y, panel_.z, panel_.w};
   }
   // One frame: UI, camera, labels, drawn and handed to the output. `seconds`: the time step
-  // (default: the wall clock since the last frame, at most 0.1 s; a recording's 1 / fps).
+  // (default: the wall clock since the last frame, at most 0.25 s; a recording's 1 / fps).
   // A lost device is a DeviceLost naming the frame; a wait past the GPU timeout a GpuTimeout.
   void frame(std::optional<double> seconds = {});
   bool quit_requested() const { return quit_; }
