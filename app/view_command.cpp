@@ -171,6 +171,51 @@ void print_summary(const Viewer& viewer, const std::string& scene) {
   std::fflush(stdout);
 }
 
+// Events, script commands and frames until the viewer quits: a frame only when one is due, and
+// no sooner than the display shows the last one.
+void run_viewer(Viewer& viewer, std::optional<Script>& script, const ViewOptions& o) {
+  const double period = display_period();
+  auto last_drawn = std::chrono::steady_clock::now() - std::chrono::hours(1);
+  while (!viewer.quit_requested()) {
+    glfwPollEvents();
+    if (script && script->frames_due() == 0 && !script->sleeping()) {
+      if (viewer.at_rest()) {
+        if (script->done()) break;
+        script->run_next(viewer);
+        continue;
+      }
+      script->wait_for(viewer);
+    }
+    // (a recording draws every frame, at its fixed time step; under a script, only those the
+    // script asks for, so that its frame count is known)
+    const bool due = viewer.busy() || (script ? script->frames_due() > 0 : viewer.recording());
+    if (due) {
+      const auto now = std::chrono::steady_clock::now();
+      const double early = period - std::chrono::duration<double>(now - last_drawn).count();
+      if (early > 0.001) {  // (not before the display shows the last frame; events meanwhile)
+        glfwWaitEventsTimeout(early);
+        continue;
+      }
+      last_drawn = now;
+      viewer.frame();
+      if (script) script->frame_drawn();
+      if (o.frames > 0 && viewer.summary().frames >= o.frames) break;
+      continue;
+    }
+    // Nothing to draw: sleep until an event (or the rest that starts the optimisation on idle).
+    const std::optional<double> wake = viewer.wake_in();
+    if (script && script->sleeping()) {
+      glfwWaitEventsTimeout(0.02);
+    } else if (wake) {
+      glfwWaitEventsTimeout(std::max(0.01, *wake));
+    } else {
+      // (a timeout all the same: events that the presentation engine's own X requests read off
+      // the connection while a frame was drawn wake no wait; the next poll finds them)
+      glfwWaitEventsTimeout(0.25);
+    }
+  }
+}
+
 void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size) {
   std::optional<Script> script;  // (a script's mistakes are found before the window opens)
   if (!o.script.empty()) script.emplace(o.script, read_script(o.script), o.settle_limit);
@@ -217,46 +262,7 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   glfwSetWindowCloseCallback(window.handle, on_close);
   glfwSetWindowRefreshCallback(window.handle, on_refresh);
 
-  const double period = display_period();
-  auto last_drawn = std::chrono::steady_clock::now() - std::chrono::hours(1);
-  while (!viewer.quit_requested()) {
-    glfwPollEvents();
-    if (script && script->frames_due() == 0 && !script->sleeping()) {
-      if (viewer.at_rest()) {
-        if (script->done()) break;
-        script->run_next(viewer);
-        continue;
-      }
-      script->wait_for(viewer);
-    }
-    // (a recording draws every frame, at its fixed time step; under a script, only those the
-    // script asks for, so that its frame count is known)
-    const bool due = viewer.busy() || (script ? script->frames_due() > 0 : viewer.recording());
-    if (due) {
-      const auto now = std::chrono::steady_clock::now();
-      const double early = period - std::chrono::duration<double>(now - last_drawn).count();
-      if (early > 0.001) {  // (not before the display shows the last frame; events meanwhile)
-        glfwWaitEventsTimeout(early);
-        continue;
-      }
-      last_drawn = now;
-      viewer.frame();
-      if (script) script->frame_drawn();
-      if (o.frames > 0 && viewer.summary().frames >= o.frames) break;
-      continue;
-    }
-    // Nothing to draw: sleep until an event (or the rest that starts the optimisation on idle).
-    const std::optional<double> wake = viewer.wake_in();
-    if (script && script->sleeping()) {
-      glfwWaitEventsTimeout(0.02);
-    } else if (wake) {
-      glfwWaitEventsTimeout(std::max(0.01, *wake));
-    } else {
-      // (a timeout all the same: events that the presentation engine's own X requests read off
-      // the connection while a frame was drawn wake no wait; the next poll finds them)
-      glfwWaitEventsTimeout(0.25);
-    }
-  }
+  run_viewer(viewer, script, o);
   output.wait_idle();
   print_summary(viewer, o.scene.file);
 }
