@@ -110,7 +110,7 @@ const std::vector<Parameter>& parameters() {
        kGhostRadiusMax, [](S s) { return &s.labels.ghost.radius; }},
       {"ghost.leaders", "the lens along rear connectors, a share of the shorter side (0: none)",
        0.0f, kGhostRadiusMax, [](S s) { return &s.labels.ghost.leader; }},
-      // (speed / epsilon bounds the force steps of a frame: at most 2,000 in a 0.1 s frame)
+      // (speed / epsilon bounds the force steps of a frame: at most 5,000 in a 0.25 s frame)
       {"forces.speed_widths", "image widths per second at full force", 0.001f, 10.0f,
        [](S s) { return &s.labels.forces.speed_widths; }},
       {"forces.epsilon_widths", "image widths: nearer than this the force shrinks", 0.0005f, 1.0f,
