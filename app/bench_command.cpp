@@ -533,6 +533,7 @@ void add_bench_command(CLI::App& app, DeviceOptions& device) {
   add_render_bench(cmd, device);
   add_placement_bench(cmd, device);
   add_encode_bench(cmd);
+  add_segmentation_bench(cmd);
   add_view_bench(cmd, device);
   add_soak_command(cmd, device);
 }

@@ -67,6 +67,10 @@ struct SceneInput {
   std::string file;
   std::string preset;             // --preset: every volume's transfer function
   std::string labels;             // --labels: a label file (.mrk.json, .fcsv, .csv) added
+  std::string segmentation;       // --segmentation: its regions as labels (segmentation.h)
+  std::string names;              // --names: its names table
+  std::vector<std::string> regions;  // --regions: the regions chosen
+  std::vector<std::string> make;     // --make: labels, masks, surfaces
   int frame = -1;                 // --frame: a 4-D volume's frame (-1: the first, with a warning)
   std::string series;             // --series: a DICOM folder's series (SeriesNumber or UID)
   std::string window;             // --window CENTER,WIDTH: a grey ramp in the volumes' values
@@ -129,5 +133,6 @@ void add_video_command(CLI::App& app, DeviceOptions& device);
 void add_pick_command(CLI::App& app, DeviceOptions& device);
 // `bench encode` (app/bench_encode.cpp), added to the `bench` command.
 void add_encode_bench(CLI::App* bench);
+void add_segmentation_bench(CLI::App* bench);
 
 }  // namespace strata::app

@@ -17,6 +17,7 @@
 #include "engine/scene/io/transfer_function_loader.h"
 #include "engine/scene/io/volume_loader.h"
 #include "engine/scene/scene_bounds.h"
+#include "engine/scene/segmentation.h"
 
 namespace strata::app {
 
@@ -219,6 +220,40 @@ Scene load_single_file(const fs::path& path) {
   return scene;
 }
 
+// A segmentation's regions: value, name, colour, voxels, volume and anchor (LPS and RAS).
+std::string describe_segmentation(const fs::path& path, const std::optional<fs::path>& names) {
+  std::vector<std::string> warnings;
+  const Segmentation seg = load_segmentation(path, names, {}, warnings);
+  for (const std::string& w : warnings) std::fprintf(stderr, "strata: warning: %s\n", w.c_str());
+  const std::vector<RegionSummary> summaries = summarise_regions(seg);
+  std::string out = format("segmentation: %s\n", seg.format.c_str());
+  if (!seg.layers.empty()) {
+    const Volume& g = seg.layers.front();
+    out += format("  grid: %ux%ux%u, spacing %g x %g x %g mm, %zu layer%s\n", g.dims.x, g.dims.y,
+                  g.dims.z, g.spacing.x, g.spacing.y, g.spacing.z, seg.layers.size(),
+                  seg.layers.size() == 1 ? "" : "s");
+  }
+  out += format("regions: %zu\n", seg.regions.size());
+  out += format("  %5s  %-28s %-17s %9s %10s  %-26s %s\n", "value", "name", "colour", "voxels",
+                "ml", "anchor LPS (mm)", "anchor RAS (mm)");
+  for (size_t r = 0; r < seg.regions.size(); ++r) {
+    const SegmentRegion& region = seg.regions[r];
+    const RegionSummary& sum = summaries[r];
+    const std::string colour =
+        region.colour ? format("(%.2f, %.2f, %.2f)", region.colour->r, region.colour->g,
+                               region.colour->b)
+                      : "-";
+    const glm::vec3 lps = sum.anchor, ras(-lps.x, -lps.y, lps.z);
+    out += format("  %5d  %-28s %-17s %9zu %10.3f  ", region.number,
+                  printable_text(region.name).c_str(), colour.c_str(), sum.voxels,
+                  sum.millilitres);
+    out += sum.voxels == 0 ? "(no voxels)\n"
+                           : format("%-26s %s", vec(lps).c_str(), vec(ras).c_str()) +
+                                 (sum.parts > 1 ? format("  (%d parts)", sum.parts) : "") + "\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 void add_info_command(CLI::App& app) {
@@ -231,8 +266,19 @@ void add_info_command(CLI::App& app) {
   cmd->add_option("--scene", *scene_file,
                   "for a label file (.mrk.json, .fcsv, .csv): check its anchors against this "
                   "scene's volumes");
-  cmd->callback([file, scene_file] {
+  auto names = std::make_shared<std::string>();
+  cmd->add_option("--names", *names,
+                  "for a label map: list its regions with this names table (a segmentation with "
+                  "names of its own lists them without)");
+  cmd->callback([file, scene_file, names] {
     const fs::path path(*file);
+    if (!names->empty() || is_segmentation(path)) {
+      if (!scene_file->empty()) throw UsageError("--scene goes with a label file only");
+      std::optional<fs::path> table;
+      if (!names->empty()) table = *names;
+      std::printf("%s\n%s", file->c_str(), describe_segmentation(path, table).c_str());
+      return;
+    }
     if (is_label_file(path)) {
       const LabelFile labels = read_label_file(path);
       std::optional<Scene> scene;

@@ -17,11 +17,35 @@ namespace strata::app {
 
 namespace {
 
+std::optional<SegmentationEntry> segmentation_entry(const SceneInput& in) {
+  if (in.segmentation.empty()) {
+    for (const auto& [given, option] : {std::pair{!in.names.empty(), "--names"},
+                                        {!in.regions.empty(), "--regions"},
+                                        {!in.make.empty(), "--make"}})
+      if (given) throw UsageError(std::string(option) + " needs --segmentation");
+    return std::nullopt;
+  }
+  SegmentationEntry entry;
+  entry.file = in.segmentation;
+  if (!in.names.empty()) entry.names = in.names;
+  entry.regions = in.regions;
+  if (!in.make.empty()) {
+    const auto has = [&](const char* what) {
+      return std::find(in.make.begin(), in.make.end(), what) != in.make.end();
+    };
+    entry.labels = has("labels");
+    entry.masks = has("masks");
+    entry.surfaces = has("surfaces");
+  }
+  return entry;
+}
+
 Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
   SceneOpenOptions options;
   options.limits = limits;
   options.preset = in.preset;
   options.labels = in.labels;
+  options.segmentation = segmentation_entry(in);
   if (in.frame >= 0) options.frame = in.frame;
   options.series = in.series;
   // A scene file names its volumes' series and frames itself.
@@ -119,6 +143,22 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
   cmd->add_option("--labels", in.labels,
                   "labels from a file: 3D Slicer markups (.mrk.json, .fcsv) or CSV "
                   "(docs/scene-format.md)");
+  cmd->add_option("--segmentation", in.segmentation,
+                  "a segmentation whose regions become labels: a label map with its names "
+                  "(TotalSegmentator .nii.gz, or --names), a folder of masks, 3D Slicer .seg.nrrd, "
+                  "DICOM SEG (docs/scene-format.md)");
+  cmd->add_option("--names", in.names,
+                  "with --segmentation: a names table (ITK-SNAP, 3D Slicer .ctbl/.csv, "
+                  "FreeSurferColorLUT.txt, AAL, nnU-Net dataset.json, MONAI channel_def)");
+  cmd->add_option("--regions", in.regions,
+                  "with --segmentation: only these regions, by name (default: every region with "
+                  "voxels)")
+      ->delimiter(',');
+  cmd->add_option("--make", in.make,
+                  "with --segmentation: what its regions become: labels, masks, surfaces "
+                  "(default: labels)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"labels", "masks", "surfaces"}));
   cmd->add_option("--frame", in.frame,
                   "a 4-D volume's frame or a DICOM series' time point, from 0 (default: the first)")
       ->check(whole_range(0, 1e6));

@@ -76,3 +76,13 @@ for entry in "${files[@]}"; do
   fi
 done
 rm -rf "$cache"/deb-*
+
+# The demo segmentation (README, docs/scene-format.md): AAL's regions grouped into 27 structures,
+# a multi-label NIfTI with its names in the header, as TotalSegmentator writes one.
+demo_seg=$cache/demo/head-regions.nii.gz
+if [[ ! -f $demo_seg || $demo_seg -ot scripts/make-demo-segmentation.py ]]; then
+  mkdir -p "$cache/demo"
+  python3 scripts/make-demo-segmentation.py "$cache/mricron/aal.nii.gz" \
+    "$cache/mricron/aal.nii.txt" "$demo_seg.part"
+  mv "$demo_seg.part" "$demo_seg"
+fi

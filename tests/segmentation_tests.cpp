@@ -1,3 +1,242 @@
+// The segmentation model (engine/scene/segmentation.h): regions packed into layers, label maps
+// with names, anchors deepest inside each region (checked against a brute-force search), and the
+// geometry checks against the scan.
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "engine/core/error.h"
 #include "engine/scene/segmentation.h"
+
+using namespace strata;
+
+namespace {
+
+Volume grid(glm::uvec3 dims, glm::vec3 spacing = glm::vec3(1.0f)) {
+  Volume v;
+  v.name = "grid";
+  v.source = "seg.nii.gz";
+  v.dims = dims;
+  v.spacing = spacing;
+  v.origin = {-10.0f, 20.0f, 5.0f};
+  return v;
+}
+
+size_t at(const Volume& v, int x, int y, int z) {
+  return (size_t(z) * v.dims.y + y) * v.dims.x + x;
+}
+
+// A C: a thick ring around the z axis at the grid's middle, open toward +x.
+std::vector<uint8_t> c_shape(const Volume& g) {
+  std::vector<uint8_t> inside(g.voxel_count(), 0);
+  const glm::vec2 centre = glm::vec2(g.dims.x, g.dims.y) * 0.5f;
+  for (int z = 2; z < int(g.dims.z) - 2; ++z)
+    for (int y = 0; y < int(g.dims.y); ++y)
+      for (int x = 0; x < int(g.dims.x); ++x) {
+        const glm::vec2 d = glm::vec2(x, y) + 0.5f - centre;
+        const float r = glm::length(d);
+        if (r >= 6.0f && r <= 10.0f && !(d.x > 0.0f && std::fabs(d.y) < 4.0f))
+          inside[at(g, x, y, z)] = 1;
+      }
+  return inside;
+}
+
+std::vector<uint8_t> ball(const Volume& g, glm::vec3 centre, float radius) {
+  std::vector<uint8_t> inside(g.voxel_count(), 0);
+  for (int z = 0; z < int(g.dims.z); ++z)
+    for (int y = 0; y < int(g.dims.y); ++y)
+      for (int x = 0; x < int(g.dims.x); ++x)
+        if (glm::length((glm::vec3(x, y, z) - centre) * g.spacing) <= radius)
+          inside[at(g, x, y, z)] = 1;
+  return inside;
+}
+
+glm::vec3 world_of(const Volume& g, glm::vec3 index) {
+  return glm::vec3(g.index_to_world() * glm::vec4(index, 1.0f));
+}
+
+}  // namespace
+
+TEST_CASE("segmentation: regions that overlap go to another layer, the others share one") {
+  const Volume g = grid({24, 24, 16});
+  Segmentation s;
+  s.source = g.source;
+  add_region_voxels(s, g, ball(g, {6, 6, 8}, 4.0f), {.number = 1, .name = "left"});
+  add_region_voxels(s, g, ball(g, {17, 17, 8}, 4.0f), {.number = 2, .name = "right"});
+  add_region_voxels(s, g, ball(g, {8, 8, 8}, 4.0f), {.number = 3, .name = "over left"});
+  REQUIRE(s.layers.size() == 2);
+  CHECK(s.regions[0].layer == 0);
+  CHECK(s.regions[1].layer == 0);
+  CHECK(s.regions[2].layer == 1);
+  CHECK(s.regions[2].value == 3);
+  CHECK(s.layers[1].type == VoxelType::uint16);
+  CHECK(s.layers[1].origin == g.origin);
+  CHECK(region_contains(s, s.regions[2], world_of(g, {8, 8, 8})));
+  CHECK(region_contains(s, s.regions[0], world_of(g, {6, 6, 8})));
+  CHECK_FALSE(region_contains(s, s.regions[1], world_of(g, {6, 6, 8})));
+  CHECK_FALSE(region_contains(s, s.regions[1], world_of(g, {-3, 6, 8})));  // outside the grid
+  // The same number again in one layer would merge two regions: it goes to the next layer
+  // where its number is free.
+  add_region_voxels(s, g, ball(g, {20, 4, 8}, 2.0f), {.number = 1, .name = "again"});
+  CHECK(s.regions[3].layer == 1);
+  add_region_voxels(s, g, ball(g, {20, 20, 2}, 1.0f), {.number = 1, .name = "third"});
+  CHECK(s.regions[4].layer == 2);
+  CHECK_THROWS_WITH_AS(add_region_voxels(s, g, ball(g, {1, 1, 1}, 1.0f), {.number = 0}),
+                       doctest::Contains("number 0 is outside 1..65535"), Error);
+  CHECK_THROWS_WITH_AS(add_region_voxels(s, g, std::vector<uint8_t>(5, 1), {.number = 9}),
+                       doctest::Contains("has 5 voxels, the grid 9216"), Error);
+}
+
+TEST_CASE("segmentation: a label map with a names table keeps the table's order and names") {
+  Volume map = grid({8, 8, 8});
+  map.type = VoxelType::uint8;
+  map.voxels.assign(map.voxel_count(), std::byte{0});
+  map.voxels[at(map, 1, 1, 1)] = std::byte{7};
+  map.voxels[at(map, 2, 2, 2)] = std::byte{3};
+  map.voxels[at(map, 3, 3, 3)] = std::byte{9};  // named by no one
+  NamesTable names{"test", {{0, "background", {}}, {7, "liver", glm::vec3(1, 0, 0)}, {3, "spleen", {}},
+                            {5, "aorta", {}}}};
+  std::vector<std::string> warnings;
+  const Segmentation s = segmentation_from_label_map(map, names, warnings);
+  REQUIRE(s.regions.size() == 3);
+  CHECK(s.regions[0].name == "liver");
+  CHECK(s.regions[0].colour == glm::vec3(1, 0, 0));
+  CHECK(s.regions[1].name == "spleen");
+  CHECK(s.regions[2].name == "aorta");
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0].find("left out: 9") != std::string::npos);
+  const std::vector<RegionSummary> summary = summarise_regions(s);
+  CHECK(summary[0].voxels == 1);
+  CHECK(summary[2].voxels == 0);  // named, no voxels
+  CHECK(summary[0].anchor == world_of(map, {1, 1, 1}));
+
+  Volume fractions = map;
+  fractions.type = VoxelType::float32;
+  fractions.voxels.assign(fractions.voxel_count() * 4, std::byte{0});
+  const float half = 0.5f;
+  std::memcpy(fractions.voxels.data() + 4 * 10, &half, 4);
+  CHECK_THROWS_WITH_AS(segmentation_from_label_map(fractions, names, warnings),
+                       doctest::Contains("not a whole number"), Error);
+}
+
+TEST_CASE("segmentation: the C-shape's anchor is inside it, where its centroid is not") {
+  const Volume g = grid({28, 28, 12}, {0.8f, 0.8f, 2.0f});
+  Segmentation s;
+  s.source = g.source;
+  const std::vector<uint8_t> c = c_shape(g);
+  add_region_voxels(s, g, c, {.number = 4, .name = "C"});
+  glm::dvec3 sum(0.0);
+  size_t count = 0;
+  for (int z = 0; z < 12; ++z)
+    for (int y = 0; y < 28; ++y)
+      for (int x = 0; x < 28; ++x)
+        if (c[at(g, x, y, z)]) sum += glm::dvec3(x, y, z), ++count;
+  const glm::vec3 centroid = world_of(g, glm::vec3(sum / double(count)));
+  CHECK_FALSE(region_contains(s, s.regions[0], centroid));
+  const RegionSummary summary = summarise_regions(s)[0];
+  CHECK(summary.parts == 1);
+  CHECK(summary.voxels == count);
+  CHECK(summary.millilitres == doctest::Approx(double(count) * 0.8 * 0.8 * 2.0 / 1000.0));
+  CHECK(region_contains(s, s.regions[0], summary.anchor));
+  // The deepest point of a ring 4 voxels thick is on the ring's middle circle (radius 8), at
+  // the middle slice pair, and opposite the opening (toward the centroid's side: -x).
+  const glm::vec3 index =
+      glm::vec3(glm::inverse(g.index_to_world()) * glm::vec4(summary.anchor, 1.0f));
+  const glm::vec2 d = glm::vec2(index) + 0.5f - glm::vec2(14.0f);
+  CHECK(glm::length(d) == doctest::Approx(8.0f).epsilon(0.12));
+  CHECK(d.x < 0.0f);
+}
+
+TEST_CASE("segmentation: the anchor is the deepest voxel, as a brute-force search finds it") {
+  std::mt19937 random(7);
+  for (int round = 0; round < 4; ++round) {
+    const glm::vec3 spacing(0.7f + 0.3f * float(round), 1.3f, 2.1f - 0.4f * float(round));
+    const Volume g = grid({14, 12, 10}, spacing);
+    std::vector<uint8_t> inside(g.voxel_count(), 0);
+    // A few overlapping balls: one connected blob of odd shape.
+    for (int b = 0; b < 4; ++b) {
+      const glm::vec3 c(float(4 + random() % 6), float(4 + random() % 4), float(3 + random() % 4));
+      const std::vector<uint8_t> one = ball(g, c, 2.5f + float(random() % 3u));
+      for (size_t i = 0; i < inside.size(); ++i) inside[i] |= one[i];
+    }
+    Segmentation s;
+    s.source = g.source;
+    add_region_voxels(s, g, inside, {.number = 1, .name = "blob"});
+    const RegionSummary summary = summarise_regions(s)[0];
+    // Brute force: each inside voxel's distance (mm) to the nearest voxel outside the region,
+    // the grid's outside counting as outside.
+    const auto depth = [&](glm::ivec3 p) {
+      double best = 1e300;
+      for (int z = -1; z <= int(g.dims.z); ++z)
+        for (int y = -1; y <= int(g.dims.y); ++y)
+          for (int x = -1; x <= int(g.dims.x); ++x) {
+            const bool out = x < 0 || y < 0 || z < 0 || x >= int(g.dims.x) ||
+                             y >= int(g.dims.y) || z >= int(g.dims.z) || !inside[at(g, x, y, z)];
+            if (!out) continue;
+            const glm::dvec3 d = glm::dvec3(glm::ivec3(x, y, z) - p) * glm::dvec3(spacing);
+            best = std::min(best, glm::dot(d, d));
+          }
+      return best;
+    };
+    double deepest = 0.0;
+    for (int z = 0; z < int(g.dims.z); ++z)
+      for (int y = 0; y < int(g.dims.y); ++y)
+        for (int x = 0; x < int(g.dims.x); ++x)
+          if (inside[at(g, x, y, z)]) deepest = std::max(deepest, depth({x, y, z}));
+    const glm::vec3 index =
+        glm::round(glm::vec3(glm::inverse(g.index_to_world()) * glm::vec4(summary.anchor, 1.0f)));
+    CAPTURE(round);
+    CHECK(depth(glm::ivec3(index)) == doctest::Approx(deepest));
+    CHECK(region_contains(s, s.regions[0], summary.anchor));
+  }
+}
+
+TEST_CASE("segmentation: a region in two parts is anchored in the larger, ties toward the centre") {
+  const Volume g = grid({30, 12, 12});
+  Segmentation s;
+  s.source = g.source;
+  std::vector<uint8_t> two = ball(g, {6, 6, 6}, 3.0f);
+  const std::vector<uint8_t> big = ball(g, {20, 6, 6}, 5.0f);
+  for (size_t i = 0; i < two.size(); ++i) two[i] |= big[i];
+  add_region_voxels(s, g, two, {.number = 2, .name = "split"});
+  const RegionSummary summary = summarise_regions(s)[0];
+  CHECK(summary.parts == 2);
+  CHECK(summary.anchor == world_of(g, {20, 6, 6}));
+
+  // A bar: every voxel of its middle line is equally deep; the one nearest its centroid wins.
+  Segmentation bar;
+  bar.source = g.source;
+  std::vector<uint8_t> inside(g.voxel_count(), 0);
+  for (int z = 5; z <= 7; ++z)
+    for (int y = 5; y <= 7; ++y)
+      for (int x = 3; x <= 25; ++x) inside[at(g, x, y, z)] = 1;
+  add_region_voxels(bar, g, inside, {.number = 1, .name = "bar"});
+  CHECK(summarise_regions(bar)[0].anchor == world_of(g, {14, 6, 6}));
+}
+
+TEST_CASE("segmentation: a grid that misses the scan or turns away from it is refused") {
+  const Volume g = grid({10, 10, 10});
+  Segmentation s;
+  s.source = "seg.nii.gz";
+  add_region_voxels(s, g, ball(g, {5, 5, 5}, 3.0f), {.number = 1, .name = "ball"});
+  Volume scan = grid({20, 20, 20});
+  scan.source = "ct.nii.gz";
+  CHECK_NOTHROW(check_segmentation_fits(s, scan));
+  // Axes swapped and flipped are the same orientation.
+  scan.direction = glm::mat3(glm::vec3(0, -1, 0), glm::vec3(1, 0, 0), glm::vec3(0, 0, 1));
+  CHECK_NOTHROW(check_segmentation_fits(s, scan));
+  scan.direction = glm::mat3(1.0f);
+  scan.origin = {500.0f, 20.0f, 5.0f};
+  CHECK_THROWS_WITH_AS(check_segmentation_fits(s, scan),
+                       doctest::Contains("seg.nii.gz and ct.nii.gz: the segmentation's grid "
+                                         "does not overlap the scan"),
+                       Error);
+  scan.origin = g.origin;
+  const float a = glm::radians(30.0f);
+  scan.direction = glm::mat3(glm::vec3(std::cos(a), std::sin(a), 0),
+                             glm::vec3(-std::sin(a), std::cos(a), 0), glm::vec3(0, 0, 1));
+  CHECK_THROWS_WITH_AS(check_segmentation_fits(s, scan),
+                       doctest::Contains("their orientations disagree"), Error);
+}

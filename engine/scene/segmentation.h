@@ -82,6 +82,10 @@ Segmentation load_segmentation(const std::filesystem::path& path,
                                const VolumeReadOptions& options,
                                std::vector<std::string>& warnings);
 
+// Whether load_segmentation reads the file without a names table: a folder of masks or holding a
+// DICOM SEG, a DICOM SEG, a 3D Slicer segmentation, a NIfTI with a label table in its header.
+bool is_segmentation(const std::filesystem::path& path);
+
 // The names-table formats, detected by content: ITK-SNAP label descriptions, 3D Slicer colour
 // tables (.ctbl/.txt and .csv), FreeSurfer's FreeSurferColorLUT.txt, AAL's "index name colour",
 // nnU-Net dataset.json ("labels") and MONAI's "channel_def". Errors: "<file>: line N: <reason>".
@@ -145,5 +149,24 @@ void check_segmentation_fits(const Segmentation& segmentation, const Volume& sca
 Volume region_mask(const Segmentation& segmentation, const SegmentRegion& region);
 // The region's surface (world space), as atlas_surface makes it.
 Mesh region_surface(const Segmentation& segmentation, const SegmentRegion& region);
+
+// ---- in a scene
+
+// What a scene's "segmentations" entry or --segmentation asks for.
+struct SegmentationEntry {
+  std::filesystem::path file;
+  std::optional<std::filesystem::path> names;  // a names table replacing the file's names
+  std::vector<std::string> regions;            // by name ('_' or ' ' alike); empty: all
+  bool labels = true, masks = false, surfaces = false;
+};
+
+// Reads the segmentation and adds, for each chosen region with voxels, a label at its anchor
+// (summarise_regions; text: the name with '_' as ' '), a mask volume and a surface mesh in its
+// colour as the entry asks, and its layers as atlases (so a point can be named). Checked
+// against the scene's first volume (check_segmentation_fits). A region without voxels is
+// skipped with a warning naming it; a name in `regions` the file does not have, or more
+// regions than the scene has room for (kMaxLabels), is an Error that says how to choose.
+void add_segmentation(Scene& scene, const SegmentationEntry& entry,
+                      const VolumeReadOptions& options);
 
 }  // namespace strata

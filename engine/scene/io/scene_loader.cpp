@@ -16,6 +16,7 @@
 #include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
 #include "engine/scene/atlas.h"
+#include "engine/scene/segmentation.h"
 #include "engine/scene/fitted_camera.h"
 #include "engine/scene/io/label_file_loader.h"
 #include "engine/scene/io/mesh_loader.h"
@@ -171,6 +172,7 @@ class SceneReader {
   void volume(const json& object, const Field& field);
   void mesh(const json& object, const Field& field);
   void atlas(const json& object, const Field& field);
+  void segmentation(const json& object, const Field& field);
   std::vector<AtlasRegion> atlas_regions(const json& object, const Field& field);
   void label(const json& object, const Field& field);
   std::optional<LabelImage> label_image(const json& object, const Field& field);
@@ -383,6 +385,25 @@ void SceneReader::atlas(const json& object, const Field& field) {
   }
 }
 
+// {"file", "names", "regions": "all" | [names], "make": [...]} (segmentation.h).
+void SceneReader::segmentation(const json& object, const Field& field) {
+  check_keys(object, field, {"file", "names", "regions", "make"});
+  SegmentationEntry entry;
+  entry.file = resolve(required(object, field, "file"), field / "file");
+  if (const json* names = optional(object, "names")) entry.names = resolve(*names, field / "names");
+  if (const json* regions = optional(object, "regions"); regions && *regions != "all") {
+    if (!regions->is_array())
+      (field / "regions").fail("expected \"all\" or an array of region names");
+    for (size_t i = 0; i < regions->size(); ++i)
+      entry.regions.push_back(string((*regions)[i], (field / "regions")[i]));
+  }
+  const std::set<std::string> make = atlas_products(object, field / "make");
+  entry.labels = make.count("labels") > 0;
+  entry.masks = make.count("masks") > 0;
+  entry.surfaces = make.count("surfaces") > 0;
+  (field / "file").wrap([&] { add_segmentation(scene_, entry, {.limits = limits_}); });
+}
+
 // "image" with its optional "image_height" and "image_side"; the picture is read here, so a bad
 // file is reported as the label's field.
 std::optional<LabelImage> SceneReader::label_image(const json& object, const Field& field) {
@@ -524,7 +545,8 @@ Scene SceneReader::read(const json& root) {
               " is not supported (this strata reads version 1)");
   }
   check_keys(root, field,
-             {"strata_scene", "volumes", "meshes", "atlas", "labels", "camera", "settings"});
+             {"strata_scene", "volumes", "meshes", "atlas", "segmentations", "labels", "camera",
+              "settings"});
   each(root, field, "volumes", [&](const json& v, const Field& f) { volume(v, f); });
   each(root, field, "meshes", [&](const json& v, const Field& f) { mesh(v, f); });
   each(root, field, "atlas", [&](const json& v, const Field& f) { atlas(v, f); });
@@ -535,6 +557,8 @@ Scene SceneReader::read(const json& root) {
   } else {
     each(root, field, "labels", [&](const json& v, const Field& f) { label(v, f); });
   }
+  // After the labels: a segmentation's labels take ids the scene's own do not use.
+  each(root, field, "segmentations", [&](const json& v, const Field& f) { segmentation(v, f); });
   if (const json* c = optional(root, "camera")) camera(*c, field / "camera");
   if (const json* s = optional(root, "settings")) settings(*s, field / "settings");
   // Placement keys its state by label id; two labels with one id would silently share it.
@@ -583,6 +607,10 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
     throw Error(path.string() + ": unknown scene format '" + extension +
                 "' (expected a scene: .json, or .xml from the thesis program; or a volume: " +
                 kVolumeExtensions + ")");
+  }
+  if (options.segmentation) {
+    VolumeReadOptions read{.limits = options.limits};
+    add_segmentation(scene, *options.segmentation, read);
   }
   if (!options.labels.empty()) add_label_file(scene, options.labels);
   if (scene.labels.size() > size_t(kMaxLabels))

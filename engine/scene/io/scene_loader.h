@@ -11,6 +11,7 @@
 #include "engine/core/atomic_file.h"
 #include "engine/scene/io/volume_loader.h"
 #include "engine/scene/scene.h"
+#include "engine/scene/segmentation.h"
 
 namespace strata {
 
@@ -18,6 +19,7 @@ namespace strata {
 struct SceneOpenOptions {
   std::string preset;               // every volume's transfer function: this preset
   std::filesystem::path labels;     // labels from this file (load_label_file) added
+  std::optional<SegmentationEntry> segmentation;  // its regions added (add_segmentation)
   std::optional<int> frame;         // a 4-D volume opened directly: this frame
   std::string series;               // a DICOM folder opened directly: this series (number or UID)
   std::optional<glm::vec2> window;  // every volume: a grey ramp at (center, width), its values
