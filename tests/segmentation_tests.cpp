@@ -6,9 +6,13 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <set>
 
 #include "engine/core/error.h"
+#include "engine/scene/atlas.h"
+#include "engine/scene/io/scene_loader.h"
 #include "engine/scene/segmentation.h"
+#include "test_files.h"
 
 using namespace strata;
 
@@ -239,4 +243,140 @@ TEST_CASE("segmentation: a grid that misses the scan or turns away from it is re
                              glm::vec3(-std::sin(a), std::cos(a), 0), glm::vec3(0, 0, 1));
   CHECK_THROWS_WITH_AS(check_segmentation_fits(s, scan),
                        doctest::Contains("their orientations disagree"), Error);
+}
+
+// ---- a segmentation in a scene (add_segmentation, the "segmentations" entry)
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A label map on the scan's grid (a 40^3 box, 2 mm voxels) holding the given balls, written as
+// .mha, and an ITK-SNAP names table for values 1..names.size().
+struct TestSegmentation {
+  fs::path folder, scan, labels, names;
+};
+
+TestSegmentation write_segmentation(const std::string& name,
+                                    const std::vector<std::pair<glm::vec3, float>>& balls,
+                                    const std::vector<std::string>& names,
+                                    glm::vec3 labels_origin = glm::vec3(-40.0f)) {
+  TestSegmentation t;
+  t.folder = test::fresh_folder("segmentation", name);
+  Volume scan = grid({40, 40, 40}, glm::vec3(2.0f));
+  scan.origin = glm::vec3(-40.0f);
+  scan.type = VoxelType::uint8;
+  scan.voxels.assign(scan.voxel_count(), std::byte{60});
+  t.scan = t.folder / "scan.mha";
+  write_metaimage(t.scan, scan);
+  Volume map = grid({40, 40, 40}, glm::vec3(2.0f));
+  map.origin = labels_origin;
+  map.type = VoxelType::uint16;
+  map.voxels.assign(map.voxel_count() * 2, std::byte{0});
+  for (size_t b = 0; b < balls.size(); ++b) {
+    const std::vector<uint8_t> inside = ball(map, balls[b].first, balls[b].second);
+    const uint16_t value = uint16_t(b + 1);
+    for (size_t i = 0; i < inside.size(); ++i)
+      if (inside[i]) std::memcpy(map.voxels.data() + 2 * i, &value, 2);
+  }
+  t.labels = t.folder / "labels.mha";
+  write_metaimage(t.labels, map);
+  std::string table = "# ITK-SNAP Label Description File\n";
+  for (size_t n = 0; n < names.size(); ++n)
+    table += std::to_string(n + 1) + " 200 100 50 1 1 1 \"" + names[n] + "\"\n";
+  t.names = test::write_file(t.folder / "names.txt", table);
+  return t;
+}
+
+std::string scene_json(const TestSegmentation& t, const std::string& entry_keys,
+                       const std::string& labels = "[]") {
+  return R"({"strata_scene": 1, "volumes": [{"file": "scan.mha"}], "labels": )" + labels +
+         R"(, "segmentations": [{"file": "labels.mha", "names": "names.txt")" + entry_keys + "}]}";
+}
+
+}  // namespace
+
+TEST_CASE("segmentation in a scene: labels named after the regions, anchored inside them") {
+  const TestSegmentation t = write_segmentation(
+      "scene", {{{10, 10, 10}, 12.0f}, {{28, 28, 28}, 10.0f}, {{30, 8, 20}, 6.0f}},
+      {"liver", "spleen_tip", "kidney"});
+  const fs::path file = test::write_file(
+      t.folder / "scene.json",
+      scene_json(t, R"(, "make": ["labels", "masks"])",
+                 R"([{"id": 0, "text": "own", "anchor": [0, 0, 0]}])"));
+  const Scene scene = load_scene_json(file);
+  REQUIRE(scene.labels.size() == 4);
+  CHECK(scene.labels[1].text == "liver");
+  CHECK(scene.labels[2].text == "spleen tip");
+  CHECK(scene.labels[3].text == "kidney");
+  std::set<int> ids;
+  for (const Label& l : scene.labels) ids.insert(l.id);
+  CHECK(ids.size() == 4);
+  // Anchors at the balls' centres (the deepest voxels), in world space.
+  CHECK(glm::length(scene.labels[1].anchor - glm::vec3(-40.0f + 2.0f * 10.0f)) < 1e-3f);
+  REQUIRE(scene.atlases.size() == 1);
+  for (size_t l = 1; l < 4; ++l) CHECK(atlas_region_at(scene, scene.labels[l].anchor) != "");
+  CHECK(atlas_region_at(scene, scene.labels[3].anchor) == "kidney");
+  // A mask per region, in the table's colour.
+  REQUIRE(scene.volumes.size() == 4);
+  CHECK(scene.volumes[1].name == "liver");
+  const TransferFunction& tf =
+      scene.transfer_functions.at(size_t(scene.volumes[1].transfer_function));
+  CHECK(glm::length(glm::vec3(tf.sample(1.0f)) - glm::vec3(200, 100, 50) / 255.0f) < 1e-3f);
+  REQUIRE(scene.segmentations.size() == 1);
+  CHECK(scene.segmentations[0].masks);
+}
+
+TEST_CASE("segmentation in a scene: regions chosen by name, empty ones warned, faults refused") {
+  const TestSegmentation t =
+      write_segmentation("choose", {{{10, 10, 10}, 8.0f}, {{30, 30, 30}, 6.0f}},
+                         {"liver", "spleen", "pancreas"});
+  const Scene some = load_scene_json(
+      test::write_file(t.folder / "some.json", scene_json(t, R"(, "regions": ["spleen"])")));
+  REQUIRE(some.labels.size() == 1);
+  CHECK(some.labels[0].text == "spleen");
+
+  const Scene all = load_scene_json(test::write_file(t.folder / "all.json", scene_json(t, "")));
+  CHECK(all.labels.size() == 2);
+  REQUIRE(all.warnings.size() == 1);
+  CHECK(all.warnings[0].find("region 'pancreas' (3) has no voxels: skipped") !=
+        std::string::npos);
+
+  const std::string unknown = test::error_of([&] {
+    load_scene_json(
+        test::write_file(t.folder / "unknown.json", scene_json(t, R"(, "regions": ["heart"])")));
+  });
+  CHECK(unknown.find("no region 'heart' (it has 3: liver, spleen, pancreas)") !=
+        std::string::npos);
+  CHECK(unknown.find("segmentations[0].file") != std::string::npos);
+}
+
+TEST_CASE("segmentation in a scene: a grid elsewhere, and more regions than labels, are refused") {
+  const TestSegmentation far = write_segmentation("far", {{{10, 10, 10}, 8.0f}}, {"liver"},
+                                                  glm::vec3(400.0f, -40.0f, -40.0f));
+  const std::string elsewhere = test::error_of([&] {
+    load_scene_json(test::write_file(far.folder / "far.json", scene_json(far, "")));
+  });
+  CHECK(elsewhere.find("labels.mha and " + (far.folder / "scan.mha").string() +
+                       ": the segmentation's grid does not overlap the scan") != std::string::npos);
+
+  // 4100 regions, one voxel each, on a 17^3 grid.
+  const fs::path folder = test::fresh_folder("segmentation", "many");
+  Volume map = grid({17, 17, 17});
+  map.type = VoxelType::uint16;
+  map.voxels.assign(map.voxel_count() * 2, std::byte{0});
+  std::string table;
+  for (uint16_t v = 1; v <= 4100; ++v) {
+    std::memcpy(map.voxels.data() + 2 * size_t(v), &v, 2);
+    table += std::to_string(v) + " 0 0 0 1 1 1 \"r" + std::to_string(v) + "\"\n";
+  }
+  write_metaimage(folder / "labels.mha", map);
+  test::write_file(folder / "names.txt", "# ITK-SNAP Label Description File\n" + table);
+  Scene scene;
+  const std::string many = test::error_of([&] {
+    add_segmentation(scene, {.file = folder / "labels.mha", .names = folder / "names.txt"}, {});
+  });
+  CHECK(many.find("4100 regions with voxels, but a scene holds at most 4096 labels: choose "
+                  "regions with --regions NAME,... or the entry's \"regions\"") !=
+        std::string::npos);
 }

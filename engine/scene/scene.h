@@ -169,6 +169,15 @@ struct SceneAtlas {
   std::map<int, std::string> names;  // region index -> name as in the file ("Thalamus_R")
 };
 
+// What a scene's "segmentations" entry or --segmentation asks for.
+// (engine/scene/segmentation.h reads it.)
+struct SegmentationEntry {
+  std::filesystem::path file;
+  std::optional<std::filesystem::path> names;  // a names table replacing the file's names
+  std::vector<std::string> regions;            // by name ('_' or ' ' alike); empty: all
+  bool labels = true, masks = false, surfaces = false;
+};
+
 struct Scene {
   std::filesystem::path source;
   std::vector<Volume> volumes;
@@ -182,6 +191,9 @@ struct Scene {
   bool has_camera = false;  // the file gave the camera's view (else complete_scene fits one)
   std::vector<CameraPose> camera_positions;  // named poses ("--camera NAME")
   std::vector<SceneAtlas> atlases;
+  // The segmentations read (their masks and surfaces have no file of their own: the scene
+  // writer writes the entry that makes them).
+  std::vector<SegmentationEntry> segmentations;
   SceneSettings settings;
   std::vector<std::string> warnings;  // e.g. a referenced file that does not exist
   // The strata scene JSON text `source` held when read (empty for other sources): save_scene_json

@@ -152,14 +152,6 @@ Mesh region_surface(const Segmentation& segmentation, const SegmentRegion& regio
 
 // ---- in a scene
 
-// What a scene's "segmentations" entry or --segmentation asks for.
-struct SegmentationEntry {
-  std::filesystem::path file;
-  std::optional<std::filesystem::path> names;  // a names table replacing the file's names
-  std::vector<std::string> regions;            // by name ('_' or ' ' alike); empty: all
-  bool labels = true, masks = false, surfaces = false;
-};
-
 // Reads the segmentation and adds, for each chosen region with voxels, a label at its anchor
 // (summarise_regions; text: the name with '_' as ' '), a mask volume and a surface mesh in its
 // colour as the entry asks, and its layers as atlases (so a point can be named). Checked

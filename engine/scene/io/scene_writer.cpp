@@ -146,6 +146,24 @@ void write_positions(ordered_json& root, const Scene& scene) {
   (*camera)["positions"] = std::move(positions);
 }
 
+// The segmentations whose masks or surfaces the scene shows, making those alone: their labels
+// are written with the scene's (where the viewer may have moved or edited them).
+ordered_json segmentations_json(const Scene& scene, const auto& relative) {
+  ordered_json result = ordered_json::array();
+  for (const SegmentationEntry& s : scene.segmentations) {
+    if (!s.masks && !s.surfaces) continue;
+    ordered_json make = ordered_json::array();
+    if (s.masks) make.push_back("masks");
+    if (s.surfaces) make.push_back("surfaces");
+    ordered_json entry = {{"file", relative(s.file)}};
+    if (s.names) entry["names"] = relative(*s.names);
+    if (!s.regions.empty()) entry["regions"] = s.regions;
+    entry["make"] = std::move(make);
+    result.push_back(std::move(entry));
+  }
+  return result;
+}
+
 // The scene's own file, as read, with its paths rebased to `path` and the scene's positions.
 ordered_json as_read(const std::filesystem::path& path, const Scene& scene) {
   ordered_json root = ordered_json::parse(scene.source_json);
@@ -153,6 +171,7 @@ ordered_json as_read(const std::filesystem::path& path, const Scene& scene) {
   rebase.each(root, "volumes", {"file", "transfer_function"});
   rebase.each(root, "meshes", {"file"});
   rebase.each(root, "atlas", {"labels", "names", "mask_transfer_function"});
+  rebase.each(root, "segmentations", {"file", "names"});
   rebase.key(root, "labels");
   rebase.each(root, "labels", {"image"});
   write_positions(root, scene);
@@ -193,6 +212,8 @@ ordered_json from_model(const std::filesystem::path& path, const Scene& scene) {
                        {"volumes", volumes},
                        {"meshes", meshes_json(scene.meshes, relative)},
                        {"labels", labels}};
+  if (const ordered_json made = segmentations_json(scene, relative); !made.empty())
+    root["segmentations"] = made;
   // A fitted camera is not written: the loader fits it again (to the same scene, the same).
   if (scene.has_camera) {
     root["camera"] = {{"fov_y", shortest_double(scene.camera.fov_y_degrees)},

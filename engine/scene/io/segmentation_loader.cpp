@@ -120,10 +120,12 @@ void add_region(Scene& scene, const Segmentation& segmentation, const SegmentReg
         {region.name, {}, {{0.0f, glm::vec4(colour, 0.0f)}, {1.0f, glm::vec4(colour, 0.5f)}}});
     scene.volumes.push_back(region_mask(segmentation, region));
     scene.volumes.back().transfer_function = int(scene.transfer_functions.size()) - 1;
+    scene.volumes.back().source.clear();  // (made, not read: see Scene::segmentations)
   }
   if (entry.surfaces) {
     scene.meshes.push_back(region_surface(segmentation, region));
     scene.meshes.back().color = glm::vec4(colour, 0.5f);
+    scene.meshes.back().source.clear();
   }
 }
 
@@ -215,6 +217,7 @@ void add_segmentation(Scene& scene, const SegmentationEntry& entry,
   for (size_t i = 0; i < kept.size(); ++i)
     add_region(scene, segmentation, segmentation.regions[kept[i]], summaries[kept[i]], entry,
                entry.labels ? ids[i] : 0);
+  scene.segmentations.push_back(entry);
   for (size_t l = 0; l < segmentation.layers.size(); ++l) {
     SceneAtlas atlas{std::move(segmentation.layers[l]), {}};
     for (const SegmentRegion& region : segmentation.regions)
