@@ -261,14 +261,14 @@ std::string value_list(const std::map<int, size_t>& values) {
 }
 
 // Clears what no segment holds: values no segment of the layer has, and voxels outside their
-// segment's extent (3D Slicer crops a segment to it). Each is a warning.
+// segment's extent (3D Slicer crops a segment to it). Each is a warning. `owner` (value ->
+// segment, -1 for none) is all -1 before and after.
 void keep_segment_voxels(const fs::path& path, const std::vector<SlicerSegment>& segments,
+                         const std::vector<size_t>& in_layer, std::vector<int>& owner,
                          Volume& layer, int64_t layer_index, std::vector<std::string>& warnings) {
-  std::vector<int> owner(size_t(kMaxRegionValue) + 1, -1);
-  for (size_t s = 0; s < segments.size(); ++s)
-    if (*segments[s].layer == layer_index) owner[size_t(segments[s].label_value)] = int(s);
-  std::map<int, size_t> unclaimed;  // value -> voxels
-  std::vector<size_t> outside(segments.size(), 0);
+  for (size_t s : in_layer) owner[size_t(segments[s].label_value)] = int(s);
+  std::map<int, size_t> unclaimed;   // value -> voxels
+  std::map<size_t, size_t> outside;  // segment -> voxels
   const glm::uvec3 d = layer.dims;
   std::byte* voxel = layer.voxels.data();
   for (uint32_t k = 0; k < d.z; ++k)
@@ -278,19 +278,24 @@ void keep_segment_voxels(const fs::path& path, const std::vector<SlicerSegment>&
         std::memcpy(&value, voxel, 2);
         if (value == 0) continue;
         const int s = owner[value];
-        const auto& extent = s >= 0 ? segments[size_t(s)].extent : std::nullopt;
-        if (s >= 0 && (!extent || inside_extent(*extent, i, j, k))) continue;
-        ++(s < 0 ? unclaimed[value] : outside[size_t(s)]);
+        if (s < 0) {
+          ++unclaimed[value];
+        } else if (const auto& extent = segments[size_t(s)].extent;
+                   extent && !inside_extent(*extent, i, j, k)) {
+          ++outside[size_t(s)];
+        } else {
+          continue;
+        }
         std::memset(voxel, 0, 2);
       }
+  for (size_t s : in_layer) owner[size_t(segments[s].label_value)] = -1;
   if (!unclaimed.empty())
     warnings.push_back(concat(path.string(), ": layer ", layer_index, ": voxels hold value(s) ",
                               value_list(unclaimed), " that no segment has: left out"));
-  for (size_t s = 0; s < segments.size(); ++s)
-    if (outside[s] > 0)
-      warnings.push_back(concat(path.string(), ": ", outside[s], " voxels of segment '",
-                                segments[s].name, "' lie outside its ",
-                                field_name(segments[s].index, "Extent"), ": left out"));
+  for (const auto& [s, count] : outside)
+    warnings.push_back(concat(path.string(), ": ", count, " voxels of segment '", segments[s].name,
+                              "' lie outside its ", field_name(segments[s].index, "Extent"),
+                              ": left out"));
 }
 
 // ---- a folder of masks
@@ -457,11 +462,14 @@ Segmentation load_slicer_segmentation(const std::filesystem::path& path,
   for (int64_t layer = 0; layer < axes.count; ++layer)
     segmentation.layers.push_back(empty_layer(grid));
   read_layers(header, type, *in, segmentation.layers);
+  std::vector<std::vector<size_t>> by_layer(size_t(axes.count));
+  for (size_t s = 0; s < segments.size(); ++s) by_layer[size_t(*segments[s].layer)].push_back(s);
+  std::vector<int> owner(size_t(kMaxRegionValue) + 1, -1);
   for (int64_t layer = 0; layer < axes.count; ++layer) {
     Volume& volume = segmentation.layers[size_t(layer)];
     if (volume.voxel_count() == 1)  // Slicer's "no image data"
       std::fill(volume.voxels.begin(), volume.voxels.end(), std::byte{0});
-    keep_segment_voxels(path, segments, volume, layer, warnings);
+    keep_segment_voxels(path, segments, by_layer[size_t(layer)], owner, volume, layer, warnings);
   }
   for (const SlicerSegment& s : segments)
     segmentation.regions.push_back({.number = int(s.label_value),
