@@ -48,7 +48,9 @@ std::optional<SegmentKey> segment_key(const fs::path& path, std::string_view key
   const std::string_view rest = key.substr(7);
   size_t digits = 0;
   while (digits < rest.size() && rest[digits] >= '0' && rest[digits] <= '9') ++digits;
-  if (digits == 0 || digits == rest.size() || rest[digits] != '_') return std::nullopt;
+  // (Slicer looks its keys up by name: "Segment01_ID" is not segment 1's)
+  if (digits == 0 || digits == rest.size() || rest[digits] != '_' || (rest[0] == '0' && digits > 1))
+    return std::nullopt;
   if (digits > 6) fail(path, concat(printable(key), ": segment number out of range"));
   SegmentKey result{.field = rest.substr(digits + 1)};
   std::from_chars(rest.data(), rest.data() + digits, result.index);
