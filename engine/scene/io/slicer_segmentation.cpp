@@ -8,7 +8,10 @@
 // shared layers are stored; strata takes 0 in a 3-D file, which has one), a missing _Extent is
 // the whole grid. A segment is the voxels of its layer that hold its label value inside its
 // extent; Slicer crops to the extent, so voxels outside it are left out. A file of one voxel holds
-// no image data (Slicer writes one for a segmentation whose segments are all empty).
+// no image data (Slicer writes one for a segmentation whose segments are all empty). A NRRD
+// without SegmentN_ fields is an Error: Slicer would import it as a plain label map with
+// segments named by value, strata asks for a names table instead; so are fields of a segment
+// past the first missing ID (Slicer ignores them) and the legacy layout (Segmentation_Extent).
 #include <algorithm>
 #include <array>
 #include <bit>
