@@ -7,7 +7,6 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const auto path = strata::fuzz::write_input(data, size, "input.seg.nrrd");
   std::vector<std::string> warnings;
-  strata::fuzz::expect_only_errors(
-      [&] { strata::load_slicer_segmentation(path, {}, warnings); });
+  strata::fuzz::expect_only_errors([&] { strata::load_slicer_segmentation(path, {}, warnings); });
   return 0;
 }

@@ -170,10 +170,12 @@ void check_kinds(const TextHeader& header, bool list_first) {
   for (int axis = 0; axis < 4 && words >> kind; ++axis) {
     const bool list_axis = list_first ? axis == 0 : axis == 3;
     const std::string k = lowercase(kind);
-    const bool wrong = list_axis ? list_first && (k == "domain" || k == "space")  // ("none": unknown)
-                                 : !spatial_kind(kind);
+    const bool wrong = list_axis
+                           ? list_first && (k == "domain" || k == "space")  // ("none": unknown)
+                           : !spatial_kind(kind);
     if (wrong)
-      fail(header.path, concat("kinds: axis ", axis, " is '", kind, "': ", layout_rule(list_first)));
+      fail(header.path,
+           concat("kinds: axis ", axis, " is '", kind, "': ", layout_rule(list_first)));
   }
 }
 
@@ -223,8 +225,8 @@ void set_direction(Volume& volume, const TextHeader& header, const NrrdAxes& lay
   for (int axis = 0; axis < std::min(rank, 3); ++axis) {
     const int entry = first_spatial + axis;
     if (!axes[size_t(entry)])
-      fail(path, concat("space directions: axis ", entry, " is 'none': ",
-                        layout_rule(layout.list_first)));
+      fail(path, concat("space directions: axis ", entry,
+                        " is 'none': ", layout_rule(layout.list_first)));
     const glm::dvec3 v =
         signs * vector_in_space(path, "space directions", *axes[size_t(entry)], space);
     const double length = glm::length(v);
@@ -244,8 +246,7 @@ void set_direction(Volume& volume, const TextHeader& header, const NrrdAxes& lay
 
 }  // namespace
 
-void volume_io::set_nrrd_geometry(Volume& volume, const TextHeader& header,
-                                  const NrrdAxes& axes) {
+void volume_io::set_nrrd_geometry(Volume& volume, const TextHeader& header, const NrrdAxes& axes) {
   const fs::path& path = header.path;
   const int rank = axes.rank;
   if (const auto text = header.get("space directions")) {
@@ -364,9 +365,8 @@ Volume load_nrrd(const std::filesystem::path& path, const VolumeReadOptions& opt
   const auto in = open_nrrd_data(header, all_frames_bytes);
   skip_frames(*in, frame, bytes);
   read_voxels(*in, bytes, volume);
-  finish_voxels(volume, {.stored = stored,
-                         .big_endian = nrrd_big_endian(header),
-                         .per_slice = {Rescale{}}});
+  finish_voxels(
+      volume, {.stored = stored, .big_endian = nrrd_big_endian(header), .per_slice = {Rescale{}}});
   return volume;
 }
 

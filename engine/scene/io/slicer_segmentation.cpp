@@ -116,7 +116,7 @@ std::vector<SlicerSegment> read_segments(const TextHeader& header,
   std::vector<SlicerSegment> segments;
   for (const auto& [index, fields] : groups) {
     if (index != int64_t(segments.size()) || !fields.contains("ID"))
-      fail(path, concat(field_name(index, fields.begin()->first), ": no ",
+      fail(path, concat(printable(field_name(index, fields.begin()->first)), ": no ",
                         field_name(int64_t(segments.size()), "ID"),
                         " (3D Slicer reads segments 0, 1, ... up to the first without an ID)"));
     SlicerSegment segment{.index = index};
