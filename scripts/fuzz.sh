@@ -30,7 +30,8 @@ all=(fuzz_nifti fuzz_metaimage fuzz_nrrd fuzz_dicom_structure fuzz_scene_json fu
      fuzz_gra fuzz_transfer_function_json fuzz_markups_json fuzz_fcsv fuzz_label_csv
      fuzz_viewer_script
      fuzz_camera_path
-     fuzz_text_layout)
+     fuzz_text_layout
+     fuzz_slicer_seg)
 targets=("$@")
 ((${#targets[@]})) || targets=("${all[@]}")
 
@@ -73,6 +74,7 @@ copy fuzz_label_csv tests/data/labels/*.csv
 copy fuzz_viewer_script fuzz/corpus/fuzz_viewer_script/*
 copy fuzz_camera_path fuzz/corpus/fuzz_camera_path/*
 copy fuzz_text_layout fuzz/corpus/fuzz_text_layout/*
+copy fuzz_slicer_seg fuzz/corpus/fuzz_slicer_seg/*
 
 dictionary() {
   case $1 in

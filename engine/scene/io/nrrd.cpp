@@ -29,7 +29,9 @@ void check_magic(const fs::path& path, const std::string& text) {
                       "' (expected NRRD0001 to NRRD0005)"));
 }
 
-TextHeader parse_header(const fs::path& path) {
+}  // namespace
+
+TextHeader volume_io::read_nrrd_header(const fs::path& path) {
   TextHeader header{.path = path, .quote_names = true};
   const std::string text = read_prefix(path, max_text_header_bytes);
   check_magic(path, text);
@@ -43,8 +45,12 @@ TextHeader parse_header(const fs::path& path) {
       header.data_offset = pos;
       break;
     }
-    if (line.starts_with('#') || line.find(":=") != std::string_view::npos) continue;  // key/value
+    if (line.starts_with('#')) continue;
     const size_t colon = line.find(": ");
+    if (const size_t key = line.find(":="); key < colon) {
+      header.key_values.emplace_back(line.substr(0, key), line.substr(key + 2));
+      continue;
+    }
     if (colon == std::string_view::npos) {
       const std::string message =
           concat("line ", line_number, ": expected 'field: value', got '", printable(line), "'");
@@ -63,6 +69,8 @@ TextHeader parse_header(const fs::path& path) {
   if (!bad_last_line.empty()) fail(path, bad_last_line);
   return header;
 }
+
+namespace {
 
 StoredType element_type(const TextHeader& header) {
   const std::string type = lowercase(header.require("type"));
@@ -141,33 +149,42 @@ glm::dvec3 to_lps(const TextHeader& header) {
   fail(header.path, concat("space '", *space, "' is not a 3D space strata knows"));
 }
 
-// The axes "dimension" and "sizes" give: three of a 3-D image; a 2-D image is one slice; a 4-D
-// image's fourth axis counts frames.
-struct Extent {
-  int rank = 3;
-  std::array<int64_t, 3> dims{1, 1, 1};
-  int64_t frames = 1;
-};
+// What a 4-D file must look like, for errors.
+const char* layout_rule(bool list_first) {
+  return list_first ? "strata reads 4-D segmentations whose first axis is the list of layers"
+                    : "strata reads 4-D images whose fourth axis is the non-spatial one (time)";
+}
 
-// A 4-D image is read a frame at a time only when its frames are stored one after the other: the
-// non-spatial axis ("none" in space directions, a kind other than domain or space) must be last.
-void check_frames_last(const TextHeader& header) {
+bool spatial_kind(const std::string& kind) {
+  const std::string k = lowercase(kind);
+  return k == "domain" || k == "space" || k == "???" || k == "none";
+}
+
+// The non-spatial axis ("none" in space directions, a kind other than domain or space) must be
+// the last (an image's frames, read one at a time) or the first (a segmentation's layers).
+void check_kinds(const TextHeader& header, bool list_first) {
   const auto kinds = header.get("kinds");
   if (!kinds) return;
   std::istringstream words{std::string(*kinds)};
   std::string kind;
-  for (int axis = 0; axis < 3 && words >> kind; ++axis)
-    if (const std::string k = lowercase(kind);
-        k != "domain" && k != "space" && k != "???" && k != "none")
-      fail(header.path, concat("kinds: axis ", axis, " is '", kind,
-                               "': strata reads 4-D images whose fourth axis is the non-spatial "
-                               "one (time)"));
+  for (int axis = 0; axis < 4 && words >> kind; ++axis) {
+    const bool list_axis = list_first ? axis == 0 : axis == 3;
+    const std::string k = lowercase(kind);
+    const bool wrong = list_axis
+                           ? list_first && (k == "domain" || k == "space")  // ("none": unknown)
+                           : !spatial_kind(kind);
+    if (wrong)
+      fail(header.path,
+           concat("kinds: axis ", axis, " is '", kind, "': ", layout_rule(list_first)));
+  }
 }
 
-Extent image_extent(const TextHeader& header) {
+}  // namespace
+
+NrrdAxes volume_io::nrrd_axes(const TextHeader& header, bool list_first) {
   const fs::path& path = header.path;
   const std::string_view dimension = trim(header.require("dimension"));
-  Extent e;
+  NrrdAxes e{.list_first = list_first};
   if (dimension == "2" || dimension == "3" || dimension == "4") {
     e.rank = dimension[0] - '0';
   } else {
@@ -178,55 +195,69 @@ Extent image_extent(const TextHeader& header) {
   if (sizes.size() != size_t(e.rank))
     fail(path, concat("sizes: expected ", e.rank, " numbers (dimension ", e.rank, "), got '",
                       printable(trim(text)), "'"));
+  const size_t first_spatial = e.rank == 4 && list_first ? 1 : 0;
   for (size_t axis = 0; axis < std::min<size_t>(3, sizes.size()); ++axis)
-    e.dims[axis] = sizes[axis];
+    e.dims[axis] = sizes[first_spatial + axis];
   if (e.rank == 4) {
-    e.frames = sizes[3];
-    if (e.frames < 1)
-      fail(path, concat("sizes: axis 3 has ", e.frames, " frames: must be positive"));
-    check_frames_last(header);
+    const size_t list_axis = list_first ? 0 : 3;
+    e.count = sizes[list_axis];
+    if (e.count < 1)
+      fail(path, concat("sizes: axis ", list_axis, " has ", e.count, " ",
+                        list_first ? "layers" : "frames", ": must be positive"));
+    check_kinds(header, list_first);
   }
   return e;
 }
 
-void set_direction(Volume& volume, const TextHeader& header, int rank, std::string_view text) {
+namespace {
+
+void set_direction(Volume& volume, const TextHeader& header, const NrrdAxes& layout,
+                   std::string_view text) {
   const fs::path& path = header.path;
+  const int rank = layout.rank;
   const glm::dvec3 signs = to_lps(header);
   const int space = space_dimension(header, rank);
   const auto axes = vectors(path, "space directions", text);
   if (axes.size() != size_t(rank))
     fail(path, concat("space directions: expected ", rank, " entries (dimension ", rank, "), got ",
                       axes.size()));
+  const int first_spatial = rank == 4 && layout.list_first ? 1 : 0;
   for (int axis = 0; axis < std::min(rank, 3); ++axis) {
-    if (!axes[size_t(axis)])
-      fail(path, concat("space directions: axis ", axis,
-                        " is 'none': strata reads 4-D images whose fourth axis is the non-spatial "
-                        "one (time)"));
+    const int entry = first_spatial + axis;
+    if (!axes[size_t(entry)])
+      fail(path, concat("space directions: axis ", entry,
+                        " is 'none': ", layout_rule(layout.list_first)));
     const glm::dvec3 v =
-        signs * vector_in_space(path, "space directions", *axes[size_t(axis)], space);
+        signs * vector_in_space(path, "space directions", *axes[size_t(entry)], space);
     const double length = glm::length(v);
     if (!(length > 0.0) || !std::isfinite(length))
       fail(path,
-           concat("space directions: axis ", axis, " has zero length: spacing must be positive"));
+           concat("space directions: axis ", entry, " has zero length: spacing must be positive"));
     volume.spacing[axis] = static_cast<float>(length);
     volume.direction[axis] = glm::vec3(v / length);
   }
-  if (rank == 4 && axes[3])
-    fail(path, "space directions: axis 3 is a vector: a 4-D image's fourth axis must be 'none'");
+  const int list_axis = layout.list_first ? 0 : 3;
+  if (rank == 4 && axes[size_t(list_axis)])
+    fail(path, concat("space directions: axis ", list_axis, " is a vector: it must be 'none' (",
+                      layout_rule(layout.list_first), ")"));
   if (rank == 2)  // one slice: k is its normal
     volume.direction[2] = glm::normalize(glm::cross(volume.direction[0], volume.direction[1]));
 }
 
-void set_geometry(Volume& volume, const TextHeader& header, int rank) {
+}  // namespace
+
+void volume_io::set_nrrd_geometry(Volume& volume, const TextHeader& header, const NrrdAxes& axes) {
   const fs::path& path = header.path;
+  const int rank = axes.rank;
   if (const auto text = header.get("space directions")) {
-    set_direction(volume, header, rank, *text);
+    set_direction(volume, header, axes, *text);
   } else if (const auto spacings = header.get("spacings")) {
     const auto s = parse_numbers<double>(path, "spacings", *spacings);
     if (s.size() != size_t(rank))
       fail(path, concat("spacings: expected ", rank, " numbers (dimension ", rank, "), got '",
                         printable(trim(*spacings)), "'"));
-    const std::array<double, 3> spatial{s[0], s[1], rank > 2 ? s[2] : 1.0};
+    const size_t first = rank == 4 && axes.list_first ? 1 : 0;
+    const std::array<double, 3> spatial{s[first], s[first + 1], rank > 2 ? s[first + 2] : 1.0};
     check_spacing(path, "spacings", spatial, "spacings", 0);
     volume.spacing = glm::vec3(glm::dvec3(spatial[0], spatial[1], spatial[2]));
   }
@@ -239,6 +270,8 @@ void set_geometry(Volume& volume, const TextHeader& header, int rank) {
   check_geometry(path, "space origin", "space directions", volume);
 }
 
+namespace {
+
 bool is_gzip_encoding(const TextHeader& header) {
   const std::string encoding = lowercase(header.require("encoding"));
   if (encoding == "raw") return false;
@@ -246,12 +279,16 @@ bool is_gzip_encoding(const TextHeader& header) {
   fail(header.path, concat("encoding '", encoding, "' is not supported (raw, gzip)"));
 }
 
-bool is_big_endian(const TextHeader& header) {
+}  // namespace
+
+bool volume_io::nrrd_big_endian(const TextHeader& header) {
   const auto endian = header.get("endian");
   if (!endian || lowercase(*endian) == "little") return false;
   if (lowercase(*endian) == "big") return true;
   fail(header.path, concat("endian '", *endian, "': expected little or big"));
 }
+
+namespace {
 
 int64_t skip_field(const TextHeader& header, std::string_view field) {
   const auto text = header.get(field);
@@ -286,43 +323,50 @@ InputFile::Source data_source(const TextHeader& header, bool gzip) {
 
 }  // namespace
 
-Volume load_nrrd(const std::filesystem::path& path, const VolumeReadOptions& options,
-                 std::vector<std::string>& warnings) {
-  existing_file_size(path);
-  const TextHeader header = parse_header(path);
-  const Extent extent = image_extent(header);
-  const StoredType stored = element_type(header);
-  const size_t bytes =
-      checked_voxel_bytes(path, "sizes", extent.dims, stored_size(stored), options.limits);
-  uint64_t all_frames_bytes = 0;
-  if (__builtin_mul_overflow(uint64_t{bytes}, uint64_t(extent.frames), &all_frames_bytes))
-    fail(path, "sizes: voxel count overflows");
-  const uint64_t frame = choose_frame(path, uint64_t(extent.frames), options, warnings);
+std::unique_ptr<InputFile> volume_io::open_nrrd_data(const TextHeader& header,
+                                                     uint64_t data_bytes) {
+  const fs::path& path = header.path;
   const bool gzip = is_gzip_encoding(header);
-
-  Volume volume;
-  volume.name = volume_name(path);
-  volume.source = path;
-  volume.dims = to_dims(extent.dims);
-  set_geometry(volume, header, extent.rank);
-
   InputFile::Source source = data_source(header, gzip);
   const int64_t byte_skip = skip_field(header, "byte skip");
   if (byte_skip < -1 || (byte_skip == -1 && gzip))
     fail(path, concat("byte skip = ", byte_skip, ": expected >= 0 (or -1 for raw data)"));
   if (byte_skip == -1) {  // the data (every frame) is at the end of the file
     const uint64_t size = fs::file_size(source.file);
-    source.offset = size >= all_frames_bytes ? size - all_frames_bytes : 0;
+    source.offset = size >= data_bytes ? size - data_bytes : 0;
   } else if (!gzip) {
     source.offset += static_cast<uint64_t>(byte_skip);
   }
-  InputFile in(std::move(source));
-  if (gzip && !in.skip(static_cast<uint64_t>(byte_skip)))
+  auto in = std::make_unique<InputFile>(std::move(source));
+  if (gzip && !in->skip(static_cast<uint64_t>(byte_skip)))
     fail(path, concat("byte skip = ", byte_skip, ": past the end of the data"));
-  skip_frames(in, frame, bytes);
-  read_voxels(in, bytes, volume);
-  finish_voxels(volume,
-                {.stored = stored, .big_endian = is_big_endian(header), .per_slice = {Rescale{}}});
+  return in;
+}
+
+Volume load_nrrd(const std::filesystem::path& path, const VolumeReadOptions& options,
+                 std::vector<std::string>& warnings) {
+  existing_file_size(path);
+  const TextHeader header = read_nrrd_header(path);
+  const NrrdAxes axes = nrrd_axes(header, false);
+  const StoredType stored = element_type(header);
+  const size_t bytes =
+      checked_voxel_bytes(path, "sizes", axes.dims, stored_size(stored), options.limits);
+  uint64_t all_frames_bytes = 0;
+  if (__builtin_mul_overflow(uint64_t{bytes}, uint64_t(axes.count), &all_frames_bytes))
+    fail(path, "sizes: voxel count overflows");
+  const uint64_t frame = choose_frame(path, uint64_t(axes.count), options, warnings);
+
+  Volume volume;
+  volume.name = volume_name(path);
+  volume.source = path;
+  volume.dims = to_dims(axes.dims);
+  set_nrrd_geometry(volume, header, axes);
+
+  const auto in = open_nrrd_data(header, all_frames_bytes);
+  skip_frames(*in, frame, bytes);
+  read_voxels(*in, bytes, volume);
+  finish_voxels(
+      volume, {.stored = stored, .big_endian = nrrd_big_endian(header), .per_slice = {Rescale{}}});
   return volume;
 }
 

@@ -212,6 +212,8 @@ struct TextHeader {
   std::vector<std::pair<std::string, std::string>> fields;  // lowercase name, value
   uint64_t data_offset = 0;  // where data that follows the header starts
   bool quote_names = false;  // NRRD's names hold spaces: errors quote them
+  // NRRD's "key:=value" lines in file order, keys as written (3D Slicer keeps its metadata there).
+  std::vector<std::pair<std::string, std::string>> key_values;
 
   // The value of a field, its name in any case.
   std::optional<std::string_view> get(std::string_view name) const;
@@ -263,5 +265,32 @@ std::array<T, N> parse_exactly(const std::filesystem::path& file, std::string_vi
   for (size_t i = 0; i < N; ++i) result[i] = values[i];
   return result;
 }
+
+// ---- NRRD (nrrd.cpp), shared with 3D Slicer's .seg.nrrd reader
+
+// A .nrrd or .nhdr header: its fields, and its "key:=value" lines in key_values.
+TextHeader read_nrrd_header(const std::filesystem::path& path);
+
+// A NRRD's axes: three spatial ones (a 2-D image's third is one voxel) and, in a 4-D image, one
+// non-spatial axis: last in an image (its frames, stored one after the other) or first in a
+// segmentation (its layers, interleaved voxel by voxel).
+struct NrrdAxes {
+  int rank = 3;
+  std::array<int64_t, 3> dims{1, 1, 1};
+  int64_t count = 1;  // along the non-spatial axis
+  bool list_first = false;
+};
+NrrdAxes nrrd_axes(const TextHeader& header, bool list_first);
+
+// The volume's spacing, origin and direction (LPS+) from "space directions" (or "spacings") and
+// "space origin", checked as check_geometry does.
+void set_nrrd_geometry(Volume& volume, const TextHeader& header, const NrrdAxes& axes);
+
+bool nrrd_big_endian(const TextHeader& header);
+
+// The data opened at its first byte: attached or in the data file, raw or gzip, after "line skip"
+// and "byte skip". `data_bytes`, the size of all of it, places data that "byte skip: -1" puts at
+// the end of its file.
+std::unique_ptr<InputFile> open_nrrd_data(const TextHeader& header, uint64_t data_bytes);
 
 }  // namespace strata::volume_io
