@@ -175,6 +175,79 @@ void nifti_seeds(const fs::path& repo, const fs::path& out) {
   }
 }
 
+// ---- NIfTI header extensions
+
+// An extension of `code` whose data is padded with NULs to a multiple of 16 with its 8 bytes.
+Bytes extension(int32_t code, const std::string& data, bool big_endian) {
+  Bytes e(8, 0);
+  e = e + text(data);
+  e.resize((e.size() + 15) / 16 * 16, 0);
+  put<int32_t>(e, 0, int32_t(e.size()), big_endian);
+  put<int32_t>(e, 4, code, big_endian);
+  return e;
+}
+
+// A NIfTI header (NIfTI-1 or -2 as `header` is) with the extender set, the chain, vox_offset after
+// it and the voxels.
+Bytes with_extensions(Bytes header, size_t header_bytes, const Bytes& chain, bool big_endian) {
+  Bytes voxels(header.begin() + std::ptrdiff_t(header_bytes + 4), header.end());
+  header.resize(header_bytes + 4);
+  header[header_bytes] = 1;
+  const size_t offset = header_bytes + 4 + chain.size();
+  if (header_bytes == 348)
+    put<float>(header, 108, float(offset), big_endian);
+  else
+    put<int64_t>(header, 168, int64_t(offset));
+  return header + chain + voxels;
+}
+
+void nifti_extension_seeds(const fs::path& out) {
+  const fs::path dir = out / "fuzz_nifti_extensions";
+  const std::string table =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?> <CaretExtension> <VolumeInformation Index=\"0\">"
+      " <LabelTable>\n<Label Key=\"1\" Red=\"1.0\" Green=\"0.0\" Blue=\"0.0\" Alpha=\"1\">"
+      "<![CDATA[spleen]]></Label>\n<Label Key=\"2\" Red=\"0.0\" Green=\"1.0\" Blue=\"0.0\" "
+      "Alpha=\"1\"><![CDATA[kidney_right]]></Label>\n </LabelTable> <VolumeType><![CDATA[Label]]>"
+      "</VolumeType> </VolumeInformation></CaretExtension>\n";
+  for (const bool big : {false, true}) {
+    const Bytes chain = extension(6, "a comment", big) + extension(0, table, big);
+    const Bytes b = with_extensions(nifti1({4, 4, 2, 1}, 2, 8, big, false), 348, chain, big);
+    save(dir / (big ? "table_big_endian.nii" : "table.nii"), b);
+    if (!big) save(dir / "table_gzip.nii", gzip(b));
+  }
+  save(dir / "table_nifti2.nii",
+       with_extensions(nifti2({3, 3, 2, 1}, 2, 8), 540, extension(0, table, false), false));
+  save(dir / "comment_only.nii", with_extensions(nifti1({4, 4, 2, 1}, 2, 8, false, false), 348,
+                                                 extension(6, "no table", false), false));
+}
+
+// ---- FreeSurfer MGH
+
+// A big-endian MGH header (dims, frames, type, goodRASflag and an oblique geometry), then the
+// voxels and the scan parameters FreeSurfer writes after them.
+Bytes mgh(std::array<int32_t, 4> dims, int32_t type, size_t element_size, int16_t good_ras) {
+  Bytes b(284, 0);
+  put<int32_t>(b, 0, 1, true);
+  for (size_t i = 0; i < 4; ++i) put<int32_t>(b, 4 + 4 * i, dims[i], true);
+  put<int32_t>(b, 20, type, true);
+  put<int16_t>(b, 28, good_ras, true);
+  const float fields[15] = {1.0f, 1.5f, 2.0f,  0.0f, 0.8f,  0.6f,   -1.0f, 0.0f,
+                            0.0f, 0.0f, -0.6f, 0.8f, 10.0f, -20.0f, 30.0f};
+  for (size_t i = 0; i < 15; ++i) put<float>(b, 30 + 4 * i, fields[i], true);
+  const size_t count = size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]) * size_t(dims[3]);
+  return b + ramp(count, element_size) + Bytes(20, 0);
+}
+
+void mgh_seeds(const fs::path& repo, const fs::path& out) {
+  const fs::path dir = out / "fuzz_mgh";
+  save(dir / "uchar.mgh", mgh({6, 5, 4, 1}, 0, 1, 1));
+  save(dir / "short_gzip.mgz", gzip(mgh({6, 5, 4, 1}, 4, 2, 1)));
+  save(dir / "int_4d.mgh", mgh({4, 3, 2, 3}, 1, 4, 1));
+  save(dir / "float_no_ras.mgz", gzip(mgh({4, 4, 4, 1}, 3, 4, 0)));
+  const Bytes real = load(repo / "assets/cache/nibabel/test.mgz");
+  if (!real.empty()) save(dir / "real_nibabel_test.mgz", real);
+}
+
 // ---- MetaImage
 
 strata::Volume small_volume(strata::VoxelType type, glm::uvec3 dims) {
@@ -339,6 +412,8 @@ int main(int argc, char** argv) {
   }
   const fs::path repo = argv[1], out = argv[2];
   nifti_seeds(repo, out);
+  nifti_extension_seeds(out);
+  mgh_seeds(repo, out);
   metaimage_seeds(out);
   nrrd_seeds(out);
   dicom_seeds(repo, out);

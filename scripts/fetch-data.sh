@@ -9,8 +9,9 @@
 #                    CT_small.dcm (one 128x128 CT slice), MR_small.dcm and MR_small_implicit.dcm
 #                    (one MR slice, explicit and implicit VR little endian)
 #   python3-nibabel: philips_mprage.dcm (an enhanced multi-frame MR: 176 frames of 256x256 in one
-#                    file; its pixels are zeros), example4d.nii.gz (4-D NIfTI, 2 frames) and
-#                    nicom's 0.dcm (a Siemens diffusion mosaic: slices tiled in one image)
+#                    file; its pixels are zeros), example4d.nii.gz (4-D NIfTI, 2 frames),
+#                    nicom's 0.dcm (a Siemens diffusion mosaic: slices tiled in one image) and
+#                    test.mgz (FreeSurfer MGH, gzipped: 3x4x5, 2 float frames, axes not of unit length)
 #   assimp-testmodels: invalid/OutOfMemory.off (309 bytes whose header claims 3.5 million vertices:
 #                    Assimp runs for minutes and takes gigabytes; the parser limits' test)
 set -euo pipefail
@@ -41,6 +42,7 @@ files+=(
   "python3-nibabel $nibabel/nicom/tests/data/philips_mprage.dcm.gz dicom/philips_mprage.dcm 00058b3a5141b839493c21393c317e1cfe12ca912be8edf2f856ad3ea69fb6e3"
   "python3-nibabel $nibabel/tests/data/example4d.nii.gz nibabel/example4d.nii.gz 42097dfbab9d2a036b41ae5c97a359591cf2cf5c3f8dc6ca6455c0b8a7f22696"
   "python3-nibabel $nibabel/nicom/tests/data/0.dcm dicom/siemens_mosaic.dcm 7045df97f3f8300f3af2f5ef4006b77b8c3c1181b5668d5f9a4783d2375c6dbb"
+  "python3-nibabel $nibabel/tests/data/test.mgz nibabel/test.mgz ee0d09022fa30dca0c16959a769893141122fe8c04b19708e2264576d2b7a6e9"
 )
 files+=(
   "assimp-testmodels usr/share/assimp/models/invalid/OutOfMemory.off assimp/OutOfMemory.off 4e337750dcd6b28e6c68392126a93d5756ef0f0d4f7d69c3c1c6ec413aefef7d"

@@ -414,7 +414,7 @@ TEST_SUITE("loaders") {
           unknown.string() +
               ": unknown scene format '.yaml' (expected a scene: .json, or .xml from the "
               "thesis program; or a volume: .nii, .nii.gz, .mhd, .mha, .nrrd, "
-              ".nhdr, .dcm and DICOM folders)");
+              ".nhdr, .mgz, .mgh, .dcm and DICOM folders)");
   }
 
   TEST_CASE("json_scene_label_image_is_read_with_its_height_and_side") {

@@ -22,7 +22,7 @@
 namespace strata {
 namespace {
 
-enum class Format { none, dicom_folder, nifti, metaimage, nrrd, dicom_file };
+enum class Format { none, dicom_folder, nifti, metaimage, nrrd, mgh, dicom_file };
 
 Format format_of(const std::filesystem::path& path) {
   namespace fs = std::filesystem;
@@ -33,6 +33,7 @@ Format format_of(const std::filesystem::path& path) {
   if (ends_with(".nii") || ends_with(".nii.gz")) return Format::nifti;
   if (ends_with(".mhd") || ends_with(".mha")) return Format::metaimage;
   if (ends_with(".nrrd") || ends_with(".nhdr")) return Format::nrrd;
+  if (ends_with(".mgz") || ends_with(".mgh")) return Format::mgh;
   // Scanners and PACS exports often write DICOM files without an extension.
   if (ends_with(".dcm") || ends_with(".dicom")) return Format::dicom_file;
   if (fs::is_regular_file(path, error) && dicom::file_kind(path) == dicom::Kind::part10)
@@ -126,6 +127,8 @@ Volume read_by_extension(const std::filesystem::path& path, const VolumeReadOpti
       return load_metaimage(path, options, warnings);
     case Format::nrrd:
       return load_nrrd(path, options, warnings);
+    case Format::mgh:
+      return load_mgh(path, options, warnings);
     case Format::dicom_file:
       return read_volume_isolated(
           path, kDicomReader, options.parser, warnings,
@@ -723,7 +726,7 @@ std::string volume_name(const std::filesystem::path& path) {
   if (name.empty()) name = path.parent_path().filename();  // "folder/"
   if (lowercase(name.extension().string()) == ".gz") name = name.stem();
   const std::string extension = lowercase(name.extension().string());
-  for (const char* known : {".nii", ".mhd", ".mha", ".nrrd", ".nhdr", ".dcm", ".dicom"})
+  for (const char* known : {".nii", ".mhd", ".mha", ".nrrd", ".nhdr", ".mgz", ".mgh", ".dcm", ".dicom"})
     if (extension == known) return name.stem().string();
   return name.string();
 }

@@ -1,8 +1,8 @@
 // Volume files: NIfTI-1 and NIfTI-2 (.nii, .nii.gz), MetaImage (.mhd + raw, .mha), NRRD (.nrrd,
-// .nhdr; raw and gzip), DICOM series (a folder of single-slice files) and DICOM files (.dcm: an
-// enhanced multi-frame CT or MR, or one slice). 2-D images load one voxel thick; of a 4-D image
-// one frame (a 3-D volume) is read. Every failure is one strata::Error that names the file, the
-// field when there is one, and the reason.
+// .nhdr; raw and gzip), FreeSurfer MGH (.mgh, .mgz), DICOM series (a folder of single-slice
+// files) and DICOM files (.dcm: an enhanced multi-frame CT or MR, or one slice). 2-D images load
+// one voxel thick; of a 4-D image one frame (a 3-D volume) is read. Every failure is one
+// strata::Error that names the file, the field when there is one, and the reason.
 #pragma once
 
 #include <filesystem>
@@ -17,7 +17,7 @@ namespace strata {
 
 // What load_volume reads, for messages.
 inline constexpr const char* kVolumeExtensions =
-    ".nii, .nii.gz, .mhd, .mha, .nrrd, .nhdr, .dcm and DICOM folders";
+    ".nii, .nii.gz, .mhd, .mha, .nrrd, .nhdr, .mgz, .mgh, .dcm and DICOM folders";
 
 // Whether load_volume takes `path` for a volume: a folder (a DICOM series), a volume extension,
 // or a file that starts as DICOM does. Says nothing of whether it loads.
@@ -59,6 +59,9 @@ Volume load_metaimage(const std::filesystem::path& path, const VolumeReadOptions
                       std::vector<std::string>& warnings);
 Volume load_nrrd(const std::filesystem::path& path, const VolumeReadOptions& options,
                  std::vector<std::string>& warnings);
+// FreeSurfer's .mgh and .mgz (gzipped .mgh).
+Volume load_mgh(const std::filesystem::path& path, const VolumeReadOptions& options,
+                std::vector<std::string>& warnings);
 Volume load_dicom_series(const std::filesystem::path& folder, const VolumeReadOptions& options,
                          std::vector<std::string>& warnings);
 // One series of a DICOM folder, as its first slice describes it.
