@@ -283,6 +283,8 @@ void add_meshes(const Scene& scene, RenderInputs& in) {
 
 }  // namespace
 
+static_assert(kMaxVolumes == VR_MAX_VOLUMES);
+
 RenderInputs prepare_render_inputs(const Scene& scene, uint32_t max_image_dimension_3d,
                                    uint64_t max_bytes) {
   if (scene.volumes.size() > VR_MAX_VOLUMES) {

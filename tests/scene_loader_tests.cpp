@@ -336,8 +336,8 @@ TEST_SUITE("loaders") {
     CHECK(load(R"({"volumes": []})") == prefix + "not a strata scene (no \"strata_scene\": 1)");
     CHECK(load(R"({"strata_scene": 1, "lables": []})") ==
           prefix +
-              "unknown key 'lables' (expected strata_scene, volumes, meshes, atlas, labels, "
-              "camera, settings)");
+              "unknown key 'lables' (expected strata_scene, volumes, meshes, atlas, "
+              "segmentations, labels, camera, settings)");
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "trasform": []}]})") ==
           prefix +
               "volumes[0]: unknown key 'trasform' (expected name, file, frame, series, "

@@ -288,8 +288,8 @@ TestSegmentation write_segmentation(const std::string& name,
   return t;
 }
 
-std::string scene_json(const TestSegmentation& t, const std::string& entry_keys,
-                       const std::string& labels = "[]") {
+// A scene of scan.mha with labels.mha and names.txt beside it (write_segmentation's files).
+std::string scene_json(const std::string& entry_keys, const std::string& labels = "[]") {
   return R"({"strata_scene": 1, "volumes": [{"file": "scan.mha"}], "labels": )" + labels +
          R"(, "segmentations": [{"file": "labels.mha", "names": "names.txt")" + entry_keys + "}]}";
 }
@@ -302,7 +302,7 @@ TEST_CASE("segmentation in a scene: labels named after the regions, anchored ins
       {"liver", "spleen_tip", "kidney"});
   const fs::path file = test::write_file(
       t.folder / "scene.json",
-      scene_json(t, R"(, "make": ["labels", "masks"])",
+      scene_json(R"(, "make": ["labels", "masks"])",
                  R"([{"id": 0, "text": "own", "anchor": [0, 0, 0]}])"));
   const Scene scene = load_scene_json(file);
   REQUIRE(scene.labels.size() == 4);
@@ -332,11 +332,11 @@ TEST_CASE("segmentation in a scene: regions chosen by name, empty ones warned, f
       write_segmentation("choose", {{{10, 10, 10}, 8.0f}, {{30, 30, 30}, 6.0f}},
                          {"liver", "spleen", "pancreas"});
   const Scene some = load_scene_json(
-      test::write_file(t.folder / "some.json", scene_json(t, R"(, "regions": ["spleen"])")));
+      test::write_file(t.folder / "some.json", scene_json(R"(, "regions": ["spleen"])")));
   REQUIRE(some.labels.size() == 1);
   CHECK(some.labels[0].text == "spleen");
 
-  const Scene all = load_scene_json(test::write_file(t.folder / "all.json", scene_json(t, "")));
+  const Scene all = load_scene_json(test::write_file(t.folder / "all.json", scene_json("")));
   CHECK(all.labels.size() == 2);
   REQUIRE(all.warnings.size() == 1);
   CHECK(all.warnings[0].find("region 'pancreas' (3) has no voxels: skipped") !=
@@ -344,7 +344,7 @@ TEST_CASE("segmentation in a scene: regions chosen by name, empty ones warned, f
 
   const std::string unknown = test::error_of([&] {
     load_scene_json(
-        test::write_file(t.folder / "unknown.json", scene_json(t, R"(, "regions": ["heart"])")));
+        test::write_file(t.folder / "unknown.json", scene_json(R"(, "regions": ["heart"])")));
   });
   CHECK(unknown.find("no region 'heart' (it has 3: liver, spleen, pancreas)") !=
         std::string::npos);
@@ -355,7 +355,7 @@ TEST_CASE("segmentation in a scene: a grid elsewhere, and more regions than labe
   const TestSegmentation far = write_segmentation("far", {{{10, 10, 10}, 8.0f}}, {"liver"},
                                                   glm::vec3(400.0f, -40.0f, -40.0f));
   const std::string elsewhere = test::error_of([&] {
-    load_scene_json(test::write_file(far.folder / "far.json", scene_json(far, "")));
+    load_scene_json(test::write_file(far.folder / "far.json", scene_json("")));
   });
   CHECK(elsewhere.find("labels.mha and " + (far.folder / "scan.mha").string() +
                        ": the segmentation's grid does not overlap the scan") != std::string::npos);

@@ -55,6 +55,7 @@ struct Volume {
 };
 
 inline constexpr size_t kMaxCutPlanes = 12;  // VR_MAX_CUT_PLANES
+inline constexpr size_t kMaxVolumes = 8;     // VR_MAX_VOLUMES: volumes one picture renders
 
 // The six planes that keep the box [lo, hi] (world space).
 std::vector<glm::vec4> crop_planes(glm::vec3 lo, glm::vec3 hi);

@@ -116,8 +116,14 @@ void add_region(Scene& scene, const Segmentation& segmentation, const SegmentReg
     scene.labels.push_back(std::move(label));
   }
   if (entry.masks) {
-    scene.transfer_functions.push_back(
-        {region.name, {}, {{0.0f, glm::vec4(colour, 0.0f)}, {1.0f, glm::vec4(colour, 0.5f)}}});
+    // Transparent up to the boundary between inside (255) and outside (0), so the mask shows
+    // its region's shape and nothing of its box.
+    scene.transfer_functions.push_back({region.name,
+                                        {},
+                                        {{0.0f, glm::vec4(colour, 0.0f)},
+                                         {0.4f, glm::vec4(colour, 0.0f)},
+                                         {0.6f, glm::vec4(colour, 0.5f)},
+                                         {1.0f, glm::vec4(colour, 0.5f)}}});
     scene.volumes.push_back(region_mask(segmentation, region));
     scene.volumes.back().transfer_function = int(scene.transfer_functions.size()) - 1;
     scene.volumes.back().source.clear();  // (made, not read: see Scene::segmentations)
@@ -213,6 +219,12 @@ void add_segmentation(Scene& scene, const SegmentationEntry& entry,
                 " regions with voxels, but a scene holds at most " + std::to_string(kMaxLabels) +
                 " labels" + (room < size_t(kMaxLabels) ? " (" + std::to_string(room) + " left)" : "") +
                 ": choose regions with --regions NAME,... or the entry's \"regions\"");
+  if (entry.masks && scene.volumes.size() + kept.size() > kMaxVolumes)
+    throw Error(entry.file.string() + ": " + std::to_string(kept.size()) + " masks and " +
+                std::to_string(scene.volumes.size()) + " volume(s) already: strata renders at most " +
+                std::to_string(kMaxVolumes) +
+                " volumes: choose regions with --regions NAME,... or the entry's \"regions\", or "
+                "make surfaces");
   const std::vector<int> ids = unused_label_ids(scene.labels, entry.labels ? kept.size() : 0);
   for (size_t i = 0; i < kept.size(); ++i)
     add_region(scene, segmentation, segmentation.regions[kept[i]], summaries[kept[i]], entry,
