@@ -153,11 +153,13 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
   cmd->add_option("--regions", in.regions,
                   "with --segmentation: only these regions, by name (default: every region with "
                   "voxels)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->allow_extra_args(false);
   cmd->add_option("--make", in.make,
                   "with --segmentation: what its regions become: labels, masks, surfaces "
                   "(default: labels)")
       ->delimiter(',')
+      ->allow_extra_args(false)
       ->check(CLI::IsMember({"labels", "masks", "surfaces"}));
   cmd->add_option("--frame", in.frame,
                   "a 4-D volume's frame or a DICOM series' time point, from 0 (default: the first)")
