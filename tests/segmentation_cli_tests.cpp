@@ -76,6 +76,18 @@ TEST_SUITE("cli") {
     CHECK(thalamus);
   }
 
+  TEST_CASE("bench_segmentation_reports_the_anchors_time_of_every_region") {
+    const auto r = run_strata("bench segmentation --size 40x30x20 --regions 9 --runs 2");
+    REQUIRE(r.exit_code == 0);
+    const nlohmann::json report = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+    CHECK(report.at("regions") == 9);
+    CHECK(report.at("regions_with_voxels") == 9);
+    CHECK(report.at("labelled_voxels").get<size_t>() > 0);
+    CHECK(report.at("anchors_ms").at("median").get<double>() > 0.0);
+    const auto bad = run_strata("bench segmentation --size 40x30");
+    CHECK(bad.exit_code == 2);
+  }
+
   TEST_CASE("segmentation_options_are_checked") {
     const auto names_alone = run_strata("render " HEAD " --names x.txt -o /dev/null");
     CHECK(names_alone.exit_code == 2);
