@@ -176,25 +176,29 @@ size_t frame_count(const Elements& e) {
   return size_t(count);
 }
 
+// BitsAllocated that each type has (PS3.3 C.8.20.2).
+const char* bits_of(SegType type) {
+  return type == SegType::binary       ? "1 bit"
+         : type == SegType::fractional ? "8 bits"
+                                       : "8 or 16 bits";
+}
+
 void read_pixel_format(const Elements& e, SegFile& seg) {
-  seg.rows = uint32_t(e.integer(0x0028, 0x0010, "Rows"));
-  seg.columns = uint32_t(e.integer(0x0028, 0x0011, "Columns"));
-  if (seg.rows == 0 || seg.columns == 0)
-    fail(e.path(), concat("Rows x Columns = ", seg.rows, " x ", seg.columns, ": must be positive"));
+  const int rows = e.integer(0x0028, 0x0010, "Rows");
+  const int columns = e.integer(0x0028, 0x0011, "Columns");
+  if (rows < 1 || columns < 1)
+    fail(e.path(), concat("Rows x Columns = ", rows, " x ", columns, ": must be positive"));
+  seg.rows = uint32_t(rows);
+  seg.columns = uint32_t(columns);
   if (const int samples = e.integer(0x0028, 0x0002, "SamplesPerPixel", 1.0); samples != 1)
     fail(e.path(), concat("SamplesPerPixel = ", samples, ": a Segmentation has 1"));
-  seg.bits_allocated = e.integer(0x0028, 0x0100, "BitsAllocated");
-  const bool fits = seg.type == SegType::binary ? seg.bits_allocated == 1
-                    : seg.type == SegType::fractional
-                        ? seg.bits_allocated == 8
-                        : seg.bits_allocated == 8 || seg.bits_allocated == 16;
+  const int bits = seg.bits_allocated = e.integer(0x0028, 0x0100, "BitsAllocated");
+  const bool fits = seg.type == SegType::binary       ? bits == 1
+                    : seg.type == SegType::fractional ? bits == 8
+                                                      : bits == 8 || bits == 16;
   if (!fits)
-    fail(e.path(), concat("BitsAllocated = ", seg.bits_allocated, ": a ", type_name(seg.type),
-                          " segmentation has ",
-                          seg.type == SegType::binary       ? "1 bit"
-                          : seg.type == SegType::fractional ? "8 bits"
-                                                            : "8 or 16 bits",
-                          " a pixel"));
+    fail(e.path(), concat("BitsAllocated = ", bits, ": a ", type_name(seg.type),
+                          " segmentation has ", bits_of(seg.type), " a pixel"));
   if (seg.type != SegType::fractional) return;
   seg.max_fractional = e.integer(0x0062, 0x000e, "MaximumFractionalValue");
   if (seg.max_fractional < 1 || seg.max_fractional > 255)
@@ -444,13 +448,16 @@ void add_segments(Segmentation& out, const Volume& grid, const SegFile& seg,
   const size_t frame_pixels = size_t{seg.rows} * seg.columns;
   std::vector<uint8_t> mask(grid.voxel_count());
   for (const Segment& segment : seg.segments) {
-    std::fill(mask.begin(), mask.end(), uint8_t{0});
-    for (size_t f : frames_of[segment.number]) {
+    const std::vector<size_t>& frames = frames_of[segment.number];
+    for (size_t f : frames) {
       uint8_t* slice = mask.data() + seg.frames[f].slice * frame_pixels;
       for (size_t p = 0; p < frame_pixels; ++p)
         if (inside(seg, bytes, f, p)) slice[p] = 1;
     }
     add_region_voxels(out, grid, mask, {segment.number, 0, 0, segment.name, segment.colour});
+    for (size_t f : frames)  // only these slices were written
+      std::fill_n(mask.begin() + ptrdiff_t(seg.frames[f].slice * frame_pixels), frame_pixels,
+                  uint8_t{0});
   }
 }
 
