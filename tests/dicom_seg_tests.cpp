@@ -93,6 +93,7 @@ struct SegmentSpec {
 struct FrameSpec {
   int segment = 0;                         // ReferencedSegmentNumber (none: 0)
   double slice = 0;                        // steps from kBase along the normal
+  glm::dvec3 offset{0.0};                  // added to its position
   std::array<uint16_t, kPixels> pixels{};  // row by row
 };
 
@@ -102,7 +103,8 @@ struct SegSpec {
   std::vector<SegmentSpec> segments;
   std::vector<FrameSpec> frames;
   bool positions = true, orientation = true;
-  std::string between;  // SpacingBetweenSlices
+  std::string between;    // SpacingBetweenSlices
+  glm::dvec3 shear{0.0};  // added to the position once a slice (gantry tilt)
 };
 
 std::string pixel_data(const SegSpec& spec) {
@@ -143,7 +145,7 @@ gdcm::DataSet segment_item(const SegmentSpec& s) {
 gdcm::DataSet frame_item(const SegSpec& spec, const FrameSpec& f) {
   gdcm::DataSet d;
   if (spec.positions) {
-    const glm::dvec3 p = kBase + f.slice * kStep * kNormal;
+    const glm::dvec3 p = kBase + f.slice * (kStep * kNormal + spec.shear) + f.offset;
     d.Insert(sequence(0x0020, 0x9113, {one(text(0x0020, 0x0032, gdcm::VR::DS, ds3(p)))}));
   }
   if (f.segment)
@@ -195,13 +197,14 @@ gdcm::DataSet seg_data_set(const SegSpec& spec) {
   return d;
 }
 
-fs::path write_seg(const std::string& name, const gdcm::DataSet& data_set) {
+fs::path write_seg(
+    const std::string& name, const gdcm::DataSet& data_set,
+    gdcm::TransferSyntax::TSType syntax = gdcm::TransferSyntax::ExplicitVRLittleEndian) {
   const fs::path path = test::fresh_folder("dicom_seg", name) / "seg.dcm";
   gdcm::Writer writer;
   writer.SetFileName(path.string().c_str());
   writer.GetFile().SetDataSet(data_set);
-  writer.GetFile().GetHeader().SetDataSetTransferSyntax(
-      gdcm::TransferSyntax::ExplicitVRLittleEndian);
+  writer.GetFile().GetHeader().SetDataSetTransferSyntax(syntax);
   REQUIRE(writer.Write());
   return path;
 }
@@ -381,33 +384,59 @@ TEST_CASE("DICOM SEG: FRACTIONAL pixels are inside from half the maximum value")
 }
 
 TEST_CASE("DICOM SEG: a LABELMAP's pixel values are its segment numbers") {
-  SegSpec spec;
-  spec.sop = kLabelMapClass;
-  spec.type = "LABELMAP";
-  spec.bits = 16;
-  spec.segments = {{1, "Spleen", "Spleen", std::nullopt}, {300, "Aorta", "Aorta", std::nullopt}};
-  FrameSpec second{.slice = 1}, first{.slice = 0};
-  first.pixels[0] = 1;
-  first.pixels[14] = 300;
-  second.pixels[3] = 300;
-  second.pixels[4] = 7;  // no segment has it
-  spec.frames = {second, first};
-  const fs::path path = write_seg("labelmap", seg_data_set(spec));
-  CHECK(is_dicom_seg(path));
-  std::vector<std::string> warnings;
-  const Segmentation seg = load_dicom_seg(path, {}, warnings);
-  CHECK(seg.format == "DICOM SEG (LABELMAP)");
-  REQUIRE(seg.layers.size() == 1);
-  REQUIRE(seg.regions.size() == 2);
-  CHECK(seg.regions[1].name == "Aorta");
-  CHECK(seg.regions[1].value == 300);
-  CHECK(seg.regions[1].layer == 0);
-  CHECK(layer_value(seg.layers[0], 0, 0, 0) == 1);
-  CHECK(layer_value(seg.layers[0], 4, 2, 0) == 300);
-  CHECK(layer_value(seg.layers[0], 3, 0, 1) == 300);
-  CHECK(layer_value(seg.layers[0], 4, 0, 1) == 0);
-  REQUIRE(warnings.size() == 1);
-  CHECK(warnings[0].find("left out") != std::string::npos);
+  for (const int bits : {8, 16}) {
+    CAPTURE(bits);
+    const int aorta = bits == 8 ? 200 : 300;
+    SegSpec spec;
+    spec.sop = kLabelMapClass;
+    spec.type = "LABELMAP";
+    spec.bits = bits;
+    spec.segments = {{1, "Spleen", "Spleen", std::nullopt},
+                     {aorta, "Aorta", "Aorta", std::nullopt}};
+    FrameSpec second{.slice = 1}, first{.slice = 0};
+    first.pixels[0] = 1;
+    first.pixels[14] = uint16_t(aorta);
+    second.pixels[3] = uint16_t(aorta);
+    second.pixels[4] = 7;  // no segment has it
+    spec.frames = {second, first};
+    const fs::path path = write_seg("labelmap" + std::to_string(bits), seg_data_set(spec));
+    CHECK(is_dicom_seg(path));
+    std::vector<std::string> warnings;
+    const Segmentation seg = load_dicom_seg(path, {}, warnings);
+    CHECK(seg.format == "DICOM SEG (LABELMAP)");
+    REQUIRE(seg.layers.size() == 1);
+    REQUIRE(seg.regions.size() == 2);
+    CHECK(seg.regions[1].name == "Aorta");
+    CHECK(seg.regions[1].value == aorta);
+    CHECK(seg.regions[1].layer == 0);
+    CHECK(layer_value(seg.layers[0], 0, 0, 0) == 1);
+    CHECK(layer_value(seg.layers[0], 4, 2, 0) == aorta);
+    CHECK(layer_value(seg.layers[0], 3, 0, 1) == aorta);
+    CHECK(layer_value(seg.layers[0], 4, 0, 1) == 0);
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("left out") != std::string::npos);
+  }
+}
+
+TEST_CASE("DICOM SEG: an implicit VR file reads as the explicit one") {
+  const Segmentation seg = load(write_seg("implicit", seg_data_set(reference_scene()),
+                                          gdcm::TransferSyntax::ImplicitVRLittleEndian));
+  REQUIRE(seg.regions.size() == 4);
+  CHECK(seg.regions[1].name == "Kidney");
+  REQUIRE(seg.layers.size() == 2);
+  check_region(seg, seg.regions[0], liver);
+  check_region(seg, seg.regions[2], tumour);
+}
+
+TEST_CASE("DICOM SEG: a sheared stack keeps each slice at its position") {
+  SegSpec spec = reference_scene();
+  spec.shear = glm::dvec3(0.0, 0.4, 0.0);  // along the rows, 0.4 mm a slice
+  const Segmentation seg = load(write_seg("sheared", seg_data_set(spec)));
+  const Volume& grid = seg.layers.at(0);
+  const glm::vec3 step = grid.direction[2] * grid.spacing.z;
+  CHECK(glm::length(step - glm::vec3(kStep * kNormal + spec.shear)) < 1e-4f);
+  check_region(seg, seg.regions[0], liver);
+  check_region(seg, seg.regions[2], tumour);
 }
 
 TEST_CASE("DICOM SEG: a folder holding one SEG file opens it") {
@@ -454,6 +483,9 @@ TEST_CASE("DICOM SEG: each fault of a file is an error naming the field") {
   spec = reference_scene();
   spec.frames[0].slice = 3.4;  // steps of 2.5 mm, then 3.5 mm
   expect("uneven", spec, "uneven slice spacing");
+  spec = reference_scene();
+  spec.frames[4].offset = glm::dvec3(0.0, 1.0, 0.0);  // the tumour's slice 2, moved along a row
+  expect("moved", spec, "frames 2 and 5 are on one slice but at different places in it");
   spec = reference_scene();
   spec.type = "FRACTIONAL";
   spec.bits = 8;
