@@ -492,6 +492,15 @@ TEST_CASE("DICOM SEG: each fault of a file is an error naming the field") {
   expect("no_maximum", spec, "MaximumFractionalValue is missing");
 }
 
+TEST_CASE("DICOM SEG: overlapping segments' layers are held to the memory limit") {
+  const fs::path path = write_seg("layers", seg_data_set(reference_scene()));
+  VolumeReadOptions options;
+  options.limits.memory_bytes = 500;  // one layer of 60 voxels and the mask, not two
+  std::vector<std::string> warnings;
+  const std::string message = test::error_of([&] { load_dicom_seg(path, options, warnings); });
+  CHECK(message.find("the segments overlap so that they need 2 layers") != std::string::npos);
+}
+
 TEST_CASE("DICOM SEG: missing sequences and short pixel data are errors") {
   const auto expect = [](const std::string& name, const gdcm::DataSet& d, const std::string& part) {
     const std::string message = test::error_of([&] { load(write_seg(name, d)); });

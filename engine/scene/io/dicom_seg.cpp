@@ -439,10 +439,22 @@ bool inside(const SegFile& seg, std::span<const std::byte> bytes, size_t f, size
   return 2 * std::to_integer<int>(bytes[index]) >= seg.max_fractional;
 }
 
+// Each overlap adds a layer as large as the grid: all of them must fit the memory a volume may
+// take, so that a small file cannot ask for many.
+void check_layers(const Segmentation& out, const Volume& grid, const VolumeLimits& limits) {
+  const uint64_t memory = limits.memory_bytes ? limits.memory_bytes : physical_memory_bytes();
+  const uint64_t bytes = out.layers.size() * uint64_t{grid.voxel_count()} * 2;
+  if (memory > 0 && bytes + grid.voxel_count() > memory / 2)
+    fail(out.source,
+         concat("SegmentSequence: the segments overlap so that they need ", out.layers.size(),
+                " layers of ", grid.voxel_count() * 2 >> 20,
+                " MiB, more than this machine's memory allows (", memory >> 20, " MiB)"));
+}
+
 // One segment at a time into a mask on the grid, so that memory holds one mask besides the
 // layers however many segments there are.
 void add_segments(Segmentation& out, const Volume& grid, const SegFile& seg,
-                  std::span<const std::byte> bytes) {
+                  std::span<const std::byte> bytes, const VolumeLimits& limits) {
   std::map<int, std::vector<size_t>> frames_of;
   for (size_t f = 0; f < seg.frames.size(); ++f) frames_of[seg.frames[f].segment].push_back(f);
   const size_t frame_pixels = size_t{seg.rows} * seg.columns;
@@ -455,6 +467,7 @@ void add_segments(Segmentation& out, const Volume& grid, const SegFile& seg,
         if (inside(seg, bytes, f, p)) slice[p] = 1;
     }
     add_region_voxels(out, grid, mask, {segment.number, 0, 0, segment.name, segment.colour});
+    check_layers(out, grid, limits);
     for (size_t f : frames)  // only these slices were written
       std::fill_n(mask.begin() + ptrdiff_t(seg.frames[f].slice * frame_pixels), frame_pixels,
                   uint8_t{0});
@@ -538,7 +551,7 @@ Segmentation read_seg_file(const fs::path& path, const VolumeReadOptions& option
   if (seg.type == SegType::labelmap)
     fill_label_map(out, grid, seg, bytes, warnings);
   else
-    add_segments(out, grid, seg, bytes);
+    add_segments(out, grid, seg, bytes, options.limits);
   return out;
 }
 
