@@ -339,10 +339,8 @@ glm::dvec3 stack_axis(const fs::path& path, std::vector<Position>& positions,
     p.step = std::llround(steps);
     if (std::fabs(steps - double(p.step)) * step > allowed)
       fail(path, concat("ImagePositionPatient: uneven slice spacing: a slice ",
-                        p.along - positions[0].along,
-                        " mm from the first is not a whole number "
-                        "of ",
-                        step, " mm steps (the closest slices' distance)"));
+                        p.along - positions[0].along, " mm from the first is not a whole number",
+                        " of ", step, " mm steps (the closest slices' distance)"));
   }
   const glm::dvec3 axis =
       (positions.back().point - positions.front().point) / double(positions.back().step);
@@ -404,11 +402,9 @@ std::span<const std::byte> pixel_bytes(const fs::path& path, const gdcm::File& f
   const gdcm::ByteValue* value = file.GetDataSet().GetDataElement(tag).GetByteValue();
   if (value && native_little_endian(file)) {
     if (value->GetLength() < needed)
-      fail(path, concat("PixelData has ", value->GetLength(),
-                        " bytes, Rows x Columns x "
-                        "NumberOfFrames (",
-                        seg.columns, " x ", seg.rows, " x ", seg.frames.size(), ") at ",
-                        seg.bits_allocated, " bits needs ", needed));
+      fail(path, concat("PixelData has ", value->GetLength(), " bytes, Rows x Columns x ",
+                        "NumberOfFrames (", seg.columns, " x ", seg.rows, " x ", seg.frames.size(),
+                        ") at ", seg.bits_allocated, " bits needs ", needed));
     return {reinterpret_cast<const std::byte*>(value->GetPointer()), size_t(needed)};
   }
   if (seg.bits_allocated == 1)
