@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
+
 #include <gdcmDataSet.h>
 #include <gdcmItem.h>
 #include <gdcmSequenceOfItems.h>
@@ -454,6 +456,10 @@ TEST_CASE("DICOM SEG: what is not a SEG is told apart") {
   const fs::path text = test::write_file(ct.parent_path() / "notes.dcm", "not DICOM at all");
   CHECK_FALSE(is_dicom_seg(text));
   CHECK_FALSE(is_dicom_seg(ct.parent_path() / "missing.dcm"));
+  const fs::path fifo = ct.parent_path() / "pipe.dcm";
+  REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+  CHECK_FALSE(is_dicom_seg(fifo));  // without blocking
+  CHECK(test::error_of([&] { load(fifo); }).find("pipe.dcm") != std::string::npos);
   CHECK(test::error_of([&] { load(text); }).find("notes.dcm: not a DICOM file") !=
         std::string::npos);
 }

@@ -69,6 +69,8 @@ struct SegFile {
 // The value of (0002,0002) MediaStorageSOPClassUID: the meta group is explicit VR little endian
 // after the 128-byte preamble and "DICM".
 std::optional<std::string> media_storage_class(const fs::path& path) {
+  std::error_code error;
+  if (!fs::is_regular_file(path, error)) return std::nullopt;  // a FIFO would block the read
   std::ifstream in(path, std::ios::binary);
   char head[132];
   if (!in.read(head, sizeof head) || std::memcmp(head + 128, "DICM", 4) != 0) return std::nullopt;
