@@ -26,8 +26,8 @@ elif [[ ${1:-} =~ ^[0-9]+$ ]]; then
   limit=(-max_total_time="$1")
   shift
 fi
-all=(fuzz_nifti fuzz_metaimage fuzz_nrrd fuzz_mgh fuzz_dicom_structure fuzz_scene_json
-     fuzz_thesis_xml fuzz_names_table fuzz_nifti_extensions
+all=(fuzz_nifti fuzz_metaimage fuzz_nrrd fuzz_mgh fuzz_dicom_structure fuzz_dicom_seg
+     fuzz_scene_json fuzz_thesis_xml fuzz_names_table fuzz_nifti_extensions
      fuzz_gra fuzz_transfer_function_json fuzz_markups_json fuzz_fcsv fuzz_label_csv
      fuzz_viewer_script
      fuzz_camera_path
@@ -77,6 +77,7 @@ copy fuzz_camera_path fuzz/corpus/fuzz_camera_path/*
 copy fuzz_text_layout fuzz/corpus/fuzz_text_layout/*
 copy fuzz_slicer_seg fuzz/corpus/fuzz_slicer_seg/*
 copy fuzz_names_table fuzz/corpus/fuzz_names_table/* assets/cache/mricron/aal.nii.txt
+copy fuzz_dicom_seg fuzz/corpus/fuzz_dicom_seg/*
 
 dictionary() {
   case $1 in

@@ -26,6 +26,7 @@
 #include <gdcmTrace.h>
 #include <gdcmTransferSyntax.h>
 
+#include "engine/scene/io/dicom_elements.h"
 #include "engine/scene/io/dicom_slice.h"
 #include "engine/scene/io/dicom_stack.h"
 #include "engine/scene/io/dicom_structure.h"
@@ -40,56 +41,6 @@ using namespace dicom;
 namespace fs = std::filesystem;
 
 const gdcm::Tag pixel_data_tag(0x7fe0, 0x0010);
-
-// Element values of one data set (the file's, or a functional group's item) as text: GDCM's
-// StringFilter renders binary VRs such as US too. Parsed by hand so that malformed values become
-// errors instead of zeros; errors name `context` ("frame 3: ") before the element.
-class Elements {
- public:
-  Elements(const gdcm::File& file, const gdcm::DataSet& data_set, fs::path path,
-           std::string context = "")
-      : data_set_(data_set), path_(std::move(path)), context_(std::move(context)) {
-    filter_.SetFile(file);
-  }
-  bool has(uint16_t group, uint16_t element) const {
-    const gdcm::Tag tag(group, element);
-    return data_set_.FindDataElement(tag) && !data_set_.GetDataElement(tag).IsEmpty();
-  }
-  std::string text(uint16_t group, uint16_t element) const {
-    if (!has(group, element)) return {};
-    return std::string(trim(filter_.ToString(data_set_.GetDataElement(gdcm::Tag(group, element)))));
-  }
-  // The backslash-separated numbers of a required element (or of an optional one, if present).
-  std::vector<double> numbers(uint16_t group, uint16_t element, const char* name, size_t count,
-                              std::optional<double> fallback = std::nullopt) const {
-    if (!has(group, element)) {
-      if (!fallback) fail(path_, concat(context_, name, " is missing"));
-      return std::vector<double>(count, *fallback);
-    }
-    std::string value = text(group, element);
-    std::replace(value.begin(), value.end(), '\\', ' ');
-    const std::vector<double> result = parse_numbers<double>(path_, context_ + name, value);
-    if (result.size() != count)
-      fail(path_,
-           concat(context_, name, " = '", printable(value), "': expected ", count, " numbers"));
-    return result;
-  }
-  int integer(uint16_t group, uint16_t element, const char* name,
-              std::optional<double> fallback = std::nullopt) const {
-    const double v = numbers(group, element, name, 1, fallback)[0];
-    if (v != std::floor(v) || std::fabs(v) > 65535.0)
-      fail(path_, concat(context_, name, " = ", v, ": expected a whole number"));
-    return static_cast<int>(v);
-  }
-  const gdcm::DataSet& data_set() const { return data_set_; }
-  const fs::path& path() const { return path_; }
-
- private:
-  const gdcm::DataSet& data_set_;
-  fs::path path_;
-  std::string context_;
-  gdcm::StringFilter filter_;
-};
 
 glm::dvec3 unit(const fs::path& file, const std::vector<double>& v, size_t first) {
   const glm::dvec3 d(v[first], v[first + 1], v[first + 2]);
@@ -117,7 +68,9 @@ double last_digit(std::string_view number) {
   return std::pow(10.0, std::clamp(exponent - decimals, -30, 30));
 }
 
-void read_position(const Elements& e, Slice& s) {
+}  // namespace
+
+void dicom::read_position(const Elements& e, Slice& s) {
   const auto position = e.numbers(0x0020, 0x0032, "ImagePositionPatient", 3);
   s.position = glm::dvec3(position[0], position[1], position[2]);
   const std::string text = e.text(0x0020, 0x0032);
@@ -133,7 +86,7 @@ void read_position(const Elements& e, Slice& s) {
                           position[2], ": the position must be finite numbers"));
 }
 
-void read_orientation(const Elements& e, Slice& s) {
+void dicom::read_orientation(const Elements& e, Slice& s) {
   const auto cosines = e.numbers(0x0020, 0x0037, "ImageOrientationPatient", 6);
   s.row_cosine = unit(e.path(), cosines, 0);
   s.column_cosine = unit(e.path(), cosines, 3);
@@ -141,7 +94,7 @@ void read_orientation(const Elements& e, Slice& s) {
     fail(e.path(), "ImageOrientationPatient: the row and column cosines are not perpendicular");
 }
 
-void read_pixel_measures(const Elements& e, Slice& s) {
+void dicom::read_pixel_measures(const Elements& e, Slice& s) {
   const auto spacing = e.numbers(0x0028, 0x0030, "PixelSpacing", 2);
   s.pixel_spacing = glm::dvec2(spacing[1], spacing[0]);  // DICOM lists the row spacing first
   if (!(spacing[0] > 0.0 && spacing[1] > 0.0 && std::isfinite(spacing[0] + spacing[1])))
@@ -149,6 +102,8 @@ void read_pixel_measures(const Elements& e, Slice& s) {
          concat("PixelSpacing = ", spacing[0], " ", spacing[1], ": spacing must be positive"));
   s.thickness = e.numbers(0x0018, 0x0050, "SliceThickness", 1, 0.0)[0];
 }
+
+namespace {
 
 void read_rescale(const Elements& e, Slice& s) {
   s.rescale.slope = e.numbers(0x0028, 0x1053, "RescaleSlope", 1, 1.0)[0];
@@ -233,49 +188,6 @@ void read_unplaced(const Elements& e, Slice& s) {
 
 // ---- enhanced multi-frame files
 
-// Calls read(item) with the first item of a sequence element; false when there is none. The
-// callback keeps GDCM's item alive while it is read (GetValueAsSQ may build it on the fly).
-template <class Read>
-bool with_first_item(const gdcm::DataSet& data_set, uint16_t group, uint16_t element, Read&& read) {
-  const gdcm::Tag tag(group, element);
-  if (!data_set.FindDataElement(tag)) return false;
-  const gdcm::SmartPointer<gdcm::SequenceOfItems> items =
-      data_set.GetDataElement(tag).GetValueAsSQ();
-  if (!items || items->GetNumberOfItems() == 0) return false;
-  read(items->GetItem(1).GetNestedDataSet());
-  return true;
-}
-
-// Per-frame and Shared Functional Groups Sequences: each item holds macros (PlanePosition,
-// PixelMeasures, ...), each macro a sequence of one item that holds the attributes.
-class FunctionalGroups {
- public:
-  explicit FunctionalGroups(const gdcm::DataSet& data_set)
-      : per_frame_(sequence(data_set, 0x9230)), shared_(sequence(data_set, 0x9229)) {}
-  bool present() const { return per_frame_ || shared_; }
-  size_t per_frame_items() const { return per_frame_ ? per_frame_->GetNumberOfItems() : 0; }
-
-  // Calls read(attributes) with frame f's macro (group, element), from the frame's own item or
-  // else the shared one; false when neither has it.
-  template <class Read>
-  bool with_macro(size_t f, uint16_t group, uint16_t element, Read&& read) const {
-    if (f < per_frame_items() &&
-        with_first_item(per_frame_->GetItem(f + 1).GetNestedDataSet(), group, element, read))
-      return true;
-    return shared_ && shared_->GetNumberOfItems() > 0 &&
-           with_first_item(shared_->GetItem(1).GetNestedDataSet(), group, element, read);
-  }
-
- private:
-  static gdcm::SmartPointer<gdcm::SequenceOfItems> sequence(const gdcm::DataSet& data_set,
-                                                            uint16_t element) {
-    const gdcm::Tag tag(0x5200, element);
-    if (!data_set.FindDataElement(tag)) return nullptr;
-    return data_set.GetDataElement(tag).GetValueAsSQ();
-  }
-  gdcm::SmartPointer<gdcm::SequenceOfItems> per_frame_, shared_;
-};
-
 // Frame f's slice: the file's pixel format (in `common`) and the frame's own attributes.
 Slice read_frame(const gdcm::File& file, const FunctionalGroups& groups, const Slice& common,
                  size_t f) {
@@ -358,21 +270,6 @@ void check_pixel_data_length(const Elements& e, const Slice& s) {
   if (value && value->GetLength() < needed)
     fail(s.file, concat("PixelData has ", value->GetLength(), " bytes, Rows x Columns",
                         s.frames_in_file > 1 ? " x NumberOfFrames" : "", " needs ", needed));
-}
-
-// GDCM refuses a transfer syntax it does not know without saying so; the meta header says which.
-[[noreturn]] void fail_to_parse(const fs::path& file, const gdcm::Reader& reader) {
-  const gdcm::FileMetaInformation& meta = reader.GetFile().GetHeader();
-  const gdcm::Tag syntax_tag(0x0002, 0x0010);
-  if (meta.FindDataElement(syntax_tag))
-    if (const gdcm::ByteValue* value = meta.GetDataElement(syntax_tag).GetByteValue()) {
-      const std::string uid(trim(std::string(value->GetPointer(), value->GetLength()).c_str()));
-      if (gdcm::TransferSyntax::GetTSType(uid.c_str()) == gdcm::TransferSyntax::TS_END)
-        fail(file, concat("TransferSyntaxUID ", printable(uid, 64),
-                          " is not supported (GDCM does not know it; strata reads uncompressed, "
-                          "RLE, JPEG, JPEG-LS and JPEG 2000 DICOM)"));
-    }
-  fail(file, "DICOM file cannot be parsed (truncated or malformed)");
 }
 
 // A file of a series folder that is not DICOM is skipped (a README, a thumbnail database), but one
@@ -841,14 +738,27 @@ Volume assemble(const fs::path& where, std::vector<Slice> slices, const VolumeLi
   return volume;
 }
 
-// Files that are not DICOM are skipped on purpose; GDCM must not print about them.
-void quiet_gdcm() {
+}  // namespace
+
+void dicom::fail_to_parse(const fs::path& file, const gdcm::Reader& reader) {
+  const gdcm::FileMetaInformation& meta = reader.GetFile().GetHeader();
+  const gdcm::Tag syntax_tag(0x0002, 0x0010);
+  if (meta.FindDataElement(syntax_tag))
+    if (const gdcm::ByteValue* value = meta.GetDataElement(syntax_tag).GetByteValue()) {
+      const std::string uid(trim(std::string(value->GetPointer(), value->GetLength()).c_str()));
+      if (gdcm::TransferSyntax::GetTSType(uid.c_str()) == gdcm::TransferSyntax::TS_END)
+        fail(file, concat("TransferSyntaxUID ", printable(uid, 64),
+                          " is not supported (GDCM does not know it; strata reads uncompressed, "
+                          "RLE, JPEG, JPEG-LS and JPEG 2000 DICOM)"));
+    }
+  fail(file, "DICOM file cannot be parsed (truncated or malformed)");
+}
+
+void dicom::quiet_gdcm() {
   gdcm::Trace::DebugOff();
   gdcm::Trace::WarningOff();
   gdcm::Trace::ErrorOff();
 }
-
-}  // namespace
 
 std::string dicom::name_of(const Slice& s) {
   return s.frames_in_file > 1 ? concat("frame ", s.frame + 1) : s.file.filename().string();

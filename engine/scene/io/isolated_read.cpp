@@ -24,6 +24,7 @@
 #include <type_traits>
 
 #include "engine/core/error.h"
+#include "engine/scene/segmentation.h"
 
 // AddressSanitizer reserves terabytes of address space for its shadow memory, so an address-space
 // limit would stop every read there; the parent's watch of the child's resident memory remains.
@@ -48,6 +49,8 @@ constexpr uint64_t kGiB = uint64_t{1} << 30;
 // added to Mesh or Volume must be added there too, or it is silently lost for meshes and DICOM.
 static_assert(sizeof(Mesh) == 224, "Mesh changed: update mesh_fields (isolated_read.cpp)");
 static_assert(sizeof(Volume) == 312, "Volume changed: update volume_fields (isolated_read.cpp)");
+static_assert(sizeof(SegmentRegion) == 64,
+              "SegmentRegion changed: update region_fields (isolated_read.cpp)");
 
 template <class T>
 constexpr bool is_vector = false;
@@ -498,6 +501,15 @@ void volume_fields(Io& io, V& volume) {
   io.field(volume.cut);
 }
 
+template <class Io, class R>
+void region_fields(Io& io, R& region) {
+  io.field(region.number);
+  io.field(region.layer);
+  io.field(region.value);
+  io.field(region.name);
+  io.field(region.colour);
+}
+
 }  // namespace
 
 ParserLimits resolved_parser_limits(const std::filesystem::path& input, ParserLimits limits) {
@@ -571,6 +583,39 @@ Volume read_volume_isolated(const std::filesystem::path& file, std::string_view 
         for (uint64_t i = 0; i < count; ++i) warnings.push_back(child.text());
       });
   return volume;
+}
+
+Segmentation read_segmentation_isolated(
+    const std::filesystem::path& file, std::string_view parser, const ParserLimits& limits,
+    std::vector<std::string>& warnings,
+    const std::function<Segmentation(std::vector<std::string>&)>& read) {
+  Segmentation segmentation;
+  run_isolated(
+      file, parser, limits,
+      [&](Writer& w) {
+        std::vector<std::string> child_warnings;
+        const Segmentation result = read(child_warnings);
+        w.outcome(Outcome::value);
+        w.field(result.source);
+        w.field(result.format);
+        w.pod(uint64_t{result.layers.size()});
+        for (const Volume& layer : result.layers) volume_fields(w, layer);
+        w.pod(uint64_t{result.regions.size()});
+        for (const SegmentRegion& region : result.regions) region_fields(w, region);
+        w.pod(uint64_t{child_warnings.size()});
+        for (const std::string& warning : child_warnings) w.text(warning);
+      },
+      [&](Child& child) {
+        child.field(segmentation.source);
+        child.field(segmentation.format);
+        segmentation.layers.resize(child.pod<uint64_t>());
+        for (Volume& layer : segmentation.layers) volume_fields(child, layer);
+        segmentation.regions.resize(child.pod<uint64_t>());
+        for (SegmentRegion& region : segmentation.regions) region_fields(child, region);
+        const auto count = child.pod<uint64_t>();
+        for (uint64_t i = 0; i < count; ++i) warnings.push_back(child.text());
+      });
+  return segmentation;
 }
 
 }  // namespace strata

@@ -14,6 +14,8 @@
 
 namespace strata {
 
+struct Segmentation;  // engine/scene/segmentation.h
+
 // What one read in a child process may take. A zero field takes the default for the input's size.
 struct ParserLimits {
   double seconds = 0.0;       // wall-clock time; also the child's CPU-time limit
@@ -36,6 +38,12 @@ std::vector<Mesh> read_meshes_isolated(const std::filesystem::path& file, std::s
 Volume read_volume_isolated(const std::filesystem::path& file, std::string_view parser,
                             const ParserLimits& limits, std::vector<std::string>& warnings,
                             const std::function<Volume(std::vector<std::string>&)>& read);
+
+// The same for a segmentation (its layers and regions).
+Segmentation read_segmentation_isolated(
+    const std::filesystem::path& file, std::string_view parser, const ParserLimits& limits,
+    std::vector<std::string>& warnings,
+    const std::function<Segmentation(std::vector<std::string>&)>& read);
 
 // The same for texts (a DICOM folder's series, each as its fields).
 std::vector<std::string> read_texts_isolated(const std::filesystem::path& file,
