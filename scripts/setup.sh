@@ -23,8 +23,8 @@ packages=(
   libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
   # the label writer's test validates its markups JSON against 3D Slicer's schema
   python3-jsonschema
-  # the DICOM SEG reader's test opens a Segmentation that pydicom writes
-  python3-pydicom
+  # the DICOM SEG reader's test opens a Segmentation that pydicom writes (with numpy's arrays)
+  python3-pydicom python3-numpy
   # window tests without a display
   xvfb xauth xdotool
   # fuzzing (scripts/fuzz.sh): clang and its runtime libraries, libFuzzer among them
