@@ -78,14 +78,10 @@ void bench_segmentation(const SegmentationBenchOptions& options) {
   }
   const bench::Stat stat = bench::stat_of(ms);
   bench::ordered_json report = {
-      {"benchmark", "segmentation"},
-      {"size", options.size},
-      {"regions", options.regions},
-      {"regions_with_voxels", with_voxels},
-      {"labelled_voxels", voxels},
-      {"threads", std::max(1u, std::thread::hardware_concurrency())},
-      {"runs", options.runs},
-      {"anchors_ms", {{"median", stat.median}, {"min", stat.min}}}};
+      {"benchmark", "segmentation"}, {"size", options.size},
+      {"regions", options.regions},  {"regions_with_voxels", with_voxels},
+      {"labelled_voxels", voxels},   {"threads", std::max(1u, std::thread::hardware_concurrency())},
+      {"runs", options.runs},        {"anchors_ms", {{"median", stat.median}, {"min", stat.min}}}};
   bench::print_report(report);
 }
 

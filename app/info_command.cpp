@@ -239,14 +239,12 @@ std::string describe_segmentation(const fs::path& path, const std::optional<fs::
   for (size_t r = 0; r < seg.regions.size(); ++r) {
     const SegmentRegion& region = seg.regions[r];
     const RegionSummary& sum = summaries[r];
-    const std::string colour =
-        region.colour ? format("(%.2f, %.2f, %.2f)", region.colour->r, region.colour->g,
-                               region.colour->b)
-                      : "-";
+    const std::string colour = region.colour ? format("(%.2f, %.2f, %.2f)", region.colour->r,
+                                                      region.colour->g, region.colour->b)
+                                             : "-";
     const glm::vec3 lps = sum.anchor, ras(-lps.x, -lps.y, lps.z);
     out += format("  %5d  %-28s %-17s %9zu %10.3f  ", region.number,
-                  printable_text(region.name).c_str(), colour.c_str(), sum.voxels,
-                  sum.millilitres);
+                  printable_text(region.name).c_str(), colour.c_str(), sum.voxels, sum.millilitres);
     out += sum.voxels == 0 ? "(no voxels)\n"
                            : format("%-26s %s", vec(lps).c_str(), vec(ras).c_str()) +
                                  (sum.parts > 1 ? format("  (%d parts)", sum.parts) : "") + "\n";

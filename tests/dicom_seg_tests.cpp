@@ -320,6 +320,10 @@ TEST_CASE("DICOM SEG: BINARY frames straddling bytes read into named, coloured r
   check_region(seg, seg.regions[1], kidney);
   check_region(seg, seg.regions[2], tumour);
   check_region(seg, seg.regions[3], nowhere);
+  // Every anchor lies in its region (the one without voxels has none).
+  const std::vector<RegionSummary> summaries = summarise_regions(seg);
+  for (size_t r = 0; r < 3; ++r) CHECK(region_contains(seg, seg.regions[r], summaries[r].anchor));
+  CHECK(summaries[3].voxels == 0);
 }
 
 TEST_CASE("DICOM SEG: the grid follows the frames' positions and orientation") {

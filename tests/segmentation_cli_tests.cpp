@@ -46,15 +46,15 @@ TEST_SUITE("cli") {
       CHECK(value == 23);
       CHECK(voxels > 5000);
       CHECK(ml == doctest::Approx(double(voxels) / 1000.0));  // 1 mm voxels
-      CHECK(l[0] > 0.0);  // the patient's left: LPS x positive
+      CHECK(l[0] > 0.0);                                      // the patient's left: LPS x positive
       CHECK(a[0] == doctest::Approx(-l[0]));
       CHECK(a[1] == doctest::Approx(-l[1]));
       CHECK(a[2] == doctest::Approx(l[2]));
     }
     CHECK(found);
     // A label map without names of its own lists its regions with a names table.
-    const auto aal = run_strata("info " CACHE "mricron/aal.nii.gz --names " CACHE
-                                "mricron/aal.nii.txt");
+    const auto aal =
+        run_strata("info " CACHE "mricron/aal.nii.gz --names " CACHE "mricron/aal.nii.txt");
     CHECK(aal.exit_code == 0);
     CHECK(aal.output.find("regions: 116") != std::string::npos);
     CHECK(aal.output.find("Precentral_L") != std::string::npos);
@@ -63,7 +63,8 @@ TEST_SUITE("cli") {
   TEST_CASE("render_segmentation_labels_every_region_in_one_command") {
     const std::string layout = test::output_dir() + "/segmentation-layout.json";
     const auto r = run_strata("--validate render " HEAD " --segmentation " REGIONS
-                              " --size 96 -o /dev/null --layout " + layout);
+                              " --size 96 -o /dev/null --layout " +
+                              layout);
     CAPTURE(r.output);
     REQUIRE(r.exit_code == 0);
     CHECK(r.output.find("validation:") == std::string::npos);
@@ -95,20 +96,19 @@ TEST_SUITE("cli") {
     const auto no_names =
         run_strata("render " HEAD " --segmentation " CACHE "mricron/aal.nii.gz -o /dev/null");
     CHECK(no_names.exit_code == 1);
-    CHECK(no_names.output.find("aal.nii.gz: the label map names no regions") !=
-          std::string::npos);
-    const auto unknown = run_strata("render " HEAD " --segmentation " REGIONS
-                                    " --regions heart -o /dev/null");
+    CHECK(no_names.output.find("aal.nii.gz: the label map names no regions") != std::string::npos);
+    const auto unknown =
+        run_strata("render " HEAD " --segmentation " REGIONS " --regions heart -o /dev/null");
     CHECK(unknown.exit_code == 1);
     CHECK(unknown.output.find("no region 'heart' (it has 27: frontal_lobe_left") !=
           std::string::npos);
-    const auto masks = run_strata("render " HEAD " --segmentation " REGIONS
-                                  " --make masks -o /dev/null");
+    const auto masks =
+        run_strata("render " HEAD " --segmentation " REGIONS " --make masks -o /dev/null");
     CHECK(masks.exit_code == 1);
     CHECK(masks.output.find("27 masks and 1 volume(s) already: strata renders at most 8") !=
           std::string::npos);
-    const auto make = run_strata("render " HEAD " --segmentation " REGIONS
-                                 " --make meshes -o /dev/null");
+    const auto make =
+        run_strata("render " HEAD " --segmentation " REGIONS " --make meshes -o /dev/null");
     CHECK(make.exit_code == 2);
   }
 }

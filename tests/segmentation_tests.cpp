@@ -8,6 +8,8 @@
 #include <random>
 #include <set>
 
+#include <zlib.h>
+
 #include "engine/core/error.h"
 #include "engine/scene/atlas.h"
 #include "engine/scene/io/scene_loader.h"
@@ -100,8 +102,11 @@ TEST_CASE("segmentation: a label map with a names table keeps the table's order 
   map.voxels[at(map, 1, 1, 1)] = std::byte{7};
   map.voxels[at(map, 2, 2, 2)] = std::byte{3};
   map.voxels[at(map, 3, 3, 3)] = std::byte{9};  // named by no one
-  NamesTable names{"test", {{0, "background", {}}, {7, "liver", glm::vec3(1, 0, 0)}, {3, "spleen", {}},
-                            {5, "aorta", {}}}};
+  NamesTable names{"test",
+                   {{0, "background", {}},
+                    {7, "liver", glm::vec3(1, 0, 0)},
+                    {3, "spleen", {}},
+                    {5, "aorta", {}}}};
   std::vector<std::string> warnings;
   const Segmentation s = segmentation_from_label_map(map, names, warnings);
   REQUIRE(s.regions.size() == 3);
@@ -176,8 +181,8 @@ TEST_CASE("segmentation: the anchor is the deepest voxel, as a brute-force searc
       for (int z = -1; z <= int(g.dims.z); ++z)
         for (int y = -1; y <= int(g.dims.y); ++y)
           for (int x = -1; x <= int(g.dims.x); ++x) {
-            const bool out = x < 0 || y < 0 || z < 0 || x >= int(g.dims.x) ||
-                             y >= int(g.dims.y) || z >= int(g.dims.z) || !inside[at(g, x, y, z)];
+            const bool out = x < 0 || y < 0 || z < 0 || x >= int(g.dims.x) || y >= int(g.dims.y) ||
+                             z >= int(g.dims.z) || !inside[at(g, x, y, z)];
             if (!out) continue;
             const glm::dvec3 d = glm::dvec3(glm::ivec3(x, y, z) - p) * glm::dvec3(spacing);
             best = std::min(best, glm::dot(d, d));
@@ -301,9 +306,8 @@ TEST_CASE("segmentation in a scene: labels named after the regions, anchored ins
       "scene", {{{10, 10, 10}, 12.0f}, {{28, 28, 28}, 10.0f}, {{30, 8, 20}, 6.0f}},
       {"liver", "spleen_tip", "kidney"});
   const fs::path file = test::write_file(
-      t.folder / "scene.json",
-      scene_json(R"(, "make": ["labels", "masks"])",
-                 R"([{"id": 0, "text": "own", "anchor": [0, 0, 0]}])"));
+      t.folder / "scene.json", scene_json(R"(, "make": ["labels", "masks"])",
+                                          R"([{"id": 0, "text": "own", "anchor": [0, 0, 0]}])"));
   const Scene scene = load_scene_json(file);
   REQUIRE(scene.labels.size() == 4);
   CHECK(scene.labels[1].text == "liver");
@@ -328,9 +332,8 @@ TEST_CASE("segmentation in a scene: labels named after the regions, anchored ins
 }
 
 TEST_CASE("segmentation in a scene: regions chosen by name, empty ones warned, faults refused") {
-  const TestSegmentation t =
-      write_segmentation("choose", {{{10, 10, 10}, 8.0f}, {{30, 30, 30}, 6.0f}},
-                         {"liver", "spleen", "pancreas"});
+  const TestSegmentation t = write_segmentation(
+      "choose", {{{10, 10, 10}, 8.0f}, {{30, 30, 30}, 6.0f}}, {"liver", "spleen", "pancreas"});
   const Scene some = load_scene_json(
       test::write_file(t.folder / "some.json", scene_json(R"(, "regions": ["spleen"])")));
   REQUIRE(some.labels.size() == 1);
@@ -339,24 +342,21 @@ TEST_CASE("segmentation in a scene: regions chosen by name, empty ones warned, f
   const Scene all = load_scene_json(test::write_file(t.folder / "all.json", scene_json("")));
   CHECK(all.labels.size() == 2);
   REQUIRE(all.warnings.size() == 1);
-  CHECK(all.warnings[0].find("region 'pancreas' (3) has no voxels: skipped") !=
-        std::string::npos);
+  CHECK(all.warnings[0].find("region 'pancreas' (3) has no voxels: skipped") != std::string::npos);
 
   const std::string unknown = test::error_of([&] {
     load_scene_json(
         test::write_file(t.folder / "unknown.json", scene_json(R"(, "regions": ["heart"])")));
   });
-  CHECK(unknown.find("no region 'heart' (it has 3: liver, spleen, pancreas)") !=
-        std::string::npos);
+  CHECK(unknown.find("no region 'heart' (it has 3: liver, spleen, pancreas)") != std::string::npos);
   CHECK(unknown.find("segmentations[0].file") != std::string::npos);
 }
 
 TEST_CASE("segmentation in a scene: a grid elsewhere, and more regions than labels, are refused") {
   const TestSegmentation far = write_segmentation("far", {{{10, 10, 10}, 8.0f}}, {"liver"},
                                                   glm::vec3(400.0f, -40.0f, -40.0f));
-  const std::string elsewhere = test::error_of([&] {
-    load_scene_json(test::write_file(far.folder / "far.json", scene_json("")));
-  });
+  const std::string elsewhere = test::error_of(
+      [&] { load_scene_json(test::write_file(far.folder / "far.json", scene_json(""))); });
   CHECK(elsewhere.find("labels.mha and " + (far.folder / "scan.mha").string() +
                        ": the segmentation's grid does not overlap the scan") != std::string::npos);
 
@@ -379,4 +379,83 @@ TEST_CASE("segmentation in a scene: a grid elsewhere, and more regions than labe
   CHECK(many.find("4100 regions with voxels, but a scene holds at most 4096 labels: choose "
                   "regions with --regions NAME,... or the entry's \"regions\"") !=
         std::string::npos);
+}
+
+TEST_CASE("segmentation: a TotalSegmentator label map names its regions from its header") {
+  // A NIfTI-1 label map 28 x 28 x 12 (0.8 x 0.8 x 2 mm), its label table in an extension of
+  // code 0 as TotalSegmentator writes it: value 1 a C, value 2 a ball, value 3 named, absent.
+  const Volume g = grid({28, 28, 12}, {0.8f, 0.8f, 2.0f});
+  const std::vector<uint8_t> c = c_shape(g), b = ball(g, {25, 2, 6}, 2.0f);  // (apart)
+  std::string voxels(g.voxel_count(), '\0');
+  for (size_t i = 0; i < voxels.size(); ++i) voxels[i] = char(c[i] ? 1 : b[i] ? 2 : 0);
+  const std::string xml =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?> <CaretExtension> <VolumeInformation "
+      "Index=\"0\"> <LabelTable>\n"
+      "<Label Key=\"1\" Red=\"1.0\" Green=\"0.5\" Blue=\"0.0\" Alpha=\"1\"><![CDATA[aorta]]>"
+      "</Label>\n<Label Key=\"2\" Red=\"0.0\" Green=\"0.0\" Blue=\"1.0\" Alpha=\"1\">"
+      "<![CDATA[kidney_left]]></Label>\n<Label Key=\"3\" Red=\"0\" Green=\"1\" Blue=\"0\" "
+      "Alpha=\"1\"><![CDATA[spleen]]></Label>\n</LabelTable> </VolumeInformation>"
+      "</CaretExtension>\n";
+  const size_t esize = (8 + xml.size() + 15) / 16 * 16;
+  std::string header(348, '\0');
+  const auto put = [&](size_t at, auto value) {
+    std::memcpy(header.data() + at, &value, sizeof value);
+  };
+  put(0, int32_t(348));
+  const int16_t dim[8] = {3, 28, 28, 12, 1, 1, 1, 1};
+  std::memcpy(header.data() + 40, dim, sizeof dim);
+  put(70, int16_t(2));  // uint8
+  put(72, int16_t(8));
+  const float pixdim[8] = {1, 0.8f, 0.8f, 2.0f, 1, 1, 1, 1};
+  std::memcpy(header.data() + 76, pixdim, sizeof pixdim);
+  put(108, float(352 + esize));
+  put(254, int16_t(1));  // sform: RAS x -> LPS -x
+  const float srow[12] = {0.8f, 0, 0, 10, 0, 0.8f, 0, -20, 0, 0, 2, 5};
+  std::memcpy(header.data() + 280, srow, sizeof srow);
+  header.replace(344, 4, std::string("n+1\0", 4));
+  std::string extension(8, '\0');
+  const int32_t size_code[2] = {int32_t(esize), 0};
+  std::memcpy(extension.data(), size_code, 8);
+  extension += xml;
+  extension.resize(esize, '\0');
+  const std::filesystem::path folder = test::fresh_folder("segmentation", "totalsegmentator");
+  const std::filesystem::path file = folder / "segmentations.nii.gz";
+  gzFile out = gzopen(file.c_str(), "wb");
+  REQUIRE(out != nullptr);
+  const std::string bytes = header + std::string("\1\0\0\0", 4) + extension + voxels;
+  CHECK(gzwrite(out, bytes.data(), unsigned(bytes.size())) == int(bytes.size()));
+  CHECK(gzclose(out) == Z_OK);
+
+  CHECK(is_segmentation(file));
+  std::vector<std::string> warnings;
+  const Segmentation s = load_segmentation(file, std::nullopt, {}, warnings);
+  CHECK(warnings.empty());
+  REQUIRE(s.regions.size() == 3);
+  CHECK(s.regions[0].name == "aorta");
+  CHECK(s.regions[1].name == "kidney_left");
+  REQUIRE(s.regions[0].colour);
+  CHECK(glm::length(*s.regions[0].colour - glm::vec3(1.0f, 0.5f, 0.0f)) < 1e-4f);
+  const std::vector<RegionSummary> summaries = summarise_regions(s);
+  CHECK(region_contains(s, s.regions[0], summaries[0].anchor));
+  CHECK(region_contains(s, s.regions[1], summaries[1].anchor));
+  CHECK(summaries[2].voxels == 0);
+  // The ball's anchor is its centre, voxel (25, 2, 6): RAS (30, -18.4, 17), LPS x and y negated.
+  CHECK(glm::length(summaries[1].anchor - glm::vec3(-30.0f, 18.4f, 17.0f)) < 1e-3f);
+  // The C's centroid is outside it; its anchor is not.
+  glm::dvec3 sum(0.0);
+  size_t count = 0;
+  for (size_t i = 0; i < c.size(); ++i)
+    if (c[i]) {
+      const size_t x = i % 28, y = i / 28 % 28, z = i / (28 * 28);
+      sum += glm::dvec3(x, y, z), ++count;
+    }
+  const glm::vec3 centroid =
+      glm::vec3(s.layers[0].index_to_world() * glm::vec4(glm::vec3(sum / double(count)), 1.0f));
+  CHECK_FALSE(region_contains(s, s.regions[0], centroid));
+  // A names table given with it replaces the header's names, matched by value.
+  const std::filesystem::path table =
+      test::write_file(folder / "names.txt",
+                       "1 Aorta 255 0 0 255\n2 Left_kidney 0 0 255 255\n3 Spleen 0 255 0 255\n");
+  const Segmentation renamed = load_segmentation(file, table, {}, warnings);
+  CHECK(renamed.regions[1].name == "Left_kidney");
 }

@@ -167,6 +167,12 @@ void check_two_segments(const Segmentation& s) {
   check_voxels(s, s.regions[0], sphere);
   check_voxels(s, s.regions[1], c_shape);
   check_geometry(s.layers[0]);
+  // Each anchor lies in its region; the C's centroid (the ring's middle) does not.
+  const std::vector<strata::RegionSummary> summaries = strata::summarise_regions(s);
+  for (size_t r = 0; r < 2; ++r)
+    CHECK(strata::region_contains(s, s.regions[r], summaries[r].anchor));
+  const glm::vec4 centroid = s.layers[0].index_to_world() * glm::vec4(4.5f, 4.5f, 3.0f, 1.0f);
+  CHECK_FALSE(strata::region_contains(s, s.regions[1], glm::vec3(centroid)));
 }
 
 // One error naming the file and saying the reason.
@@ -503,6 +509,9 @@ TEST_CASE("mask folder: each mask is a region named after its file, numbered in 
   check_voxels(s, s.regions[0], c_shape);
   check_voxels(s, s.regions[1], box);
   check_voxels(s, s.regions[2], sphere);
+  const std::vector<strata::RegionSummary> summaries = strata::summarise_regions(s);
+  for (size_t r = 0; r < 3; ++r)
+    CHECK(strata::region_contains(s, s.regions[r], summaries[r].anchor));
   // Voxel (2, 3, 1): RAS (-17, 14.5, 6.5) is LPS (17, -14.5, 6.5).
   const glm::vec4 world = s.layers[0].index_to_world() * glm::vec4(2, 3, 1, 1);
   CHECK(world.x == doctest::Approx(17.0f));

@@ -1,10 +1,10 @@
 #include "engine/scene/segmentation.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <atomic>
 #include <limits>
 #include <map>
 #include <thread>
@@ -145,9 +145,9 @@ Segmentation segmentation_from_label_map(Volume label_map, const NamesTable& nam
       }
       list += (list.empty() ? "" : ", ") + std::to_string(value);
     }
-    warnings.push_back(label_map.source.string() + ": " + std::to_string(unnamed.size()) +
-                       " value(s) with voxels that the names table does not name are left out: " +
-                       list);
+    warnings.push_back(
+        label_map.source.string() + ": " + std::to_string(unnamed.size()) +
+        " value(s) with voxels that the names table does not name are left out: " + list);
   }
   for (const auto& [value, entry] : named) {
     (void)value;
@@ -180,7 +180,8 @@ std::vector<RegionExtent> region_extents(const Segmentation& segmentation) {
   for (size_t l = 0; l < segmentation.layers.size(); ++l) {
     std::vector<int> region_of(kMaxRegionValue + 1, -1);
     for (size_t r = 0; r < segmentation.regions.size(); ++r)
-      if (segmentation.regions[r].layer == int(l)) region_of[segmentation.regions[r].value] = int(r);
+      if (segmentation.regions[r].layer == int(l))
+        region_of[segmentation.regions[r].value] = int(r);
     const Volume& layer = segmentation.layers[l];
     const glm::ivec3 dims(layer.dims);
     size_t i = 0;
@@ -385,9 +386,9 @@ void check_segmentation_fits(const Segmentation& segmentation, const Volume& sca
     const glm::vec3 axis = glm::mat3(grid.transform) * grid.direction[a];
     float best = 0.0f;
     for (int b = 0; b < 3; ++b)
-      best = std::max(best, std::fabs(glm::dot(glm::normalize(axis),
-                                               glm::normalize(glm::mat3(scan.transform) *
-                                                              scan.direction[b]))));
+      best = std::max(
+          best, std::fabs(glm::dot(glm::normalize(axis),
+                                   glm::normalize(glm::mat3(scan.transform) * scan.direction[b]))));
     if (best < std::cos(glm::radians(1.0f)))
       throw Error(both + ": their orientations disagree (the segmentation's axis " +
                   std::to_string(a) + " is " + std::to_string(glm::degrees(std::acos(best))) +

@@ -108,8 +108,7 @@ Segmentation load_slicer_segmentation(const std::filesystem::path& path,
 
 // A folder of binary masks, one <name>.nii.gz (or .nii) per structure on one grid
 // (TotalSegmentator without --ml); the region is named after the file.
-Segmentation load_mask_folder(const std::filesystem::path& folder,
-                              const VolumeReadOptions& options,
+Segmentation load_mask_folder(const std::filesystem::path& folder, const VolumeReadOptions& options,
                               std::vector<std::string>& warnings);
 
 // A DICOM Segmentation object (a .dcm file, or a folder holding one): BINARY, FRACTIONAL

@@ -18,7 +18,8 @@ std::string lower(std::string text) {
 }
 
 bool ends_with(const std::string& text, std::string_view tail) {
-  return text.size() >= tail.size() && text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
+  return text.size() >= tail.size() &&
+         text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
 }
 
 bool is_nifti_name(const std::filesystem::path& path) {
@@ -60,7 +61,6 @@ void rename_regions(Segmentation& segmentation, const NamesTable& names,
     if (it->colour) region.colour = it->colour;
   }
 }
-
 
 std::string spaced(std::string name) {
   std::replace(name.begin(), name.end(), '_', ' ');
@@ -185,8 +185,8 @@ Segmentation load_segmentation(const std::filesystem::path& path,
       throw Error(path.string() +
                   ": the label map names no regions (no label table in its header): give a "
                   "names table (--names, or \"names\" in the scene)");
-    segmentation = segmentation_from_label_map(load_volume(path, options, warnings), *table,
-                                               warnings);
+    segmentation =
+        segmentation_from_label_map(load_volume(path, options, warnings), *table, warnings);
     segmentation.format = "label map, names from " + table->format;
     return segmentation;
   }
@@ -217,12 +217,13 @@ void add_segmentation(Scene& scene, const SegmentationEntry& entry,
   if (entry.labels && kept.size() > room)
     throw Error(entry.file.string() + ": " + std::to_string(kept.size()) +
                 " regions with voxels, but a scene holds at most " + std::to_string(kMaxLabels) +
-                " labels" + (room < size_t(kMaxLabels) ? " (" + std::to_string(room) + " left)" : "") +
+                " labels" +
+                (room < size_t(kMaxLabels) ? " (" + std::to_string(room) + " left)" : "") +
                 ": choose regions with --regions NAME,... or the entry's \"regions\"");
   if (entry.masks && scene.volumes.size() + kept.size() > kMaxVolumes)
     throw Error(entry.file.string() + ": " + std::to_string(kept.size()) + " masks and " +
-                std::to_string(scene.volumes.size()) + " volume(s) already: strata renders at most " +
-                std::to_string(kMaxVolumes) +
+                std::to_string(scene.volumes.size()) +
+                " volume(s) already: strata renders at most " + std::to_string(kMaxVolumes) +
                 " volumes: choose regions with --regions NAME,... or the entry's \"regions\", or "
                 "make surfaces");
   const std::vector<int> ids = unused_label_ids(scene.labels, entry.labels ? kept.size() : 0);
