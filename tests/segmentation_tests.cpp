@@ -265,7 +265,8 @@ struct TestSegmentation {
 TestSegmentation write_segmentation(const std::string& name,
                                     const std::vector<std::pair<glm::vec3, float>>& balls,
                                     const std::vector<std::string>& names,
-                                    glm::vec3 labels_origin = glm::vec3(-40.0f)) {
+                                    glm::vec3 labels_origin = glm::vec3(-40.0f),
+                                    glm::mat3 labels_direction = glm::mat3(1.0f)) {
   TestSegmentation t;
   t.folder = test::fresh_folder("segmentation", name);
   Volume scan = grid({40, 40, 40}, glm::vec3(2.0f));
@@ -276,6 +277,7 @@ TestSegmentation write_segmentation(const std::string& name,
   write_metaimage(t.scan, scan);
   Volume map = grid({40, 40, 40}, glm::vec3(2.0f));
   map.origin = labels_origin;
+  map.direction = labels_direction;
   map.type = VoxelType::uint16;
   map.voxels.assign(map.voxel_count() * 2, std::byte{0});
   for (size_t b = 0; b < balls.size(); ++b) {
@@ -350,6 +352,18 @@ TEST_CASE("segmentation in a scene: regions chosen by name, empty ones warned, f
   });
   CHECK(unknown.find("no region 'heart' (it has 3: liver, spleen, pancreas)") != std::string::npos);
   CHECK(unknown.find("segmentations[0].file") != std::string::npos);
+}
+
+TEST_CASE("segmentation in a scene: a grid of its own is placed through world space") {
+  // The label map's x axis runs right to left and its y and z axes are swapped: its voxel
+  // (10, 12, 8) is world (40 - 20, -40 + 16, -40 + 24).
+  const glm::mat3 turned(glm::vec3(-1, 0, 0), glm::vec3(0, 0, 1), glm::vec3(0, 1, 0));
+  const TestSegmentation t = write_segmentation("turned", {{{10, 12, 8}, 7.0f}}, {"liver"},
+                                                glm::vec3(40.0f, -40.0f, -40.0f), turned);
+  const Scene scene = load_scene_json(test::write_file(t.folder / "turned.json", scene_json("")));
+  REQUIRE(scene.labels.size() == 1);
+  CHECK(glm::length(scene.labels[0].anchor - glm::vec3(20.0f, -24.0f, -16.0f)) < 1e-3f);
+  CHECK(atlas_region_at(scene, scene.labels[0].anchor) == "liver");
 }
 
 TEST_CASE("segmentation in a scene: a grid elsewhere, and more regions than labels, are refused") {
