@@ -298,7 +298,11 @@ TEST_SUITE("loaders") {
     REQUIRE(chosen.volumes.size() == 2);
     CHECK(chosen.volumes[0].name == "Precentral_R");
     REQUIRE(chosen.volumes[0].transfer_function >= 0);
-    CHECK(chosen.transfer_functions[size_t(chosen.volumes[0].transfer_function)].stops.size() == 2);
+    // Clear below the boundary between outside (0) and inside (1), the surface colour above it.
+    const strata::TransferFunction& mask_tf =
+        chosen.transfer_functions[size_t(chosen.volumes[0].transfer_function)];
+    CHECK(mask_tf.sample(0.3f).a == 0.0f);
+    CHECK(mask_tf.sample(1.0f) == chosen.meshes[1].color);
     REQUIRE(chosen.meshes.size() == 2);
     CHECK(chosen.meshes[1].name == "Precentral_L");
     CHECK(chosen.meshes[1].color == glm::vec4(0.0f, 1.0f, 0.0f, 0.25f));

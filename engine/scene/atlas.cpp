@@ -257,6 +257,11 @@ Volume atlas_mask(const Volume& labels, const AtlasRegion& region) {
   return mask;
 }
 
+TransferFunction mask_transfer_function(const std::string& name, glm::vec4 colour) {
+  const glm::vec4 clear(glm::vec3(colour), 0.0f);
+  return {name, {}, {{0.0f, clear}, {0.4f, clear}, {0.6f, colour}, {1.0f, colour}}};
+}
+
 Mesh atlas_surface(const Volume& labels, const AtlasRegion& region, int smoothing_iterations) {
   require_label_volume(labels);
   const Grid grid = region_grid(labels, region.index);

@@ -33,6 +33,10 @@ std::string atlas_region_at(const Scene& scene, glm::vec3 world);
 // A uint8 volume on the label volume's grid: 255 inside the region, 0 outside.
 Volume atlas_mask(const Volume& labels, const AtlasRegion& region);
 
+// A mask's transfer function: transparent up to the boundary between outside (0) and inside
+// (255), `colour` inside, so the mask shows its region's shape and nothing of its box.
+TransferFunction mask_transfer_function(const std::string& name, glm::vec4 colour);
+
 // The region's boundary as a triangle mesh (marching cubes on the mask, then Taubin smoothing),
 // in world space, with per-vertex normals.
 Mesh atlas_surface(const Volume& labels, const AtlasRegion& region, int smoothing_iterations = 10);

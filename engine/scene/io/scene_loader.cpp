@@ -343,9 +343,7 @@ void SceneReader::atlas(const json& object, const Field& field) {
   int mask_tf =
       mask_tf_json ? transfer_function(*mask_tf_json, field / "mask_transfer_function") : -1;
   if (make.count("masks") && mask_tf < 0) {
-    // Masks hold 0 and 255: transparent outside, the surface colour inside.
-    scene_.transfer_functions.push_back(
-        {"atlas mask", {}, {{0.0f, glm::vec4(glm::vec3(surface), 0.0f)}, {1.0f, surface}}});
+    scene_.transfer_functions.push_back(mask_transfer_function("atlas mask", surface));
     mask_tf = int(scene_.transfer_functions.size()) - 1;
   }
 

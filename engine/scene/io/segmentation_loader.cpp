@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "engine/core/error.h"
+#include "engine/scene/atlas.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/segmentation.h"
 
@@ -116,14 +117,8 @@ void add_region(Scene& scene, const Segmentation& segmentation, const SegmentReg
     scene.labels.push_back(std::move(label));
   }
   if (entry.masks) {
-    // Transparent up to the boundary between inside (255) and outside (0), so the mask shows
-    // its region's shape and nothing of its box.
-    scene.transfer_functions.push_back({region.name,
-                                        {},
-                                        {{0.0f, glm::vec4(colour, 0.0f)},
-                                         {0.4f, glm::vec4(colour, 0.0f)},
-                                         {0.6f, glm::vec4(colour, 0.5f)},
-                                         {1.0f, glm::vec4(colour, 0.5f)}}});
+    scene.transfer_functions.push_back(
+        mask_transfer_function(region.name, glm::vec4(colour, 0.5f)));
     scene.volumes.push_back(region_mask(segmentation, region));
     scene.volumes.back().transfer_function = int(scene.transfer_functions.size()) - 1;
     scene.volumes.back().source.clear();  // (made, not read: see Scene::segmentations)
