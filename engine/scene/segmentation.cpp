@@ -347,12 +347,19 @@ RegionSummary summarise(const Segmentation& segmentation, const SegmentRegion& r
 }  // namespace
 
 std::vector<RegionSummary> summarise_regions(const Segmentation& segmentation) {
+  std::vector<size_t> all(segmentation.regions.size());
+  for (size_t r = 0; r < all.size(); ++r) all[r] = r;
+  return summarise_regions(segmentation, all);
+}
+
+std::vector<RegionSummary> summarise_regions(const Segmentation& segmentation,
+                                             const std::vector<size_t>& which) {
   const std::vector<RegionExtent> extents = region_extents(segmentation);
-  std::vector<RegionSummary> summaries(segmentation.regions.size());
+  std::vector<RegionSummary> summaries(which.size());
   std::atomic<size_t> next{0};
   const auto work = [&] {
-    for (size_t r; (r = next++) < summaries.size();)
-      summaries[r] = summarise(segmentation, segmentation.regions[r], extents[r]);
+    for (size_t i; (i = next++) < summaries.size();)
+      summaries[i] = summarise(segmentation, segmentation.regions.at(which[i]), extents[which[i]]);
   };
   const unsigned threads =
       std::clamp<unsigned>(std::thread::hardware_concurrency(), 1, unsigned(summaries.size()) + 1);

@@ -110,6 +110,8 @@ Segmentation load_slicer_segmentation(const std::filesystem::path& path,
 // (TotalSegmentator without --ml); the region is named after the file.
 Segmentation load_mask_folder(const std::filesystem::path& folder, const VolumeReadOptions& options,
                               std::vector<std::string>& warnings);
+// Whether load_mask_folder reads the file as a mask: a .nii or .nii.gz that is not hidden.
+bool is_mask_file(const std::filesystem::path& file);
 
 // A DICOM Segmentation object (a .dcm file, or a folder holding one): BINARY, FRACTIONAL
 // (inside where the value is at least half the Maximum Fractional Value) and LABELMAP. GDCM
@@ -134,6 +136,10 @@ struct RegionSummary {
 // from any voxel outside it, ties broken toward that part's centroid. Regions without voxels
 // have voxels == 0.
 std::vector<RegionSummary> summarise_regions(const Segmentation& segmentation);
+// The same for the regions `which` (indices into segmentation.regions), in that order: only
+// their anchors are computed.
+std::vector<RegionSummary> summarise_regions(const Segmentation& segmentation,
+                                             const std::vector<size_t>& which);
 
 // Whether the region holds the voxel of its layer nearest to `world`.
 bool region_contains(const Segmentation& segmentation, const SegmentRegion& region,

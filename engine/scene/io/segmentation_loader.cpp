@@ -2,51 +2,38 @@
 // masks and surfaces (add_segmentation).
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include "engine/core/error.h"
 #include "engine/scene/atlas.h"
 #include "engine/scene/io/scene_loader.h"
+#include "engine/scene/io/volume_io.h"
 #include "engine/scene/segmentation.h"
 
 namespace strata {
 namespace {
 
-std::string lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return text;
-}
-
-bool ends_with(const std::string& text, std::string_view tail) {
-  return text.size() >= tail.size() &&
-         text.compare(text.size() - tail.size(), tail.size(), tail) == 0;
-}
-
 bool is_nifti_name(const std::filesystem::path& path) {
-  const std::string name = lower(path.filename().string());
-  return ends_with(name, ".nii") || ends_with(name, ".nii.gz");
+  const std::string name = volume_io::lowercase(path.filename().string());
+  return name.ends_with(".nii") || name.ends_with(".nii.gz");
 }
 
 // A folder of NIfTI masks (TotalSegmentator) rather than a DICOM folder.
-bool holds_nifti(const std::filesystem::path& folder) {
+bool holds_masks(const std::filesystem::path& folder) {
   std::error_code error;
   for (const auto& entry : std::filesystem::directory_iterator(folder, error))
-    if (is_nifti_name(entry.path())) return true;
+    if (is_mask_file(entry.path())) return true;
   return false;
 }
 
 // A NRRD whose header has 3D Slicer's segment fields.
 bool is_slicer_segmentation(const std::filesystem::path& path) {
-  const std::string name = lower(path.filename().string());
-  if (ends_with(name, ".seg.nrrd")) return true;
-  if (!ends_with(name, ".nrrd") && !ends_with(name, ".nhdr")) return false;
-  std::ifstream in(path, std::ios::binary);
-  std::string header(64 * 1024, '\0');
-  in.read(header.data(), std::streamsize(header.size()));
-  header.resize(size_t(in.gcount()));
-  const size_t end = header.find("\n\n");
-  return header.substr(0, end).find("Segment0_") != std::string::npos;
+  const std::string name = volume_io::lowercase(path.filename().string());
+  if (name.ends_with(".seg.nrrd")) return true;
+  if (!name.ends_with(".nrrd") && !name.ends_with(".nhdr")) return false;
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return false;  // (a FIFO would block)
+  const std::string header = volume_io::read_prefix(path, 64 * 1024);
+  return header.substr(0, header.find("\n\n")).find("Segment0_") != std::string::npos;
 }
 
 // The file's own names replaced (matched by number) by the table's.
@@ -142,7 +129,7 @@ bool holds_dicom_seg(const std::filesystem::path& folder) {
 
 bool is_segmentation(const std::filesystem::path& path) {
   std::error_code error;
-  if (std::filesystem::is_directory(path, error)) return holds_nifti(path) || holds_dicom_seg(path);
+  if (std::filesystem::is_directory(path, error)) return holds_masks(path) || holds_dicom_seg(path);
   if (!std::filesystem::is_regular_file(path, error)) return false;
   if (is_slicer_segmentation(path) || is_dicom_seg(path)) return true;
   try {
@@ -160,7 +147,7 @@ Segmentation load_segmentation(const std::filesystem::path& path,
   if (!std::filesystem::exists(path, error)) throw Error(path.string() + ": no such file");
   Segmentation segmentation;
   if (std::filesystem::is_directory(path, error)) {
-    segmentation = holds_nifti(path) ? load_mask_folder(path, options, warnings)
+    segmentation = holds_masks(path) ? load_mask_folder(path, options, warnings)
                                      : load_dicom_seg(path, options, warnings);
   } else if (is_dicom_seg(path)) {
     segmentation = load_dicom_seg(path, options, warnings);
@@ -197,14 +184,14 @@ void add_segmentation(Scene& scene, const SegmentationEntry& entry,
   Segmentation segmentation = load_segmentation(entry.file, entry.names, options, scene.warnings);
   if (!scene.volumes.empty()) check_segmentation_fits(segmentation, scene.volumes.front());
   const std::vector<size_t> chosen = chosen_regions(segmentation, entry);
-  const std::vector<RegionSummary> summaries = summarise_regions(segmentation);
-  std::vector<size_t> kept;
-  for (size_t r : chosen) {
-    if (summaries[r].voxels > 0) {
-      kept.push_back(r);
+  const std::vector<RegionSummary> summaries = summarise_regions(segmentation, chosen);
+  std::vector<size_t> kept;  // indices into chosen
+  for (size_t i = 0; i < chosen.size(); ++i) {
+    if (summaries[i].voxels > 0) {
+      kept.push_back(i);
       continue;
     }
-    const SegmentRegion& region = segmentation.regions[r];
+    const SegmentRegion& region = segmentation.regions[chosen[i]];
     scene.warnings.push_back(entry.file.string() + ": region '" + region.name + "' (" +
                              std::to_string(region.number) + ") has no voxels: skipped");
   }
@@ -223,8 +210,8 @@ void add_segmentation(Scene& scene, const SegmentationEntry& entry,
                 "make surfaces");
   const std::vector<int> ids = unused_label_ids(scene.labels, entry.labels ? kept.size() : 0);
   for (size_t i = 0; i < kept.size(); ++i)
-    add_region(scene, segmentation, segmentation.regions[kept[i]], summaries[kept[i]], entry,
-               entry.labels ? ids[i] : 0);
+    add_region(scene, segmentation, segmentation.regions[chosen[kept[i]]], summaries[kept[i]],
+               entry, entry.labels ? ids[i] : 0);
   scene.segmentations.push_back(entry);
   for (size_t l = 0; l < segmentation.layers.size(); ++l) {
     SceneAtlas atlas{std::move(segmentation.layers[l]), {}};

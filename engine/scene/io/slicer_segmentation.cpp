@@ -309,12 +309,6 @@ bool ends_with(const std::string& text, std::string_view suffix) {
   return text.size() > suffix.size() && text.ends_with(suffix);
 }
 
-// A NIfTI, not a hidden file (a copy's "._spleen.nii.gz" resource fork is not a mask).
-bool is_mask_file(const fs::path& file) {
-  const std::string name = lowercase(file.filename().string());
-  return !name.starts_with('.') && (ends_with(name, ".nii.gz") || ends_with(name, ".nii"));
-}
-
 std::string mask_name(const fs::path& file) {
   const std::string name = file.filename().string();
   const size_t cut = ends_with(lowercase(name), ".nii.gz") ? 7 : 4;
@@ -404,6 +398,12 @@ std::vector<fs::path> mask_files(const fs::path& folder) {
 }
 
 }  // namespace
+
+// A NIfTI, not a hidden file (a copy's "._spleen.nii.gz" resource fork is not a mask).
+bool is_mask_file(const std::filesystem::path& file) {
+  const std::string name = lowercase(file.filename().string());
+  return !name.starts_with('.') && (ends_with(name, ".nii.gz") || ends_with(name, ".nii"));
+}
 
 Segmentation load_mask_folder(const std::filesystem::path& folder, const VolumeReadOptions& options,
                               std::vector<std::string>& warnings) {
