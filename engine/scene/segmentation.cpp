@@ -149,23 +149,16 @@ Segmentation segmentation_from_label_map(Volume label_map, const NamesTable& nam
         label_map.source.string() + ": " + std::to_string(unnamed.size()) +
         " value(s) with voxels that the names table does not name are left out: " + list);
   }
-  for (const auto& [value, entry] : named) {
-    (void)value;
-    const NamedValue& e = names.entries[size_t(entry)];
-    segmentation.regions.push_back({e.value, 0, e.value, e.name, e.colour});
-  }
   // The table's order, not the values' (a table lists its regions as its tool shows them).
-  std::stable_sort(segmentation.regions.begin(), segmentation.regions.end(),
-                   [&](const SegmentRegion& a, const SegmentRegion& b) {
-                     return named[a.value] < named[b.value];
-                   });
+  for (size_t i = 0; i < names.entries.size(); ++i) {
+    const NamedValue& e = names.entries[i];
+    if (e.value != 0 && named.at(e.value) == int(i))
+      segmentation.regions.push_back({e.value, 0, e.value, e.name, e.colour});
+  }
   segmentation.layers.push_back(std::move(layer));
   return segmentation;
 }
 
-}  // namespace strata
-
-namespace strata {
 namespace {
 
 // One region's voxels in its layer: count, bounding box (voxel indices, inclusive).
@@ -381,9 +374,6 @@ bool region_contains(const Segmentation& segmentation, const SegmentRegion& regi
   return layer_at(layer, (size_t(i.z) * layer.dims.y + i.y) * layer.dims.x + i.x) == region.value;
 }
 
-}  // namespace strata
-
-namespace strata {
 
 void check_segmentation_fits(const Segmentation& segmentation, const Volume& scan) {
   if (segmentation.layers.empty()) return;
