@@ -92,10 +92,13 @@ PlacementPlan PlacementPlan::choose(const Context& ctx, uint32_t label_count,
 
 std::vector<ComputePipeline> Placement::create_pipelines(Context& ctx, uint32_t label_count) {
   const bool large = tidy_states_in_buffer(label_count);
-  const std::array<std::string_view, 5> shaders{
-      "integral_costs.comp", "placement_bounds.comp", "place_label.comp",
+  const std::array<std::string_view, 6> shaders{
+      "integral_costs.comp",
+      "placement_bounds.comp",
+      "place_label.comp",
       large ? "placement_tidy_large.comp" : "placement_tidy.comp",
-      large ? "placement_tidy_search_large.comp" : "placement_tidy_search.comp"};
+      large ? "placement_tidy_search_large.comp" : "placement_tidy_search.comp",
+      "place_rounds.comp"};
   return create_compute_pipelines(ctx, shaders);
 }
 
@@ -106,7 +109,7 @@ std::vector<ComputePipeline> Placement::take_pipelines(uint32_t label_count) {
   if (tidy_states_in_buffer(label_count) != tidy_states_in_buffer(label_count_))
     return create_pipelines(ctx_, label_count);
   std::vector<ComputePipeline> out;
-  for (ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &tidy_, &search_})
+  for (ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &tidy_, &search_, &rounds_})
     out.push_back(std::move(*p));
   return out;
 }
@@ -122,6 +125,7 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
       place_(std::move(pipelines[2])),
       tidy_(std::move(pipelines[3])),
       search_(std::move(pipelines[4])),
+      rounds_(std::move(pipelines[5])),
       tables_(ctx),
       readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu)) {
   static_assert(LABEL_MAX == kMaxLabels, "the scene side's label limit is the placement's");
@@ -162,6 +166,8 @@ void Placement::set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_
   active_ = std::min(active.value_or(label_count_), label_count_);
   labels_ = std::move(labels);
   order_ = std::move(order);
+  ranks_.assign(label_count_, LABEL_MAX);
+  for (uint32_t s = 0; s < order_.size(); ++s) ranks_[order_[s]] = s;
   settings_ = settings;
 }
 
@@ -192,11 +198,14 @@ Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
   if (in.adjust_labels) in.adjust_labels(graph, b.labels);
   add_costs(graph, b, in);
   add_bounds(graph, b);
-  const graph::PassId loop = add_label_loop(graph, b);
+  const graph::PassId loop = settings_.method == PlacementMethod::rounds
+                                ? add_rounds(graph, b)
+                                : add_label_loop(graph, b);
   const auto loop_end = static_cast<graph::PassId>(graph.passes().size());
   add_tidy(graph, b);
-  return {b.labels,  b.placements, b.saliency,    b.costs, b.tables, b.constraints,
-          b.results, b.buckets,    b.tidy_rounds, b.order, loop,     loop_end};
+  return {b.labels,      b.placements,    b.saliency,   b.costs, b.tables, b.constraints,
+          b.results,     b.buckets,       b.tidy_rounds, b.round_counts,
+          b.round_of,    b.order,         loop,         loop_end};
 }
 
 Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
@@ -229,6 +238,13 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
   b.regions = graph.add_buffer(
       "placement.regions",
       fixed(VkDeviceSize{gpu::placement_pair_count(n)} * sizeof(gpu::PairRegionsGpu)));
+  b.ranks = graph.add_buffer("placement.ranks", fixed(n * sizeof(uint32_t)));
+  b.round_of = graph.add_buffer("placement.round_of", fixed(n * sizeof(uint32_t)));
+  b.round_list = graph.add_buffer("placement.round_list", fixed(n * sizeof(uint32_t)));
+  b.round_args =
+      graph.add_buffer("placement.round_args", fixed(ROUNDS_MAX * 3 * sizeof(uint32_t)));
+  b.round_counts =
+      graph.add_buffer("placement.round_counts", fixed((ROUNDS_MAX + 1) * sizeof(uint32_t)));
   b.readback = readback_.import(graph, "placement.readback");
   return b;
 }
@@ -245,7 +261,11 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                    {b.lower, Use::transfer_dst},
                    {b.speculative, Use::transfer_dst},
                    {b.samples, Use::transfer_dst},
-                   {b.tidy_args, Use::transfer_dst}},
+                   {b.tidy_args, Use::transfer_dst},
+                   {b.ranks, Use::transfer_dst},
+                   {b.round_of, Use::transfer_dst},
+                   {b.round_args, Use::transfer_dst},
+                   {b.round_counts, Use::transfer_dst}},
                   [this, b](graph::PassContext& pc) {
                     record_update(pc.cmd, pc.buffer(b.labels), 0, as_bytes(labels_));
                     record_update(pc.cmd, pc.buffer(b.order), 0, as_bytes(order_));
@@ -261,6 +281,18 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                     fill(b.samples, 0xFFFFFFFFu);
                     // (indirect: no round runs until the one before sizes it)
                     fill(b.tidy_args, 0);
+                    // The rounds: every label undecided; each round's search sized by its list.
+                    record_update(pc.cmd, pc.buffer(b.ranks), 0, as_bytes(ranks_));
+                    fill(b.round_of, ROUND_UNDECIDED);
+                    std::vector<uint32_t> args(ROUNDS_MAX * 3, 1u);
+                    for (uint32_t r = 0; r < ROUNDS_MAX; ++r) {
+                      args[3 * r] = round_groups(pc.viewport);
+                      args[3 * r + 1] = 0;
+                    }
+                    record_update(pc.cmd, pc.buffer(b.round_args), 0, as_bytes(args));
+                    std::vector<uint32_t> counts(ROUNDS_MAX + 1, 0u);
+                    counts[0] = uint32_t(order_.size());
+                    record_update(pc.cmd, pc.buffer(b.round_counts), 0, as_bytes(counts));
                     // (placement.regions needs none: the loop writes each pair, from the placed
                     // label's result, before a later label reads it; a label never placed
                     // writes regions that constrain nobody)
@@ -370,6 +402,69 @@ graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
   return first;
 }
 
+uint32_t Placement::round_count() const {
+  return std::min({settings_.rounds, ROUNDS_MAX, std::max(uint32_t(order_.size()), 1u)});
+}
+
+uint32_t Placement::round_groups(graph::Extent viewport) const {
+  const glm::uvec2 across = gpu::placement_tiles(viewport.width, viewport.height);
+  return std::clamp(settings_.round_tiles, 1u, across.x * across.y);
+}
+
+// The greedy placement in rounds (place_rounds.comp): mark, search, commit, each over every label
+// at once. Where the device has conditional rendering, a block of kTidyBlockRounds rounds past the
+// first runs only while some label is undecided before it.
+graph::PassId Placement::add_rounds(graph::Graph& graph, const Buffers& b) {
+  std::vector<graph::ResourceUse> uses{
+      {b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
+      {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+      {b.results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
+      {b.constraints, Use::storage_write, PLACEMENT_BINDING_CONSTRAINTS},
+      {b.buckets, Use::storage_read, PLACEMENT_BINDING_BUCKETS},
+      {b.tiles, Use::storage_read, PLACEMENT_BINDING_TILES},
+      {b.ranks, Use::storage_read, PLACEMENT_BINDING_RANKS},
+      {b.round_of, Use::storage_read_write, PLACEMENT_BINDING_ROUND_OF},
+      // (written: each round marks its list before it searches it)
+      {b.round_list, Use::storage_write, PLACEMENT_BINDING_ROUND_LIST},
+      {b.round_args, Use::storage_read_write, PLACEMENT_BINDING_ROUND_ARGS},
+      {b.round_counts, Use::storage_read_write, PLACEMENT_BINDING_ROUND_COUNTS},
+      {b.round_args, Use::indirect}};
+  const bool skip_idle = ctx_.conditional_rendering() && layout_.skip_idle_blocks;
+  if (skip_idle) uses.push_back({b.round_counts, Use::conditional});
+  return graph.add_pass(
+      {"placement.rounds", graph::PassKind::compute, std::move(uses),
+       [this, b, skip_idle](graph::PassContext& pc) {
+         if (order_.empty()) return;
+         gpu::PlacementParams p = params(pc.viewport, 0);
+         const uint32_t rounds = round_count();
+         p.label = rounds;
+         p.spec_label = round_groups(pc.viewport);
+         const uint32_t n = frame_count();
+         for (uint32_t round = 0; round < rounds; ++round) {
+           p.step = round;
+           const uint32_t block_start = round - round % kTidyBlockRounds;
+           const bool conditional = skip_idle && block_start > 0;
+           if (conditional && round == block_start) {
+             pc.barrier_for_predicates();
+             pc.begin_conditional(b.round_counts, block_start * sizeof(uint32_t));
+           } else if (round > 0) {
+             pc.barrier();
+           }
+           p.phase = ROUNDS_PHASE_MARK;
+           pc.dispatch_groups(rounds_, p, {n, 1, 1});
+           pc.barrier();
+           p.phase = ROUNDS_PHASE_EVALUATE;
+           pc.dispatch_indirect(rounds_, p, b.round_args, VkDeviceSize{round} * 3 * sizeof(uint32_t));
+           pc.barrier();
+           p.phase = ROUNDS_PHASE_COMMIT;
+           pc.dispatch_groups(rounds_, p, {n, 1, 1});
+           const bool block_ends = (round + 1) % kTidyBlockRounds == 0 || round + 1 == rounds;
+           if (conditional && block_ends) pc.end_conditional();
+         }
+       },
+       "placement"});
+}
+
 void Placement::declare_sizes(std::vector<graph::ResourceUse>& uses, ResourceId args) const {
   // (a direct plan declares none: an indirect use makes every barrier of the pass wait for
   // indirect reads too, which costs a GPU's hundreds of barriers dearly)
@@ -465,7 +560,8 @@ void Placement::record_tidy_rounds(graph::PassContext& pc, gpu::PlacementParams 
 
 std::vector<PipelineReport> Placement::pipeline_statistics() const {
   std::vector<PipelineReport> out;
-  for (const ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &tidy_, &search_}) {
+  for (const ComputePipeline* p :
+       {&integral_costs_, &bounds_, &place_, &tidy_, &search_, &rounds_}) {
     out.push_back({p->name(), p->statistics()});
   }
   return out;

@@ -24,8 +24,22 @@
 
 namespace strata {
 
+// How the greedy placement decides its labels: in parallel rounds (shared/placement_rounds.h), or
+// one after the other in insertion order (the thesis's loop, kept as the reference to compare).
+enum class PlacementMethod {
+  rounds,
+  sequential,
+};
+
 struct PlacementSettings {
-  CostWeights weights;  // eq. 3.1 (scene settings; defaults: the thesis's final paper)
+  CostWeights weights;
+  PlacementMethod method = PlacementMethod::rounds;
+  // The rounds: how many at most (the last decides every label still undecided, conflicts and
+  // all, for the tidy-up to settle), and how many of its 32x32 tiles of candidates a label
+  // searches at most: the buckets of its tile list, cheapest bound first, while they fit (bucket
+  // 0 always).
+  uint32_t rounds = 128;
+  uint32_t round_tiles = 64;  // eq. 3.1 (scene settings; defaults: the thesis's final paper)
   // Around label boxes in the constraints, in ems: label text sizes, which keep two labels apart
   // legibly at any image size (6 px at the default 14 px font).
   float margin_em = 6.0f / 14.0f;
@@ -134,6 +148,9 @@ class Placement {
     // uint per tidy-up round r: 1 for round 0, then the changes round r - 1 applied (round r runs
     // only when that is not 0; benchmark statistics)
     graph::ResourceId tidy_rounds;
+    // The rounds (PlacementMethod::rounds): uint per round r, the labels undecided before it;
+    // uint per label, the round that decided it.
+    graph::ResourceId round_counts, round_of;
     graph::ResourceId order;  // uint[]: the frame's insertion order (label indices)
     // The passes that place the labels one by one, [label_loop, label_loop_end): one, or with
     // PlacementLayout::pass_per_label pass label_loop + s records step s (place_label dispatch s:
@@ -178,6 +195,7 @@ class Placement {
     graph::ResourceId labels, order, results, placements, saliency, costs, tables, constraints;
     graph::ResourceId bounds, tiles, buckets, lower, args, speculative, samples, regions, tidy,
         tidy_rounds, tidy_args;
+    graph::ResourceId ranks, round_of, round_list, round_args, round_counts;
     graph::ResourceId readback;
   };
   Buffers add_buffers(graph::Graph& graph);
@@ -186,6 +204,10 @@ class Placement {
   void add_bounds(graph::Graph& graph, const Buffers& b);
   // The loop's first pass; its last is the graph's last.
   graph::PassId add_label_loop(graph::Graph& graph, const Buffers& b);
+  graph::PassId add_rounds(graph::Graph& graph, const Buffers& b);
+  // Rounds recorded for this frame, and the workgroups a round's search has per label.
+  uint32_t round_count() const;
+  uint32_t round_groups(graph::Extent viewport) const;
   void add_tidy(graph::Graph& graph, const Buffers& b);
   void record_tidy_rounds(graph::PassContext& pc, gpu::PlacementParams p, const Buffers& b) const;
   // The one place that tells direct and indirect dispatches apart: the use a pass declares for
@@ -209,8 +231,9 @@ class Placement {
   uint32_t layer_count_ = 1;
   std::vector<gpu::LabelGpu> labels_;
   std::vector<uint32_t> order_;
+  std::vector<uint32_t> ranks_;  // per label: its position in order_, LABEL_MAX for none
   PlacementSettings settings_;
-  ComputePipeline integral_costs_, bounds_, place_, tidy_, search_;
+  ComputePipeline integral_costs_, bounds_, place_, tidy_, search_, rounds_;
   SummedAreaTable tables_;
   graph::Readback readback_;
 };

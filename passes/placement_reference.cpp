@@ -287,6 +287,150 @@ std::vector<uint64_t> greedy_reference(ReferencePlacement& out,
 
 }  // namespace
 
+namespace gpu {
+namespace {
+
+// The rounds (shared/placement_rounds.h) as their definition reads: each round every undecided
+// label searches all of its searched tiles again against the labels decided before it (the GPU
+// searches again only where a newly decided label constrains a choice).
+struct Rounder {
+  PlacementParams params;
+  std::span<const LabelGpu> labels;
+  const std::vector<float>& tables;
+  std::vector<PairRegionsGpu> decided;  // the regions of the shown labels decided before the round
+  std::vector<vec2> anchors;            // every enabled label's anchor
+
+  uint placed_count() const { return uint(decided.size()); }
+  PairRegionsGpu placed_regions(uint k) const { return decided[k]; }
+  uint anchor_count() const { return uint(anchors.size()); }
+  vec2 anchor_at(uint k) const { return anchors[k]; }
+  float table_at(uint layer, int x, int y) const {
+    return table_value(tables, params, layer, x, y);
+  }
+
+#include "shared/placement_cost.h"
+#include "shared/placement_bound.h"
+#include "shared/placement_rounds.h"
+
+  // The tiles a label searches (placement_bounds.comp's buckets, rounds_searched_tiles).
+  std::vector<uint> searched_tiles(const LabelGpu& me, uint budget) {
+    const uvec2 across = placement_tiles(params.width, params.height);
+    const uint tiles = across.x * across.y;
+    const uint cells = (PLACEMENT_TILE / PLACEMENT_CELL) * (PLACEMENT_TILE / PLACEMENT_CELL);
+    std::vector<float> bounds(tiles, std::numeric_limits<float>::infinity());
+    float lowest = std::numeric_limits<float>::infinity();
+    for (uint t = 0; t < tiles; ++t) {
+      for (uint c = 0; c < cells; ++c) bounds[t] = std::min(bounds[t], tile_cell_bound(me, t, c));
+      lowest = std::min(lowest, bounds[t]);
+    }
+    PlacementBucketsGpu b{};
+    std::vector<uint> bucket(tiles, PLACEMENT_BUCKETS);
+    for (uint t = 0; t < tiles; ++t) {
+      if (std::isinf(bounds[t])) continue;
+      bucket[t] = params.write_constraints != 0u
+                      ? 0u
+                      : placement_bucket(bounds[t] - lowest, params.bucket_width);
+      ++b.counts[bucket[t]];
+    }
+    const uint count = rounds_searched_tiles(b, budget);
+    uint last = 0, total = 0;
+    while (total < count) total += b.counts[last++];
+    std::vector<uint> out;
+    for (uint t = 0; t < tiles; ++t) {
+      if (bucket[t] < last) out.push_back(t);
+    }
+    return out;
+  }
+
+  // The label's cheapest candidate over the tiles against the decided labels, as in the loop.
+  uint64_t cheapest(const LabelGpu& me, const std::vector<uint>& tiles) {
+    const uint tiles_x = placement_tiles(params.width, params.height).x;
+    uint64_t best = PLACEMENT_NONE;
+    for (const uint t : tiles) {
+      const uvec2 first = uvec2(t % tiles_x, t / tiles_x) * uint(PLACEMENT_TILE);
+      for (uint y = first.y; y < first.y + PLACEMENT_TILE && y < params.height; ++y) {
+        for (uint x = first.x; x < first.x + PLACEMENT_TILE && x < params.width; ++x) {
+          const uvec2 p(x, y);
+          if (!candidate_allowed(me, p)) continue;
+          const vec2 origin = box_origin(p, me.size);
+          const vec2 centre = origin + me.size * 0.5f;
+          const uint bits = constraint_bits(me, centre, 0u, std::numeric_limits<float>::infinity());
+          if (params.hard != 0u && bits != 0u) continue;
+          const float cost = candidate_cost(me, origin, centre, bits);
+          uint cost_bits;
+          std::memcpy(&cost_bits, &cost, 4);
+          best = std::min(best, (uint64_t(cost_bits) << 32) | (y * params.width + x));
+        }
+      }
+    }
+    return best;
+  }
+};
+static_assert(PlacementCostAccess<Rounder>);
+
+}  // namespace
+}  // namespace gpu
+
+bool rounds_conflict_reference(const gpu::LabelGpu& a, uint64_t ka, const gpu::LabelGpu& b,
+                               uint64_t kb, const PlacementSettings& settings, graph::Extent size) {
+  const std::vector<float> no_tables;
+  gpu::Rounder rounder{placement_params(settings, size, 1, 2, 0), {}, no_tables, {}, {}};
+  return rounder.rounds_conflict(a, ka, b, kb);
+}
+
+ReferenceRounds rounds_reference(std::span<const gpu::LabelGpu> labels,
+                                 std::span<const uint32_t> order, const std::vector<float>& tables,
+                                 const PlacementSettings& settings, graph::Extent size,
+                                 uint32_t layer_count) {
+  const auto n = uint32_t(labels.size());
+  gpu::Rounder rounder{placement_params(settings, size, layer_count, n, 0), labels, tables, {}, {}};
+  for (const gpu::LabelGpu& l : labels) {
+    if ((l.flags & LABEL_ENABLED) != 0u) rounder.anchors.push_back(l.anchor);
+  }
+  const glm::uvec2 across = gpu::placement_tiles(size.width, size.height);
+  const uint32_t budget = std::clamp(settings.round_tiles, 1u, across.x * across.y);
+  std::vector<std::vector<uint32_t>> tiles(n);
+  std::vector<uint32_t> ranks(n, LABEL_MAX);
+  for (uint32_t s = 0; s < order.size(); ++s) {
+    ranks[order[s]] = s;
+    tiles[order[s]] = rounder.searched_tiles(labels[order[s]], budget);
+  }
+  ReferenceRounds out;
+  out.results.assign(n, PLACEMENT_NONE);
+  out.round_of.assign(n, ROUND_UNDECIDED);
+  const uint32_t rounds =
+      std::min({settings.rounds, ROUNDS_MAX, std::max(uint32_t(order.size()), 1u)});
+  std::vector<uint32_t> open(order.begin(), order.end());
+  for (uint32_t r = 0; r < rounds && !open.empty(); ++r) {
+    out.undecided.push_back(uint32_t(open.size()));
+    for (const uint32_t i : open) {
+      rounder.decided.clear();
+      for (uint32_t j = 0; j < n; ++j) {
+        if (out.round_of[j] == ROUND_UNDECIDED || out.results[j] == PLACEMENT_NONE) continue;
+        rounder.decided.push_back(rounder.pair_regions(
+            labels[i], labels[j], rounder.key_placed(labels[j], out.results[j]),
+            margin_pixels(settings)));
+      }
+      out.results[i] = rounder.cheapest(labels[i], tiles[i]);
+    }
+    std::vector<uint32_t> waiting;
+    for (const uint32_t i : open) {
+      bool conflict = false;
+      for (const uint32_t j : open) {
+        conflict = conflict || (ranks[j] < ranks[i] &&
+                                rounder.rounds_conflict(labels[i], out.results[i], labels[j],
+                                                        out.results[j]));
+      }
+      if (conflict && r + 1 < rounds) waiting.push_back(i);
+    }
+    for (const uint32_t i : open) {
+      if (std::find(waiting.begin(), waiting.end(), i) == waiting.end()) out.round_of[i] = r;
+    }
+    open = std::move(waiting);
+  }
+  return out;
+}
+
 ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
                                    std::span<const glm::vec4> layers, uint32_t layer_count,
                                    std::span<const gpu::LabelGpu> labels,
@@ -303,8 +447,15 @@ ReferencePlacement place_reference(std::span<const uint8_t> final_rgba8,
         summed_area_table_reference(std::span(out.costs).subspan(l * pixels, pixels), w, h);
     for (size_t p = 0; p < pixels; ++p) out.tables[l * pixels + p] = float(table[p]);
   }
-  const std::vector<uint64_t> results =
-      greedy_reference(out, labels, order, settings, size, layer_count);
+  std::vector<uint64_t> results;
+  if (settings.method == PlacementMethod::rounds) {
+    ReferenceRounds rounds = rounds_reference(labels, order, out.tables, settings, size, layer_count);
+    results = std::move(rounds.results);
+    out.round_of = std::move(rounds.round_of);
+    out.undecided = std::move(rounds.undecided);
+  } else {
+    results = greedy_reference(out, labels, order, settings, size, layer_count);
+  }
   out.placements = tidy_reference(labels, order, results, out.tables, settings, size, layer_count);
   return out;
 }

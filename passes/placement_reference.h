@@ -17,7 +17,26 @@ struct ReferencePlacement {
   std::vector<float> tables;    // their summed-area tables
   std::vector<uint32_t> constraints;          // bits of the last label placed, per pixel
   std::vector<gpu::PlacementGpu> placements;  // per label
+  // PlacementMethod::rounds: the round that decided each label, and per round the labels
+  // undecided before it.
+  std::vector<uint32_t> round_of, undecided;
 };
+
+// The greedy placement in rounds (shaders/shared/placement_rounds.h) over the placement's
+// `tables`: per label its result (cost bits << 32 | pixel) and round, per round the labels
+// undecided before it.
+struct ReferenceRounds {
+  std::vector<uint64_t> results;
+  std::vector<uint32_t> round_of, undecided;
+};
+// Whether labels a and b, at result keys ka and kb, constrain each other (rounds_conflict).
+bool rounds_conflict_reference(const gpu::LabelGpu& a, uint64_t ka, const gpu::LabelGpu& b,
+                               uint64_t kb, const PlacementSettings& settings, graph::Extent size);
+
+ReferenceRounds rounds_reference(std::span<const gpu::LabelGpu> labels,
+                                 std::span<const uint32_t> order, const std::vector<float>& tables,
+                                 const PlacementSettings& settings, graph::Extent size,
+                                 uint32_t layer_count);
 
 // The placement tidy-up pass: the greedy loop's results (cost bits << 32 | pixel per label)
 // after the tidy-up (shaders/shared/tidy.h) over the placement's `tables`.

@@ -115,6 +115,7 @@ float cost_of(uint64_t key) {
 #include "place_label_tile.glsl"
 #include "place_label_classify.glsl"
 #include "place_label_evaluate.glsl"
+#include "place_label_pass.glsl"
 #include "place_label_regions.glsl"
 #include "place_label_finish.glsl"
 

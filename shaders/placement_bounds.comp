@@ -26,58 +26,15 @@ float table_at(uint layer, int x, int y) {
   return tables[layer * params.width * params.height + uint(y) * params.width + uint(x)];
 }
 
-// Candidates p of the tile may hold the label when its box [p - floor(size / 2), + size) lies on
-// screen (internal labels: only the anchor's pixel).
-bool has_candidates(LabelGpu me, uvec2 first, uvec2 last) {
-  if ((me.flags & LABEL_INTERNAL) != 0u) {
-    const uvec2 a = uvec2(me.anchor);
-    return all(greaterThanEqual(a, first)) && all(lessThanEqual(a, last));
-  }
-  const vec2 half_size = floor(me.size * 0.5);
-  const vec2 lo = max(vec2(first), half_size);
-  const vec2 hi = min(vec2(last), vec2(params.width, params.height) - me.size + half_size);
-  return all(lessThanEqual(lo, hi));
-}
-
-// Eq. 3.1 over the candidates first..last (pixels) is at least: the distance terms at their
-// nearest box centre, direction 1, no constraints, and the integral costs over the part all their
-// boxes share (costs are >= 0). The table's float sums of two boxes may differ from their true
-// order by a few ulps of the table's largest value, so that much is taken off the shared part;
-// the rest is scaled by 0.9999 against rounding in the candidates' own sums. Internal labels have
-// one candidate: 0.
-float cell_bound(LabelGpu me, uvec2 first, uvec2 last) {
-  if (!has_candidates(me, first, last)) return INFINITY;
-  if ((me.flags & LABEL_INTERNAL) != 0u) return 0.0;
-  const CostWeightsGpu w = params.weights;
-  const vec2 lo_centre = box_origin(first, me.size) + me.size * 0.5;
-  const vec2 hi_centre = box_origin(last, me.size) + me.size * 0.5;
-  const vec2 to_anchor = max(max(lo_centre - me.anchor, me.anchor - hi_centre), vec2(0.0));
-  const vec2 to_previous = max(max(lo_centre - me.previous, me.previous - hi_centre), vec2(0.0));
-  // The hold is added unless the held position is one of the cell's candidates' centres.
-  const vec2 to_held = max(max(lo_centre - me.held, me.held - hi_centre), vec2(0.0));
-  const float hold = any(greaterThan(to_held, vec2(0.5))) ? me.hold : 0.0;
-  float bound = 0.9999 * (w.distance_to_anchor * length(to_anchor) + w.connector_direction +
-                          w.previous_position * length(to_previous) + hold);
-  const vec2 shared_lo = max(box_origin(last, me.size), vec2(0.0));
-  const vec2 shared_hi = min(box_origin(first, me.size) + me.size, vec2(params.width, params.height));
-  if (all(lessThan(shared_lo, shared_hi))) {
-    const ivec2 a = ivec2(shared_lo), b = ivec2(shared_hi) - 1;
-    const float sum = table_at(me.layer, b.x, b.y) - table_at(me.layer, a.x - 1, b.y) -
-                      table_at(me.layer, b.x, a.y - 1) + table_at(me.layer, a.x - 1, a.y - 1);
-    const float slack = 1e-4 * table_at(me.layer, int(params.width) - 1, int(params.height) - 1);
-    bound += w.integral_costs * max(sum - slack, 0.0);
-  }
-  return bound;
-}
+#include "shared/placement_bound.h"
 
 uint tile_count() {
   const uvec2 tiles = placement_tiles(params.width, params.height);
   return tiles.x * tiles.y;
 }
 
-// A tile's bound: the lowest of its cells' of 4 x 4 candidates (the integral part needs cells
-// smaller than the label boxes: what all boxes of a whole tile share is often nothing). A
-// workgroup takes PLACEMENT_BOUNDS_TILES tiles of one label, an invocation a cell.
+// A tile's bound: the lowest of its cells' (tile_cell_bound). A workgroup takes
+// PLACEMENT_BOUNDS_TILES tiles of one label, an invocation a cell.
 shared uint tile_lowest[PLACEMENT_BOUNDS_TILES];
 void tile_bounds(uint group, uint s) {
   const uint cells = (PLACEMENT_TILE / PLACEMENT_CELL) * (PLACEMENT_TILE / PLACEMENT_CELL);
@@ -86,15 +43,8 @@ void tile_bounds(uint group, uint s) {
   if (c == 0u) tile_lowest[local_tile] = floatBitsToUint(INFINITY);
   barrier();
   const bool in_range = tile < tile_count();
-  const uint tiles_x = placement_tiles(params.width, params.height).x;
-  const uint cells_x = PLACEMENT_TILE / PLACEMENT_CELL;
   const LabelGpu me = labels[order[s]];
-  float bound = INFINITY;
-  if (in_range) {
-    const uvec2 first = uvec2(tile % tiles_x, tile / tiles_x) * PLACEMENT_TILE +
-                        uvec2(c % cells_x, c / cells_x) * PLACEMENT_CELL;
-    bound = cell_bound(me, first, first + uvec2(PLACEMENT_CELL - 1u));
-  }
+  const float bound = in_range ? tile_cell_bound(me, tile, c) : INFINITY;
   atomicMin(tile_lowest[local_tile], floatBitsToUint(bound));  // bounds >= 0: bits order too
   barrier();
   if (in_range && c == 0u) {

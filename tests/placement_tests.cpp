@@ -85,6 +85,9 @@ struct GpuPlacement {
   std::vector<gpu::PlacementGpu> placements;
   std::vector<gpu::PlacementBucketsGpu> buckets;  // per order position (and one more)
   std::vector<uint32_t> tidy_rounds;  // per tidy-up round: changes the round before applied
+  std::vector<uint64_t> results;      // per label: the greedy placement's (cost, pixel)
+  std::vector<uint32_t> round_of;     // per label: the round that decided it
+  std::vector<uint32_t> round_counts;  // per round: labels undecided before it
 };
 
 template <typename T>
@@ -144,6 +147,9 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
   out.constraints = as<uint32_t>(runner.download_buffer(r.constraints));
   out.buckets = as<gpu::PlacementBucketsGpu>(runner.download_buffer(r.buckets));
   out.tidy_rounds = as<uint32_t>(runner.download_buffer(r.tidy_rounds));
+  out.results = as<uint64_t>(runner.download_buffer(r.results));
+  out.round_of = as<uint32_t>(runner.download_buffer(r.round_of));
+  out.round_counts = as<uint32_t>(runner.download_buffer(r.round_counts));
   const auto results = placement.results();
   out.placements.assign(results.begin(), results.end());
   return out;
@@ -237,6 +243,19 @@ Inputs crowded_scene(graph::Extent size, float margin, uint32_t count, glm::vec2
 }  // namespace
 
 TEST_SUITE("cpu") {
+  // The conflict test itself: two labels whose boxes overlap conflict, one far away does not.
+  TEST_CASE("labels_whose_boxes_or_leaders_touch_conflict_in_a_round") {
+    const graph::Extent size{64, 64};
+    const PlacementSettings settings;
+    const auto key = [&](glm::uvec2 p) { return uint64_t(p.y * size.width + p.x); };
+    const gpu::LabelGpu a = label({10, 10}, {12, 6}, 0), b = label({30, 10}, {12, 6}, 0);
+    CHECK(rounds_conflict_reference(a, key({20, 20}), b, key({22, 22}), settings, size));
+    CHECK_FALSE(rounds_conflict_reference(a, key({8, 30}), b, key({40, 30}), settings, size));
+    // b's leader from (30, 10) down to (8, 40) passes a's box at (14, 30)
+    CHECK(rounds_conflict_reference(a, key({16, 30}), b, key({8, 45}), settings, size));
+    CHECK_FALSE(rounds_conflict_reference(a, PLACEMENT_NONE, b, key({22, 22}), settings, size));
+  }
+
   // Past 256 labels a round of the tidy-up weighs every conflicted label's moves and every
   // crossing pair against all labels: the rounds asked for are capped, 64 (256 / n)^2 at most
   // and at least one, so a frame of 4096 labels ends; up to 256 labels, as asked.
@@ -441,7 +460,9 @@ TEST_SUITE("gpu") {
     for (uint32_t count : {3u, 6u}) {
       CAPTURE(count);
       const Inputs in = disc_scene(count);
+      // (the constraint image is the sequential loop's: the last label's constraints)
       PlacementSettings settings;
+      settings.method = PlacementMethod::sequential;
       settings.write_constraints = true;
       const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
       const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
@@ -453,7 +474,8 @@ TEST_SUITE("gpu") {
       check_placements(gpu, cpu);
       // Without the constraint image, tiles that cannot beat the best cost so far are skipped:
       // the positions must not change.
-      check_placements(place_on_gpu(ctx, in, {}), cpu);
+      settings.write_constraints = false;
+      check_placements(place_on_gpu(ctx, in, settings), cpu);
       size_t shown = 0;
       for (const auto& p : gpu.placements) shown += p.shown == PLACEMENT_SHOWN;
       CHECK(shown == count);
@@ -602,6 +624,55 @@ TEST_SUITE("gpu") {
     const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                    in.labels, in.order, {}, in.size);
     check_placements_across(ctx, in, cpu, {0.01f, 1.0f, 1e9f});
+  }
+
+  // The rounds on a crowded scene: the GPU's choices, the round each label was decided in and
+  // the labels undecided before each round are the reference's exactly, over the same tables (the reference searches
+  // every undecided label again each round, the GPU only those a newly decided label
+  // constrains); no two labels decided in one round constrain each other, but for the last
+  // round, which decides all that are left.
+  TEST_CASE_FIXTURE(test::GpuTest, "rounds_match_the_reference_and_commit_no_conflicting_pair") {
+    Inputs in = disc_scene(0, 2.0f);
+    for (uint32_t i = 0; i < 40; ++i) {
+      const glm::vec2 anchor(float(60 + (i * 37) % 72), float(40 + (i * 23) % 64));
+      in.labels.push_back(label(anchor, {float(14 + 2 * (i % 5)), 8.0f}, i % 2));
+      in.order.push_back((i * 7) % 40);
+    }
+    for (const uint32_t rounds : {128u, 3u}) {
+      for (const bool hard : {false, true}) {
+        CAPTURE(rounds);
+        CAPTURE(hard);
+        PlacementSettings settings;
+        settings.tidy_rounds = 0;
+        settings.rounds = rounds;
+        settings.hard = hard;
+        const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
+        // (over the GPU's tables: its costs are then the same floats)
+        const ReferenceRounds cpu = rounds_reference(in.labels, in.order, gpu.tables, settings,
+                                                     in.size, in.layer_count);
+        const auto n = uint32_t(in.labels.size());
+        CHECK(std::vector(gpu.results.begin(), gpu.results.begin() + n) == cpu.results);
+        CHECK(std::vector(gpu.round_of.begin(), gpu.round_of.begin() + n) == cpu.round_of);
+        const auto used = uint32_t(cpu.undecided.size());
+        CHECK(std::vector(gpu.round_counts.begin(), gpu.round_counts.begin() + used) ==
+              cpu.undecided);
+        CHECK(gpu.round_counts[used] == 0u);
+        MESSAGE(used << " rounds");
+        CHECK(used >= 3u);  // (crowded: labels wait for others)
+        size_t pairs = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+          for (uint32_t j = i + 1; j < n; ++j) {
+            if (gpu.round_of[i] != gpu.round_of[j] || gpu.round_of[i] + 1 == rounds) continue;
+            ++pairs;
+            CAPTURE(i);
+            CAPTURE(j);
+            CHECK_FALSE(rounds_conflict_reference(in.labels[i], gpu.results[i], in.labels[j],
+                                                  gpu.results[j], settings, in.size));
+          }
+        }
+        CHECK(pairs > 10);
+      }
+    }
   }
 
   // More labels than a workgroup culls at once (256) and than the tidy-up keeps in shared memory:

@@ -59,6 +59,11 @@
 #define PLACEMENT_BINDING_TIDY 18         // TidyGpu per label: the tidy-up's state
 #define PLACEMENT_BINDING_TIDY_ROUNDS 19  // uint per tidy-up round + 1: changes applied before it
 #define PLACEMENT_BINDING_TIDY_ARGS 20    // uint[3] per tidy-up round and step: its workgroups
+#define PLACEMENT_BINDING_RANKS 21        // uint per label: its order position (LABEL_MAX: none)
+#define PLACEMENT_BINDING_ROUND_OF 22     // uint per label: the round it was decided in
+#define PLACEMENT_BINDING_ROUND_LIST 23   // uint[]: the labels a round searches again
+#define PLACEMENT_BINDING_ROUND_ARGS 24   // uint[3] per round: its search's workgroups
+#define PLACEMENT_BINDING_ROUND_COUNTS 25  // uint per round + 1: labels undecided before it
 
 // PlacementParams.phase of placement_tidy.comp: the tidy-up's start, the four steps of each
 // round (params.step), and the placements' output. The changes a round applies are taken up by
@@ -100,6 +105,14 @@
 #define PLACEMENT_PHASE_BOUNDS 0u  // placement_bounds.comp: tile bounds and each label's lowest
 #define PLACEMENT_PHASE_COUNT 1u   // ... tiles per bucket
 #define PLACEMENT_PHASE_SORT 2u    // ... tiles sorted by bucket, the first dispatch's size
+
+// PlacementParams.phase of place_rounds.comp.
+#define ROUNDS_PHASE_MARK 0u      // per undecided label: search again? (the round's list)
+#define ROUNDS_PHASE_EVALUATE 1u  // per listed label and searched tile: its cheapest candidate
+#define ROUNDS_PHASE_COMMIT 2u    // per undecided label: commit, unless an earlier one conflicts
+#define ROUNDS_STEPS 3u           // dispatches per round
+#define ROUNDS_MAX 256u           // rounds at most (PlacementSettings::rounds)
+#define ROUND_UNDECIDED 0xFFFFFFFFu  // a label's round while it has none
 
 // The tidy-up after the greedy placement (shared/tidy.h).
 #define TIDY_SUBPIXEL 64.0f
