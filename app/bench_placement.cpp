@@ -46,6 +46,7 @@ struct PlacementBenchOptions {
   bool no_baseline = false;  // skip the readback-per-label baseline (slow with many labels)
   uint32_t runs = 50;
   std::optional<float> ghost;  // ghosting's strength; none: the scene's settings.ghost
+  PlacementMethod greedy = PlacementMethod::rounds;
 };
 
 // --labels: "100" or "10,50,100", each 0 (the scene's own labels) to kMaxLabels.
@@ -77,6 +78,7 @@ struct PlacementRun {
   std::optional<double> baseline_loop_ms;  // the label loop with a readback after every label
   double first_tiles = 0.0, rest_tiles = 0.0;
   uint32_t tidy_rounds = 0, tidy_rounds_run = 0;  // asked (after the cap), and that ran
+  uint32_t greedy_rounds = 0;  // rounds of the greedy placement that decided labels (rounds only)
   ordered_json pipelines;
 
   // The stages before the loop (per-pass stamps) plus the loop with a readback per label.
@@ -157,8 +159,21 @@ uint32_t tidy_rounds_run(LabelledRenderer& frame, uint32_t rounds) {
   return run;
 }
 
-LabellingSettings labelling_settings(const Scene& scene) {
+// How many of the greedy placement's rounds decided labels in the last frame (0: sequential).
+uint32_t greedy_rounds_run(LabelledRenderer& frame) {
+  if (frame.settings().placement.method != PlacementMethod::rounds) return 0;
+  graph::GraphRunner& runner = frame.runner();
+  const std::vector<std::byte> bytes = runner.download_buffer(frame.placement().round_counts);
+  std::vector<uint32_t> undecided(bytes.size() / sizeof(uint32_t));
+  std::memcpy(undecided.data(), bytes.data(), undecided.size() * sizeof(uint32_t));
+  uint32_t run = 0;
+  for (const uint32_t count : undecided) run += count != 0;
+  return run;
+}
+
+LabellingSettings labelling_settings(const Scene& scene, PlacementMethod greedy) {
   LabellingSettings settings;
+  settings.placement.method = greedy;
   settings.placement.weights = scene.settings.weights;
   settings.ghost.strength = scene.settings.ghost;
   settings.ghost.radius = scene.settings.ghost_radius;
@@ -166,8 +181,8 @@ LabellingSettings labelling_settings(const Scene& scene) {
 }
 
 PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& camera,
-                               graph::Extent size, uint32_t runs) {
-  const LabellingSettings settings = labelling_settings(scene);
+                               graph::Extent size, uint32_t runs, PlacementMethod greedy) {
+  const LabellingSettings settings = labelling_settings(scene, greedy);
   LabelledRenderer frame(ctx, scene, camera, size, settings);
   frame.run();  // warm up, and grow the HA-Buffer if it must
   graph::GraphRunner& runner = frame.runner();
@@ -192,6 +207,7 @@ PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& c
   r.tidy_rounds =
       placement_params(settings.placement, size, 1, uint32_t(scene.labels.size()), 0).tidy_rounds;
   r.tidy_rounds_run = tidy_rounds_run(frame, r.tidy_rounds);
+  r.greedy_rounds = greedy_rounds_run(frame);
   const LabelledFrame last = frame.result(false);
   r.labels = uint32_t(scene.labels.size());
   for (const LabelLayout& l : last.labels) r.labels_shown += l.placed;
@@ -217,7 +233,10 @@ ordered_json placement_results(const PlacementRun& r) {
           {"tiles_per_label_speculative", r.first_tiles},
           {"tiles_per_label_main_beyond_speculative", r.rest_tiles},
           {"tidy_rounds", r.tidy_rounds},
-          {"tidy_rounds_run", r.tidy_rounds_run}};
+          {"tidy_rounds_run", r.tidy_rounds_run},
+          {"greedy_rounds", r.greedy_rounds},
+          {"greedy_ms_per_round",
+           r.greedy_rounds ? ordered_json(ms_json(r.loop_ms / r.greedy_rounds)) : ordered_json(nullptr)}};
 }
 
 // The label loop's time per label asked for, in µs: how the loop's chain of dispatches grows.
@@ -245,9 +264,9 @@ ordered_json sweep_entry(const PlacementRun& r) {
 // a while): the whole placement, then its parts from the run with a stamp around every pass.
 void print_placement_row(const PlacementRun* r) {
   if (!r) {
-    std::fprintf(stderr, "%6s %6s %12s %10s %9s %12s %9s %9s %9s %12s\n", "labels", "shown",
-                 "placement", "loop", "us/label", "tidy-up", "rounds", "rest", "forces",
-                 "baseline");
+    std::fprintf(stderr, "%6s %6s %12s %10s %7s %9s %12s %9s %9s %9s %12s\n", "labels", "shown",
+                 "placement", "greedy", "rounds", "us/label", "tidy-up", "rounds", "rest",
+                 "forces", "baseline");
     return;
   }
   const std::optional<double> baseline = r->baseline_ms();
@@ -255,8 +274,9 @@ void print_placement_row(const PlacementRun* r) {
   if (baseline) std::snprintf(base, sizeof base, "%.3f", *baseline);
   char rounds[32];  // (tidy-up rounds that ran of those asked)
   std::snprintf(rounds, sizeof rounds, "%u/%u", r->tidy_rounds_run, r->tidy_rounds);
-  std::fprintf(stderr, "%6u %6u %12.3f %10.3f %9.2f %12.3f %9s %9.3f %9.4f %12s   (ms)\n",
-               r->labels, r->labels_shown, r->whole_ms, r->loop_ms, loop_us_per_label(*r),
+  std::fprintf(stderr, "%6u %6u %12.3f %10.3f %7u %9.2f %12.3f %9s %9.3f %9.4f %12s   (ms)\n",
+               r->labels, r->labels_shown, r->whole_ms, r->loop_ms, r->greedy_rounds,
+               loop_us_per_label(*r),
                r->tidy_ms, rounds, r->stamped_ms - r->loop_ms - r->tidy_ms, r->forces_ms, base);
 }
 
@@ -278,16 +298,19 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
   print_placement_row(nullptr);
   for (std::vector<Label>& these : labels) {
     scene.labels = std::move(these);
-    measured.push_back(measure_placement(ctx, scene, camera, size, o.runs));
+    measured.push_back(measure_placement(ctx, scene, camera, size, o.runs, o.greedy));
     if (!o.no_baseline) {
+      // (the sequential loop's, the thesis program's structure)
       measured.back().baseline_loop_ms = label_loop_with_readback_per_label(
-          ctx, scene, camera, size, labelling_settings(scene), o.runs);
+          ctx, scene, camera, size, labelling_settings(scene, PlacementMethod::sequential),
+          o.runs);
     }
     print_placement_row(&measured.back());
   }
   if (counts.size() == 1) {
     const PlacementRun& r = measured.front();
     const ordered_json setup = {{"benchmark", "placement"}, {"scene", scene_file},
+                                {"greedy", o.greedy == PlacementMethod::rounds ? "rounds" : "sequential"},
                                 {"width", size.width},      {"height", size.height},
                                 {"labels", r.labels},       {"labels_shown", r.labels_shown},
                                 {"layers", r.layers},       {"ghost", scene.settings.ghost}};
@@ -302,6 +325,7 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
                          {"driver", ctx.report().driver},
                          {"benchmark", "placement"},
                          {"scene", scene_file},
+                         {"greedy", o.greedy == PlacementMethod::rounds ? "rounds" : "sequential"},
                          {"ghost", scene.settings.ghost},
                          {"width", size.width},
                          {"height", size.height},
@@ -331,6 +355,7 @@ void add_placement_bench(CLI::App* bench_cmd, DeviceOptions& device) {
       ->add_option("--ghost", place->ghost,
                    "ghosting's strength, 0 (off) to 1 (default: the scene's settings.ghost)")
       ->check(finite_range(0.0, 1.0));
+  add_greedy_option(place_cmd, place->greedy);
   place_cmd->add_flag("--no-baseline", place->no_baseline,
                       "skip the baseline with a readback after every label (slow with many)");
   place_cmd->add_option("--runs", place->runs, "timed runs after 3 warm-up runs")

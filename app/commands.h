@@ -15,7 +15,8 @@
 #include "engine/scene/scene.h"
 
 namespace strata {
-struct Ghosting;  // frame/labelled_render.h
+struct Ghosting;                // frame/labelled_render.h
+enum class PlacementMethod;     // passes/placement.h
 }
 
 namespace strata::app {
@@ -109,6 +110,8 @@ void add_label_look_options(CLI::App* cmd, LabelLookOptions& o);
 void add_tidy_rounds_option(CLI::App* cmd, uint32_t& rounds, const char* when);
 // --hard (render, video): hard constraints.
 void add_hard_option(CLI::App* cmd, bool& hard);
+// --greedy (render, video, bench placement): the greedy placement in rounds or one by one.
+void add_greedy_option(CLI::App* cmd, PlacementMethod& method);
 // The ghosting asked for: the options, else the scene's settings.
 Ghosting look_ghosting(const LabelLookOptions& o, const Scene& scene);
 

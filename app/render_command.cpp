@@ -28,6 +28,7 @@ struct RenderOptions {
   uint32_t blur = 12;
   bool no_labels = false;
   bool hard = false;
+  PlacementMethod greedy = PlacementMethod::rounds;
   bool internal = false;
   LabelLookOptions look;
   bool decoret = false;
@@ -113,6 +114,7 @@ LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene)
   settings.render = render_settings(o, scene);
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
+  settings.placement.method = o.greedy;
   settings.placement.tidy_rounds = o.tidy_rounds;
   settings.internal = o.internal;
   settings.label_scale = o.look.label_scale;
@@ -276,6 +278,7 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--no-skipping", o->no_skipping, "turn empty-space skipping off");
   cmd->add_flag("--no-labels", o->no_labels, "render the scene without its labels");
   add_hard_option(cmd, o->hard);
+  add_greedy_option(cmd, o->greedy);
   cmd->add_flag("--internal", o->internal, "internal labelling: labels drawn on their anchors");
   add_label_look_options(cmd, o->look);
   cmd->add_option("--order", o->order,

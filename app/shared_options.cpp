@@ -2,6 +2,7 @@
 // queue), and the checks that run over a whole command's options.
 #include <algorithm>
 #include <cstdlib>
+#include <map>
 #include <string>
 
 #include "app/commands.h"
@@ -73,6 +74,16 @@ void add_tidy_rounds_option(CLI::App* cmd, uint32_t& rounds, const char* when) {
 
 void add_hard_option(CLI::App* cmd, bool& hard) {
   cmd->add_flag("--hard", hard, "hard constraints: a label with no allowed position is hidden");
+}
+
+void add_greedy_option(CLI::App* cmd, PlacementMethod& method) {
+  static const std::map<std::string, PlacementMethod> names{
+      {"rounds", PlacementMethod::rounds}, {"sequential", PlacementMethod::sequential}};
+  cmd->add_option("--greedy", method,
+                  "how the greedy placement decides the labels: rounds (in parallel rounds) or "
+                  "sequential (one by one in insertion order, the thesis's loop)")
+      ->transform(CLI::CheckedTransformer(names, CLI::ignore_case))
+      ->default_str("rounds");
 }
 
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {

@@ -42,6 +42,7 @@ struct VideoOptions {
   bool screen_space = false;
   bool no_forces = false;
   bool hard = false;
+  PlacementMethod greedy = PlacementMethod::rounds;
   bool plan = true;  // --plan: the labels' ranges planned over the whole path first
   LabelLookOptions look;
   ForceSettings forces;
@@ -98,6 +99,7 @@ LabellingSettings labelling_settings(const Scene& scene, const VideoOptions& o) 
   settings.layer_count = o.scene.layer_count(scene);
   settings.placement.weights = scene.settings.weights;
   settings.placement.hard = o.hard;
+  settings.placement.method = o.greedy;
   settings.placement.tidy_rounds = o.tidy_rounds;
   settings.label_scale = o.look.label_scale;
   settings.layer_colors = o.look.layer_colors;
@@ -359,6 +361,7 @@ void add_placement_options(CLI::App* cmd, const std::shared_ptr<VideoOptions>& o
          "(one steady range per stretch in view); off: every frame placed as the viewer would")
       ->default_str("on");
   add_hard_option(cmd, o->hard);
+  add_greedy_option(cmd, o->greedy);
   add_label_look_options(cmd, o->look);
 }
 

@@ -494,7 +494,14 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
   if (moving && camera_moved_ && settings_.forces.keep_apart) settings.edge_em = settings.margin_em;
   std::vector<uint32_t> order = insertion_order(labels_, layering_, within, priorities_);
   std::erase_if(order, [this](uint32_t i) { return i < withheld_.size() && withheld_[i]; });
-  parts_->placement.set_frame(slot_labels(), slots_.to_slots(order), settings, slots_.used());
+  // (the rounds decide a priority's labels only once every higher priority's are decided)
+  std::vector<uint32_t> group_first(order.size(), 0);
+  const auto priority = [this](uint32_t i) { return i < priorities_.size() ? priorities_[i] : 0.0f; };
+  for (uint32_t s = 1; s < order.size(); ++s) {
+    group_first[s] = priority(order[s]) == priority(order[s - 1]) ? group_first[s - 1] : s;
+  }
+  parts_->placement.set_frame(slot_labels(), slots_.to_slots(order), settings, slots_.used(),
+                              group_first);
   parts_->forces.set_active(slots_.used());
   parts_->drawing->set_layer_frames(settings_.layer_colors);
   const GhostSettings ghost{settings_.ghost.strength, settings_.ghost.radius * side,

@@ -37,6 +37,16 @@ uint32_t tidy_rounds_for(uint32_t asked, uint32_t labels) {
 }
 }  // namespace
 
+std::vector<uint32_t> rounds_ranks(uint32_t label_count, std::span<const uint32_t> order,
+                                   std::span<const uint32_t> group_first) {
+  std::vector<uint32_t> ranks(label_count, ROUNDS_NO_RANK);
+  for (uint32_t s = 0; s < order.size(); ++s) {
+    const uint32_t first = s < group_first.size() ? std::min(group_first[s], s) : 0u;
+    ranks[order[s]] = s | first << 16u;
+  }
+  return ranks;
+}
+
 gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent viewport,
                                       uint32_t layer_count, uint32_t label_count, uint32_t step) {
   gpu::PlacementParams p{};
@@ -158,7 +168,8 @@ uint32_t Placement::classify_tiles(graph::Extent viewport) const {
 }
 
 void Placement::set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_t> order,
-                          const PlacementSettings& settings, std::optional<uint32_t> active) {
+                          const PlacementSettings& settings, std::optional<uint32_t> active,
+                          std::span<const uint32_t> group_first) {
   if (labels.size() != label_count_ || order.size() > label_count_) {
     throw Error("placement: set_frame got " + std::to_string(labels.size()) + " labels and " +
                 std::to_string(order.size()) + " in the order for " + std::to_string(label_count_));
@@ -166,8 +177,7 @@ void Placement::set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_
   active_ = std::min(active.value_or(label_count_), label_count_);
   labels_ = std::move(labels);
   order_ = std::move(order);
-  ranks_.assign(label_count_, LABEL_MAX);
-  for (uint32_t s = 0; s < order_.size(); ++s) ranks_[order_[s]] = s;
+  ranks_ = rounds_ranks(label_count_, order_, group_first);
   settings_ = settings;
 }
 

@@ -59,7 +59,8 @@ struct PlacementSettings {
   // in the lenses of the rear labels count as legible where the opened layers let them through.
   float ghost_strength = 0.0f;
   float ghost_radius = 0.0f;
-  bool write_constraints = false;  // keep each label's constraint image (tests, debugging)
+  // Keep each label's constraint image (tests, debugging; the sequential loop only).
+  bool write_constraints = false;
   // Cost above a label's lowest tile bound that its speculative pass covers (speed only:
   // the positions do not depend on it).
   float bucket_width = 0.0625f;
@@ -68,6 +69,11 @@ struct PlacementSettings {
   // and overlaps counted); 0: none. Hard mode has none: its layouts have no conflicts.
   uint32_t tidy_rounds = 64;
 };
+
+// Per label of `label_count`: its position in `order` | the first position of its priority
+// (`group_first`, per position; empty: 0) << 16; all bits for a label not in the order.
+std::vector<uint32_t> rounds_ranks(uint32_t label_count, std::span<const uint32_t> order,
+                                   std::span<const uint32_t> group_first = {});
 
 // The margin in pixels.
 inline float margin_pixels(const PlacementSettings& s) {
@@ -176,9 +182,12 @@ class Placement {
 
   // This frame's labels (label_count of them; disabled ones are skipped) and insertion order
   // (indices of the enabled labels). Read when the frame is recorded. Labels from `active` on
-  // are all disabled (spare label slots): the placement's work leaves them out.
+  // are all disabled (spare label slots): the placement's work leaves them out. `group_first`:
+  // per order position, the first position of its priority (the rounds decide none of a
+  // priority's labels while a label of a higher one is undecided); empty: one priority.
   void set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_t> order,
-                 const PlacementSettings& settings, std::optional<uint32_t> active = {});
+                 const PlacementSettings& settings, std::optional<uint32_t> active = {},
+                 std::span<const uint32_t> group_first = {});
 
   // Labels in this frame's insertion order.
   uint32_t order_count() const { return uint32_t(order_.size()); }
@@ -231,7 +240,9 @@ class Placement {
   uint32_t layer_count_ = 1;
   std::vector<gpu::LabelGpu> labels_;
   std::vector<uint32_t> order_;
-  std::vector<uint32_t> ranks_;  // per label: its position in order_, LABEL_MAX for none
+  // per label: its position in order_ | the first position of its priority << 16; all bits for
+  // none (rounds_rank, rounds_group_first)
+  std::vector<uint32_t> ranks_;
   PlacementSettings settings_;
   ComputePipeline integral_costs_, bounds_, place_, tidy_, search_, rounds_;
   SummedAreaTable tables_;

@@ -381,7 +381,7 @@ bool rounds_conflict_reference(const gpu::LabelGpu& a, uint64_t ka, const gpu::L
 ReferenceRounds rounds_reference(std::span<const gpu::LabelGpu> labels,
                                  std::span<const uint32_t> order, const std::vector<float>& tables,
                                  const PlacementSettings& settings, graph::Extent size,
-                                 uint32_t layer_count) {
+                                 uint32_t layer_count, std::span<const uint32_t> group_first) {
   const auto n = uint32_t(labels.size());
   gpu::Rounder rounder{placement_params(settings, size, layer_count, n, 0), labels, tables, {}, {}};
   for (const gpu::LabelGpu& l : labels) {
@@ -390,9 +390,11 @@ ReferenceRounds rounds_reference(std::span<const gpu::LabelGpu> labels,
   const glm::uvec2 across = gpu::placement_tiles(size.width, size.height);
   const uint32_t budget = std::clamp(settings.round_tiles, 1u, across.x * across.y);
   std::vector<std::vector<uint32_t>> tiles(n);
-  std::vector<uint32_t> ranks(n, LABEL_MAX);
+  const std::vector<uint32_t> packed = rounds_ranks(n, order, group_first);
+  std::vector<uint32_t> ranks(n, LABEL_MAX), firsts(n, 0);
   for (uint32_t s = 0; s < order.size(); ++s) {
-    ranks[order[s]] = s;
+    ranks[order[s]] = gpu::rounds_rank(packed[order[s]]);
+    firsts[order[s]] = gpu::rounds_group_first(packed[order[s]]);
     tiles[order[s]] = rounder.searched_tiles(labels[order[s]], budget);
   }
   ReferenceRounds out;
@@ -418,8 +420,9 @@ ReferenceRounds rounds_reference(std::span<const gpu::LabelGpu> labels,
       bool conflict = false;
       for (const uint32_t j : open) {
         conflict = conflict || (ranks[j] < ranks[i] &&
-                                rounder.rounds_conflict(labels[i], out.results[i], labels[j],
-                                                        out.results[j]));
+                                (ranks[j] < firsts[i] ||
+                                 rounder.rounds_conflict(labels[i], out.results[i], labels[j],
+                                                         out.results[j])));
       }
       if (conflict && r + 1 < rounds) waiting.push_back(i);
     }

@@ -36,7 +36,7 @@ bool rounds_conflict_reference(const gpu::LabelGpu& a, uint64_t ka, const gpu::L
 ReferenceRounds rounds_reference(std::span<const gpu::LabelGpu> labels,
                                  std::span<const uint32_t> order, const std::vector<float>& tables,
                                  const PlacementSettings& settings, graph::Extent size,
-                                 uint32_t layer_count);
+                                 uint32_t layer_count, std::span<const uint32_t> group_first = {});
 
 // The placement tidy-up pass: the greedy loop's results (cost bits << 32 | pixel per label)
 // after the tidy-up (shaders/shared/tidy.h) over the placement's `tables`.

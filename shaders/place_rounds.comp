@@ -17,7 +17,8 @@
 //    turns): the tile's cheapest candidate against the labels decided before the round, into the
 //    label's result by a 64-bit atomicMin (place_label_evaluate.glsl, as the sequential loop);
 //  - COMMIT, a workgroup per label: an undecided label is decided in this round unless its choice
-//    conflicts with an undecided label's before it in the order (the last round decides all).
+//    conflicts with an undecided label's before it in the order, or a label of a higher priority
+//    is undecided (the last round decides all).
 layout(local_size_x = PLACE_GROUP_X, local_size_y = PLACE_GROUP_Y) in;
 layout(binding = PLACEMENT_BINDING_TABLES, std430) readonly buffer Tables { float tables[]; };
 layout(binding = PLACEMENT_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
@@ -83,7 +84,7 @@ float cost_of(uint64_t key) {
 #include "place_label_evaluate.glsl"
 
 bool undecided(uint i) {
-  return i < params.label_count && ranks[i] < params.order_count && round_of[i] == ROUND_UNDECIDED;
+  return i < params.label_count && ranks[i] != ROUNDS_NO_RANK && round_of[i] == ROUND_UNDECIDED;
 }
 
 void mark(uint i, uint r) {
@@ -107,7 +108,7 @@ void mark(uint i, uint r) {
 
 void evaluate(uint r) {
   const uint i = round_list[gl_WorkGroupID.y];
-  const uint s = ranks[i];
+  const uint s = rounds_rank(ranks[i]);
   const uvec2 tiles_xy = placement_tiles(params.width, params.height);
   const uint tiles = tiles_xy.x * tiles_xy.y;
   const uint searched = rounds_searched_tiles(buckets[s], tiles_budget());
@@ -129,11 +130,13 @@ void commit(uint i, uint r) {
   barrier();
   const uint threads = PLACE_GROUP_X * PLACE_GROUP_Y;
   const uint64_t mine = results[i];
-  const uint rank = ranks[i];
+  const uint rank = rounds_rank(ranks[i]), first = rounds_group_first(ranks[i]);
   for (uint j = gl_LocalInvocationIndex; j < params.label_count && any_hit == 0u; j += threads) {
     // (undecided when the round began: a label deciding in this round writes r)
-    const bool open = round_of[j] == ROUND_UNDECIDED || round_of[j] == r;
-    if (j != i && open && ranks[j] < rank && rounds_conflict(labels[i], mine, labels[j], results[j])) {
+    const bool open = ranks[j] != ROUNDS_NO_RANK && (round_of[j] == ROUND_UNDECIDED || round_of[j] == r);
+    const uint other = rounds_rank(ranks[j]);
+    if (j != i && open && other < rank &&
+        (other < first || rounds_conflict(labels[i], mine, labels[j], results[j]))) {
       any_hit = 1u;
     }
   }

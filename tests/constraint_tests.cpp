@@ -85,6 +85,7 @@ TEST_SUITE("cpu") {
     const std::vector<glm::vec4> layers(pixels, glm::vec4(0.0f));
     PlacementSettings settings;
     settings.write_constraints = true;
+    settings.method = PlacementMethod::sequential;  // (its constraint image)
     settings.margin_em = 1.0f / 14.0f;  // a pixel at the default text size
     const ReferencePlacement r = place_reference(image, layers, 1, labels, order, settings, size);
     REQUIRE(r.placements[0].shown == PLACEMENT_SHOWN);

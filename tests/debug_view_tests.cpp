@@ -369,6 +369,7 @@ TEST_SUITE("gpu") {
     runner.set_viewport(size);
     PlacementSettings settings;
     settings.write_constraints = true;
+    settings.method = PlacementMethod::sequential;  // (its constraint image)
     settings.margin_em = 2.0f / settings.text_pixels;
     placement.set_frame(labels, order, settings);
     view.set_placement(static_cast<uint32_t>(order.size()), margin_pixels(settings));

@@ -161,9 +161,9 @@ TEST_SUITE("gpu") {
       LabelledRenderer renderer(ctx, scene, camera_for(scene, "front"), {64, 64}, {});
       const graph::GraphRunner& runner = renderer.runner();
       CHECK(runner.graph().passes().size() == 25);  // (with picking, labels.ghost, .anchor_cover)
-      CHECK(graph::barrier_count(runner.compiled()) == 60);
+      CHECK(graph::barrier_count(runner.compiled()) == 61);
       const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
-      CHECK(loop.name == "placement.labels");
+      CHECK(loop.name == "placement.rounds");
     }
   }
 }

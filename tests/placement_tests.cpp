@@ -37,6 +37,7 @@ struct Inputs {
   std::vector<glm::vec4> layers;
   std::vector<gpu::LabelGpu> labels;
   std::vector<uint32_t> order;
+  std::vector<uint32_t> group_first;  // per order position (empty: one priority)
 };
 
 gpu::LabelGpu label(glm::vec2 anchor, glm::vec2 size, uint32_t layer) {
@@ -138,7 +139,7 @@ GpuPlacement place_on_gpu(Context& ctx, const Inputs& in, const PlacementSetting
                                                     .adjust_labels = adjust});
   graph::GraphRunner runner(ctx, std::move(g));
   runner.set_viewport(in.size);
-  placement.set_frame(in.labels, in.order, settings);
+  placement.set_frame(in.labels, in.order, settings, {}, in.group_first);
   runner.run_now();
   GpuPlacement out;
   out.saliency = as<float>(runner.download_buffer(r.saliency));
@@ -638,18 +639,22 @@ TEST_SUITE("gpu") {
       in.labels.push_back(label(anchor, {float(14 + 2 * (i % 5)), 8.0f}, i % 2));
       in.order.push_back((i * 7) % 40);
     }
-    for (const uint32_t rounds : {128u, 3u}) {
+    // (and with two priorities: the order's second half waits for the first)
+    for (const uint32_t rounds : {128u, 3u, 0u}) {
       for (const bool hard : {false, true}) {
+        const bool priorities = rounds == 0u;
+        in.group_first.assign(priorities ? 40 : 0, 0u);
+        for (uint32_t s = 20; s < in.group_first.size(); ++s) in.group_first[s] = 20;
         CAPTURE(rounds);
         CAPTURE(hard);
         PlacementSettings settings;
         settings.tidy_rounds = 0;
-        settings.rounds = rounds;
+        settings.rounds = priorities ? 128u : rounds;
         settings.hard = hard;
         const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
         // (over the GPU's tables: its costs are then the same floats)
         const ReferenceRounds cpu = rounds_reference(in.labels, in.order, gpu.tables, settings,
-                                                     in.size, in.layer_count);
+                                                     in.size, in.layer_count, in.group_first);
         const auto n = uint32_t(in.labels.size());
         CHECK(std::vector(gpu.results.begin(), gpu.results.begin() + n) == cpu.results);
         CHECK(std::vector(gpu.round_of.begin(), gpu.round_of.begin() + n) == cpu.round_of);
@@ -662,7 +667,9 @@ TEST_SUITE("gpu") {
         size_t pairs = 0;
         for (uint32_t i = 0; i < n; ++i) {
           for (uint32_t j = i + 1; j < n; ++j) {
-            if (gpu.round_of[i] != gpu.round_of[j] || gpu.round_of[i] + 1 == rounds) continue;
+            if (gpu.round_of[i] != gpu.round_of[j] || gpu.round_of[i] + 1 == settings.rounds) {
+              continue;
+            }
             ++pairs;
             CAPTURE(i);
             CAPTURE(j);
@@ -671,6 +678,15 @@ TEST_SUITE("gpu") {
           }
         }
         CHECK(pairs > 10);
+        if (priorities) {
+          uint32_t first_done = 0, second_starts = ROUND_UNDECIDED;
+          for (uint32_t s = 0; s < n; ++s) {
+            const uint32_t r = gpu.round_of[in.order[s]];
+            if (s < 20) first_done = std::max(first_done, r);
+            else second_starts = std::min(second_starts, r);
+          }
+          CHECK(first_done < second_starts);
+        }
       }
     }
   }
@@ -829,6 +845,7 @@ TEST_SUITE("gpu") {
     in.labels[0] = label({20.0f, 36.0f}, {16.0f, 8.0f}, 0);
     in.labels[1] = label({70.0f, 36.0f}, {10.0f, 6.0f}, 0);
     PlacementSettings settings;
+    settings.method = PlacementMethod::sequential;  // (its constraint image)
     settings.write_constraints = true;
     settings.margin_em = 0.0f;
     const GpuPlacement gpu = place_on_gpu(ctx, in, settings);

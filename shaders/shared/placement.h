@@ -113,6 +113,7 @@
 #define ROUNDS_STEPS 3u           // dispatches per round
 #define ROUNDS_MAX 256u           // rounds at most (PlacementSettings::rounds)
 #define ROUND_UNDECIDED 0xFFFFFFFFu  // a label's round while it has none
+#define ROUNDS_NO_RANK 0xFFFFFFFFu   // PLACEMENT_BINDING_RANKS of a label not in the order
 
 // The tidy-up after the greedy placement (shared/tidy.h).
 #define TIDY_SUBPIXEL 64.0f
@@ -230,6 +231,15 @@ struct PlacementBucketsGpu {
   uint cursors[PLACEMENT_BUCKETS];
   float lowest;  // the smallest of the label's tile bounds (the buckets' reference)
 };
+
+// A label's entry of PLACEMENT_BINDING_RANKS: its order position, and the first order position
+// of its priority (labels of a priority wait while a higher priority's are undecided).
+STRATA_INLINE uint rounds_rank(uint packed) {
+  return packed & 0xFFFFu;
+}
+STRATA_INLINE uint rounds_group_first(uint packed) {
+  return packed >> 16u;
+}
 
 // The top-left pixel of a label box of `size` whose candidate pixel is p.
 STRATA_INLINE vec2 box_origin(uvec2 p, vec2 size) {
