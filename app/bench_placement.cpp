@@ -46,7 +46,11 @@ struct PlacementBenchOptions {
   bool no_baseline = false;  // skip the readback-per-label baseline (slow with many labels)
   uint32_t runs = 50;
   std::optional<float> ghost;  // ghosting's strength; none: the scene's settings.ghost
-  PlacementMethod greedy = PlacementMethod::rounds;
+  PlacementMethod greedy = PlacementMethod::sequential;
+  uint32_t rounds = PlacementSettings{}.rounds;            // the rounds at most
+  uint32_t round_tiles = PlacementSettings{}.round_tiles;  // tiles a label searches at most
+  uint32_t tidy_rounds = PlacementSettings{}.tidy_rounds;
+  bool wide = false;  // PlacementSettings::wide_search
 };
 
 // --labels: "100" or "10,50,100", each 0 (the scene's own labels) to kMaxLabels.
@@ -171,9 +175,13 @@ uint32_t greedy_rounds_run(LabelledRenderer& frame) {
   return run;
 }
 
-LabellingSettings labelling_settings(const Scene& scene, PlacementMethod greedy) {
+LabellingSettings labelling_settings(const Scene& scene, const PlacementBenchOptions& o) {
   LabellingSettings settings;
-  settings.placement.method = greedy;
+  settings.placement.method = o.greedy;
+  settings.placement.rounds = o.rounds;
+  settings.placement.round_tiles = o.round_tiles;
+  settings.placement.tidy_rounds = o.tidy_rounds;
+  settings.placement.wide_search = o.wide;
   settings.placement.weights = scene.settings.weights;
   settings.ghost.strength = scene.settings.ghost;
   settings.ghost.radius = scene.settings.ghost_radius;
@@ -181,26 +189,28 @@ LabellingSettings labelling_settings(const Scene& scene, PlacementMethod greedy)
 }
 
 PlacementRun measure_placement(Context& ctx, const Scene& scene, const Camera& camera,
-                               graph::Extent size, uint32_t runs, PlacementMethod greedy) {
-  const LabellingSettings settings = labelling_settings(scene, greedy);
+                               graph::Extent size, const PlacementBenchOptions& o) {
+  const LabellingSettings settings = labelling_settings(scene, o);
   LabelledRenderer frame(ctx, scene, camera, size, settings);
   frame.run();  // warm up, and grow the HA-Buffer if it must
   graph::GraphRunner& runner = frame.runner();
   PlacementRun r;
   // (three warm-up runs: with one, a sweep read a count's loop much slower than a run of that
   // count alone; the GPU idles while the CPU builds each count's frame)
-  r.timings = measure(runner, 3, runs);
+  r.timings = measure(runner, 3, o.runs);
   // The whole placement again with timestamps only where groups begin and end (a stamp waits for
   // the GPU to drain and costs time the real frame does not spend).
   runner.set_timestamps_per_pass(false);
-  for (const auto& [name, stat] : measure(runner, 3, runs).groups) {
+  for (const auto& [name, stat] : measure(runner, 3, o.runs).groups) {
     if (name == "placement") r.whole_ms = stat.median;
   }
   runner.set_timestamps_per_pass(true);
   for (const auto& [name, stat] : r.timings.groups) {
     if (name == "placement") r.stamped_ms = stat.median;
   }
-  r.loop_ms = r.ms_per_pass(runner.graph().passes()[frame.placement().label_loop].name);
+  // (the greedy placement: one of the two passes records dispatches)
+  r.loop_ms = r.ms_per_pass(runner.graph().passes()[frame.placement().label_loop].name) +
+              r.ms_per_pass(runner.graph().passes()[frame.placement().rounds].name);
   r.tidy_ms = r.ms_per_pass("placement.tidy");   // the tidy-up
   r.forces_ms = r.ms_per_pass("labels.forces");  // thesis 3.4: one invocation per label
   std::tie(r.first_tiles, r.rest_tiles) = tiles_per_label(frame);  // (runs a frame)
@@ -298,12 +308,13 @@ void bench_placement(DeviceOptions& device, const PlacementBenchOptions& o) {
   print_placement_row(nullptr);
   for (std::vector<Label>& these : labels) {
     scene.labels = std::move(these);
-    measured.push_back(measure_placement(ctx, scene, camera, size, o.runs, o.greedy));
+    measured.push_back(measure_placement(ctx, scene, camera, size, o));
     if (!o.no_baseline) {
       // (the sequential loop's, the thesis program's structure)
+      PlacementBenchOptions sequential = o;
+      sequential.greedy = PlacementMethod::sequential;
       measured.back().baseline_loop_ms = label_loop_with_readback_per_label(
-          ctx, scene, camera, size, labelling_settings(scene, PlacementMethod::sequential),
-          o.runs);
+          ctx, scene, camera, size, labelling_settings(scene, sequential), o.runs);
     }
     print_placement_row(&measured.back());
   }
@@ -356,6 +367,17 @@ void add_placement_bench(CLI::App* bench_cmd, DeviceOptions& device) {
                    "ghosting's strength, 0 (off) to 1 (default: the scene's settings.ghost)")
       ->check(finite_range(0.0, 1.0));
   add_greedy_option(place_cmd, place->greedy);
+  place_cmd->add_option("--rounds", place->rounds, "the greedy placement's rounds at most")
+      ->check(whole_range(1, ROUNDS_MAX))
+      ->capture_default_str();
+  place_cmd
+      ->add_option("--round-tiles", place->round_tiles,
+                   "32x32 tiles of candidates a label searches at most in the rounds")
+      ->check(whole_range(1, 65536))
+      ->capture_default_str();
+  add_tidy_rounds_option(place_cmd, place->tidy_rounds, "after the placement (0: none)");
+  place_cmd->add_flag("--wide", place->wide,
+                      "in the rounds, a label with no wanted position in its tiles searches all");
   place_cmd->add_flag("--no-baseline", place->no_baseline,
                       "skip the baseline with a readback after every label (slow with many)");
   place_cmd->add_option("--runs", place->runs, "timed runs after 3 warm-up runs")

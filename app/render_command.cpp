@@ -28,7 +28,7 @@ struct RenderOptions {
   uint32_t blur = 12;
   bool no_labels = false;
   bool hard = false;
-  PlacementMethod greedy = PlacementMethod::rounds;
+  PlacementMethod greedy = PlacementMethod::sequential;
   bool internal = false;
   LabelLookOptions look;
   bool decoret = false;

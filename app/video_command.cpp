@@ -42,7 +42,7 @@ struct VideoOptions {
   bool screen_space = false;
   bool no_forces = false;
   bool hard = false;
-  PlacementMethod greedy = PlacementMethod::rounds;
+  PlacementMethod greedy = PlacementMethod::sequential;
   bool plan = true;  // --plan: the labels' ranges planned over the whole path first
   LabelLookOptions look;
   ForceSettings forces;

@@ -208,14 +208,14 @@ Placement::Outputs Placement::add_to(graph::Graph& graph, const Inputs& in) {
   if (in.adjust_labels) in.adjust_labels(graph, b.labels);
   add_costs(graph, b, in);
   add_bounds(graph, b);
-  const graph::PassId loop = settings_.method == PlacementMethod::rounds
-                                ? add_rounds(graph, b)
-                                : add_label_loop(graph, b);
+  // (both ways are in the graph, whichever the frame's settings choose: a frame records one)
+  const graph::PassId loop = add_label_loop(graph, b);
   const auto loop_end = static_cast<graph::PassId>(graph.passes().size());
+  const graph::PassId rounds = add_rounds(graph, b);
   add_tidy(graph, b);
-  return {b.labels,      b.placements,    b.saliency,   b.costs, b.tables, b.constraints,
-          b.results,     b.buckets,       b.tidy_rounds, b.round_counts,
-          b.round_of,    b.order,         loop,         loop_end};
+  return {b.labels,  b.placements, b.saliency,    b.costs,        b.tables,
+          b.constraints, b.results, b.buckets,    b.tidy_rounds,  b.round_counts,
+          b.round_of, b.order,     loop,          loop_end,       rounds};
 }
 
 Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
@@ -255,6 +255,10 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
       graph.add_buffer("placement.round_args", fixed(ROUNDS_MAX * 3 * sizeof(uint32_t)));
   b.round_counts =
       graph.add_buffer("placement.round_counts", fixed((ROUNDS_MAX + 1) * sizeof(uint32_t)));
+  b.round_bits = graph.add_buffer(
+      "placement.round_bits", fixed(VkDeviceSize{n} * gpu::rounds_row_words(n) * sizeof(uint32_t)));
+  b.round_done = graph.add_buffer("placement.round_done", fixed(ROUNDS_MAX * sizeof(uint32_t)));
+  b.round_wide = graph.add_buffer("placement.round_wide", fixed(n * sizeof(uint32_t)));
   b.readback = readback_.import(graph, "placement.readback");
   return b;
 }
@@ -275,7 +279,8 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                    {b.ranks, Use::transfer_dst},
                    {b.round_of, Use::transfer_dst},
                    {b.round_args, Use::transfer_dst},
-                   {b.round_counts, Use::transfer_dst}},
+                   {b.round_counts, Use::transfer_dst},
+                   {b.round_done, Use::transfer_dst}},
                   [this, b](graph::PassContext& pc) {
                     record_update(pc.cmd, pc.buffer(b.labels), 0, as_bytes(labels_));
                     record_update(pc.cmd, pc.buffer(b.order), 0, as_bytes(order_));
@@ -294,6 +299,7 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                     // The rounds: every label undecided; each round's search sized by its list.
                     record_update(pc.cmd, pc.buffer(b.ranks), 0, as_bytes(ranks_));
                     fill(b.round_of, ROUND_UNDECIDED);
+                    fill(b.round_done, 0);
                     std::vector<uint32_t> args(ROUNDS_MAX * 3, 1u);
                     for (uint32_t r = 0; r < ROUNDS_MAX; ++r) {
                       args[3 * r] = round_groups(pc.viewport);
@@ -392,6 +398,7 @@ graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
   // Steps [first, end) of the loop, those the frame's order has.
   const auto steps = [this, args = b.args](uint32_t first, uint32_t end) {
     return [this, args, first, end](graph::PassContext& pc) {
+      if (settings_.method != PlacementMethod::sequential) return;
       const glm::uvec3 groups = direct_groups(pc.viewport);
       for (uint32_t step = first; step < end && step <= order_.size() && !order_.empty(); ++step) {
         if (step > first) pc.barrier();
@@ -418,7 +425,7 @@ uint32_t Placement::round_count() const {
 
 uint32_t Placement::round_groups(graph::Extent viewport) const {
   const glm::uvec2 across = gpu::placement_tiles(viewport.width, viewport.height);
-  return std::clamp(settings_.round_tiles, 1u, across.x * across.y);
+  return std::min(ROUNDS_GROUPS, across.x * across.y);
 }
 
 // The greedy placement in rounds (place_rounds.comp): mark, search, commit, each over every label
@@ -438,17 +445,22 @@ graph::PassId Placement::add_rounds(graph::Graph& graph, const Buffers& b) {
       {b.round_list, Use::storage_write, PLACEMENT_BINDING_ROUND_LIST},
       {b.round_args, Use::storage_read_write, PLACEMENT_BINDING_ROUND_ARGS},
       {b.round_counts, Use::storage_read_write, PLACEMENT_BINDING_ROUND_COUNTS},
+      // (written: each label clears its row before it sets bits)
+      {b.round_bits, Use::storage_write, PLACEMENT_BINDING_ROUND_BITS},
+      {b.round_done, Use::storage_read_write, PLACEMENT_BINDING_ROUND_DONE},
+      // (written: MARK resets a label's before EVALUATE counts on it)
+      {b.round_wide, Use::storage_write, PLACEMENT_BINDING_ROUND_WIDE},
       {b.round_args, Use::indirect}};
   const bool skip_idle = ctx_.conditional_rendering() && layout_.skip_idle_blocks;
   if (skip_idle) uses.push_back({b.round_counts, Use::conditional});
   return graph.add_pass(
       {"placement.rounds", graph::PassKind::compute, std::move(uses),
        [this, b, skip_idle](graph::PassContext& pc) {
-         if (order_.empty()) return;
+         if (order_.empty() || settings_.method != PlacementMethod::rounds) return;
          gpu::PlacementParams p = params(pc.viewport, 0);
          const uint32_t rounds = round_count();
          p.label = rounds;
-         p.spec_label = round_groups(pc.viewport);
+         p.spec_label = std::max(settings_.round_tiles, 1u);
          const uint32_t n = frame_count();
          for (uint32_t round = 0; round < rounds; ++round) {
            p.step = round;
@@ -466,6 +478,12 @@ graph::PassId Placement::add_rounds(graph::Graph& graph, const Buffers& b) {
            p.phase = ROUNDS_PHASE_EVALUATE;
            pc.dispatch_indirect(rounds_, p, b.round_args, VkDeviceSize{round} * 3 * sizeof(uint32_t));
            pc.barrier();
+           if (settings_.wide_search) {
+             p.phase = ROUNDS_PHASE_WIDE;
+             pc.dispatch_indirect(rounds_, p, b.round_args,
+                                  VkDeviceSize{round} * 3 * sizeof(uint32_t));
+             pc.barrier();
+           }
            p.phase = ROUNDS_PHASE_COMMIT;
            pc.dispatch_groups(rounds_, p, {n, 1, 1});
            const bool block_ends = (round + 1) % kTidyBlockRounds == 0 || round + 1 == rounds;

@@ -24,22 +24,27 @@
 
 namespace strata {
 
-// How the greedy placement decides its labels: in parallel rounds (shared/placement_rounds.h), or
-// one after the other in insertion order (the thesis's loop, kept as the reference to compare).
+// How the greedy placement decides its labels: one after the other in insertion order (the
+// thesis's loop), or in parallel rounds (shared/placement_rounds.h: several times faster on a
+// GPU, but crowded pictures show fewer labels; docs/performance.md).
 enum class PlacementMethod {
-  rounds,
   sequential,
+  rounds,
 };
 
 struct PlacementSettings {
-  CostWeights weights;
-  PlacementMethod method = PlacementMethod::rounds;
+  CostWeights weights;  // eq. 3.1 (scene settings; defaults: the thesis's final paper)
+  PlacementMethod method = PlacementMethod::sequential;
   // The rounds: how many at most (the last decides every label still undecided, conflicts and
   // all, for the tidy-up to settle), and how many of its 32x32 tiles of candidates a label
   // searches at most: the buckets of its tile list, cheapest bound first, while they fit (bucket
-  // 0 always).
-  uint32_t rounds = 128;
-  uint32_t round_tiles = 64;  // eq. 3.1 (scene settings; defaults: the thesis's final paper)
+  // 0 always). With `wide_search`, a label that finds no position there it wants
+  // (rounds_wide_cost) searches all of its tiles, as the sequential loop does: crowded scenes
+  // show more labels, but those labels all make for the same free places, and the rounds
+  // multiply (docs/performance.md).
+  uint32_t rounds = ROUNDS_DEFAULT;
+  uint32_t round_tiles = 64;
+  bool wide_search = false;
   // Around label boxes in the constraints, in ems: label text sizes, which keep two labels apart
   // legibly at any image size (6 px at the default 14 px font).
   float margin_em = 6.0f / 14.0f;
@@ -160,8 +165,9 @@ class Placement {
     graph::ResourceId order;  // uint[]: the frame's insertion order (label indices)
     // The passes that place the labels one by one, [label_loop, label_loop_end): one, or with
     // PlacementLayout::pass_per_label pass label_loop + s records step s (place_label dispatch s:
-    // the main pass of order position s - 1 and the speculative one of s).
-    graph::PassId label_loop, label_loop_end;
+    // the main pass of order position s - 1 and the speculative one of s); and the rounds' pass.
+    // A frame records the ones its PlacementSettings::method names; the others record nothing.
+    graph::PassId label_loop, label_loop_end, rounds;
   };
 
   // `label_count` sizes the per-label buffers; a frame may enable fewer labels.
@@ -204,7 +210,8 @@ class Placement {
     graph::ResourceId labels, order, results, placements, saliency, costs, tables, constraints;
     graph::ResourceId bounds, tiles, buckets, lower, args, speculative, samples, regions, tidy,
         tidy_rounds, tidy_args;
-    graph::ResourceId ranks, round_of, round_list, round_args, round_counts;
+    graph::ResourceId ranks, round_of, round_list, round_args, round_counts, round_bits, round_done,
+        round_wide;
     graph::ResourceId readback;
   };
   Buffers add_buffers(graph::Graph& graph);
@@ -214,7 +221,8 @@ class Placement {
   // The loop's first pass; its last is the graph's last.
   graph::PassId add_label_loop(graph::Graph& graph, const Buffers& b);
   graph::PassId add_rounds(graph::Graph& graph, const Buffers& b);
-  // Rounds recorded for this frame, and the workgroups a round's search has per label.
+  // Rounds recorded for this frame, and the workgroups a round's search has per label
+  // (ROUNDS_GROUPS, at most the tiles).
   uint32_t round_count() const;
   uint32_t round_groups(graph::Extent viewport) const;
   void add_tidy(graph::Graph& graph, const Buffers& b);

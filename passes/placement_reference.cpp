@@ -389,13 +389,15 @@ ReferenceRounds rounds_reference(std::span<const gpu::LabelGpu> labels,
   }
   const glm::uvec2 across = gpu::placement_tiles(size.width, size.height);
   const uint32_t budget = std::clamp(settings.round_tiles, 1u, across.x * across.y);
-  std::vector<std::vector<uint32_t>> tiles(n);
+  // (more than the tiles searches them all, as does the GPU)
+  std::vector<std::vector<uint32_t>> tiles(n), all_tiles(n);
   const std::vector<uint32_t> packed = rounds_ranks(n, order, group_first);
   std::vector<uint32_t> ranks(n, LABEL_MAX), firsts(n, 0);
   for (uint32_t s = 0; s < order.size(); ++s) {
     ranks[order[s]] = gpu::rounds_rank(packed[order[s]]);
     firsts[order[s]] = gpu::rounds_group_first(packed[order[s]]);
     tiles[order[s]] = rounder.searched_tiles(labels[order[s]], budget);
+    all_tiles[order[s]] = rounder.searched_tiles(labels[order[s]], ~0u);
   }
   ReferenceRounds out;
   out.results.assign(n, PLACEMENT_NONE);
@@ -414,20 +416,43 @@ ReferenceRounds rounds_reference(std::span<const gpu::LabelGpu> labels,
             margin_pixels(settings)));
       }
       out.results[i] = rounder.cheapest(labels[i], tiles[i]);
+      const float cost = out.results[i] == PLACEMENT_NONE
+                             ? std::numeric_limits<float>::infinity()
+                             : glm::uintBitsToFloat(uint32_t(out.results[i] >> 32));
+      if (settings.wide_search && cost >= rounder.rounds_wide_cost()) {
+        out.results[i] = rounder.cheapest(labels[i], all_tiles[i]);
+      }
+    }
+    // The passes of the selection (the last round decides all): which earlier undecided labels
+    // each one depends on, then each pass from the one before.
+    enum State { open_state, in_state, out_state };
+    std::vector<State> state(n, open_state);
+    std::vector<std::vector<uint32_t>> depends(n);
+    for (const uint32_t i : open) {
+      for (const uint32_t j : open) {
+        if (ranks[j] >= ranks[i]) continue;
+        if (ranks[j] < firsts[i]) state[i] = out_state;
+        else if (rounder.rounds_conflict(labels[i], out.results[i], labels[j], out.results[j]))
+          depends[i].push_back(j);
+      }
+    }
+    for (uint32_t pass = 0; pass < ROUNDS_SELECT_PASSES && r + 1 < rounds; ++pass) {
+      std::vector<State> next = state;
+      for (const uint32_t i : open) {
+        if (state[i] != open_state) continue;
+        bool any_in = false, all_out = true;
+        for (const uint32_t j : depends[i]) {
+          any_in = any_in || state[j] == in_state;
+          all_out = all_out && state[j] == out_state;
+        }
+        next[i] = any_in ? out_state : all_out ? in_state : open_state;
+      }
+      state = std::move(next);
     }
     std::vector<uint32_t> waiting;
     for (const uint32_t i : open) {
-      bool conflict = false;
-      for (const uint32_t j : open) {
-        conflict = conflict || (ranks[j] < ranks[i] &&
-                                (ranks[j] < firsts[i] ||
-                                 rounder.rounds_conflict(labels[i], out.results[i], labels[j],
-                                                         out.results[j])));
-      }
-      if (conflict && r + 1 < rounds) waiting.push_back(i);
-    }
-    for (const uint32_t i : open) {
-      if (std::find(waiting.begin(), waiting.end(), i) == waiting.end()) out.round_of[i] = r;
+      if (r + 1 == rounds || state[i] == in_state) out.round_of[i] = r;
+      else waiting.push_back(i);
     }
     open = std::move(waiting);
   }

@@ -102,6 +102,37 @@ TEST_SUITE("cpu") {
 }
 
 TEST_SUITE("gpu") {
+  // The same scene placed in rounds: every label on screen, none overlapping, most legible.
+  TEST_CASE_FIXTURE(test::GpuTest, "head_demo_labels_placed_in_rounds_are_on_screen_and_apart") {
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    const graph::Extent size{256, 256};
+    LabellingSettings settings;
+    settings.placement.method = PlacementMethod::rounds;
+    const LabelledFrame frame =
+        render_labelled(ctx, scene, camera_for(scene, "oblique"), size, settings);
+    REQUIRE(frame.labels.size() == scene.labels.size());
+    size_t legible = 0;
+    for (size_t i = 0; i < frame.labels.size(); ++i) {
+      const LabelLayout& a = frame.labels[i];
+      CAPTURE(a.text);
+      CHECK(a.placed);
+      legible += a.shown ? 1 : 0;
+      CHECK(a.box_origin.x >= 0.0f);
+      CHECK(a.box_origin.y >= 0.0f);
+      CHECK(a.box_origin.x + a.box_size.x <= float(size.width));
+      CHECK(a.box_origin.y + a.box_size.y <= float(size.height));
+      for (size_t j = i + 1; j < frame.labels.size(); ++j) {
+        const LabelLayout& b = frame.labels[j];
+        const bool apart = a.box_origin.x + a.box_size.x <= b.box_origin.x ||
+                           b.box_origin.x + b.box_size.x <= a.box_origin.x ||
+                           a.box_origin.y + a.box_size.y <= b.box_origin.y ||
+                           b.box_origin.y + b.box_size.y <= a.box_origin.y;
+        CHECK_MESSAGE(apart, a.text << " overlaps " << b.text);
+      }
+    }
+    CHECK(legible >= 5);
+  }
+
   TEST_CASE_FIXTURE(test::GpuTest, "head_demo_labels_are_all_on_screen_and_never_overlap") {
     const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
     const graph::Extent size{256, 256};
@@ -160,10 +191,12 @@ TEST_SUITE("gpu") {
       const Scene scene = load_scene(std::string(STRATA_SOURCE_DIR "/assets/scenes/") + file);
       LabelledRenderer renderer(ctx, scene, camera_for(scene, "front"), {64, 64}, {});
       const graph::GraphRunner& runner = renderer.runner();
-      CHECK(runner.graph().passes().size() == 25);  // (with picking, labels.ghost, .anchor_cover)
-      CHECK(graph::barrier_count(runner.compiled()) == 61);
+      // (with picking, labels.ghost, .anchor_cover, the sequential loop's and the rounds' passes)
+      CHECK(runner.graph().passes().size() == 26);
+      CHECK(graph::barrier_count(runner.compiled()) == 69);
       const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
-      CHECK(loop.name == "placement.rounds");
+      CHECK(loop.name == "placement.labels");
+      CHECK(runner.graph().passes()[renderer.placement().rounds].name == "placement.rounds");
     }
   }
 }

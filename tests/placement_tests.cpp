@@ -628,10 +628,12 @@ TEST_SUITE("gpu") {
   }
 
   // The rounds on a crowded scene: the GPU's choices, the round each label was decided in and
-  // the labels undecided before each round are the reference's exactly, over the same tables (the reference searches
-  // every undecided label again each round, the GPU only those a newly decided label
-  // constrains); no two labels decided in one round constrain each other, but for the last
-  // round, which decides all that are left.
+  // the labels undecided before each round are the reference's exactly, over the same tables
+  // (the reference searches every undecided label again each round, the GPU only those a newly
+  // decided label constrains); no two labels decided in one round constrain each other, but for
+  // the last round, which decides all that are left. Also with few rounds, with two priorities
+  // (the order's second half waits for the first) and with few tiles searched (the labels that
+  // find no position there search the rest).
   TEST_CASE_FIXTURE(test::GpuTest, "rounds_match_the_reference_and_commit_no_conflicting_pair") {
     Inputs in = disc_scene(0, 2.0f);
     for (uint32_t i = 0; i < 40; ++i) {
@@ -639,17 +641,20 @@ TEST_SUITE("gpu") {
       in.labels.push_back(label(anchor, {float(14 + 2 * (i % 5)), 8.0f}, i % 2));
       in.order.push_back((i * 7) % 40);
     }
-    // (and with two priorities: the order's second half waits for the first)
-    for (const uint32_t rounds : {128u, 3u, 0u}) {
+    // (rounds 0: two priorities; 1: two tiles searched)
+    for (const uint32_t rounds : {128u, 3u, 0u, 1u}) {
       for (const bool hard : {false, true}) {
-        const bool priorities = rounds == 0u;
+        const bool priorities = rounds == 0u, few_tiles = rounds == 1u;
         in.group_first.assign(priorities ? 40 : 0, 0u);
         for (uint32_t s = 20; s < in.group_first.size(); ++s) in.group_first[s] = 20;
         CAPTURE(rounds);
         CAPTURE(hard);
         PlacementSettings settings;
+        settings.method = PlacementMethod::rounds;
         settings.tidy_rounds = 0;
-        settings.rounds = priorities ? 128u : rounds;
+        settings.rounds = priorities || few_tiles ? 128u : rounds;
+        settings.round_tiles = few_tiles ? 2u : settings.round_tiles;
+        settings.wide_search = few_tiles;
         settings.hard = hard;
         const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
         // (over the GPU's tables: its costs are then the same floats)

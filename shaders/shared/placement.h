@@ -64,6 +64,10 @@
 #define PLACEMENT_BINDING_ROUND_LIST 23   // uint[]: the labels a round searches again
 #define PLACEMENT_BINDING_ROUND_ARGS 24   // uint[3] per round: its search's workgroups
 #define PLACEMENT_BINDING_ROUND_COUNTS 25  // uint per round + 1: labels undecided before it
+#define PLACEMENT_BINDING_ROUND_BITS 26    // uint[label_count / 32] per label: its conflicts
+#define PLACEMENT_BINDING_ROUND_DONE 27    // uint per round: its COMMIT workgroups finished
+#define PLACEMENT_BINDING_ROUND_WIDE 28    // uint per label: EVALUATE's workgroups finished, then
+                                           // whether WIDE searches on (ROUNDS_GROUPS + 1)
 
 // PlacementParams.phase of placement_tidy.comp: the tidy-up's start, the four steps of each
 // round (params.step), and the placements' output. The changes a round applies are taken up by
@@ -109,11 +113,15 @@
 // PlacementParams.phase of place_rounds.comp.
 #define ROUNDS_PHASE_MARK 0u      // per undecided label: search again? (the round's list)
 #define ROUNDS_PHASE_EVALUATE 1u  // per listed label and searched tile: its cheapest candidate
-#define ROUNDS_PHASE_COMMIT 2u    // per undecided label: commit, unless an earlier one conflicts
-#define ROUNDS_STEPS 3u           // dispatches per round
+#define ROUNDS_PHASE_COMMIT 2u    // per undecided label: its conflicts; the last workgroup decides
+#define ROUNDS_PHASE_WIDE 3u      // ... the rest of its tiles, where its best is one no label wants
+#define ROUNDS_STEPS 4u           // dispatches per round
 #define ROUNDS_MAX 256u           // rounds at most (PlacementSettings::rounds)
 #define ROUND_UNDECIDED 0xFFFFFFFFu  // a label's round while it has none
 #define ROUNDS_NO_RANK 0xFFFFFFFFu   // PLACEMENT_BINDING_RANKS of a label not in the order
+#define ROUNDS_DEFAULT 24u           // PlacementSettings::rounds by default
+#define ROUNDS_GROUPS 64u            // EVALUATE's workgroups per label (each takes every 64th tile)
+#define ROUNDS_SELECT_PASSES 8u      // passes of a round's selection (placement_rounds.h)
 
 // The tidy-up after the greedy placement (shared/tidy.h).
 #define TIDY_SUBPIXEL 64.0f
@@ -239,6 +247,11 @@ STRATA_INLINE uint rounds_rank(uint packed) {
 }
 STRATA_INLINE uint rounds_group_first(uint packed) {
   return packed >> 16u;
+}
+
+// Words of a label's conflict row (PLACEMENT_BINDING_ROUND_BITS) for n labels.
+STRATA_INLINE uint rounds_row_words(uint n) {
+  return (n + 31u) / 32u;
 }
 
 // The top-left pixel of a label box of `size` whose candidate pixel is p.

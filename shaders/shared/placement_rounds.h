@@ -3,12 +3,28 @@
 //
 // Every label of the insertion order starts undecided. In a round, each undecided label takes its
 // cheapest candidate (eq. 3.1) against the labels decided in earlier rounds, over the tiles its
-// rounds search (rounds_searched_tiles); then each commits unless its choice and the choice of an
-// undecided label before it in the order constrain each other (rounds_conflict). The first
-// undecided label always commits, so every round decides one at least. Labels that commit in one
-// round never constrain each other: each one's choice is what it would be with the others decided
-// first. A label's choice stands while no newly decided label constrains it (costs only grow as
-// labels are decided), so the GPU searches again only for those (place_rounds.comp).
+// rounds search (rounds_searched_tiles; with PlacementSettings::wide_search, all of its tiles
+// where those hold no position a label wants: rounds_wide_cost). Then the round decides labels
+// in ROUNDS_SELECT_PASSES passes over the undecided ones. A label whose choice and an earlier
+// undecided label's constrain each other (rounds_conflict) depends on it (earlier: in insertion
+// order); a label while a label of a higher priority is undecided waits. In each pass, a label is
+// decided when every label it depends on was left out in the pass before, and left out when one
+// of them was decided in the pass before; labels still open after the passes wait. (Passes
+// without end would find the first maximal independent set, in insertion order, of the graph of
+// conflicting choices: what the sequential greedy keeps of the round's choices.) The first
+// undecided label is always decided, so every round decides one at least, and labels decided in
+// one round never constrain each other: each one's choice is what it would be with the others
+// decided first. A label's choice
+// stands while no newly decided label constrains it (costs only grow as labels are decided), so
+// the GPU searches again only for those (place_rounds.comp).
+
+// A label whose best over the tiles its rounds search (rounds_searched_tiles) costs this much or
+// more (it overlaps a decided label's box, covers an anchor or is illegible; or has none) searches
+// the rest of its tile list too.
+float rounds_wide_cost() {
+  CostWeightsGpu w = params.weights;
+  return min(min(w.label_shadow, w.anchor_constraint), w.illegible);
+}
 
 // Label me's box centre for the result key (z = 1), or 0 for none.
 vec3 key_placed(LabelGpu me, uint64_t key) {
