@@ -102,13 +102,10 @@ PlacementPlan PlacementPlan::choose(const Context& ctx, uint32_t label_count,
 
 std::vector<ComputePipeline> Placement::create_pipelines(Context& ctx, uint32_t label_count) {
   const bool large = tidy_states_in_buffer(label_count);
-  const std::array<std::string_view, 6> shaders{
-      "integral_costs.comp",
-      "placement_bounds.comp",
-      "place_label.comp",
+  const std::array<std::string_view, 5> shaders{
+      "integral_costs.comp", "placement_bounds.comp", "place_label.comp",
       large ? "placement_tidy_large.comp" : "placement_tidy.comp",
-      large ? "placement_tidy_search_large.comp" : "placement_tidy_search.comp",
-      "place_rounds.comp"};
+      large ? "placement_tidy_search_large.comp" : "placement_tidy_search.comp"};
   return create_compute_pipelines(ctx, shaders);
 }
 
@@ -119,7 +116,7 @@ std::vector<ComputePipeline> Placement::take_pipelines(uint32_t label_count) {
   if (tidy_states_in_buffer(label_count) != tidy_states_in_buffer(label_count_))
     return create_pipelines(ctx_, label_count);
   std::vector<ComputePipeline> out;
-  for (ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &tidy_, &search_, &rounds_})
+  for (ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &tidy_, &search_})
     out.push_back(std::move(*p));
   return out;
 }
@@ -135,7 +132,6 @@ Placement::Placement(Context& ctx, uint32_t label_count, PlacementLayout layout,
       place_(std::move(pipelines[2])),
       tidy_(std::move(pipelines[3])),
       search_(std::move(pipelines[4])),
-      rounds_(std::move(pipelines[5])),
       tables_(ctx),
       readback_(ctx, std::max<VkDeviceSize>(1, label_count) * sizeof(gpu::PlacementGpu)) {
   static_assert(LABEL_MAX == kMaxLabels, "the scene side's label limit is the placement's");
@@ -457,6 +453,9 @@ graph::PassId Placement::add_rounds(graph::Graph& graph, const Buffers& b) {
       {"placement.rounds", graph::PassKind::compute, std::move(uses),
        [this, b, skip_idle](graph::PassContext& pc) {
          if (order_.empty() || settings_.method != PlacementMethod::rounds) return;
+         // (made when a frame first asks for the rounds: it costs a CPU device's startup)
+         if (!rounds_) rounds_.emplace(ctx_, "place_rounds.comp");
+         const ComputePipeline& pipeline = *rounds_;
          gpu::PlacementParams p = params(pc.viewport, 0);
          const uint32_t rounds = round_count();
          p.label = rounds;
@@ -473,19 +472,19 @@ graph::PassId Placement::add_rounds(graph::Graph& graph, const Buffers& b) {
              pc.barrier();
            }
            p.phase = ROUNDS_PHASE_MARK;
-           pc.dispatch_groups(rounds_, p, {n, 1, 1});
+           pc.dispatch_groups(pipeline, p, {n, 1, 1});
            pc.barrier();
            p.phase = ROUNDS_PHASE_EVALUATE;
-           pc.dispatch_indirect(rounds_, p, b.round_args, VkDeviceSize{round} * 3 * sizeof(uint32_t));
+           pc.dispatch_indirect(pipeline, p, b.round_args, VkDeviceSize{round} * 3 * sizeof(uint32_t));
            pc.barrier();
            if (settings_.wide_search) {
              p.phase = ROUNDS_PHASE_WIDE;
-             pc.dispatch_indirect(rounds_, p, b.round_args,
+             pc.dispatch_indirect(pipeline, p, b.round_args,
                                   VkDeviceSize{round} * 3 * sizeof(uint32_t));
              pc.barrier();
            }
            p.phase = ROUNDS_PHASE_COMMIT;
-           pc.dispatch_groups(rounds_, p, {n, 1, 1});
+           pc.dispatch_groups(pipeline, p, {n, 1, 1});
            const bool block_ends = (round + 1) % kTidyBlockRounds == 0 || round + 1 == rounds;
            if (conditional && block_ends) pc.end_conditional();
          }
@@ -588,10 +587,10 @@ void Placement::record_tidy_rounds(graph::PassContext& pc, gpu::PlacementParams 
 
 std::vector<PipelineReport> Placement::pipeline_statistics() const {
   std::vector<PipelineReport> out;
-  for (const ComputePipeline* p :
-       {&integral_costs_, &bounds_, &place_, &tidy_, &search_, &rounds_}) {
+  for (const ComputePipeline* p : {&integral_costs_, &bounds_, &place_, &tidy_, &search_}) {
     out.push_back({p->name(), p->statistics()});
   }
+  if (rounds_) out.push_back({rounds_->name(), rounds_->statistics()});
   return out;
 }
 

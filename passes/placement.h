@@ -252,7 +252,8 @@ class Placement {
   // none (rounds_rank, rounds_group_first)
   std::vector<uint32_t> ranks_;
   PlacementSettings settings_;
-  ComputePipeline integral_costs_, bounds_, place_, tidy_, search_, rounds_;
+  ComputePipeline integral_costs_, bounds_, place_, tidy_, search_;
+  std::optional<ComputePipeline> rounds_;  // made when a frame first places in rounds
   SummedAreaTable tables_;
   graph::Readback readback_;
 };
