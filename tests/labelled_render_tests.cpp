@@ -101,6 +101,37 @@ TEST_SUITE("cpu") {
   }
 }
 
+namespace {
+
+// Every label of the frame placed, its box inside the image with room for the font, no two
+// boxes overlapping; returns how many are legible.
+size_t check_on_screen_and_apart(const LabelledFrame& frame, graph::Extent size) {
+  size_t legible = 0;
+  for (size_t i = 0; i < frame.labels.size(); ++i) {
+    const LabelLayout& a = frame.labels[i];
+    CAPTURE(a.text);
+    CHECK(a.placed);
+    CHECK(a.shown == (a.visible >= kLegibleShare));
+    legible += a.shown ? 1 : 0;
+    CHECK(a.box_origin.x >= 0.0f);
+    CHECK(a.box_origin.y >= 0.0f);
+    CHECK(a.box_origin.x + a.box_size.x <= float(size.width));
+    CHECK(a.box_origin.y + a.box_size.y <= float(size.height));
+    CHECK(a.box_size.y >= 12.0f);  // room for the 14-pixel font's lowercase and padding
+    for (size_t j = i + 1; j < frame.labels.size(); ++j) {
+      const LabelLayout& b = frame.labels[j];
+      const bool apart = a.box_origin.x + a.box_size.x <= b.box_origin.x ||
+                         b.box_origin.x + b.box_size.x <= a.box_origin.x ||
+                         a.box_origin.y + a.box_size.y <= b.box_origin.y ||
+                         b.box_origin.y + b.box_size.y <= a.box_origin.y;
+      CHECK_MESSAGE(apart, a.text << " overlaps " << b.text);
+    }
+  }
+  return legible;
+}
+
+}  // namespace
+
 TEST_SUITE("gpu") {
   // The same scene placed in rounds: every label on screen, none overlapping, most legible.
   TEST_CASE_FIXTURE(test::GpuTest, "head_demo_labels_placed_in_rounds_are_on_screen_and_apart") {
@@ -111,26 +142,7 @@ TEST_SUITE("gpu") {
     const LabelledFrame frame =
         render_labelled(ctx, scene, camera_for(scene, "oblique"), size, settings);
     REQUIRE(frame.labels.size() == scene.labels.size());
-    size_t legible = 0;
-    for (size_t i = 0; i < frame.labels.size(); ++i) {
-      const LabelLayout& a = frame.labels[i];
-      CAPTURE(a.text);
-      CHECK(a.placed);
-      legible += a.shown ? 1 : 0;
-      CHECK(a.box_origin.x >= 0.0f);
-      CHECK(a.box_origin.y >= 0.0f);
-      CHECK(a.box_origin.x + a.box_size.x <= float(size.width));
-      CHECK(a.box_origin.y + a.box_size.y <= float(size.height));
-      for (size_t j = i + 1; j < frame.labels.size(); ++j) {
-        const LabelLayout& b = frame.labels[j];
-        const bool apart = a.box_origin.x + a.box_size.x <= b.box_origin.x ||
-                           b.box_origin.x + b.box_size.x <= a.box_origin.x ||
-                           a.box_origin.y + a.box_size.y <= b.box_origin.y ||
-                           b.box_origin.y + b.box_size.y <= a.box_origin.y;
-        CHECK_MESSAGE(apart, a.text << " overlaps " << b.text);
-      }
-    }
-    CHECK(legible >= 5);
+    CHECK(check_on_screen_and_apart(frame, size) >= 5);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "head_demo_labels_are_all_on_screen_and_never_overlap") {
@@ -140,33 +152,11 @@ TEST_SUITE("gpu") {
       CAPTURE(camera);
       const LabelledFrame frame = render_labelled(ctx, scene, camera_for(scene, camera), size, {});
       REQUIRE(frame.labels.size() == scene.labels.size());
-      size_t legible = 0;
-      for (const LabelLayout& l : frame.labels) {
-        CAPTURE(l.text);
-        CHECK(l.placed);
-        CHECK(l.shown == (l.visible >= kLegibleShare));
-        legible += l.shown ? 1 : 0;
-        CHECK(l.box_origin.x >= 0.0f);
-        CHECK(l.box_origin.y >= 0.0f);
-        CHECK(l.box_origin.x + l.box_size.x <= float(size.width));
-        CHECK(l.box_origin.y + l.box_size.y <= float(size.height));
-        CHECK(l.box_size.y >= 12.0f);  // room for the 14-pixel font's lowercase and padding
-      }
       // Rear labels can still lie behind the head (the placement does not yet avoid them): the
       // count says so.
+      const size_t legible = check_on_screen_and_apart(frame, size);
       MESSAGE(legible << " of " << frame.labels.size() << " legible");
       CHECK(legible >= 5);
-      for (size_t i = 0; i < frame.labels.size(); ++i) {
-        for (size_t j = i + 1; j < frame.labels.size(); ++j) {
-          const LabelLayout& a = frame.labels[i];
-          const LabelLayout& b = frame.labels[j];
-          const bool apart = a.box_origin.x + a.box_size.x <= b.box_origin.x ||
-                             b.box_origin.x + b.box_size.x <= a.box_origin.x ||
-                             a.box_origin.y + a.box_size.y <= b.box_origin.y ||
-                             b.box_origin.y + b.box_size.y <= a.box_origin.y;
-          CHECK_MESSAGE(apart, a.text << " overlaps " << b.text);
-        }
-      }
       if (std::getenv("STRATA_KEEP_IMAGES")) {
         write_png(test::output_dir() + "/labelled-" + camera + ".png", size.width, size.height,
                   frame.image);
