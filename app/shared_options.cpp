@@ -2,7 +2,6 @@
 // queue), and the checks that run over a whole command's options.
 #include <algorithm>
 #include <cstdlib>
-#include <map>
 #include <string>
 
 #include "app/commands.h"
@@ -77,13 +76,15 @@ void add_hard_option(CLI::App* cmd, bool& hard) {
 }
 
 void add_greedy_option(CLI::App* cmd, PlacementMethod& method) {
-  static const std::map<std::string, PlacementMethod> names{
-      {"rounds", PlacementMethod::rounds}, {"sequential", PlacementMethod::sequential}};
-  cmd->add_option("--greedy", method,
-                  "how the greedy placement decides the labels: sequential (one by one in "
-                  "insertion order, the thesis's loop) or rounds (in parallel rounds: faster on a "
-                  "GPU, fewer labels shown in crowded pictures)")
-      ->transform(CLI::CheckedTransformer(names, CLI::ignore_case))
+  cmd->add_option_function<std::string>(
+         "--greedy",
+         [&method](const std::string& name) {
+           method = name == "rounds" ? PlacementMethod::rounds : PlacementMethod::sequential;
+         },
+         "how the greedy placement decides the labels: sequential (one by one in insertion "
+         "order, the thesis's loop) or rounds (in parallel rounds: faster on a GPU, fewer labels "
+         "shown in crowded pictures)")
+      ->check(CLI::IsMember({"sequential", "rounds"}))
       ->default_str("sequential");
 }
 
