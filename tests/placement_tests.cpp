@@ -661,7 +661,17 @@ TEST_SUITE("gpu") {
         const ReferenceRounds cpu = rounds_reference(in.labels, in.order, gpu.tables, settings,
                                                      in.size, in.layer_count, in.group_first);
         const auto n = uint32_t(in.labels.size());
-        CHECK(std::vector(gpu.results.begin(), gpu.results.begin() + n) == cpu.results);
+        // (the same pixels everywhere; the same cost bits on a CPU device, whose float
+        // arithmetic is the reference's: a GPU's square roots may differ in the last bits)
+        const bool cpu_device = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+        for (uint32_t i = 0; i < n; ++i) {
+          CAPTURE(i);
+          CHECK(uint32_t(gpu.results[i]) == uint32_t(cpu.results[i]));
+          const float a = glm::uintBitsToFloat(uint32_t(gpu.results[i] >> 32));
+          const float b = glm::uintBitsToFloat(uint32_t(cpu.results[i] >> 32));
+          if (cpu_device || cpu.results[i] == PLACEMENT_NONE) CHECK(gpu.results[i] == cpu.results[i]);
+          else CHECK(std::abs(a - b) <= 1e-5f * std::max(1.0f, std::abs(b)));
+        }
         CHECK(std::vector(gpu.round_of.begin(), gpu.round_of.begin() + n) == cpu.round_of);
         const auto used = uint32_t(cpu.undecided.size());
         CHECK(std::vector(gpu.round_counts.begin(), gpu.round_counts.begin() + used) ==
