@@ -1,12 +1,13 @@
-// Included by place_label.comp: the MAIN and SPEC workgroups of dispatch j, which evaluate tiles
-// of 32x32 candidates: the main pass's tiles of the label at order position j - 1 and the
-// speculative pass's of the label at position j. Each invocation takes PLACE_SPAN_X x
-// PLACE_SPAN_Y candidates; a tile's constraints are culled once for all of them (cull), and the
-// workgroup returns its lowest (cost, pixel).
+// Included by place_label.comp (its MAIN and SPEC workgroups: the main pass's tiles of the label
+// at order position j - 1, the speculative pass's of the label at position j) and by
+// place_rounds.comp (EVALUATE): a workgroup evaluates a tile of 32x32 candidates. Each
+// invocation takes PLACE_SPAN_X x PLACE_SPAN_Y candidates; a tile's constraints are culled once
+// for all of them (cull), and the workgroup returns its lowest (cost, pixel). The includer says
+// which labels constrain: `placed` of them, regions_of(position, s) against the s-th.
 
-// The tile's candidate-reaching placed labels and anchors of the chunk from `from` (order
-// positions of placed labels, indices of anchors), and the constraints all of its candidates have
-// (the shared counts start at 0; a barrier follows).
+// The tile's candidate-reaching placed labels and anchors of the chunk from `from` (placed labels
+// by the includer's numbering, indices of anchors), and the constraints all of its candidates
+// have (the shared counts start at 0; a barrier follows).
 void cull(LabelGpu me, uvec2 tile, uint from) {
   vec2 centre, extent;
   tile_centres(me, tile, centre, extent);
