@@ -292,19 +292,23 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                     fill(b.samples, 0xFFFFFFFFu);
                     // (indirect: no round runs until the one before sizes it)
                     fill(b.tidy_args, 0);
-                    // The rounds: every label undecided; each round's search sized by its list.
-                    record_update(pc.cmd, pc.buffer(b.ranks), 0, as_bytes(ranks_));
-                    fill(b.round_of, ROUND_UNDECIDED);
-                    fill(b.round_done, 0);
-                    std::vector<uint32_t> args(ROUNDS_MAX * 3, 1u);
-                    for (uint32_t r = 0; r < ROUNDS_MAX; ++r) {
-                      args[3 * r] = round_groups(pc.viewport);
-                      args[3 * r + 1] = 0;
+                    // The rounds, where the frame places in them: every label undecided; each
+                    // recorded round's search sized by its list.
+                    if (settings_.method == PlacementMethod::rounds) {
+                      record_update(pc.cmd, pc.buffer(b.ranks), 0, as_bytes(ranks_));
+                      fill(b.round_of, ROUND_UNDECIDED);
+                      fill(b.round_done, 0);
+                      const uint32_t rounds = round_count();
+                      std::vector<uint32_t> args(rounds * 3, 1u);
+                      for (uint32_t r = 0; r < rounds; ++r) {
+                        args[3 * r] = round_groups(pc.viewport);
+                        args[3 * r + 1] = 0;
+                      }
+                      record_update(pc.cmd, pc.buffer(b.round_args), 0, as_bytes(args));
+                      std::vector<uint32_t> counts(rounds + 1, 0u);
+                      counts[0] = uint32_t(order_.size());
+                      record_update(pc.cmd, pc.buffer(b.round_counts), 0, as_bytes(counts));
                     }
-                    record_update(pc.cmd, pc.buffer(b.round_args), 0, as_bytes(args));
-                    std::vector<uint32_t> counts(ROUNDS_MAX + 1, 0u);
-                    counts[0] = uint32_t(order_.size());
-                    record_update(pc.cmd, pc.buffer(b.round_counts), 0, as_bytes(counts));
                     // (placement.regions needs none: the loop writes each pair, from the placed
                     // label's result, before a later label reads it; a label never placed
                     // writes regions that constrain nobody)
