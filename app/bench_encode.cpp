@@ -1,6 +1,7 @@
 // `strata bench encode`: how fast `strata video` compresses its frames, without a GPU: frames of
-// a made-up picture through the same FrameWriter, to PNG (worker threads) and to an H.264 MP4,
-// frames a second for each as JSON. The same command on two machines compares their CPUs alone.
+// a made-up picture through the same FrameWriter, to PNG (worker threads), to an H.264 MP4 and to
+// a GIF, frames a second for each as JSON. The same command on two machines compares their CPUs
+// alone.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -164,6 +165,7 @@ void bench_encode(const EncodeBenchOptions& o) {
   out["hardware_threads"] = std::thread::hardware_concurrency();
   out["png"] = run_json(png, o.frames);
   out["mp4"] = nullptr;
+  out["gif"] = nullptr;
   std::fprintf(stderr, "bench encode: %u frames of %ux%u, %u thread%s: PNG %.2f frames/s", o.frames,
                size.width, size.height, settings.threads, settings.threads == 1 ? "" : "s",
                o.frames / png.seconds);
@@ -171,9 +173,13 @@ void bench_encode(const EncodeBenchOptions& o) {
     settings.format = FrameWriter::Format::mp4;
     const EncodeRun mp4 = encode(panorama, o.frames, folder.path / "video.mp4", settings);
     out["mp4"] = run_json(mp4, o.frames);
-    std::fprintf(stderr, ", MP4 %.2f frames/s\n", o.frames / mp4.seconds);
+    settings.format = FrameWriter::Format::gif;
+    const EncodeRun gif = encode(panorama, o.frames, folder.path / "video.gif", settings);
+    out["gif"] = run_json(gif, o.frames);
+    std::fprintf(stderr, ", MP4 %.2f frames/s, GIF %.2f frames/s\n", o.frames / mp4.seconds,
+                 o.frames / gif.seconds);
   } else {
-    std::fprintf(stderr, "; MP4 not built (STRATA_VIDEO=OFF)\n");
+    std::fprintf(stderr, "; MP4 and GIF not built (STRATA_VIDEO=OFF)\n");
   }
   print_report(out);
 }
@@ -184,7 +190,8 @@ void bench_encode(const EncodeBenchOptions& o) {
 void add_encode_bench(CLI::App* bench) {
   auto o = std::make_shared<bench::EncodeBenchOptions>();
   CLI::App* cmd = bench->add_subcommand(
-      "encode", "CPU only: frames/s of `strata video`'s PNG and MP4 writers on a made-up picture");
+      "encode",
+      "CPU only: frames/s of `strata video`'s PNG, MP4 and GIF writers on a made-up picture");
   cmd->add_option("--size", o->size, "N or WxH")->capture_default_str();
   cmd->add_option("--frames", o->frames, "frames written to each")
       ->check(whole_range(1, 100000))

@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "engine/core/background.h"
 #include "engine/core/error.h"
 #include "engine/gpu/context.h"
 #include "engine/graph/render_graph.h"
@@ -114,6 +115,11 @@ void add_hard_option(CLI::App* cmd, bool& hard);
 void add_greedy_option(CLI::App* cmd, PlacementMethod& method);
 // The ghosting asked for: the options, else the scene's settings.
 Ghosting look_ghosting(const LabelLookOptions& o, const Scene& scene);
+
+// --background's black, white, transparent or #rrggbb; a UsageError naming the option otherwise.
+Background parse_background(const std::string& text);
+// --background (render, video, view): the picture's background, parse_background's.
+void add_background_option(CLI::App* cmd, Background& background);
 
 // "1024" or "1024x768"; throws UsageError naming the option when it is neither or a side is outside
 // 1 to 16384 (the device's own limit is checked when it is open: check_image_size).

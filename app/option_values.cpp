@@ -1,6 +1,7 @@
-// Option values the commands share the reading of: lists of numbers, sizes, windows and camera
-// positions, each refused as a usage error that names the option.
+// Option values the commands share the reading of: lists of numbers, sizes, windows, backgrounds
+// and camera positions, each refused as a usage error that names the option.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -45,6 +46,22 @@ Camera option_camera(const Scene& scene, const std::string& name, const char* op
   } catch (const Error& e) {
     throw UsageError(std::string(option) + ": " + e.what());
   }
+}
+
+Background parse_background(const std::string& text) {
+  if (text == "black") return {};
+  if (text == "white") return {glm::vec3(1.0f)};
+  if (text == "transparent") return {glm::vec3(0.0f), true};
+  const bool hex = text.size() == 7 && text[0] == '#' &&
+                   std::all_of(text.begin() + 1, text.end(),
+                               [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
+  if (!hex) {
+    throw UsageError("--background: '" + text +
+                     "' is not a background (black, white, transparent or #rrggbb)");
+  }
+  const unsigned long rgb = std::stoul(text.substr(1), nullptr, 16);
+  return {glm::vec3(float((rgb >> 16) & 255u), float((rgb >> 8) & 255u), float(rgb & 255u)) /
+          255.0f};
 }
 
 graph::Extent parse_size(const std::string& text, const char* option) {

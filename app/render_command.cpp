@@ -31,6 +31,7 @@ struct RenderOptions {
   PlacementMethod greedy = PlacementMethod::sequential;
   bool internal = false;
   LabelLookOptions look;
+  Background background;
   bool decoret = false;
   std::string order = "scene";
   std::string layout;
@@ -120,6 +121,7 @@ LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene)
   settings.label_scale = o.look.label_scale;
   settings.layer_colors = o.look.layer_colors;
   settings.ghost = look_ghosting(o.look, scene);
+  settings.background = o.background;
   if (o.order == "apollonius") settings.order = InsertionOrder::apollonius;
   if (o.order == "optimized") settings.order = InsertionOrder::optimized;
   if (o.decoret) {  // Stein & Decoret's setting, as the thesis compares against it
@@ -209,7 +211,8 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
   SceneRender job(device, o);
   Context& ctx = job.ctx;
   const graph::Extent size = job.size;
-  const RenderSettings settings = render_settings(o, job.scene);
+  RenderSettings settings = render_settings(o, job.scene);
+  settings.background = o.background;  // (no placement reads this picture)
   VolumeRenderer renderer(ctx, job.scene, settings);
   HeadlessTarget target(ctx);
   graph::Graph graph;
@@ -281,6 +284,7 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   add_greedy_option(cmd, o->greedy);
   cmd->add_flag("--internal", o->internal, "internal labelling: labels drawn on their anchors");
   add_label_look_options(cmd, o->look);
+  add_background_option(cmd, o->background);
   cmd->add_option("--order", o->order,
                   "insertion order: scene, apollonius (Stein & Decoret, innermost first) or "
                   "optimized (random orders, the best kept)")
@@ -302,6 +306,9 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
     } catch (const Error& e) {
       throw UsageError(std::string("-o: ") + e.what());
     }
+    if (o->background.transparent && !image_keeps_alpha(o->output))
+      throw UsageError("--background transparent: " + o->output +
+                       ": JPEG has no alpha; write a PNG");
     check_options_apply(cmd, !o->scene.file.empty(), {"--output", "--size", "--dump-graph"},
                         {"--blur"});
     if (o->scene.file.empty()) {

@@ -88,6 +88,15 @@ void add_greedy_option(CLI::App* cmd, PlacementMethod& method) {
       ->default_str("sequential");
 }
 
+void add_background_option(CLI::App* cmd, Background& background) {
+  cmd->add_option_function<std::string>(
+         "--background",
+         [&background](const std::string& text) { background = parse_background(text); },
+         "what the picture shows where the scene and labels leave it empty: black, white, #rrggbb "
+         "or transparent (PNG only, with alpha); the labels are placed alike on any")
+      ->default_str("black");
+}
+
 void add_label_look_options(CLI::App* cmd, LabelLookOptions& o) {
   cmd->add_option("--label-scale", o.label_scale, "label text and boxes times this (0.25 to 4)")
       ->check(finite_range(0.25, 4.0))

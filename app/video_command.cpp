@@ -2,10 +2,10 @@
 // seconds, with the labels moved by the forces between frames (a fixed time step, so the same
 // command gives the same frames). By default the path is first rehearsed without writing a frame
 // and each label's active ranges planned over all of it (labeling/video_plan.h); `--plan off`
-// places every frame as the viewer would. Frames go into an H.264 MP4 (-o NAME.mp4) or a folder
-// as a numbered PNG sequence, and with --layout-dir each frame's layout as JSON (for `strata
-// eval`), with --still-layouts a still placement's of the same camera, and with --report the
-// layout-quality summary of `strata eval` over the frames at the end.
+// places every frame as the viewer would. Frames go into an H.264 MP4 (-o NAME.mp4), a looping GIF
+// (-o NAME.gif) or a folder as a numbered PNG sequence, and with --layout-dir each frame's layout
+// as JSON (for `strata eval`), with --still-layouts a still placement's of the same camera, and
+// with --report the layout-quality summary of `strata eval` over the frames at the end.
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -45,6 +45,7 @@ struct VideoOptions {
   PlacementMethod greedy = PlacementMethod::sequential;
   bool plan = true;  // --plan: the labels' ranges planned over the whole path first
   LabelLookOptions look;
+  Background background;
   ForceSettings forces;
   float layer_margin = LayerHysteresis{}.margin;
   uint32_t tidy_rounds = PlacementSettings{}.tidy_rounds;
@@ -67,17 +68,27 @@ CameraPath camera_path(const Scene& scene, const VideoOptions& o) {
   return orbit_path(scene, option_camera(scene, o.camera), o.orbit, seconds);
 }
 
-// -o: NAME.mp4, or a folder for PNG frames (no extension, or one that exists). Anything else
-// (x.avi) is a usage error, not a folder of PNGs nobody asked for.
-bool is_mp4(const std::filesystem::path& output) {
+// -o: NAME.mp4, NAME.gif, or a folder for PNG frames (no extension, or one that exists). Anything
+// else (x.avi) is a usage error, not a folder of PNGs nobody asked for; so is a transparent
+// background in a video, which keeps no alpha.
+FrameWriter::Format output_format(const std::filesystem::path& output,
+                                  const Background& background) {
   std::string extension = output.extension().string();
   for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".mp4") return true;
+  if (extension == ".mp4" || extension == ".gif") {
+    if (background.transparent) {
+      throw UsageError("--background transparent: " + output.string() +
+                       " keeps no alpha; write PNG frames to a folder");
+    }
+    return extension == ".gif" ? FrameWriter::Format::gif : FrameWriter::Format::mp4;
+  }
   std::error_code error;
-  if (extension.empty() || std::filesystem::is_directory(output, error)) return false;
+  if (extension.empty() || std::filesystem::is_directory(output, error))
+    return FrameWriter::Format::png_folder;
   throw UsageError("-o: '" + output.string() + "': cannot write a video as '" +
                    output.extension().string() +
-                   "' (expected NAME.mp4, or a folder without an extension for PNG frames)");
+                   "' (expected NAME.mp4, NAME.gif, or a folder without an extension for PNG "
+                   "frames)");
 }
 
 // A frame's layout as `strata eval` reads it (the JSON parsed back, so that a plan and the report
@@ -104,6 +115,7 @@ LabellingSettings labelling_settings(const Scene& scene, const VideoOptions& o) 
   settings.label_scale = o.look.label_scale;
   settings.layer_colors = o.look.layer_colors;
   settings.ghost = look_ghosting(o.look, scene);
+  settings.background = o.background;
   settings.forces = o.forces;
   settings.forces.anchor_relative = !o.screen_space;
   settings.hysteresis.margin = o.layer_margin;
@@ -130,9 +142,9 @@ unsigned writer_threads(const Context& ctx, const VideoOptions& o) {
   return ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 1 : default_frame_threads();
 }
 
-FrameWriter::Settings writer_settings(const Context& ctx, bool mp4, graph::Extent size,
-                                      const VideoOptions& o) {
-  return {.format = mp4 ? FrameWriter::Format::mp4 : FrameWriter::Format::png_folder,
+FrameWriter::Settings writer_settings(const Context& ctx, FrameWriter::Format format,
+                                      graph::Extent size, const VideoOptions& o) {
+  return {.format = format,
           .width = size.width,
           .height = size.height,
           .fps = o.fps,
@@ -164,19 +176,19 @@ void print_written(const VideoOptions& o, graph::Extent size, size_t frames, dou
 }
 
 // The folders of numbered files the video writes: PNG frames (-o FOLDER) and layouts.
-std::vector<FrameFolder> frame_folders(const VideoOptions& o, bool mp4) {
+std::vector<FrameFolder> frame_folders(const VideoOptions& o, bool video) {
   std::vector<FrameFolder> folders;
-  if (!mp4) folders.push_back({"-o", o.output, "png"});
+  if (!video) folders.push_back({"-o", o.output, "png"});
   if (!o.layout_dir.empty()) folders.push_back({"--layout-dir", o.layout_dir, "json"});
   if (!o.still_layouts.empty()) folders.push_back({"--still-layouts", o.still_layouts, "json"});
   return folders;
 }
 
 // Every output is checked before anything renders; then the folders are made and cleared of an
-// earlier run's frames before the video is opened, so a folder that cannot be made leaves no MP4.
-void prepare_outputs(const VideoOptions& o, bool mp4, size_t frames) {
-  const std::vector<FrameFolder> folders = frame_folders(o, mp4);
-  if (mp4) check_output_file("-o", o.output);
+// earlier run's frames before the video is opened, so a folder that cannot be made leaves no video.
+void prepare_outputs(const VideoOptions& o, bool video, size_t frames) {
+  const std::vector<FrameFolder> folders = frame_folders(o, video);
+  if (video) check_output_file("-o", o.output);
   for (const FrameFolder& f : folders) f.check(frames);
   // (the frames' layouts and the stills' have the same names)
   const auto same = [](const std::filesystem::path& a, const std::filesystem::path& b) {
@@ -274,18 +286,19 @@ ActiveRanges plan_video(const PathDrawing& d) {
 void video(DeviceOptions& device, const VideoOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
   const std::filesystem::path output = o.output;
-  const bool mp4 = is_mp4(output);
+  const FrameWriter::Format format = output_format(output, o.background);
+  const bool video_file = format != FrameWriter::Format::png_folder;
   Context ctx(device.context());
   const Scene scene = load_scene_reporting(o.scene, ctx);
   const std::vector<Camera> cameras = sampled_cameras(camera_path(scene, o), o.fps);
-  prepare_outputs(o, mp4, cameras.size());
+  prepare_outputs(o, video_file, cameras.size());
   const PathDrawing drawing{ctx, scene, cameras, size, labelling_settings(scene, o), o};
   std::optional<PlanFollower> follower;
   if (o.plan) follower.emplace(plan_video(drawing), label_ids(scene));
 
-  // Frames are compressed on worker threads while the next one renders; an MP4 goes to a
-  // temporary file, put in place by finish(): an error on the way leaves no MP4.
-  FrameWriter writer(output, writer_settings(ctx, mp4, size, o));
+  // Frames are compressed on worker threads while the next one renders; a video goes to a
+  // temporary file, put in place by finish(): an error on the way leaves no video.
+  FrameWriter writer(output, writer_settings(ctx, format, size, o));
   Progress progress("frame", cameras.size());
   // --still-layouts: a second renderer places every frame's camera afresh, as a still.
   std::unique_ptr<LabelledRenderer> still;
@@ -333,7 +346,8 @@ void add_path_and_output_options(CLI::App* cmd, const std::shared_ptr<VideoOptio
       ->check(finite_range(1.0, 240.0))
       ->capture_default_str();
   cmd->add_option("--size", o->size, "image size, N or WxH")->capture_default_str();
-  cmd->add_option("-o,--output", o->output, "NAME.mp4 (H.264), or a folder for PNG frames")
+  cmd->add_option("-o,--output", o->output,
+                  "NAME.mp4 (H.264), NAME.gif (looping, one palette), or a folder for PNG frames")
       ->required();
   cmd->add_option("--layout-dir", o->layout_dir, "folder for each frame's layout JSON");
   cmd->add_option("--still-layouts", o->still_layouts,
@@ -363,6 +377,7 @@ void add_placement_options(CLI::App* cmd, const std::shared_ptr<VideoOptions>& o
   add_hard_option(cmd, o->hard);
   add_greedy_option(cmd, o->greedy);
   add_label_look_options(cmd, o->look);
+  add_background_option(cmd, o->background);
 }
 
 // How the labels move from frame to frame (labeling/forces.h).

@@ -44,6 +44,7 @@ struct ViewOptions {
   std::string placement = "auto";
   std::optional<double> frame_budget;  // ms; none: by the device's type
   float label_scale = 1.0f;            // times the display's content scale
+  Background background;
 };
 
 struct Window {
@@ -240,6 +241,7 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   settings.ghost.radius = scene.settings.ghost_radius;
   // HiDPI: label text and boxes follow the display's content scale, as the panel does.
   settings.label_scale = std::clamp(o.label_scale * std::max(scale_x, scale_y), 0.25f, 4.0f);
+  settings.background = o.background;
   ViewerOptions options;
   options.scene_path = o.scene.file;
   options.screenshot_dir = o.screenshot_dir;
@@ -348,11 +350,14 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
                   "label text and boxes times this and the display's content scale (0.25 to 4)")
       ->check(finite_range(0.25, 4.0))
       ->capture_default_str();
+  add_background_option(cmd, o->background);
   cmd->add_option("--blur", o->blur, "test pattern only: box-filter radius of its right half")
       ->check(whole_range(0, 16384))
       ->capture_default_str();
   cmd->callback([cmd, &device, o] {
     const graph::Extent size = parse_size(o->size, "--size");
+    if (o->background.transparent)
+      throw UsageError("--background transparent: a window shows no alpha; give a colour");
     check_options_apply(cmd, !o->scene.file.empty(), {"--size", "--frames", "--frames-in-flight"},
                         {"--blur"});
     if (o->scene.file.empty()) {

@@ -403,7 +403,7 @@ void LabelledRenderer::build_graph() {
                             .placements = moved.drawn,
                             .glyphs = glyph_buffer,
                             .output = labelled,
-                            .background = render.background,
+                            .background = settings_.background,
                             .ghost = graph_ghost_,
                             .depth = rendered.depth,
                             .frame = rendered.frame,

@@ -62,6 +62,9 @@ struct LabellingSettings {
   uint32_t spare_label_slots = 0;
   uint64_t seed = 1;      // k-means++
   RenderSettings render;  // its layer_count and splits come from the layering
+  // The picture's, under the labels' composite; the placement reads the scene over
+  // render.background (black), so a layout is the same on any picture background.
+  Background background;
 };
 
 // A layer image array (rgba16f, premultiplied) read back after the frame: layer after layer.

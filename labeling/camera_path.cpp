@@ -228,6 +228,20 @@ CameraPath orbit_path(const Scene& scene, const Camera& start, double degrees, d
   return path;
 }
 
+bool CameraPath::loops() const {
+  if (keys.size() < 2 || !(duration() > 0.0)) return false;
+  // (a full turn comes back only to the float rounding of its view matrix)
+  const glm::mat4 start = keys.front().camera.view, end = at(duration()).view;
+  float scale = 1.0f, difference = 0.0f;
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      scale = std::max(scale, std::abs(start[c][r]));
+      difference = std::max(difference, std::abs(start[c][r] - end[c][r]));
+    }
+  }
+  return difference <= 1e-5f * scale;
+}
+
 double sampled_frames(const CameraPath& path, double fps) {
   return std::round(path.duration() * fps) + 1.0;
 }
@@ -245,6 +259,8 @@ std::vector<Camera> sample(const CameraPath& path, double fps) {
     // The last frame lands on the end exactly, whatever the rounding of duration * fps.
     frames.push_back(path.at(path.duration() * double(i) / double(intervals)));
   }
+  // Played in a loop, the first frame follows the last a step later, as every other frame.
+  if (frames.size() > 1 && path.loops()) frames.pop_back();
   return frames;
 }
 

@@ -38,6 +38,9 @@ struct CameraPath {
   double duration() const { return keys.empty() ? 0.0 : keys.back().time; }
   // The camera at `seconds`, clamped to [0, duration()]: exactly the key's pose at a key's time.
   Camera at(double seconds) const;
+  // Whether it moves and ends where it starts (a turntable of whole turns, a path back to its
+  // first position): its video loops.
+  bool loops() const;
 };
 
 // The name a path gives the scene's own camera (`Scene::camera`), unless the scene has a position
@@ -64,8 +67,9 @@ CameraPath parse_camera_path(const Scene& scene, const std::string& text);
 CameraPath orbit_path(const Scene& scene, const Camera& start, double degrees, double seconds);
 
 // The frames of a video at `fps`: round(duration * fps) + 1 cameras, evenly spaced from t = 0 to
-// t = duration (so exactly 1 / fps apart when duration * fps is whole). A looping video (a full
-// turn) drops the last frame, which repeats the first. One frame for a path of one position.
+// t = duration (so exactly 1 / fps apart when duration * fps is whole). A looping path
+// (CameraPath::loops) drops the last frame, which repeats the first. One frame for a path of one
+// position.
 // An Error, before any allocation, past kMaxVideoFrames or for an fps that is not positive.
 std::vector<Camera> sample(const CameraPath& path, double fps);
 // The frames sample() would give (before a looping video drops its last): duration * fps + 1.

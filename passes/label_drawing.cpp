@@ -31,6 +31,7 @@ struct LabelDrawReference {
   }
   LabelGpu label_at(uint i) const { return data.labels[i]; }
   bool layer_frames() const { return data.layer_frames; }
+  bool connector_halos() const { return data.connector_halos; }
   float anchor_hidden_at(uint i) const {
     return i < data.covers.size() ? data.covers[i].hidden : 0.0f;
   }
@@ -122,14 +123,19 @@ void LabelDrawing::bind(graph::GraphRunner& runner) const {
   }
 }
 
+bool connector_halos(const Background& background) {
+  const float luminance = glm::dot(background.color, glm::vec3(0.2126f, 0.7152f, 0.0722f));
+  return background.transparent || luminance > 0.5f;
+}
+
 gpu::LabelDrawParams LabelDrawing::params(graph::Extent viewport) const {
   return {viewport.width,
           viewport.height,
           layer_count_,
           label_count_,
-          glm::vec4(background_, 1.0f),
+          background_rgba(background_),
           layer_frames_ ? 1u : 0u,
-          0u,
+          connector_halos(background_) ? 1u : 0u,
           0u,
           0u};
 }
@@ -302,7 +308,7 @@ std::vector<gpu::AnchorCoverGpu> anchor_cover_reference(std::span<const glm::vec
 }
 
 std::vector<uint8_t> composite_reference(std::span<const glm::vec4> layers, graph::Extent size,
-                                         uint32_t layer_count, glm::vec3 background,
+                                         uint32_t layer_count, const Background& background,
                                          const LabelDrawData& data) {
   check_layers(layers, size, layer_count);
   const size_t pixels = size_t{size.width} * size.height;
@@ -316,7 +322,7 @@ std::vector<uint8_t> composite_reference(std::span<const glm::vec4> layers, grap
       front[l] = accumulated.a;
       accumulated = gpu::label_over(accumulated, layers[l * pixels + p]);
     }
-    glm::vec4 c = gpu::label_over_background(accumulated, background);
+    glm::vec4 c = gpu::over_background(accumulated, background_rgba(background));
     const glm::vec2 centre(float(p % size.width) + 0.5f, float(p / size.width) + 0.5f);
     for (size_t i = 0; i < count; ++i) {
       const gpu::LabelGpu& label = data.labels[i];
@@ -324,8 +330,9 @@ std::vector<uint8_t> composite_reference(std::span<const glm::vec4> layers, grap
       const float hidden = i < data.covers.size() ? data.covers[i].hidden : 0.0f;
       const glm::vec4 behind =
           gpu::label_behind(label, data.placements[i], centre, front[label.layer], hidden);
-      c = glm::vec4(glm::vec3(gpu::label_over(behind, c)), 1.0f);
+      c = gpu::label_over_composite(behind, c);
     }
+    c = gpu::straight_alpha(c);
     for (int ch = 0; ch < 4; ++ch) {
       out.push_back(static_cast<uint8_t>(std::lround(glm::clamp(c[ch], 0.0f, 1.0f) * 255.0f)));
     }

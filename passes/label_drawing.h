@@ -8,6 +8,7 @@
 //                        mark; dashed and hollow where the anchor is hidden) over the layer's
 //                        content, in place
 //   labels.composite     the layers front to back over the background into an rgba8 image
+//                        (straight alpha: opaque unless the background is none)
 // The shapes and the per-pixel loop are shared with the CPU reference below
 // (shaders/shared/label_drawing.h, label_draw_pixel.h).
 #pragma once
@@ -19,6 +20,7 @@
 
 #include <glm/glm.hpp>
 
+#include "engine/core/background.h"
 #include "engine/core/font.h"
 #include "engine/core/image_atlas.h"
 #include "engine/gpu/resources.h"
@@ -41,6 +43,10 @@ struct GhostSettings {
 gpu::GhostParams ghost_params(const GhostSettings& ghost, graph::Extent size, uint32_t layer_count,
                               uint32_t label_count);
 
+// Whether solid connectors get a dark halo on this background: on a light one (or none, which any
+// page may show through) a white line alone is lost. Black keeps the thesis's look.
+bool connector_halos(const Background& background);
+
 class LabelDrawing {
  public:
   // Uploads the font's atlas and the labels' pictures once.
@@ -55,7 +61,7 @@ class LabelDrawing {
     graph::ResourceId placements;  // PlacementGpu[], one per label, with content
     graph::ResourceId glyphs;      // GlyphGpu[], with content
     graph::ResourceId output;      // a viewport-sized rgba8 image the composite overwrites
-    glm::vec3 background{0.0f};
+    Background background;    // under the composite (the placement never sees it)
     bool ghost = false;       // with the ghosting pass (its settings: set_ghost)
     graph::ResourceId depth;  // the renderer's r32f depth image (VolumeRenderer::Outputs)
     graph::ResourceId frame;  // the renderer's FrameGpu: layer splits, ray step, depth_alpha
@@ -77,7 +83,7 @@ class LabelDrawing {
   // How many labels of the labels buffer to draw (read when the graph is recorded); the shader
   // never reads past the end of the labels or placements buffer either way.
   void set_label_count(uint32_t count) { label_count_ = count; }
-  void set_background(glm::vec3 background) { background_ = background; }
+  void set_background(const Background& background) { background_ = background; }
   // Borders in their layer's colour (LABEL_LAYER_COLORS), read when the graph is recorded.
   void set_layer_frames(bool on) { layer_frames_ = on; }
   // Ghosting's settings, read when the graph is recorded (strength 0: the pass records nothing).
@@ -96,7 +102,7 @@ class LabelDrawing {
   GhostSettings ghost_;
   uint32_t layer_count_ = 0;
   uint32_t label_count_ = LABEL_MAX;
-  glm::vec3 background_{0.0f};
+  Background background_;
   bool layer_frames_ = false;
 };
 
@@ -108,6 +114,7 @@ struct LabelDrawData {
   bool layer_frames = false;  // as LabelDrawing::set_layer_frames
   // What hides each label's anchor (anchor_cover_reference); none: every anchor is seen.
   std::span<const gpu::AnchorCoverGpu> covers = {};
+  bool connector_halos = false;  // as connector_halos() of LabelDrawing's background
 };
 
 // labels.draw on the CPU. `layers` holds layer_count images of `size`, layer after layer, rows
@@ -132,10 +139,10 @@ std::vector<glm::vec4> ghost_reference(std::span<const glm::vec4> layers, graph:
                                        uint32_t layer_count, const LabelDrawData& data,
                                        const GhostSettings& ghost);
 
-// labels.composite on the CPU: rgba8, rows top to bottom, with the rear labels' connectors and
-// anchors drawn again where the layers in front hide them (label_behind).
+// labels.composite on the CPU: rgba8 (straight alpha), rows top to bottom, with the rear labels'
+// connectors and anchors drawn again where the layers in front hide them (label_behind).
 std::vector<uint8_t> composite_reference(std::span<const glm::vec4> layers, graph::Extent size,
-                                         uint32_t layer_count, glm::vec3 background,
+                                         uint32_t layer_count, const Background& background,
                                          const LabelDrawData& data);
 
 }  // namespace strata

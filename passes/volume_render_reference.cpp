@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "shared/background.h"
 #include "shared/resolve_walk_access.h"
 #include "shared/volume_shading.h"
 
@@ -192,7 +193,8 @@ ReferenceImage render_reference(const RenderInputs& inputs, const Camera& camera
       glm::vec4 all(0.0f);
       for (uint32_t l = 0; l < settings.layer_count; ++l)
         all = gpu::over(all, image.layers[l * pixels + p]);
-      image.final[p] = glm::vec4(glm::vec3(all) + (1.0f - all.a) * settings.background, 1.0f);
+      image.final[p] =
+          gpu::straight_alpha(gpu::over_background(all, background_rgba(settings.background)));
       image.depth[p] = r.depth;
       image.samples += r.samples;
       image.shaded += r.shaded;

@@ -388,7 +388,7 @@ gpu::FrameGpu frame_data(const RenderInputs& in, const Camera& camera,
   f.clip_to_view = glm::inverse(projection);
   const std::vector<float> splits = split_depths(in, camera, settings);
   for (size_t i = 0; i < splits.size(); ++i) f.splits[i / 4][int(i % 4)] = splits[i];
-  f.background = glm::vec4(settings.background, 1.0f);
+  f.background = background_rgba(settings.background);
   f.width = e.width;
   f.height = e.height;
   f.layer_count = settings.layer_count;

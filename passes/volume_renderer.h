@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/core/background.h"
 #include "engine/gpu/resources.h"
 #include "engine/gpu/shader_library.h"
 #include "engine/graph/graph_runner.h"
@@ -31,7 +32,9 @@ struct RenderSettings {
   bool skip_empty = true;     // empty-space skipping with the per-volume brick grids
   float termination_alpha = 0.99f;
   float depth_alpha = 0.5f;
-  glm::vec3 background{0.0f};
+  // The final image's (render --no-labels): a labelled frame's placement reads that image, so
+  // LabelledRenderer leaves it black and puts its own under the labels' composite.
+  Background background;
   float expected_depth_complexity = 4.0f;  // HA-Buffer sizing: mesh fragments per pixel expected
   float load_factor = 0.5f;                // ... and the share of slots they should fill
   // Interactive rendering (shared/upscale.h): the graph casts rays into lower-resolution images

@@ -19,8 +19,9 @@ packages=(
   fonts-wqy-microhei
   # file formats: gzip, DICOM, meshes, JSON, XML, JPEG (label pictures)
   zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev libjpeg62-turbo-dev
-  # videos: H.264 in MP4 through FFmpeg's libraries; ffprobe checks them in the tests
-  libavcodec-dev libavformat-dev libswscale-dev libavutil-dev ffmpeg
+  # videos: H.264 in MP4 and GIF (palettes by libavfilter) through FFmpeg's libraries; ffprobe
+  # checks them in the tests
+  libavcodec-dev libavformat-dev libavfilter-dev libswscale-dev libavutil-dev ffmpeg
   # the label writer's test validates its markups JSON against 3D Slicer's schema
   python3-jsonschema
   # the DICOM SEG reader's test opens a Segmentation that pydicom writes (with numpy's arrays)

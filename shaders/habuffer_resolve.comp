@@ -13,6 +13,7 @@
 #else
 #define VR_RESOLVE_MESHES (frame.mesh_count > 0u)
 #endif
+#include "shared/background.h"
 #include "shared/volume_shading.h"
 #include "resolve_scene.glsl"
 
@@ -59,7 +60,6 @@ void main() {
     atomicAdd(counters[VR_COUNTER_FETCHES], fetches);
   }
   if (!inside) return;
-  imageStore(final_image, ivec2(px),
-             vec4(all_layers.rgb + (1.0 - all_layers.a) * frame.background.rgb, 1.0));
+  imageStore(final_image, ivec2(px), straight_alpha(over_background(all_layers, frame.background)));
   imageStore(depth_image, ivec2(px), vec4(r.depth));
 }

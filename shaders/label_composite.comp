@@ -4,9 +4,9 @@
 #include "shared/volume_render.h"  // VR_MAX_LAYERS
 
 // The depth layers, labels drawn, composited front to back (layer 0 is nearest) over the
-// background: the final image. Then, on top, the connectors and anchors' marks of rear labels where
-// the layers in front of theirs hide them (label_behind): every leader can be followed to its
-// anchor.
+// background: the final image (straight alpha; opaque unless the background is none). Then, on
+// top, the connectors and anchors' marks of rear labels where the layers in front of theirs hide
+// them (label_behind): every leader can be followed to its anchor.
 layout(local_size_x = LABEL_DRAW_GROUP, local_size_y = LABEL_DRAW_GROUP) in;
 layout(binding = LABEL_DRAW_BINDING_LAYERS, rgba16f) readonly uniform image2DArray layers;
 layout(binding = LABEL_DRAW_BINDING_LABELS, std430) readonly buffer Labels { LabelGpu labels[]; };
@@ -56,7 +56,7 @@ void main() {
     front[l] = accumulated.a;
     accumulated = label_over(accumulated, imageLoad(layers, ivec3(px, l)));
   }
-  vec4 result = label_over_background(accumulated, params.background.rgb);
+  vec4 result = over_background(accumulated, params.background);
   const vec2 p = vec2(px) + 0.5;
   for (uint w = 0u; w < words; ++w) {
     uint bits = tile_labels[w];
@@ -65,8 +65,8 @@ void main() {
       bits &= bits - 1u;
       const vec4 behind =
           label_behind(labels[i], placements[i], p, front[labels[i].layer], covers[i].hidden);
-      result = vec4(vec3(label_over(behind, result)), 1.0);
+      result = label_over_composite(behind, result);
     }
   }
-  imageStore(final_image, ivec2(px), result);
+  imageStore(final_image, ivec2(px), straight_alpha(result));
 }

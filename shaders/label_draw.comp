@@ -29,6 +29,7 @@ GlyphGpu glyph_at(uint i) { return glyphs[i]; }
 float atlas_coverage(vec2 uv) { return textureLod(atlas, uv, 0.0).r; }
 vec4 image_texel(vec2 uv) { return textureLod(images, uv, 0.0); }
 bool layer_frames() { return params.layer_frames != 0u; }
+bool connector_halos() { return params.connector_halos != 0u; }
 float anchor_hidden_at(uint i) { return i < uint(covers.length()) ? covers[i].hidden : 0.0; }
 
 #include "shared/label_draw_pixel.h"

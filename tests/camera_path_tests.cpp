@@ -260,6 +260,43 @@ TEST_SUITE("cpu") {
     CHECK_THROWS_AS(sample(path, 0.0), Error);
   }
 
+  // Every way a video comes back to its start (whole turns either way, a path back to its first
+  // position) loops: its last frame, the first again, is dropped, and the step from the last
+  // frame to the first is every other step. Paths that end elsewhere keep their last frame.
+  TEST_CASE("a_looping_path_drops_the_frame_that_repeats_the_first_and_keeps_its_step") {
+    const Scene& scene = head_scene();
+    const Camera start = camera_for(scene, "oblique");
+    const auto turn = [](const Camera& a, const Camera& b) {
+      return rotation_degrees(orientation_of(b) * glm::transpose(orientation_of(a)));
+    };
+    for (const double degrees : {360.0, -360.0, 720.0}) {
+      CAPTURE(degrees);
+      const CameraPath path = orbit_path(scene, start, degrees, 2.0);
+      CHECK(path.loops());
+      const std::vector<Camera> frames = sample(path, 12.0);
+      REQUIRE(frames.size() == 24);
+      const double step = std::abs(degrees) / 24.0;
+      for (size_t i = 0; i < frames.size(); ++i) {
+        CAPTURE(i);
+        const Camera& next = frames[(i + 1) % frames.size()];
+        CHECK(turn(frames[i], next) == doctest::Approx(step).epsilon(1e-4));
+      }
+    }
+    CHECK_FALSE(orbit_path(scene, start, 359.0, 2.0).loops());
+    CHECK(sample(orbit_path(scene, start, 180.0, 2.0), 12.0).size() == 25);
+
+    const Scene boxes = box_scene();
+    const CameraPath there_and_back = parse_camera_path(boxes, "front,left_2,top_1,front_1");
+    CHECK(there_and_back.loops());
+    const std::vector<Camera> frames = sample(there_and_back, 10.0);
+    REQUIRE(frames.size() == 40);
+    CHECK(max_difference(frames.back().view, frames.front().view) > 1e-3f);
+    CHECK(max_difference(frames.back().view, there_and_back.at(3.9).view) < 1e-5f);
+    CHECK_FALSE(parse_camera_path(boxes, "front,left_2").loops());
+    CHECK_FALSE(parse_camera_path(boxes, "front").loops());
+    CHECK(sample(parse_camera_path(boxes, "front"), 10.0).size() == 1);
+  }
+
   TEST_CASE("scene_bounds_cover_volumes_and_transformed_meshes_and_empty_scenes_centre_on_zero") {
     Scene scene;
     CHECK(scene_bounds(scene).empty());

@@ -336,7 +336,7 @@ TEST_SUITE("cli") {
   }
 
   // A write that fails on a worker thread (files limited to one block, as on a full disk) ends
-  // the run with the first frame's error and exit 1, and leaves no frame and no MP4.
+  // the run with the first frame's error and exit 1, and leaves no frame, no MP4 and no GIF.
   TEST_CASE("video_whose_frames_fail_on_worker_threads_exits_1_with_the_first_frames_error") {
     const std::string dir = empty_folder("video-threads-full");
     const std::string video = short_video(dir, "--threads 3 ");
@@ -352,11 +352,15 @@ TEST_SUITE("cli") {
     CHECK(mp4.exit_code == 1);
     CHECK(mp4.output.find("File too large") != std::string::npos);
     CHECK(!std::filesystem::exists(dir + "/video.mp4"));
+    const auto gif = run_strata(video + "/video.gif", small_files);
+    CHECK(gif.exit_code == 1);
+    CHECK(gif.output.find("File too large") != std::string::npos);
+    CHECK(!std::filesystem::exists(dir + "/video.gif"));
 #endif
   }
 
   // The video's writers alone: frames a second of each, and the files they wrote kept.
-  TEST_CASE("bench_encode_reports_the_frames_a_second_of_the_png_and_mp4_writers") {
+  TEST_CASE("bench_encode_reports_the_frames_a_second_of_the_png_mp4_and_gif_writers") {
     const std::string dir = empty_folder("bench-encode");
     const auto r = run_strata("bench encode --size 64x48 --frames 5 --threads 2 --output " + dir);
     REQUIRE(r.exit_code == 0);
@@ -368,10 +372,82 @@ TEST_SUITE("cli") {
 #if STRATA_VIDEO
     CHECK(report["mp4"]["frames_per_second"].get<double>() > 0.0);
     CHECK(test::probe_video(dir + "/video.mp4", "width,height,nb_read_frames") == "64,48,5");
+    CHECK(report["gif"]["frames_per_second"].get<double>() > 0.0);
+    CHECK(test::probe_video(dir + "/video.gif", "codec_name,nb_read_frames") == "gif,5");
 #else
     CHECK(report["mp4"].is_null());
+    CHECK(report["gif"].is_null());
 #endif
   }
+
+  // --background: a value it does not know, and transparency where the output keeps no alpha, are
+  // usage errors before anything renders; a colour fills what the scene leaves empty.
+  TEST_CASE("background_is_a_colour_or_transparent_where_the_output_keeps_alpha") {
+    const std::string head = STRATA_SOURCE_DIR "/assets/scenes/head.json";
+    const std::string dir = empty_folder("background");
+    const auto pink = run_strata("render " + head + " --background pink -o " + dir + "/x.png");
+    CHECK(pink.exit_code == 2);
+    CHECK(pink.output.find("--background: 'pink' is not a background (black, white, transparent "
+                           "or #rrggbb)") != std::string::npos);
+    const auto jpeg =
+        run_strata("render " + head + " --background transparent -o " + dir + "/x.jpg");
+    CHECK(jpeg.exit_code == 2);
+    CHECK(jpeg.output.find("JPEG has no alpha") != std::string::npos);
+    for (const char* video : {"x.mp4", "x.gif"}) {
+      CAPTURE(video);
+      const auto r = run_strata("video " + head + " --orbit 10 --background transparent -o " + dir +
+                                "/" + video);
+      CHECK(r.exit_code == 2);
+      CHECK(r.output.find("keeps no alpha; write PNG frames to a folder") != std::string::npos);
+    }
+    CHECK(std::filesystem::is_empty(dir));
+    const auto red = run_strata(
+        "render " + head + " --no-labels --background '#ff0000' --size 32 -o " + dir + "/red.png");
+    REQUIRE(red.exit_code == 0);
+    const Rgba8Image image = read_png(dir + "/red.png");
+    CHECK(std::vector<uint8_t>(image.pixels.begin(), image.pixels.begin() + 4) ==
+          std::vector<uint8_t>{255, 0, 0, 255});
+  }
+
+#if STRATA_VIDEO
+  // A turntable as a GIF that FFmpeg reads with every frame; and a full turn either way loops
+  // without a seam: the last frame is not the first again, and the step from it to the first is
+  // like the steps between the others (a bare volume: only the camera moves).
+  TEST_CASE("a_full_turn_loops_as_a_gif_without_repeating_its_first_frame") {
+    const std::string dir = empty_folder("turn-loop");
+    const auto gif = run_strata("video " STRATA_SOURCE_DIR
+                                "/assets/scenes/head.json --orbit 360 --seconds 1 --fps 6 "
+                                "--size 64 --background white -o " +
+                                dir + "/turn.gif");
+    REQUIRE(gif.exit_code == 0);
+    CHECK(gif.output.find("wrote 6 frames (64x64, 6 fps)") != std::string::npos);
+    CHECK(test::probe_video(dir + "/turn.gif", "codec_name,width,height,nb_read_frames") ==
+          "gif,64,64,6");
+    const auto png = run_strata("video " STRATA_SOURCE_DIR
+                                "/assets/cache/mricron/ch2.nii.gz --orbit -360 --seconds 1 "
+                                "--fps 8 --size 64 -o " +
+                                dir + "/frames");
+    REQUIRE(png.exit_code == 0);
+    std::vector<Rgba8Image> frames;
+    for (const auto& [name, bytes] : test::folder_bytes(dir + "/frames"))
+      frames.push_back(read_png(dir + "/frames/" + name));
+    REQUIRE(frames.size() == 8);
+    const auto step = [](const Rgba8Image& a, const Rgba8Image& b) {
+      double sum = 0.0;
+      for (size_t i = 0; i < a.pixels.size(); ++i)
+        sum += std::abs(int(a.pixels[i]) - int(b.pixels[i]));
+      return sum / double(a.pixels.size());
+    };
+    const double seam = step(frames.back(), frames.front());
+    for (size_t i = 0; i + 1 < frames.size(); ++i) {
+      const double other = step(frames[i], frames[i + 1]);
+      CAPTURE(i);
+      CAPTURE(other);
+      CHECK(seam > 0.5 * other);
+      CHECK(seam < 2.0 * other);
+    }
+  }
+#endif
 
   TEST_CASE("video_with_two_paths_or_none_is_one_clear_error") {
     const auto both = run_strata("video " STRATA_SOURCE_DIR

@@ -82,16 +82,16 @@ std::string output_dir() {
 }
 
 void check_close(const std::vector<uint8_t>& actual, const std::vector<uint8_t>& expected,
-                 graph::Extent size, const std::string& name, int tolerance) {
+                 graph::Extent size, const std::string& name, int tolerance, int channels) {
   REQUIRE(actual.size() == expected.size());
   size_t bad = 0;
   std::vector<uint8_t> diff(actual.size(), 255);
   for (size_t p = 0; p < actual.size() / 4; ++p) {
     int worst = 0;
-    for (int ch = 0; ch < 3; ++ch) {
+    for (int ch = 0; ch < channels; ++ch) {
       const int d = std::abs(int(actual[4 * p + ch]) - int(expected[4 * p + ch]));
       worst = std::max(worst, d);
-      diff[4 * p + ch] = uint8_t(std::min(255, d * 8));
+      if (ch < 3) diff[4 * p + ch] = uint8_t(std::min(255, d * 8));
     }
     bad += worst > tolerance;
   }

@@ -43,9 +43,10 @@ std::string probe_video(const std::string& file, const std::string& entries);
 std::string output_dir();
 
 // Two rgba8 images of `size` agree: at most 1% of the pixels differ by more than `tolerance` in
-// some colour channel. Otherwise the actual, expected and difference images go to output_dir()
-// as NAME.actual.png, NAME.expected.png, NAME.difference.png.
+// some colour channel (the first `channels`: 4 compares alpha too). Otherwise the actual, expected
+// and difference images go to output_dir() as NAME.actual.png, NAME.expected.png,
+// NAME.difference.png.
 void check_close(const std::vector<uint8_t>& actual, const std::vector<uint8_t>& expected,
-                 graph::Extent size, const std::string& name, int tolerance = 3);
+                 graph::Extent size, const std::string& name, int tolerance = 3, int channels = 3);
 
 }  // namespace strata::test

@@ -65,7 +65,7 @@ struct LabelScene {
   std::vector<gpu::LabelGpu> labels;
   std::vector<gpu::PlacementGpu> placements;
   std::vector<gpu::GlyphGpu> glyphs;
-  glm::vec3 background{0.2f, 0.25f, 0.3f};
+  Background background{{0.2f, 0.25f, 0.3f}};
   bool layer_frames = false;
   ImageAtlas images;    // the labels' pictures (none: one transparent texel)
   GhostSettings ghost;  // (off)
@@ -248,7 +248,8 @@ std::vector<gpu::AnchorCoverGpu> reference_covers(const LabelScene& s) {
 // The layers ghosted (when the scene asks for it), then the labels drawn.
 std::vector<glm::vec4> reference_layers(const LabelScene& s) {
   const std::vector<gpu::AnchorCoverGpu> covers = reference_covers(s);
-  const LabelDrawData data{s.labels, s.placements, s.glyphs, s.layer_frames, covers};
+  const LabelDrawData data{s.labels,       s.placements, s.glyphs,
+                           s.layer_frames, covers,       connector_halos(s.background)};
   const std::vector<glm::vec4> ghosted =
       ghost_reference(s.layers, s.size, s.layer_count, data, s.ghost);
   return draw_labels_reference(ghosted, s.size, s.layer_count, data, test_atlas(), s.images);
@@ -720,7 +721,7 @@ TEST_SUITE("cpu") {
               const glm::vec4 none(0.0f);
               for (const float hidden : {0.0f, 0.5f, 1.0f}) {  // (seen, turning, hidden)
                 touched += gpu::label_frame(p, label.anchor, centre, label.size, true,
-                                            gpu::LABEL_BORDER_COLOR, hidden) != none ||
+                                            gpu::LABEL_BORDER_COLOR, hidden, true) != none ||
                            gpu::label_anchor_mark(p, label.anchor, hidden) != none ||
                            gpu::label_box_distance(p, centre, half, 0.0f) <= 1.0f ||
                            gpu::label_behind(label, placement, p, 1.0f, hidden) != none;
@@ -746,6 +747,36 @@ TEST_SUITE("gpu") {
     if (std::getenv("STRATA_KEEP_IMAGES")) {
       write_png(test::output_dir() + "/labels.png", s.size.width, s.size.height, gpu.final);
     }
+  }
+
+  // With no background the composite keeps its alpha, straight: as the reference, nothing where
+  // every layer is empty, and over white the composite on white again (connectors with halos on
+  // both).
+  TEST_CASE_FIXTURE(test::GpuTest, "a_transparent_composite_is_straight_alpha_as_the_reference") {
+    LabelScene s = make_scene();
+    for (uint32_t y = 80; y < s.size.height; ++y) {  // (the rear layer opaque above only)
+      for (uint32_t x = 0; x < s.size.width; ++x) s.at(2, x, y) = glm::vec4(0.0f);
+    }
+    s.background = {glm::vec3(1.0f)};
+    const DrawnLabels opaque = draw_matching_the_reference(ctx, s);
+    s.background.transparent = true;
+    const DrawnLabels clear = draw_matching_the_reference(ctx, s);
+    size_t empty = 0, partial = 0;
+    int worst = 0;
+    for (size_t p = 0; p < s.pixels(); ++p) {
+      const int a = clear.final[4 * p + 3];
+      empty += a == 0;
+      partial += a > 0 && a < 255;
+      for (int ch = 0; ch < 3; ++ch) {
+        const float over = (float(clear.final[4 * p + ch]) * float(a) +
+                            (255.0f - float(a)) * 255.0f * s.background.color[ch]) /
+                           255.0f;
+        worst = std::max(worst, int(std::lround(std::abs(over - float(opaque.final[4 * p + ch])))));
+      }
+    }
+    CHECK(empty > 0);
+    CHECK(partial > 0);
+    CHECK(worst <= 2);
   }
 
   TEST_CASE_FIXTURE(test::GpuTest, "many_overlapping_labels_match_the_cpu_reference") {

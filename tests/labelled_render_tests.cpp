@@ -172,6 +172,56 @@ TEST_SUITE("gpu") {
 }
 
 TEST_SUITE("gpu") {
+  // The head demo on white and on nothing (a PNG with alpha), against their goldens: the labels
+  // are placed exactly as on black (the placement reads the scene over black), and the
+  // transparent picture over white is the white one.
+  TEST_CASE_FIXTURE(test::GpuTest, "head_demo_on_white_or_transparent_places_as_on_black") {
+    const Scene scene = load_scene(STRATA_SOURCE_DIR "/assets/scenes/head.json");
+    const graph::Extent size{256, 256};
+    const Camera camera = camera_for(scene, "oblique");
+    const auto render = [&](const Background& background) {
+      LabellingSettings settings;
+      settings.background = background;
+      return render_labelled(ctx, scene, camera, size, settings);
+    };
+    const LabelledFrame black = render({});
+    const LabelledFrame white = render({glm::vec3(1.0f)});
+    const LabelledFrame clear = render({glm::vec3(0.0f), true});
+    for (const LabelledFrame* frame : {&white, &clear}) {
+      REQUIRE(frame->labels.size() == black.labels.size());
+      for (size_t i = 0; i < black.labels.size(); ++i) {
+        const LabelLayout &a = black.labels[i], &b = frame->labels[i];
+        CAPTURE(a.text);
+        CHECK(b.placed == a.placed);
+        CHECK(b.layer == a.layer);
+        CHECK(b.box_origin == a.box_origin);
+        CHECK(b.box_size == a.box_size);
+        CHECK(b.cost == a.cost);
+      }
+    }
+    const Rgba8Image on_white =
+        read_png(STRATA_SOURCE_DIR "/tests/golden/head-oblique-labelled-white-256.png");
+    const Rgba8Image transparent =
+        read_png(STRATA_SOURCE_DIR "/tests/golden/head-oblique-labelled-transparent-256.png");
+    REQUIRE(on_white.width == size.width);
+    REQUIRE(transparent.width == size.width);
+    test::check_close(white.image, on_white.pixels, size, "head-oblique-labelled-white-256");
+    test::check_close(clear.image, transparent.pixels, size,
+                      "head-oblique-labelled-transparent-256", 3, 4);
+    size_t empty = 0;
+    int worst = 0;
+    for (size_t p = 0; p < clear.image.size() / 4; ++p) {
+      const int a = clear.image[4 * p + 3];
+      empty += a == 0;
+      for (int ch = 0; ch < 3; ++ch) {
+        const double over = (clear.image[4 * p + ch] * a + 255.0 * (255 - a)) / 255.0;
+        worst = std::max(worst, int(std::lround(std::abs(over - white.image[4 * p + ch]))));
+      }
+    }
+    CHECK(empty > clear.image.size() / 4 / 10);  // (the corners)
+    CHECK(worst <= 2);
+  }
+
   // The labelled frame's graph, built (on the test device, for its pipelines) but not run: its
   // passes and barriers do not grow with the labels, and a change that multiplies them fails here.
   TEST_CASE_FIXTURE(test::GpuTest,

@@ -130,7 +130,7 @@ TEST_SUITE("cli") {
                    (dir / "x.avi").string());
     CHECK(video.exit_code == 2);
     CHECK(video.output.find("-o: '" + (dir / "x.avi").string() + "'") != std::string::npos);
-    CHECK(video.output.find("NAME.mp4, or a folder") != std::string::npos);
+    CHECK(video.output.find("NAME.mp4, NAME.gif, or a folder") != std::string::npos);
     CHECK(fs::is_empty(dir));
   }
 

@@ -124,7 +124,7 @@ void check_against_reference(Context& ctx, const Scene& scene, const Camera& cam
   // Guards against comparing two empty pictures: a fifth of the view shows something.
   size_t covered = 0;
   for (const glm::vec4& c : ref.final)
-    covered += glm::length(glm::vec3(c) - settings.background) > 0.02f;
+    covered += glm::length(glm::vec3(c) - settings.background.color) > 0.02f;
   CHECK_MESSAGE(covered * 5 >= ref.final.size(),
                 name << ": only " << covered << " pixels show anything");
   test::check_close(gpu.final, to_rgba8(ref.final), size, name);
@@ -314,6 +314,28 @@ TEST_SUITE("gpu") {
     check_against_reference(ctx, scene, camera_at({12.0f, 9.0f, 32.0f}), "one-volume");
   }
 
+  // With no background (render --no-labels --background transparent) the final image keeps its
+  // alpha, straight, as the reference's: nothing around the ball, partly there at its soft edge.
+  TEST_CASE_FIXTURE(test::GpuTest, "a_transparent_final_image_is_straight_alpha_as_the_reference") {
+    Scene scene;
+    add_volume(scene, ball({24, 24, 24}, glm::vec3(-12.0f), 11.0f), ramp({1.0f, 0.6f, 0.3f}));
+    RenderSettings settings;
+    settings.background.transparent = true;
+    const Camera camera = camera_at({12.0f, 9.0f, 32.0f});
+    const graph::Extent size{96, 96};
+    const GpuResult gpu = render_gpu(ctx, scene, camera, settings, size);
+    const ReferenceImage ref =
+        render_reference(prepare_render_inputs(scene, 2048), camera, settings, size);
+    test::check_close(gpu.final, to_rgba8(ref.final), size, "one-volume-transparent", 3, 4);
+    size_t clear = 0, partial = 0;
+    for (size_t p = 0; p < gpu.final.size() / 4; ++p) {
+      clear += gpu.final[4 * p + 3] == 0;
+      partial += gpu.final[4 * p + 3] > 0 && gpu.final[4 * p + 3] < 255;
+    }
+    CHECK(clear > 0);
+    CHECK(partial > 0);
+  }
+
   // A scene of one volume and no meshes gets the resolve specialised for it (which the test above
   // checks against the reference); a mesh or a second volume, the general one.
   TEST_CASE_FIXTURE(test::GpuTest, "one_volume_without_meshes_takes_the_specialised_resolve") {
@@ -414,7 +436,7 @@ TEST_SUITE("gpu") {
       glm::vec4 all(0.0f);
       for (uint32_t l = 0; l < settings.layer_count; ++l)
         all = all + (1.0f - all.a) * gpu.layers[l * composite.size() + p];
-      composite[p] = glm::vec4(glm::vec3(all) + (1.0f - all.a) * settings.background, 1.0f);
+      composite[p] = glm::vec4(glm::vec3(all) + (1.0f - all.a) * settings.background.color, 1.0f);
     }
     size_t non_empty_layers = 0;
     for (uint32_t l = 0; l < settings.layer_count; ++l) {

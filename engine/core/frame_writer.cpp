@@ -43,19 +43,20 @@ unsigned default_frame_threads() {
 
 namespace {
 
-// One thread: the caller's, no worker. An MP4's encoding stays in order on one worker.
+// One thread: the caller's, no worker. A video's encoding stays in order on one worker.
 unsigned workers(const FrameWriter::Settings& s) {
   if (s.threads <= 1) return 0;
-  return s.format == FrameWriter::Format::mp4 ? 1 : s.threads;
+  return s.format == FrameWriter::Format::png_folder ? s.threads : 1;
 }
 
 }  // namespace
 
 FrameWriter::FrameWriter(const std::filesystem::path& output, const Settings& settings)
     : output_(output), settings_(settings), pool_(workers(settings), 2 * workers(settings)) {
-  if (settings.format == Format::mp4) {
-    video_ =
-        std::make_unique<VideoFile>(output.string(), settings.width, settings.height, settings.fps);
+  if (settings.format != Format::png_folder) {
+    video_ = std::make_unique<VideoFile>(
+        output.string(), settings.width, settings.height, settings.fps,
+        settings.format == Format::gif ? VideoFormat::gif : VideoFormat::mp4);
   }
 }
 

@@ -1,7 +1,7 @@
-// A sequence of frames written as numbered PNGs in a folder or as an H.264 MP4, compressed on
-// worker threads (an OrderedPool) while the caller renders the next frame. The files are the same
-// whatever the thread count: each PNG is one frame's alone, and an MP4's frames go to the
-// encoder in order, on one thread (libx264 has threads of its own).
+// A sequence of frames written as numbered PNGs in a folder, as an H.264 MP4 or as a GIF,
+// compressed on worker threads (an OrderedPool) while the caller renders the next frame. The files
+// are the same whatever the thread count: each PNG is one frame's alone, and a video's frames go
+// to the encoder in order, on one thread (libx264 has threads of its own).
 #pragma once
 
 #include <cstdint>
@@ -27,24 +27,24 @@ unsigned default_frame_threads();
 
 class FrameWriter {
  public:
-  enum class Format { png_folder, mp4 };
+  enum class Format { png_folder, mp4, gif };
   struct Settings {
     Format format = Format::png_folder;
     uint32_t width = 0, height = 0;
-    double fps = 30.0;  // (an MP4's)
+    double fps = 30.0;  // (a video's)
     // 1: every frame compressed and written by write() itself, one after another; more: PNGs on
-    // that many threads, an MP4 on one.
+    // that many threads, a video on one.
     unsigned threads = 1;
   };
 
-  // Opens the MP4 (a temporary until finish(): VideoFile), or writes into an existing folder.
+  // Opens the video (a temporary until finish(): VideoFile), or writes into an existing folder.
   FrameWriter(const std::filesystem::path& output, const Settings& settings);
 
   // Hands a frame of width x height RGBA8 pixels over; it is frame number frames(). Waits while
   // twice as many frames as there are workers are being written, and throws the error of an
   // earlier frame (the first by frame order, naming its file: "<file>: cannot write PNG: ...").
   void write(std::vector<uint8_t> rgba);
-  // Waits for every frame and puts an MP4 in place; throws the first frame's error as write().
+  // Waits for every frame and puts a video in place; throws the first frame's error as write().
   void finish();
 
   size_t frames() const { return frames_; }

@@ -146,6 +146,10 @@ void check_image_extension(const std::filesystem::path& path) {
   image_format(path);
 }
 
+bool image_keeps_alpha(const std::filesystem::path& path) {
+  return image_format(path) == ImageFormat::png;
+}
+
 void write_image(const std::filesystem::path& path, uint32_t width, uint32_t height,
                  std::span<const uint8_t> rgba) {
   if (image_format(path) == ImageFormat::png) {

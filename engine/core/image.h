@@ -27,6 +27,8 @@ void write_image(const std::filesystem::path& path, uint32_t width, uint32_t hei
 // Whether write_image writes `path`; else an Error naming the extensions (checked before a
 // long render, so a typo costs no time).
 void check_image_extension(const std::filesystem::path& path);
+// Whether write_image keeps alpha in `path` (PNG: yes; JPEG: no). Throws as check_image_extension.
+bool image_keeps_alpha(const std::filesystem::path& path);
 
 // `image` (straight alpha) resampled to width x height, premultiplied: a triangle filter as wide
 // as one source texel or one target pixel, whichever is larger (bilinear when enlarging, an

@@ -54,7 +54,8 @@ vec4 draw_label_at(uint i, vec2 p, uint layer, vec4 content) {
   if (label_far_from(p, label.anchor, centre, label.size)) return content;
   float hidden = is_internal ? 0.0f : anchor_hidden_at(i);
   vec4 color = label_frame(p, label.anchor, centre, label.size, !is_internal,
-                           label_border_color(label.layer, layer_frames()), hidden);
+                           label_border_color(label.layer, layer_frames()), hidden,
+                           connector_halos());
   vec2 top_left = centre - 0.5f * label.size;
   color = label_over(image_color(p, top_left, label), color);
   float text = text_coverage(p, top_left, label);

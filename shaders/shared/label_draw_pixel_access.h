@@ -20,6 +20,7 @@ concept LabelDrawPixelAccess = requires(const T& t, uint i, vec2 uv) {
   // the image atlas (premultiplied), bilinear, clamped likewise
   { t.image_texel(uv) } -> std::same_as<vec4>;
   { t.layer_frames() } -> std::same_as<bool>;  // borders in their layer's colour
+  { t.connector_halos() } -> std::same_as<bool>;  // solid connectors with a dark halo
   // how hidden label i's anchor is (AnchorCoverGpu::hidden)
   { t.anchor_hidden_at(i) } -> std::same_as<float>;
 };
@@ -32,6 +33,7 @@ GlyphGpu glyph_at(uint i);
 float atlas_coverage(vec2 uv);
 vec4 image_texel(vec2 uv);
 bool layer_frames();
+bool connector_halos();
 float anchor_hidden_at(uint i);
 #endif
 

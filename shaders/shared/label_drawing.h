@@ -7,6 +7,7 @@
 #ifndef STRATA_SHARED_LABEL_DRAWING_H
 #define STRATA_SHARED_LABEL_DRAWING_H
 
+#include "background.h"
 #include "labels.h"
 
 #define LABEL_DRAW_GROUP 16  // (8 x 8 culled the labels four times as often: docs/performance.md)
@@ -15,7 +16,7 @@
 #define LABEL_DRAW_BINDING_PLACEMENTS 2  // PlacementGpu[], one per label
 #define LABEL_DRAW_BINDING_GLYPHS 3      // GlyphGpu[]
 #define LABEL_DRAW_BINDING_ATLAS 4       // R8 font coverage, sampled bilinearly
-#define LABEL_DRAW_BINDING_FINAL 5       // rgba8: the layers composited over the background
+#define LABEL_DRAW_BINDING_FINAL 5       // rgba8, straight: the layers over the background
 #define LABEL_DRAW_BINDING_IMAGES 6      // rgba8 label pictures, premultiplied, sampled bilinearly
 #define LABEL_DRAW_BINDING_COVERS 7      // AnchorCoverGpu[], one per label
 
@@ -34,9 +35,11 @@ struct LabelDrawParams {
   uint height;
   uint layer_count;
   uint label_count;   // labels to consider (the shader also stops at the buffer's end)
-  vec4 background;    // rgb: what the composite shows where every layer is transparent
+  vec4 background;    // where every layer is transparent: shared/background.h
   uint layer_frames;  // 1: a box's border (and leader) in its layer's colour (a depth cue)
-  uint pad0;
+  // 1: solid connectors with the dashed ones' dark halo (a white line alone is lost on a light
+  // background)
+  uint connector_halos;
   uint pad1;
   uint pad2;
 };
@@ -157,16 +160,21 @@ STRATA_INLINE vec4 label_dashed_connector(vec2 p, vec2 anchor, vec2 end) {
 }
 
 // The connector (from the anchor to the nearest point of the box), the box and its border at p,
-// premultiplied: everything of a label but its text and anchor mark. The connector is solid,
-// dashed as far as the anchor is hidden (anchor_hidden: 0 to 1).
+// premultiplied: everything of a label but its text and anchor mark. The connector is solid (with
+// a halo if asked), dashed as far as the anchor is hidden (anchor_hidden: 0 to 1).
 STRATA_INLINE vec4 label_frame(vec2 p, vec2 anchor, vec2 centre, vec2 size, bool connector,
-                               vec4 border, float anchor_hidden) {
+                               vec4 border, float anchor_hidden, bool halo) {
   vec2 half_size = 0.5f * size;
   vec4 color = vec4(0.0f);
   if (connector) {
     vec2 end = clamp(anchor, centre - half_size, centre + half_size);
     float d = label_segment_distance(p, anchor, end);
     color = label_premultiplied(LABEL_LINE_COLOR, label_edge_coverage(d - LABEL_LINE_HALF_WIDTH));
+    if (halo) {
+      color = label_over(color, label_premultiplied(LABEL_HALO_COLOR,
+                                                    label_edge_coverage(d - LABEL_LINE_HALF_WIDTH -
+                                                                        LABEL_HALO_WIDTH)));
+    }
     if (anchor_hidden > 0.0f) {
       color = mix(color, label_dashed_connector(p, anchor, end), anchor_hidden);
     }
@@ -301,9 +309,11 @@ STRATA_INLINE bool label_far_from_tile(vec2 tile_lo, vec2 tile_hi, vec2 anchor, 
   return label_segment_misses_box(anchor, end, tile_lo - line_margin, tile_hi + line_margin);
 }
 
-// The final pixel: the layers' front-to-back composite over the background, opaque.
-STRATA_INLINE vec4 label_over_background(vec4 layers, vec3 background) {
-  return vec4(vec3(layers) + (1.0f - layers.a) * background, 1.0f);
+// A rear label's connector or mark (label_behind) over the composite, premultiplied: a composite
+// over an opaque background stays exactly opaque.
+STRATA_INLINE vec4 label_over_composite(vec4 behind, vec4 composite) {
+  vec4 c = label_over(behind, composite);
+  return vec4(vec3(c), composite.a == 1.0f ? 1.0f : c.a);
 }
 STRATA_END
 

@@ -43,7 +43,7 @@
 #define VR_BINDING_TRANSFER 9    // vec4[VR_TF_SIZE] per volume, straight RGBA, alpha per step
 #define VR_BINDING_OCCUPANCY 10  // one uint per brick, all volumes one after the other
 #define VR_BINDING_LAYERS 11     // image2DArray rgba16f, premultiplied
-#define VR_BINDING_FINAL 12      // image2D rgba8, layers over the background
+#define VR_BINDING_FINAL 12      // image2D rgba8, layers over the background, straight alpha
 #define VR_BINDING_DEPTH 13      // image2D r32f, eye depth where alpha first passes depth_alpha
 
 STRATA_BEGIN
@@ -70,7 +70,7 @@ struct FrameGpu {
   mat4 view_to_clip;
   mat4 clip_to_view;
   vec4 splits[2];   // layer boundaries (eye depth): split i is splits[i / 4][i % 4]
-  vec4 background;  // straight RGB, a = 1
+  vec4 background;  // the final image's (shared/background.h): RGB with a = 1, or all 0: none
   uint width;
   uint height;
   uint layer_count;
