@@ -1,0 +1,239 @@
+// A labelled still's labels as vector shapes: the raster drawing's shapes
+// (shaders/shared/label_drawing.h, label_draw_pixel.h) with its sizes and colours, each label a
+// group at its opacity.
+#include <algorithm>
+#include <numeric>
+
+#include "engine/core/error.h"
+#include "frame/vector_picture.h"
+#include "shared/label_drawing.h"
+
+namespace strata {
+namespace {
+
+VectorShape line(glm::vec2 a, glm::vec2 b, glm::vec4 color, float width, glm::vec2 dash = {}) {
+  VectorShape s{VectorShape::Kind::line, a, b};
+  s.stroke = color;
+  s.stroke_width = width;
+  s.round_caps = dash.x <= 0.0f;  // (the raster's solid line is a capsule)
+  s.dash = dash;
+  return s;
+}
+
+VectorShape circle(glm::vec2 centre, float radius, glm::vec4 fill, glm::vec4 stroke = {},
+                   float width = 0.0f) {
+  VectorShape s{VectorShape::Kind::circle, centre, {radius, 0.0f}};
+  s.fill = fill;
+  s.stroke = stroke;
+  s.stroke_width = width;
+  return s;
+}
+
+// What covers a rear label's connector from the front: the layers in front of its own, as the
+// ghosting leaves them, and the boxes of labels on those layers.
+struct FrontCover {
+  std::span<const glm::vec4> layers;  // label-free, layer after layer; empty: none
+  graph::Extent size;
+  uint32_t layer_count = 0;
+  std::span<const LabelLayout> labels;
+
+  // Whether the composite draws a label on `layer` again on top at p (label_behind), taken where
+  // its ramp passes the middle.
+  bool hides(glm::vec2 p, uint32_t layer) const {
+    float alpha = 0.0f;
+    const glm::ivec2 q(glm::floor(p));
+    const size_t pixels = size_t{size.width} * size.height;
+    if (q.x >= 0 && q.y >= 0 && q.x < int(size.width) && q.y < int(size.height) &&
+        layers.size() == pixels * layer_count) {
+      const size_t at = size_t(q.y) * size.width + size_t(q.x);
+      for (uint32_t k = 0; k < std::min(layer, layer_count); ++k)
+        alpha += (1.0f - alpha) * layers[k * pixels + at].a;
+    }
+    for (const LabelLayout& l : labels) {
+      const glm::vec2 from = p - l.box_origin;
+      if (l.layer < layer && l.placed && from.x >= 0.0f && from.y >= 0.0f &&
+          from.x <= l.box_size.x && from.y <= l.box_size.y) {
+        alpha += (1.0f - alpha) * gpu::LABEL_BOX_COLOR.a * l.opacity;
+      }
+    }
+    return glm::smoothstep(gpu::LABEL_BEHIND_FROM, gpu::LABEL_BEHIND_TO, alpha) >= 0.5f;
+  }
+};
+
+// A stretch of a connector, in distances from the anchor.
+struct Stretch {
+  float from = 0.0f, to = 0.0f;
+  bool hidden = false;
+};
+
+// The connector cut where the front starts or stops hiding it (a rear label's; a front label's is
+// one stretch, seen).
+std::vector<Stretch> connector_stretches(const FrontCover& front, glm::vec2 anchor, glm::vec2 end,
+                                         uint32_t layer) {
+  constexpr float kStep = 0.5f;
+  const float length = glm::length(end - anchor);
+  std::vector<Stretch> out{{0.0f, length, layer > 0 && front.hides(anchor, layer)}};
+  if (layer == 0 || length <= 0.0f) return out;
+  for (float s = kStep; s < length; s += kStep) {
+    const bool hidden = front.hides(anchor + (end - anchor) * (s / length), layer);
+    if (hidden == out.back().hidden) continue;
+    out.back().to = s;
+    out.push_back({s, length, hidden});
+  }
+  return out;
+}
+
+// A stretch of the connector dashed, with a dark halo under the dashes, the dashes counted from
+// the anchor's mark's reach (label_dashed_connector).
+void add_dashes(std::vector<VectorItem>& items, glm::vec2 anchor, glm::vec2 end, Stretch stretch) {
+  const float length = glm::length(end - anchor);
+  const float from = std::max(stretch.from, gpu::LABEL_ANCHOR_REACH);
+  if (stretch.to <= from) return;
+  const glm::vec2 a = anchor + (end - anchor) * (from / length);
+  const glm::vec2 b = anchor + (end - anchor) * (stretch.to / length);
+  const glm::vec2 dash(gpu::LABEL_DASH_ON, gpu::LABEL_DASH - gpu::LABEL_DASH_ON);
+  const float half = gpu::LABEL_LINE_HALF_WIDTH;
+  for (const VectorShape& s :
+       {line(a, b, gpu::LABEL_HALO_COLOR, 2.0f * (half + gpu::LABEL_HALO_WIDTH), dash),
+        line(a, b, gpu::LABEL_LINE_COLOR, 2.0f * half, dash)}) {
+    VectorShape shape = s;
+    shape.dash_offset = from - gpu::LABEL_ANCHOR_REACH;
+    items.push_back(shape);
+  }
+}
+
+// The leader from the anchor to the box's nearest point, in the label's own layer: dashed where
+// the anchor is hidden, else solid where the front does not hide it (there the composite's
+// dashes on top are what is seen).
+void add_connector(std::vector<VectorItem>& items, glm::vec2 anchor, glm::vec2 end, bool hidden,
+                   const std::vector<Stretch>& stretches) {
+  const float length = glm::length(end - anchor);
+  if (hidden) {
+    if (length > 0.0f) add_dashes(items, anchor, end, {0.0f, length, true});
+    return;
+  }
+  for (const Stretch& s : stretches) {
+    if (s.hidden) continue;
+    const glm::vec2 a = length > 0.0f ? anchor + (end - anchor) * (s.from / length) : anchor;
+    const glm::vec2 b = length > 0.0f ? anchor + (end - anchor) * (s.to / length) : end;
+    items.push_back(line(a, b, gpu::LABEL_LINE_COLOR, 2.0f * gpu::LABEL_LINE_HALF_WIDTH));
+  }
+}
+
+// The anchor's mark: a white disc in a dark rim, or (hidden) a white ring outlined dark on both
+// sides.
+void add_anchor_mark(std::vector<VectorItem>& items, glm::vec2 anchor, bool hidden) {
+  const glm::vec4 none(0.0f);
+  if (!hidden) {
+    items.push_back(circle(anchor, gpu::LABEL_MARKER_RADIUS, gpu::LABEL_MARKER_OUTLINE_COLOR));
+    items.push_back(circle(anchor, gpu::LABEL_MARKER_RADIUS - gpu::LABEL_MARKER_OUTLINE,
+                           gpu::LABEL_MARKER_COLOR));
+    return;
+  }
+  items.push_back(circle(anchor, gpu::LABEL_RING_RADIUS, none, gpu::LABEL_MARKER_OUTLINE_COLOR,
+                         gpu::LABEL_RING_BAND + 2.0f * gpu::LABEL_RING_OUTLINE));
+  items.push_back(
+      circle(anchor, gpu::LABEL_RING_RADIUS, none, gpu::LABEL_MARKER_COLOR, gpu::LABEL_RING_BAND));
+}
+
+// The box's fill over its whole shape, then its border: the ring of one border width inside the
+// shape, as a stroke along the middle of that ring.
+void add_box(std::vector<VectorItem>& items, glm::vec2 top_left, glm::vec2 size, glm::vec4 border) {
+  VectorShape fill{VectorShape::Kind::box, top_left, size, gpu::LABEL_BOX_RADIUS};
+  fill.fill = gpu::LABEL_BOX_COLOR;
+  items.push_back(fill);
+  const float inset = 0.5f * gpu::LABEL_BORDER_WIDTH;
+  VectorShape ring{VectorShape::Kind::box, top_left + inset, size - 2.0f * inset,
+                   gpu::LABEL_BOX_RADIUS - inset};
+  ring.stroke = border;
+  ring.stroke_width = gpu::LABEL_BORDER_WIDTH;
+  items.push_back(ring);
+}
+
+struct LabelLook {
+  std::shared_ptr<const Font> font;
+  TextStyle style;
+  const LabellingSettings& settings;
+  const LabelImages& images;
+  FrontCover front;
+};
+
+// One label as label_draw_pixel.h draws it (connector, box, picture, text, anchor mark), and what
+// the composite draws of it on top (label_behind: its connector's hidden stretches dashed, its
+// mark where the front hides the anchor).
+std::pair<VectorGroup, VectorGroup> label_groups(const LabelLayout& l, const Label& label,
+                                                 size_t index, const LabelLook& look) {
+  const Font& font = *look.font;
+  const std::vector<ShapedLine> lines = shape_label_text(font, label.text, look.style);
+  const LabelBoxLayout box = place_label_text(font, lines, label.text.empty(), look.style,
+                                              l.box_size, look.images.blocks[index]);
+  const bool internal = look.settings.internal;
+  const glm::vec2 centre = internal ? l.anchor : l.box_origin + 0.5f * l.box_size;
+  const glm::vec2 top_left = centre - 0.5f * box.size;
+  const bool hidden = !internal && l.anchor_hidden.value_or(false);
+  VectorGroup group{l.opacity, {}};
+  VectorGroup behind{gpu::LABEL_BEHIND_OPACITY * l.opacity, {}};
+  if (!internal) {
+    const glm::vec2 end = glm::clamp(l.anchor, top_left, top_left + box.size);
+    const std::vector<Stretch> stretches = connector_stretches(look.front, l.anchor, end, l.layer);
+    add_connector(group.items, l.anchor, end, hidden, stretches);
+    for (const Stretch& s : stretches)
+      if (s.hidden) add_dashes(behind.items, l.anchor, end, s);
+  }
+  add_box(group.items, top_left, box.size,
+          gpu::label_border_color(l.layer, look.settings.layer_colors));
+  if (box.image && label.image) {
+    const glm::vec4 r = *box.image;
+    group.items.push_back(
+        VectorImage{top_left + glm::vec2(r.x, r.y), {r.z - r.x, r.w - r.y}, label.image->pixels});
+  }
+  for (size_t i = 0; i < lines.size(); ++i) {
+    group.items.push_back(
+        VectorText{look.font, lines[i], top_left + box.line_origins[i], gpu::LABEL_TEXT_COLOR});
+  }
+  if (!internal) {
+    add_anchor_mark(group.items, l.anchor, hidden);
+    if (l.layer > 0 && look.front.hides(l.anchor, l.layer))
+      add_anchor_mark(behind.items, l.anchor, hidden);
+  }
+  return {std::move(group), std::move(behind)};
+}
+
+}  // namespace
+
+VectorPicture labelled_picture(const LabelledFrame& frame, const Scene& scene,
+                               const LabellingSettings& settings,
+                               std::span<const glm::vec4> layers) {
+  VectorPicture picture = image_picture(frame.size.width, frame.size.height, frame.image);
+  if (frame.labels.size() != scene.labels.size()) {
+    throw Error("vector picture: " + std::to_string(frame.labels.size()) + " laid out labels for " +
+                std::to_string(scene.labels.size()) + " scene labels");
+  }
+  const float scale = settings.label_scale;
+  const LabelImages images = bake_label_images(scene.labels, scale);
+  const LabelLook look{std::make_shared<const Font>(settings.font_pixels * scale),
+                       label_text_style(settings),
+                       settings,
+                       images,
+                       {layers, frame.size, frame.layering.layer_count, frame.labels}};
+  // The layers are composited front over back: a rear layer's labels lie under a front one's.
+  std::vector<size_t> order(frame.labels.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return frame.labels[a].layer > frame.labels[b].layer;
+  });
+  std::vector<VectorGroup> behind(frame.labels.size());
+  for (const size_t i : order) {
+    const LabelLayout& l = frame.labels[i];
+    if (!l.placed || !(l.opacity > 0.0f)) continue;
+    auto [group, on_top] = label_groups(l, scene.labels[i], i, look);
+    picture.groups.push_back(std::move(group));
+    behind[i] = std::move(on_top);
+  }
+  for (VectorGroup& group : behind) {  // (the composite's, in label order)
+    if (!group.items.empty()) picture.groups.push_back(std::move(group));
+  }
+  return picture;
+}
+
+}  // namespace strata
