@@ -248,7 +248,7 @@ TEST_SUITE("cli") {
           render_three(STRATA_SOURCE_DIR "/assets/scenes/" + std::string(name) + ".json",
                        "--camera oblique", 1024, folder);
       const InkDifference d = compare_ink(r);
-      MESSAGE(name << ": " << d.labels << " shown labels, text ink within " << d.svg
+      MESSAGE(std::string(name) << ": " << d.labels << " shown labels, text ink within " << d.svg
                    << " px (SVG) and " << d.pdf << " px (PDF) of the PNG's");
       CHECK(d.svg <= 1);
       CHECK(d.pdf <= 1);
