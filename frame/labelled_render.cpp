@@ -693,6 +693,7 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
       frame.labels[i].visible = visible[i];
       frame.labels[i].front_alpha = cover.front_alpha;
       frame.labels[i].anchor_hidden = cover.hidden >= gpu::LABEL_HIDDEN_AT;
+      frame.labels[i].hidden = cover.hidden;
     }
   }
   for (LabelLayout& l : frame.labels) {

@@ -94,6 +94,9 @@ struct LabelLayout {
   // shaders/shared/label_drawing.h); the connector is then drawn dashed, the anchor's mark
   // hollow. None where it was not measured, as front_alpha.
   std::optional<bool> anchor_hidden;
+  // The same as the drawing mixes it, 0 (seen) to 1 (hidden): AnchorCoverGpu::hidden; NaN where
+  // it was not measured.
+  float hidden = std::numeric_limits<float>::quiet_NaN();
   // The top-left corner of the placement's box this frame, where the label is heading (its size
   // is box_size); none where the placement did not place it.
   std::optional<glm::vec2> target_origin;

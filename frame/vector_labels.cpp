@@ -2,6 +2,7 @@
 // (shaders/shared/label_drawing.h, label_draw_pixel.h) with its sizes and colours, each label a
 // group at its opacity.
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "engine/core/error.h"
@@ -29,111 +30,131 @@ VectorShape circle(glm::vec2 centre, float radius, glm::vec4 fill, glm::vec4 str
   return s;
 }
 
-// What covers a rear label's connector from the front: the layers in front of its own, as the
-// ghosting leaves them, and the boxes of labels on those layers.
+// What lies in front of a rear label: the layers in front of its own, as the ghosting leaves
+// them, and the boxes of labels on those layers.
 struct FrontCover {
   std::span<const glm::vec4> layers;  // label-free, layer after layer; empty: none
   graph::Extent size;
   uint32_t layer_count = 0;
   std::span<const LabelLayout> labels;
 
-  // Whether the composite draws a label on `layer` again on top at p (label_behind), taken where
-  // its ramp passes the middle.
-  bool hides(glm::vec2 p, uint32_t layer) const {
-    float alpha = 0.0f;
+  // Their composite's alpha at p over a label on `layer`.
+  float alpha(glm::vec2 p, uint32_t layer) const {
+    float a = 0.0f;
     const glm::ivec2 q(glm::floor(p));
     const size_t pixels = size_t{size.width} * size.height;
     if (q.x >= 0 && q.y >= 0 && q.x < int(size.width) && q.y < int(size.height) &&
         layers.size() == pixels * layer_count) {
       const size_t at = size_t(q.y) * size.width + size_t(q.x);
       for (uint32_t k = 0; k < std::min(layer, layer_count); ++k)
-        alpha += (1.0f - alpha) * layers[k * pixels + at].a;
+        a += (1.0f - a) * layers[k * pixels + at].a;
     }
     for (const LabelLayout& l : labels) {
       const glm::vec2 from = p - l.box_origin;
       if (l.layer < layer && l.placed && from.x >= 0.0f && from.y >= 0.0f &&
           from.x <= l.box_size.x && from.y <= l.box_size.y) {
-        alpha += (1.0f - alpha) * gpu::LABEL_BOX_COLOR.a * l.opacity;
+        a += (1.0f - a) * gpu::LABEL_BOX_COLOR.a * l.opacity;
       }
     }
-    return glm::smoothstep(gpu::LABEL_BEHIND_FROM, gpu::LABEL_BEHIND_TO, alpha) >= 0.5f;
+    return a;
   }
 };
 
-// A stretch of a connector, in distances from the anchor.
+// A stretch of a connector, in distances from the anchor, and the alpha in front of it there
+// (in eighths: a stretch ends where that changes).
 struct Stretch {
   float from = 0.0f, to = 0.0f;
-  bool hidden = false;
+  float front = 0.0f;
 };
 
-// The connector cut where the front starts or stops hiding it (a rear label's; a front label's is
-// one stretch, seen).
-std::vector<Stretch> connector_stretches(const FrontCover& front, glm::vec2 anchor, glm::vec2 end,
+std::vector<Stretch> connector_stretches(const FrontCover& cover, glm::vec2 anchor, glm::vec2 end,
                                          uint32_t layer) {
-  constexpr float kStep = 0.5f;
+  constexpr float kStep = 0.5f, kLevels = 8.0f;
   const float length = glm::length(end - anchor);
-  std::vector<Stretch> out{{0.0f, length, layer > 0 && front.hides(anchor, layer)}};
-  if (layer == 0 || length <= 0.0f) return out;
+  const auto front = [&](float s) {
+    if (layer == 0) return 0.0f;
+    const glm::vec2 p = length > 0.0f ? anchor + (end - anchor) * (s / length) : anchor;
+    return std::round(cover.alpha(p, layer) * kLevels) / kLevels;
+  };
+  std::vector<Stretch> out{{0.0f, length, front(0.0f)}};
   for (float s = kStep; s < length; s += kStep) {
-    const bool hidden = front.hides(anchor + (end - anchor) * (s / length), layer);
-    if (hidden == out.back().hidden) continue;
+    const float here = front(s);
+    if (here == out.back().front) continue;
     out.back().to = s;
-    out.push_back({s, length, hidden});
+    out.push_back({s, length, here});
   }
   return out;
 }
 
-// A stretch of the connector dashed, with a dark halo under the dashes, the dashes counted from
-// the anchor's mark's reach (label_dashed_connector).
-void add_dashes(std::vector<VectorItem>& items, glm::vec2 anchor, glm::vec2 end, Stretch stretch) {
+VectorShape faded(VectorShape shape, float share) {
+  shape.fill.a *= share;
+  shape.stroke.a *= share;
+  return shape;
+}
+
+// A stretch of the connector solid (label_frame) or dashed with a dark halo under the dashes,
+// the dashes counted from the anchor's mark's reach (label_dashed_connector), `share` as opaque.
+void add_leader(std::vector<VectorItem>& items, glm::vec2 anchor, glm::vec2 end, Stretch stretch,
+                bool dashed, float share) {
   const float length = glm::length(end - anchor);
-  const float from = std::max(stretch.from, gpu::LABEL_ANCHOR_REACH);
-  if (stretch.to <= from) return;
+  const float from = dashed ? std::max(stretch.from, gpu::LABEL_ANCHOR_REACH) : stretch.from;
+  if (share <= 1.0f / 512.0f || length <= 0.0f || stretch.to <= from) return;
   const glm::vec2 a = anchor + (end - anchor) * (from / length);
   const glm::vec2 b = anchor + (end - anchor) * (stretch.to / length);
-  const glm::vec2 dash(gpu::LABEL_DASH_ON, gpu::LABEL_DASH - gpu::LABEL_DASH_ON);
   const float half = gpu::LABEL_LINE_HALF_WIDTH;
+  if (!dashed) {
+    items.push_back(faded(line(a, b, gpu::LABEL_LINE_COLOR, 2.0f * half), share));
+    return;
+  }
+  const glm::vec2 dash(gpu::LABEL_DASH_ON, gpu::LABEL_DASH - gpu::LABEL_DASH_ON);
   for (const VectorShape& s :
        {line(a, b, gpu::LABEL_HALO_COLOR, 2.0f * (half + gpu::LABEL_HALO_WIDTH), dash),
         line(a, b, gpu::LABEL_LINE_COLOR, 2.0f * half, dash)}) {
-    VectorShape shape = s;
+    VectorShape shape = faded(s, share);
     shape.dash_offset = from - gpu::LABEL_ANCHOR_REACH;
     items.push_back(shape);
   }
 }
 
-// The leader from the anchor to the box's nearest point, in the label's own layer: dashed where
-// the anchor is hidden, else solid where the front does not hide it (there the composite's
-// dashes on top are what is seen).
-void add_connector(std::vector<VectorItem>& items, glm::vec2 anchor, glm::vec2 end, bool hidden,
-                   const std::vector<Stretch>& stretches) {
-  const float length = glm::length(end - anchor);
-  if (hidden) {
-    if (length > 0.0f) add_dashes(items, anchor, end, {0.0f, length, true});
-    return;
+// The anchor's mark, `share` as opaque: a white disc in a dark rim, becoming (as far as the anchor
+// is hidden) a white ring outlined dark on both sides.
+void add_anchor_mark(std::vector<VectorItem>& items, glm::vec2 anchor, float hidden, float share) {
+  const glm::vec4 none(0.0f);
+  if (share * (1.0f - hidden) > 1.0f / 512.0f) {
+    const float f = share * (1.0f - hidden);
+    items.push_back(
+        faded(circle(anchor, gpu::LABEL_MARKER_RADIUS, gpu::LABEL_MARKER_OUTLINE_COLOR), f));
+    items.push_back(faded(circle(anchor, gpu::LABEL_MARKER_RADIUS - gpu::LABEL_MARKER_OUTLINE,
+                                 gpu::LABEL_MARKER_COLOR),
+                          f));
   }
-  for (const Stretch& s : stretches) {
-    if (s.hidden) continue;
-    const glm::vec2 a = length > 0.0f ? anchor + (end - anchor) * (s.from / length) : anchor;
-    const glm::vec2 b = length > 0.0f ? anchor + (end - anchor) * (s.to / length) : end;
-    items.push_back(line(a, b, gpu::LABEL_LINE_COLOR, 2.0f * gpu::LABEL_LINE_HALF_WIDTH));
+  if (share * hidden > 1.0f / 512.0f) {
+    const float f = share * hidden;
+    items.push_back(
+        faded(circle(anchor, gpu::LABEL_RING_RADIUS, none, gpu::LABEL_MARKER_OUTLINE_COLOR,
+                     gpu::LABEL_RING_BAND + 2.0f * gpu::LABEL_RING_OUTLINE),
+              f));
+    items.push_back(faded(
+        circle(anchor, gpu::LABEL_RING_RADIUS, none, gpu::LABEL_MARKER_COLOR, gpu::LABEL_RING_BAND),
+        f));
   }
 }
 
-// The anchor's mark: a white disc in a dark rim, or (hidden) a white ring outlined dark on both
-// sides.
-void add_anchor_mark(std::vector<VectorItem>& items, glm::vec2 anchor, bool hidden) {
-  const glm::vec4 none(0.0f);
-  if (!hidden) {
-    items.push_back(circle(anchor, gpu::LABEL_MARKER_RADIUS, gpu::LABEL_MARKER_OUTLINE_COLOR));
-    items.push_back(circle(anchor, gpu::LABEL_MARKER_RADIUS - gpu::LABEL_MARKER_OUTLINE,
-                           gpu::LABEL_MARKER_COLOR));
-    return;
+// How much the composite draws again on top where `front` lies in front (label_behind).
+float behind_share(float front) {
+  return gpu::LABEL_BEHIND_OPACITY *
+         glm::smoothstep(gpu::LABEL_BEHIND_FROM, gpu::LABEL_BEHIND_TO, front);
+}
+
+// A label's connector and anchor mark, in its layer (`own`, seen as far as the front lets it
+// through: solid, dashed as far as the anchor is hidden) and on top (`on_top`, label_behind).
+void add_connector(std::vector<VectorItem>& own, std::vector<VectorItem>& on_top,
+                   const LabelLayout& l, glm::vec2 end, float hidden, const FrontCover& cover) {
+  for (const Stretch& s : connector_stretches(cover, l.anchor, end, l.layer)) {
+    add_leader(own, l.anchor, end, s, false, (1.0f - s.front) * (1.0f - hidden));
+    add_leader(own, l.anchor, end, s, true, (1.0f - s.front) * hidden);
+    if (l.layer > 0) add_leader(on_top, l.anchor, end, s, true, behind_share(s.front));
   }
-  items.push_back(circle(anchor, gpu::LABEL_RING_RADIUS, none, gpu::LABEL_MARKER_OUTLINE_COLOR,
-                         gpu::LABEL_RING_BAND + 2.0f * gpu::LABEL_RING_OUTLINE));
-  items.push_back(
-      circle(anchor, gpu::LABEL_RING_RADIUS, none, gpu::LABEL_MARKER_COLOR, gpu::LABEL_RING_BAND));
 }
 
 // The box's fill over its whole shape, then its border: the ring of one border width inside the
@@ -158,9 +179,14 @@ struct LabelLook {
   FrontCover front;
 };
 
+// How hidden the label's anchor is, 0 to 1, as the drawing mixes its solid and dashed leader.
+float hidden_amount(const LabelLayout& l) {
+  if (!std::isnan(l.hidden)) return l.hidden;
+  return l.anchor_hidden.value_or(false) ? 1.0f : 0.0f;
+}
+
 // One label as label_draw_pixel.h draws it (connector, box, picture, text, anchor mark), and what
-// the composite draws of it on top (label_behind: its connector's hidden stretches dashed, its
-// mark where the front hides the anchor).
+// the composite draws of it on top (label_behind).
 std::pair<VectorGroup, VectorGroup> label_groups(const LabelLayout& l, const Label& label,
                                                  size_t index, const LabelLook& look) {
   const Font& font = *look.font;
@@ -170,15 +196,12 @@ std::pair<VectorGroup, VectorGroup> label_groups(const LabelLayout& l, const Lab
   const bool internal = look.settings.internal;
   const glm::vec2 centre = internal ? l.anchor : l.box_origin + 0.5f * l.box_size;
   const glm::vec2 top_left = centre - 0.5f * box.size;
-  const bool hidden = !internal && l.anchor_hidden.value_or(false);
+  const float hidden = hidden_amount(l);
   VectorGroup group{l.opacity, {}};
-  VectorGroup behind{gpu::LABEL_BEHIND_OPACITY * l.opacity, {}};
+  VectorGroup behind{l.opacity, {}};
   if (!internal) {
     const glm::vec2 end = glm::clamp(l.anchor, top_left, top_left + box.size);
-    const std::vector<Stretch> stretches = connector_stretches(look.front, l.anchor, end, l.layer);
-    add_connector(group.items, l.anchor, end, hidden, stretches);
-    for (const Stretch& s : stretches)
-      if (s.hidden) add_dashes(behind.items, l.anchor, end, s);
+    add_connector(group.items, behind.items, l, end, hidden, look.front);
   }
   add_box(group.items, top_left, box.size,
           gpu::label_border_color(l.layer, look.settings.layer_colors));
@@ -192,9 +215,9 @@ std::pair<VectorGroup, VectorGroup> label_groups(const LabelLayout& l, const Lab
         VectorText{look.font, lines[i], top_left + box.line_origins[i], gpu::LABEL_TEXT_COLOR});
   }
   if (!internal) {
-    add_anchor_mark(group.items, l.anchor, hidden);
-    if (l.layer > 0 && look.front.hides(l.anchor, l.layer))
-      add_anchor_mark(behind.items, l.anchor, hidden);
+    const float front = l.layer > 0 ? look.front.alpha(l.anchor, l.layer) : 0.0f;
+    add_anchor_mark(group.items, l.anchor, hidden, 1.0f - front);
+    if (l.layer > 0) add_anchor_mark(behind.items, l.anchor, hidden, behind_share(front));
   }
   return {std::move(group), std::move(behind)};
 }
