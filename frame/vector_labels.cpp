@@ -171,6 +171,19 @@ void add_box(std::vector<VectorItem>& items, glm::vec2 top_left, glm::vec2 size,
   items.push_back(ring);
 }
 
+// The share of a box that the front lets through, over its pixels: where labels lie on the
+// content (internal labelling) the layers in front hide rear ones as they hide their layers.
+float box_seen(const FrontCover& cover, glm::vec2 top_left, glm::vec2 size, uint32_t layer) {
+  if (layer == 0) return 1.0f;
+  float seen = 0.0f;
+  int count = 0;
+  for (float y = 0.5f; y < size.y; y += 1.0f) {
+    for (float x = 0.5f; x < size.x; x += 1.0f, ++count)
+      seen += 1.0f - cover.alpha(top_left + glm::vec2(x, y), layer);
+  }
+  return count > 0 ? seen / float(count) : 1.0f;
+}
+
 struct LabelLook {
   std::shared_ptr<const Font> font;
   TextStyle style;
@@ -185,10 +198,11 @@ float hidden_amount(const LabelLayout& l) {
   return l.anchor_hidden.value_or(false) ? 1.0f : 0.0f;
 }
 
-// One label as label_draw_pixel.h draws it (connector, box, picture, text, anchor mark), and what
-// the composite draws of it on top (label_behind).
-std::pair<VectorGroup, VectorGroup> label_groups(const LabelLayout& l, const Label& label,
-                                                 size_t index, const LabelLook& look) {
+// One label as label_draw_pixel.h draws it, in three groups: its connector; its box, picture and
+// text, seen as far as the front lets them through; its anchor mark. Then what the composite
+// draws of it on top (label_behind).
+std::vector<VectorGroup> label_groups(const LabelLayout& l, const Label& label, size_t index,
+                                      const LabelLook& look, VectorGroup& behind) {
   const Font& font = *look.font;
   const std::vector<ShapedLine> lines = shape_label_text(font, label.text, look.style);
   const LabelBoxLayout box = place_label_text(font, lines, label.text.empty(), look.style,
@@ -197,29 +211,31 @@ std::pair<VectorGroup, VectorGroup> label_groups(const LabelLayout& l, const Lab
   const glm::vec2 centre = internal ? l.anchor : l.box_origin + 0.5f * l.box_size;
   const glm::vec2 top_left = centre - 0.5f * box.size;
   const float hidden = hidden_amount(l);
-  VectorGroup group{l.opacity, {}};
-  VectorGroup behind{l.opacity, {}};
+  behind = {l.opacity, {}};
+  std::vector<VectorGroup> groups(3, VectorGroup{l.opacity, {}});
+  groups[1].opacity *= box_seen(look.front, top_left, box.size, l.layer);
   if (!internal) {
     const glm::vec2 end = glm::clamp(l.anchor, top_left, top_left + box.size);
-    add_connector(group.items, behind.items, l, end, hidden, look.front);
+    add_connector(groups[0].items, behind.items, l, end, hidden, look.front);
   }
-  add_box(group.items, top_left, box.size,
+  add_box(groups[1].items, top_left, box.size,
           gpu::label_border_color(l.layer, look.settings.layer_colors));
   if (box.image && label.image) {
     const glm::vec4 r = *box.image;
-    group.items.push_back(
+    groups[1].items.push_back(
         VectorImage{top_left + glm::vec2(r.x, r.y), {r.z - r.x, r.w - r.y}, label.image->pixels});
   }
   for (size_t i = 0; i < lines.size(); ++i) {
-    group.items.push_back(
+    groups[1].items.push_back(
         VectorText{look.font, lines[i], top_left + box.line_origins[i], gpu::LABEL_TEXT_COLOR});
   }
   if (!internal) {
     const float front = l.layer > 0 ? look.front.alpha(l.anchor, l.layer) : 0.0f;
-    add_anchor_mark(group.items, l.anchor, hidden, 1.0f - front);
+    add_anchor_mark(groups[2].items, l.anchor, hidden, 1.0f - front);
     if (l.layer > 0) add_anchor_mark(behind.items, l.anchor, hidden, behind_share(front));
   }
-  return {std::move(group), std::move(behind)};
+  std::erase_if(groups, [](const VectorGroup& g) { return g.items.empty(); });
+  return groups;
 }
 
 }  // namespace
@@ -249,9 +265,8 @@ VectorPicture labelled_picture(const LabelledFrame& frame, const Scene& scene,
   for (const size_t i : order) {
     const LabelLayout& l = frame.labels[i];
     if (!l.placed || !(l.opacity > 0.0f)) continue;
-    auto [group, on_top] = label_groups(l, scene.labels[i], i, look);
-    picture.groups.push_back(std::move(group));
-    behind[i] = std::move(on_top);
+    for (VectorGroup& group : label_groups(l, scene.labels[i], i, look, behind[i]))
+      picture.groups.push_back(std::move(group));
   }
   for (VectorGroup& group : behind) {  // (the composite's, in label order)
     if (!group.items.empty()) picture.groups.push_back(std::move(group));

@@ -86,10 +86,11 @@ VectorPicture image_picture(uint32_t width, uint32_t height, std::span<const uin
 
 // The frame's picture (rendered with LabellingSettings::marks off) with its labels drawn over it
 // as the raster drawing draws them: every label placed and not faded out, rear layers first, in
-// label order within a layer; then, on top, a rear label's connector dashed where the layers in
-// front of its own (`layers`: LabelledRenderer::download_layers; none: no content in front) or a
-// front label's box hide it (label_behind). frame.labels[i] is scene.labels[i]; `settings` those
-// it was rendered with (font, scale, wrap width, layer colours, internal labelling).
+// label order within a layer, a rear label seen as far as what lies in front of it lets it
+// through (`layers`: LabelledRenderer::download_layers, and the front labels' boxes; no layers:
+// no content in front); then, on top, a rear label's connector dashed and its mark where the
+// front hides them (label_behind). frame.labels[i] is scene.labels[i]; `settings` those it was
+// rendered with (font, scale, wrap width, layer colours, internal labelling).
 VectorPicture labelled_picture(const LabelledFrame& frame, const Scene& scene,
                                const LabellingSettings& settings,
                                std::span<const glm::vec4> layers = {});
