@@ -10,6 +10,7 @@
 #include "engine/graph/headless_target.h"
 #include "engine/scene/io/scene_loader.h"
 #include "frame/labelled_render.h"
+#include "frame/vector_picture.h"
 #include "labeling/camera_path.h"
 #include "passes/test_pattern.h"
 #include "passes/volume_renderer.h"
@@ -132,6 +133,26 @@ LabellingSettings labelling_settings(const RenderOptions& o, const Scene& scene)
   return settings;
 }
 
+// -o: a raster image (engine/core/image.h) or a vector file (frame/vector_picture.h).
+void check_picture_extension(const std::string& path) {
+  if (vector_format(path)) return;
+  try {
+    check_image_extension(path);
+  } catch (const Error&) {
+    throw Error(path + ": cannot write images as '" +
+                std::filesystem::path(path).extension().string() +
+                "' (the extension must be .png, .jpg, .jpeg, .svg or .pdf)");
+  }
+}
+
+void write_picture(const std::string& path, graph::Extent size, std::span<const uint8_t> rgba) {
+  if (vector_format(path)) {
+    write_vector_picture(path, image_picture(size.width, size.height, rgba));
+  } else {
+    write_image(path, size.width, size.height, rgba);
+  }
+}
+
 void write_layout(const std::string& path, const LabelledFrame& frame) {
   write_text_file(path, layout_json(frame));
   std::printf("wrote %s\n", path.c_str());
@@ -139,7 +160,9 @@ void write_layout(const std::string& path, const LabelledFrame& frame) {
 
 void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions& o,
                            graph::Extent size, const Still& still) {
-  const LabellingSettings settings = labelling_settings(o, scene);
+  LabellingSettings settings = labelling_settings(o, scene);
+  const bool vector = vector_format(still.image).has_value();
+  settings.marks = !vector;  // (a vector file draws the labels itself)
   LabelledRenderer renderer(ctx, scene, still.camera, size, settings);
   print_graph(o, renderer.runner());
   if (settings.order == InsertionOrder::optimized) {
@@ -149,7 +172,12 @@ void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions
     renderer.run();
   }
   const LabelledFrame frame = renderer.result();
-  write_image(still.image, size.width, size.height, frame.image);
+  if (vector) {
+    write_vector_picture(still.image,
+                         labelled_picture(frame, scene, settings, renderer.download_layers()));
+  } else {
+    write_image(still.image, size.width, size.height, frame.image);
+  }
   uint32_t shown = 0, placed = 0;
   for (const LabelLayout& l : frame.labels) {
     shown += l.shown;
@@ -170,7 +198,7 @@ void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions
 // layers' folders are made.
 void prepare_outputs(const std::vector<Still>& all, uint32_t layer_count) {
   for (const Still& still : all) {
-    check_image_extension(still.image);
+    check_picture_extension(still.image);
     check_output_file("-o", still.image);
     if (!still.layout.empty()) check_output_file("--layout", still.layout);
     std::vector<std::filesystem::path> layers;
@@ -228,7 +256,7 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
       std::fprintf(stderr, "strata: HA-Buffer overflow (%u fragments), table grows to %u slots\n",
                    s.overflow, renderer.table_slots(size));
     });
-    write_image(still.image, size.width, size.height, target.pixels());
+    write_picture(still.image, size, target.pixels());
     std::printf(
         "wrote %s (%ux%u, %u layers): %u fragments, load factor %.2f, %.1f samples per ray\n",
         still.image.c_str(), size.width, size.height, settings.layer_count, stats.fragments,
@@ -242,7 +270,7 @@ void render_scene(DeviceOptions& device, const RenderOptions& o) {
 
 void render_test_pattern(DeviceOptions& device, const RenderOptions& o) {
   const graph::Extent size = parse_size(o.size, "--size");
-  check_image_extension(o.output);
+  check_picture_extension(o.output);
   check_output_file("-o", o.output);
   Context ctx(device.context());
   check_image_size(ctx, size, "--size");
@@ -255,7 +283,7 @@ void render_test_pattern(DeviceOptions& device, const RenderOptions& o) {
   target.bind(runner);
   print_graph(o, runner);
   runner.run_now();
-  write_image(o.output, size.width, size.height, target.pixels());
+  write_picture(o.output, size, target.pixels());
   std::printf("wrote %s (%ux%u)\n", o.output.c_str(), size.width, size.height);
 }
 
@@ -263,12 +291,14 @@ void render_test_pattern(DeviceOptions& device, const RenderOptions& o) {
 
 void add_render_command(CLI::App& app, DeviceOptions& device) {
   CLI::App* cmd =
-      app.add_subcommand("render", "Render a scene offline and write it as PNG or JPEG");
+      app.add_subcommand("render", "Render a scene offline and write it as PNG, JPEG, SVG or PDF");
   auto o = std::make_shared<RenderOptions>();
   cmd->add_option("scene", o->scene.file,
                   "scene file (.json, or .xml of the thesis program), or a volume (.nii, .nii.gz, "
                   ".mhd, .mha, .nrrd, .nhdr, a DICOM file or folder); none: a test pattern");
-  cmd->add_option("-o,--output", o->output, "image to write: .png, .jpg or .jpeg")
+  cmd->add_option(
+         "-o,--output", o->output,
+         "image to write: .png, .jpg, .jpeg, or .svg or .pdf (labels as vector shapes and text)")
       ->capture_default_str();
   add_scene_input_options(cmd, o->scene);
   cmd->add_option("--size", o->size, "image size, N or WxH")->capture_default_str();
@@ -302,13 +332,13 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->callback([cmd, &device, o] {
     // An unknown image extension is a usage error, found before any work (and before -o exists).
     try {
-      check_image_extension(o->output);
+      check_picture_extension(o->output);
     } catch (const Error& e) {
       throw UsageError(std::string("-o: ") + e.what());
     }
-    if (o->background.transparent && !image_keeps_alpha(o->output))
+    if (o->background.transparent && !vector_format(o->output) && !image_keeps_alpha(o->output))
       throw UsageError("--background transparent: " + o->output +
-                       ": JPEG has no alpha; write a PNG");
+                       ": JPEG has no alpha; write a PNG, SVG or PDF");
     check_options_apply(cmd, !o->scene.file.empty(), {"--output", "--size", "--dump-graph"},
                         {"--blur"});
     if (o->scene.file.empty()) {

@@ -154,6 +154,12 @@ void LabelledRenderer::drop_runner() {
   if (!uploads.empty()) ctx_.run_now([&](VkCommandBuffer cmd) { uploads.record(cmd); });
 }
 
+TextStyle label_text_style(const LabellingSettings& settings) {
+  TextStyle style;
+  style.max_width = settings.wrap_width;
+  return style.scaled(settings.label_scale);
+}
+
 void check_label_text(float font_pixels, float label_scale) {
   if (!(font_pixels >= 4.0f && font_pixels <= 128.0f)) {
     throw Error("label font size must be 4 to 128 px, not " + std::to_string(font_pixels));
@@ -170,9 +176,7 @@ void LabelledRenderer::build_labels() {
   const float scale = settings_.label_scale;
   if (!font_) font_.emplace(settings_.font_pixels * scale);
   const Font& font = *font_;
-  TextStyle style;
-  style.max_width = settings_.wrap_width;
-  style = style.scaled(scale);
+  const TextStyle style = label_text_style(settings_);
   std::vector<std::string> texts;
   for (const Label& label : scene_.labels) texts.push_back(label.text);
   Parts& p = *parts_;
@@ -496,7 +500,9 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
   std::erase_if(order, [this](uint32_t i) { return i < withheld_.size() && withheld_[i]; });
   // (the rounds decide a priority's labels only once every higher priority's are decided)
   std::vector<uint32_t> group_first(order.size(), 0);
-  const auto priority = [this](uint32_t i) { return i < priorities_.size() ? priorities_[i] : 0.0f; };
+  const auto priority = [this](uint32_t i) {
+    return i < priorities_.size() ? priorities_[i] : 0.0f;
+  };
   for (uint32_t s = 1; s < order.size(); ++s) {
     group_first[s] = priority(order[s]) == priority(order[s - 1]) ? group_first[s - 1] : s;
   }
@@ -504,6 +510,7 @@ void LabelledRenderer::set_placement_frame(bool moving, const std::vector<uint32
                               group_first);
   parts_->forces.set_active(slots_.used());
   parts_->drawing->set_layer_frames(settings_.layer_colors);
+  parts_->drawing->set_marks(settings_.marks);
   const GhostSettings ghost{settings_.ghost.strength, settings_.ghost.radius * side,
                             settings_.ghost.leader * side};
   parts_->drawing->set_ghost(ghost);
@@ -686,6 +693,7 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
       frame.labels[i].visible = visible[i];
       frame.labels[i].front_alpha = cover.front_alpha;
       frame.labels[i].anchor_hidden = cover.hidden >= gpu::LABEL_HIDDEN_AT;
+      frame.labels[i].hidden = cover.hidden;
     }
   }
   for (LabelLayout& l : frame.labels) {

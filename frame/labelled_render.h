@@ -57,6 +57,9 @@ struct LabellingSettings {
   float wrap_width = 240.0f;
   bool layer_colors = false;  // label borders in their layer's colour (the thesis's depth cue)
   Ghosting ghost;
+  // false: the labels are placed, ghost the layers and are measured, but not drawn into the
+  // picture (a vector file draws them over it: frame/vector_picture.h).
+  bool marks = true;
   // Label slots kept free beyond the scene's labels (frame/label_slots.h): labels added later
   // (labels_changed) fill them without new buffers or a new graph; the viewer keeps some.
   uint32_t spare_label_slots = 0;
@@ -94,6 +97,9 @@ struct LabelLayout {
   // shaders/shared/label_drawing.h); the connector is then drawn dashed, the anchor's mark
   // hollow. None where it was not measured, as front_alpha.
   std::optional<bool> anchor_hidden;
+  // The same as the drawing mixes it, 0 (seen) to 1 (hidden): AnchorCoverGpu::hidden; NaN where
+  // it was not measured.
+  float hidden = std::numeric_limits<float>::quiet_NaN();
   // The top-left corner of the placement's box this frame, where the label is heading (its size
   // is box_size); none where the placement did not place it.
   std::optional<glm::vec2> target_origin;
@@ -366,6 +372,9 @@ class LabelledRenderer {
   bool graph_ghost_ = false;   // the graph has the ghosting pass (LabellingSettings::ghost)
   LabellingSettings settings_;
 };
+
+// The label text's style for `settings`: wrapped at its wrap width, every length times its scale.
+TextStyle label_text_style(const LabellingSettings& settings);
 
 // Throws Error unless the font size (4..128 px) and label scale (0.25..4) are in range.
 void check_label_text(float font_pixels, float label_scale);

@@ -85,17 +85,7 @@ std::vector<std::string> missing_glyph_warnings(const Font& font, std::span<cons
     if (missing.empty()) continue;
     std::string characters;
     for (const char32_t c : missing) {
-      std::string utf8;  // (the character itself, unless it is a control character)
-      if (c < 0x80) {
-        utf8 = std::string(1, char(c));
-      } else if (c < 0x800) {
-        utf8 = {char(0xC0 | (c >> 6)), char(0x80 | (c & 0x3F))};
-      } else if (c < 0x10000) {
-        utf8 = {char(0xE0 | (c >> 12)), char(0x80 | ((c >> 6) & 0x3F)), char(0x80 | (c & 0x3F))};
-      } else {
-        utf8 = {char(0xF0 | (c >> 18)), char(0x80 | ((c >> 12) & 0x3F)),
-                char(0x80 | ((c >> 6) & 0x3F)), char(0x80 | (c & 0x3F))};
-      }
+      const std::string utf8 = encode_utf8(std::u32string(1, c));
       const std::string shown = printable_text(utf8);
       characters += (characters.empty() ? "" : ", ") + codepoint_name(c) +
                     (shown == utf8 ? " (" + utf8 + ")" : "");
@@ -130,13 +120,9 @@ LabelImages bake_label_images(std::span<const Label> labels, float scale) {
   return out;
 }
 
-LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std::string_view text,
-                                  const TextStyle& style, glm::vec2 min_size,
-                                  const std::optional<LabelImageBlock>& image,
-                                  const std::vector<ShapedLine>* shaped_lines) {
-  const std::vector<ShapedLine> own =
-      shaped_lines ? std::vector<ShapedLine>{} : shape_label_text(font, text, style);
-  const std::vector<ShapedLine>& lines = shaped_lines ? *shaped_lines : own;
+LabelBoxLayout place_label_text(const Font& font, const std::vector<ShapedLine>& lines,
+                                bool empty_text, const TextStyle& style, glm::vec2 min_size,
+                                const std::optional<LabelImageBlock>& image) {
   float widest = 0.0f;
   for (const ShapedLine& line : lines) widest = std::max(widest, line.advance);
   const float spacing = std::round(font.line_spacing());
@@ -146,7 +132,7 @@ LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std:
   // comes from the text box, or from the text box's padding alone when there is no text).
   glm::vec2 text_box(std::max(std::ceil(widest + 2.0f * style.padding_x), style.min_width),
                      std::ceil(text_height + 2.0f * style.padding_y));
-  if (image && text.empty()) text_box = {style.padding_x, style.padding_y};
+  if (image && empty_text) text_box = {style.padding_x, style.padding_y};
   const glm::vec2 padding = glm::round(glm::vec2(style.padding_x, style.padding_y));
   glm::vec2 strip(0.0f), box = text_box;
   if (image && image->left) {
@@ -157,29 +143,42 @@ LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std:
     box = {std::max(text_box.x, image->size.x + 2.0f * padding.x), strip.y + text_box.y};
   }
 
-  LabelTextLayout out;
-  out.lines = lines.size();
+  LabelBoxLayout out;
   out.size = glm::ceil(glm::max(glm::max(box, min_size), glm::vec2(style.min_width, 0.0f)));
   if (image) {
     const glm::vec2 at =
         image->left ? glm::vec2(padding.x, std::round(0.5f * (out.size.y - image->size.y)))
                     : glm::vec2(std::round(0.5f * (out.size.x - image->size.x)), padding.y);
-    out.image = gpu::GlyphGpu{image->atlas, glm::vec4(at, at + image->size)};
+    out.image = glm::vec4(at, at + image->size);
   }
-
-  // Glyphs sit on whole pixels: with quads aligned to the texel grid, a box at a whole-pixel
-  // position samples texel centres and the text stays sharp.
   const glm::vec2 region = out.size - strip;  // what the text is centred in
   float baseline = strip.y + std::round(0.5f * (region.y - text_height) + font.ascent());
   for (const ShapedLine& line : lines) {
-    const float start = strip.x + std::round(0.5f * (region.x - line.advance));
-    for (const ShapedGlyph& shaped : line.glyphs) {
+    out.line_origins.emplace_back(strip.x + std::round(0.5f * (region.x - line.advance)), baseline);
+    baseline += spacing;
+  }
+  return out;
+}
+
+LabelTextLayout layout_label_text(const Font& font, const FontAtlas& atlas, std::string_view text,
+                                  const TextStyle& style, glm::vec2 min_size,
+                                  const std::optional<LabelImageBlock>& image,
+                                  const std::vector<ShapedLine>* shaped_lines) {
+  const std::vector<ShapedLine> own =
+      shaped_lines ? std::vector<ShapedLine>{} : shape_label_text(font, text, style);
+  const std::vector<ShapedLine>& lines = shaped_lines ? *shaped_lines : own;
+  const LabelBoxLayout box = place_label_text(font, lines, text.empty(), style, min_size, image);
+  LabelTextLayout out;
+  out.lines = lines.size();
+  out.size = box.size;
+  if (box.image) out.image = gpu::GlyphGpu{image->atlas, *box.image};
+  for (size_t l = 0; l < lines.size(); ++l) {
+    for (const ShapedGlyph& shaped : lines[l].glyphs) {
       const GlyphMetrics g = atlas.glyph(shaped.key);
       if (g.empty()) continue;
-      const glm::vec2 origin(start + std::round(shaped.pen.x), baseline + std::round(shaped.pen.y));
+      const glm::vec2 origin = glyph_origin(box.line_origins[l], shaped);
       out.glyphs.push_back({g.uv, glm::vec4(origin, origin) + g.quad});
     }
-    baseline += spacing;
   }
   return out;
 }

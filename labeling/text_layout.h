@@ -86,6 +86,23 @@ std::vector<GlyphKey> label_glyph_keys(const Font& font, std::span<const std::st
 FontAtlas bake_label_texts(const Font& font, std::span<const std::string> texts,
                            const TextStyle& style = {});
 
+// Where a label's text and picture lie in its box, before its glyphs are looked up in an atlas:
+// what the raster drawing (layout_label_text) and the vector writer (frame/vector_picture.h) share.
+struct LabelBoxLayout {
+  glm::vec2 size{0.0f};                 // the label box, whole pixels
+  std::vector<glm::vec2> line_origins;  // each line's start on its baseline, from the box's corner
+  std::optional<glm::vec4> image;       // the picture's rectangle: x0, y0, x1, y1
+};
+LabelBoxLayout place_label_text(const Font& font, const std::vector<ShapedLine>& lines,
+                                bool empty_text, const TextStyle& style, glm::vec2 min_size,
+                                const std::optional<LabelImageBlock>& image);
+
+// Where a glyph's pen lies in the box: on whole pixels, so that with quads aligned to the texel
+// grid a box at a whole-pixel position samples texel centres and the text stays sharp.
+inline glm::vec2 glyph_origin(glm::vec2 line_origin, const ShapedGlyph& glyph) {
+  return line_origin + glm::round(glyph.pen);
+}
+
 // The box for `text` and its glyphs (from `atlas`, which holds them: bake_label_texts), each line
 // centred in the box. The box is at least `min_size` (zero: from the text alone), so a label's
 // given size is kept. With an image, the box holds it (padding around it, centred across the

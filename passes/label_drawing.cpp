@@ -193,6 +193,7 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
         {atlas, Use::sampled, LABEL_DRAW_BINDING_ATLAS},
         {images, Use::sampled, LABEL_DRAW_BINDING_IMAGES}},
        [this](graph::PassContext& pc) {
+         if (!marks_) return;
          pc.dispatch(draw_, params(pc.viewport), {pc.viewport.width, pc.viewport.height, 1});
        },
        "labels"});
@@ -205,7 +206,9 @@ void LabelDrawing::add_to(graph::Graph& graph, const Inputs& in) {
         {in.covers, Use::storage_read, LABEL_DRAW_BINDING_COVERS},
         {in.output, Use::storage_write, LABEL_DRAW_BINDING_FINAL}},
        [this](graph::PassContext& pc) {
-         pc.dispatch(composite_, params(pc.viewport), {pc.viewport.width, pc.viewport.height, 1});
+         gpu::LabelDrawParams p = params(pc.viewport);
+         if (!marks_) p.label_count = 0;  // (no rear label's leader drawn on top either)
+         pc.dispatch(composite_, p, {pc.viewport.width, pc.viewport.height, 1});
        },
        "labels"});
 }

@@ -88,6 +88,9 @@ class LabelDrawing {
   void set_layer_frames(bool on) { layer_frames_ = on; }
   // Ghosting's settings, read when the graph is recorded (strength 0: the pass records nothing).
   void set_ghost(const GhostSettings& ghost) { ghost_ = ghost; }
+  // Whether labels.draw and the composite draw the labels (read when the graph is recorded); off,
+  // the ghosting and anchor covers are still made (a vector file draws the labels over it).
+  void set_marks(bool on) { marks_ = on; }
 
  private:
   gpu::LabelDrawParams params(graph::Extent viewport) const;
@@ -104,6 +107,7 @@ class LabelDrawing {
   uint32_t label_count_ = LABEL_MAX;
   Background background_;
   bool layer_frames_ = false;
+  bool marks_ = true;
 };
 
 // What the CPU reference draws: the contents of the three buffers.

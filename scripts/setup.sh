@@ -17,6 +17,8 @@ packages=(
   # lacks, WenQuanYi Micro Hei for Chinese, Japanese and Korean
   libfreetype-dev libharfbuzz-dev libfribidi-dev fonts-dejavu-core fonts-freefont-ttf
   fonts-wqy-microhei
+  # vector stills: PDF through cairo; the tests rasterise SVG (rsvg-convert) and PDF (poppler)
+  libcairo2-dev librsvg2-bin poppler-utils
   # file formats: gzip, DICOM, meshes, JSON, XML, JPEG (label pictures)
   zlib1g-dev libgdcm-dev libassimp-dev nlohmann-json3-dev libpugixml-dev libjpeg62-turbo-dev
   # videos: H.264 in MP4 and GIF (palettes by libavfilter) through FFmpeg's libraries; ffprobe

@@ -124,7 +124,7 @@ TEST_SUITE("cli") {
     const auto render = run_strata("render --size 32 -o " + (dir / "x.bmp").string());
     CHECK(render.exit_code == 2);
     CHECK(render.output.find("-o: " + (dir / "x.bmp").string()) != std::string::npos);
-    CHECK(render.output.find(".png, .jpg or .jpeg") != std::string::npos);
+    CHECK(render.output.find(".png, .jpg, .jpeg, .svg or .pdf") != std::string::npos);
     const auto video =
         run_strata("video " STRATA_SOURCE_DIR "/assets/scenes/head.json --orbit 10 --size 32 -o " +
                    (dir / "x.avi").string());

@@ -92,6 +92,24 @@ std::u32string decode_utf8(std::string_view text) {
   return out;
 }
 
+std::string encode_utf8(std::u32string_view text) {
+  std::string out;
+  for (char32_t c : text) {
+    if (c > 0x10FFFF || (c >= 0xD800 && c <= 0xDFFF)) c = kReplacement;
+    if (c < 0x80) {
+      out += char(c);
+    } else if (c < 0x800) {
+      out += {char(0xC0 | (c >> 6)), char(0x80 | (c & 0x3F))};
+    } else if (c < 0x10000) {
+      out += {char(0xE0 | (c >> 12)), char(0x80 | ((c >> 6) & 0x3F)), char(0x80 | (c & 0x3F))};
+    } else {
+      out += {char(0xF0 | (c >> 18)), char(0x80 | ((c >> 12) & 0x3F)),
+              char(0x80 | ((c >> 6) & 0x3F)), char(0x80 | (c & 0x3F))};
+    }
+  }
+  return out;
+}
+
 std::string codepoint_name(char32_t c) {
   char name[16];
   std::snprintf(name, sizeof name, "U+%04X", unsigned(c));
@@ -187,7 +205,9 @@ Font::Font(float pixel_height, const std::string& path) : faces_(std::make_uniqu
       descent_ = float(face->descender) * scale;
       line_spacing_ = std::max(float(face->height) * scale, ascent_ - descent_);
     }
-    FT_Set_Char_Size(face, 0, FT_F26Dot6(std::lround(em_pixels * 64.0f)), 72, 72);
+    const FT_F26Dot6 em = FT_F26Dot6(std::lround(em_pixels * 64.0f));
+    FT_Set_Char_Size(face, 0, em, 72, 72);
+    em_pixels_ = float(em) / 64.0f;
     faces_->faces.push_back(face);
     hb_font_t* font = hb_ft_font_create_referenced(face);
     hb_ft_font_set_load_flags(font, kLoadFlags);
@@ -202,6 +222,15 @@ Font& Font::operator=(Font&&) noexcept = default;
 
 size_t Font::face_count() const {
   return faces_->faces.size();
+}
+
+FT_FaceRec_* Font::face(size_t index) const {
+  return faces_->faces.at(index);
+}
+
+std::string Font::family_name(size_t index) const {
+  const FT_Face face = faces_->faces.at(index);
+  return face->family_name ? face->family_name : "";
 }
 
 bool Font::covers(char32_t codepoint) const {
@@ -336,6 +365,7 @@ void shape_run(hb_buffer_t* buffer, hb_font_t* font, const std::u32string& text,
   hb_buffer_set_script(buffer, run.script);
   hb_buffer_guess_segment_properties(buffer);  // (the language)
   hb_shape(font, buffer, nullptr, 0);
+  out.runs.push_back({out.glyphs.size(), 0, run.start, run.count, run.rtl});
   unsigned glyphs = 0;
   const hb_glyph_info_t* info = hb_buffer_get_glyph_infos(buffer, &glyphs);
   const hb_glyph_position_t* position = hb_buffer_get_glyph_positions(buffer, &glyphs);
@@ -350,6 +380,7 @@ void shape_run(hb_buffer_t* buffer, hb_font_t* font, const std::u32string& text,
       out.missing.push_back(c);
     }
   }
+  out.runs.back().glyph_count = glyphs;
 }
 
 }  // namespace
@@ -366,6 +397,7 @@ ShapedLine Font::shape(std::string_view line, TextDirection direction) const {
   const VisualOrder order = visual_order(text, direction);
 
   ShapedLine out;
+  out.text = text;
   out.right_to_left = FRIBIDI_IS_RTL(order.base);
   glm::vec2 pen(0.0f);
   hb_buffer_t* buffer = hb_buffer_create();

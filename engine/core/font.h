@@ -17,6 +17,8 @@
 
 #include <glm/glm.hpp>
 
+struct FT_FaceRec_;  // FreeType's face (FT_Face), for writers that draw the outlines
+
 namespace strata {
 
 // From Debian's fonts-dejavu-core.
@@ -52,8 +54,18 @@ struct ShapedGlyph {
   uint32_t cluster = 0;  // the (first) character it draws: an index into the line's code points
 };
 
+// Glyphs shaped together: one face, one direction, the characters [first_char, first_char +
+// char_count) of the line drawn by glyphs [first_glyph, first_glyph + glyph_count).
+struct ShapedRun {
+  size_t first_glyph = 0, glyph_count = 0;
+  size_t first_char = 0, char_count = 0;
+  bool right_to_left = false;
+};
+
 struct ShapedLine {
+  std::u32string text;              // the line's characters in logical order (what clusters index)
   std::vector<ShapedGlyph> glyphs;  // in visual order, left to right
+  std::vector<ShapedRun> runs;      // in visual order
   float advance = 0.0f;             // the line's width, pixels
   bool right_to_left = false;       // the paragraph's resolved direction
   std::vector<char32_t> missing;    // characters no face has (drawn as the missing-glyph box),
@@ -93,6 +105,13 @@ class Font {
   // Baseline to baseline.
   float line_spacing() const { return line_spacing_; }
   size_t face_count() const;
+  // The size of an em in pixels, as the faces are set (ascent to descent is pixel_height).
+  float em_pixels() const { return em_pixels_; }
+  // Face `index` (0: the main face, then the fallbacks) at em_pixels, for drawing its outlines
+  // (frame/vector_picture.cpp); the Font keeps it.
+  FT_FaceRec_* face(size_t index) const;
+  // Its family name ("DejaVu Sans").
+  std::string family_name(size_t index) const;
 
   // One line of UTF-8 text (malformed bytes become U+FFFD), shaped: its embedding levels resolved
   // in `direction` (the paragraph's: see paragraph_direction), cut into runs of one level, face
@@ -112,6 +131,7 @@ class Font {
   float ascent_ = 0.0f;
   float descent_ = 0.0f;
   float line_spacing_ = 0.0f;
+  float em_pixels_ = 0.0f;
 };
 
 // The font file to read for `path`: STRATA_FONT, when set, replaces the default font (hosts
@@ -120,6 +140,9 @@ std::string font_file(const std::string& path = kDefaultFontPath);
 
 // UTF-8 to code points; a malformed or truncated sequence becomes one U+FFFD.
 std::u32string decode_utf8(std::string_view text);
+
+// Code points to UTF-8 (a value past U+10FFFF or a surrogate becomes U+FFFD).
+std::string encode_utf8(std::u32string_view text);
 
 // The direction of the first strong character of `paragraph` (UTF-8): right_to_left or
 // left_to_right (also when it has none).

@@ -10,19 +10,29 @@
 
 namespace strata {
 
-void write_png(const std::string& path, uint32_t width, uint32_t height,
-               std::span<const uint8_t> rgba) {
+std::vector<uint8_t> encode_png(uint32_t width, uint32_t height, std::span<const uint8_t> rgba) {
   if (rgba.size() != size_t{width} * height * 4) {
-    throw Error(path + ": " + std::to_string(rgba.size()) + " bytes is not a " +
-                std::to_string(width) + "x" + std::to_string(height) + " rgba8 image");
+    throw Error(std::to_string(rgba.size()) + " bytes is not a " + std::to_string(width) + "x" +
+                std::to_string(height) + " rgba8 image");
   }
-  // Encoded in memory, then written whole or not at all (atomic_file.h): stb's own file writer
-  // ignores failed writes (a full disk would leave a cut file and a "wrote" message).
   std::vector<uint8_t> encoded;
   if (!stbi_write_png_to_func(append_encoded, &encoded, static_cast<int>(width),
                               static_cast<int>(height), 4, rgba.data(),
                               static_cast<int>(width * 4))) {
-    throw Error(path + ": cannot encode PNG");
+    throw Error("cannot encode PNG");
+  }
+  return encoded;
+}
+
+void write_png(const std::string& path, uint32_t width, uint32_t height,
+               std::span<const uint8_t> rgba) {
+  // Encoded in memory, then written whole or not at all (atomic_file.h): stb's own file writer
+  // ignores failed writes (a full disk would leave a cut file and a "wrote" message).
+  std::vector<uint8_t> encoded;
+  try {
+    encoded = encode_png(width, height, rgba);
+  } catch (const Error& e) {
+    throw Error(path + ": " + e.what());
   }
   write_file_checked(path, encoded, "PNG");
 }

@@ -13,6 +13,9 @@ void write_file_checked(const std::string& path, std::span<const uint8_t> bytes,
 // stb's write callback: appends to the std::vector<uint8_t> at `bytes`.
 void append_encoded(void* bytes, void* data, int size);
 
+// Tightly packed rgba8 pixels as a PNG file's bytes; throws Error when the size is wrong.
+std::vector<uint8_t> encode_png(uint32_t width, uint32_t height, std::span<const uint8_t> rgba);
+
 // Writes tightly packed rgba8 pixels; throws Error naming the file when it cannot.
 void write_png(const std::string& path, uint32_t width, uint32_t height,
                std::span<const uint8_t> rgba);
