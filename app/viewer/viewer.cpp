@@ -220,8 +220,10 @@ void Viewer::draw_frame(std::optional<double> step) {
   draw_cut_aways();
   ui_.end_frame();
   apply_submitted();
-  if (panel_ != labelled_->settings().placement.keep_out) {
-    labelled_->settings().placement.keep_out = panel_;  // (the panel moved, or was shown or hidden)
+  const std::vector<glm::uvec4> keep_out{panel_};
+  if (keep_out != labelled_->settings().placement.keep_out) {
+    // (the panel moved, or was shown or hidden)
+    labelled_->settings().placement.keep_out = keep_out;
     changed();
   }
   if (ui_frames_ > 0) --ui_frames_;
