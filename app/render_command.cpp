@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "app/annotation_options.h"
 #include "app/commands.h"
 #include "app/output_files.h"
 #include "app/progress.h"
@@ -31,6 +32,7 @@ struct RenderOptions {
   PlacementMethod greedy = PlacementMethod::sequential;
   bool internal = false;
   LabelLookOptions look;
+  AnnotationOptions notes;
   bool decoret = false;
   std::string order = "scene";
   std::string layout;
@@ -140,13 +142,22 @@ void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions
   const LabellingSettings settings = labelling_settings(o, scene);
   LabelledRenderer renderer(ctx, scene, still.camera, size, settings);
   print_graph(o, renderer.runner());
-  if (settings.order == InsertionOrder::optimized) {
-    Progress progress("insertion order", settings.optimize_tries);
-    renderer.run([&](uint32_t done, uint32_t) { progress.step_done(done); });
+  const auto run = [&] {
+    if (settings.order == InsertionOrder::optimized) {
+      Progress progress("insertion order", settings.optimize_tries);
+      renderer.run([&](uint32_t done, uint32_t) { progress.step_done(done); });
+    } else {
+      renderer.run();
+    }
+  };
+  std::optional<LabelledFrame> annotated;
+  if (o.notes.any()) {
+    Annotations notes(o.notes, settings, {size.width, size.height});
+    annotated = annotated_still(renderer, notes, scene, run);
   } else {
-    renderer.run();
+    run();
   }
-  const LabelledFrame frame = renderer.result();
+  const LabelledFrame frame = annotated ? std::move(*annotated) : renderer.result();
   write_image(still.image, size.width, size.height, frame.image);
   uint32_t shown = 0, placed = 0;
   for (const LabelLayout& l : frame.labels) {
@@ -281,6 +292,7 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   add_greedy_option(cmd, o->greedy);
   cmd->add_flag("--internal", o->internal, "internal labelling: labels drawn on their anchors");
   add_label_look_options(cmd, o->look);
+  add_annotation_options(cmd, o->notes);
   cmd->add_option("--order", o->order,
                   "insertion order: scene, apollonius (Stein & Decoret, innermost first) or "
                   "optimized (random orders, the best kept)")
@@ -304,6 +316,9 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
     }
     check_options_apply(cmd, !o->scene.file.empty(), {"--output", "--size", "--dump-graph"},
                         {"--blur"});
+    if (o->no_labels && o->notes.any()) {
+      throw UsageError("--title and --legend: a picture without labels (--no-labels) has none");
+    }
     if (o->scene.file.empty()) {
       render_test_pattern(device, *o);
     } else if (o->no_labels) {
