@@ -13,8 +13,8 @@ void add_annotation_options(CLI::App* cmd, AnnotationOptions& o) {
                   "a title centred along the top of the picture, in a box as the labels' (labels "
                   "keep off it)");
   cmd->add_flag("--legend", o.legend,
-                "a legend in the bottom-right corner: the labels shown (a video: all the "
-                "scene's), each with its colour where it has one; labels keep off it");
+                "a legend in a corner: the labels (a still: those it shows; a video, the viewer: "
+                "all the scene's), each with its colour where it has one; labels keep off it");
 }
 
 Annotations::Annotations(const AnnotationOptions& o, const LabellingSettings& labelling,
