@@ -27,6 +27,13 @@ std::string fitted(const Font& font, const std::string& text, float width) {
   return kEllipsis;
 }
 
+// A text on one line: its line breaks (a label's text may have some) become spaces.
+std::string one_line(std::string text) {
+  std::replace_if(
+      text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+  return text;
+}
+
 glm::vec4 text_colour() {
   const gpu::vec4 c = gpu::LABEL_TEXT_COLOR;
   return {c.x, c.y, c.z, c.w};
@@ -49,7 +56,7 @@ TitleLayout layout_title(const Font& font, const AnnotationSettings& s, glm::uve
                          float gap) {
   const glm::vec2 padding = glm::round(glm::vec2(s.style.padding_x, s.style.padding_y));
   const float room = std::max(float(image.x) - 2.0f * gap - 2.0f * padding.x, 0.0f);
-  const std::string text = fitted(font, s.title, room);
+  const std::string text = fitted(font, one_line(s.title), room);
   const float width = advance(font, text);
   const glm::vec2 size = glm::ceil(glm::vec2(std::max(width + 2.0f * padding.x, s.style.min_width),
                                              font.line_height() + 2.0f * padding.y));
@@ -84,7 +91,9 @@ std::optional<LegendLayout> layout_legend(const Font& font, const AnnotationSett
   const float text_room = std::max(room.z - room.x - 2.0f * padding.x - indent, 0.0f);
 
   std::vector<std::string> texts;
-  for (size_t i = 0; i < listed; ++i) texts.push_back(fitted(font, entries[i].text, text_room));
+  for (size_t i = 0; i < listed; ++i) {
+    texts.push_back(fitted(font, one_line(entries[i].text), text_room));
+  }
   if (listed < entries.size())
     texts.push_back("+" + std::to_string(entries.size() - listed) + " more");
   float widest = 0.0f;

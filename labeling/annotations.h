@@ -6,10 +6,12 @@
 // LABEL_BORDER_WIDTH, LABEL_BOX_RADIUS), its text is white label text (LABEL_TEXT_COLOR), so it
 // reads the same on any background.
 //
-// Where they go: the title centred along the top edge, the legend in a corner (the
-// bottom-right one unless the settings say), both a gap (AnnotationSettings::gap_em) inside the
-// image. Pixels, x right, y down; rectangles
-// are x0, y0, x1, y1 with [x0, x1) x [y0, y1).
+// A swatch is its colour, opaque, with a one-pixel rim of LABEL_BORDER_COLOR. Text runs are
+// single lines in the label font (engine/core/font.h), shaped left to right from their origin.
+//
+// Where they go: the title centred along the top edge, the legend in a corner (the bottom-right
+// one unless the settings say), both a gap (AnnotationSettings::gap_em) inside the image.
+// Pixels, x right, y down; rectangles are x0, y0, x1, y1 with [x0, x1) x [y0, y1).
 #pragma once
 
 #include <optional>

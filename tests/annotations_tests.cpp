@@ -118,6 +118,15 @@ TEST_SUITE("cpu") {
     CHECK(text.substr(text.size() - 3) == "\xE2\x80\xA6");
     CHECK(cut.legend->box.rect.z - cut.legend->box.rect.x <= 128.0f);
 
+    // A line break (a label's text may have one) is a space: a title and each row are one line.
+    AnnotationSettings broken;
+    broken.title = "Line one\nline two";
+    broken.legend = true;
+    const std::vector<LegendEntry> two_lines{{"Left\nhippocampus", std::nullopt}};
+    const AnnotationLayout one = layout_annotations(fonts(), broken, {256, 256}, two_lines);
+    CHECK(one.title->text.text == "Line one line two");
+    CHECK(one.legend->rows[0].text.text == "Left hippocampus");
+
     // No entries, or no room for a row: no legend, nothing kept out.
     CHECK_FALSE(layout_annotations(fonts(), s, {256, 256}, {}).legend);
     CHECK(layout_annotations(fonts(), s, {256, 256}, {}).keep_out.empty());
