@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "app/annotation_options.h"
 #include "app/commands.h"
 #include "app/output_files.h"
 #include "app/progress.h"
@@ -33,6 +34,7 @@ struct RenderOptions {
   bool internal = false;
   LabelLookOptions look;
   Background background;
+  AnnotationOptions notes;
   bool decoret = false;
   std::string order = "scene";
   std::string layout;
@@ -165,17 +167,30 @@ void render_labelled_still(Context& ctx, const Scene& scene, const RenderOptions
   settings.marks = !vector;  // (a vector file draws the labels itself)
   LabelledRenderer renderer(ctx, scene, still.camera, size, settings);
   print_graph(o, renderer.runner());
-  if (settings.order == InsertionOrder::optimized) {
-    Progress progress("insertion order", settings.optimize_tries);
-    renderer.run([&](uint32_t done, uint32_t) { progress.step_done(done); });
+  const auto run = [&] {
+    if (settings.order == InsertionOrder::optimized) {
+      Progress progress("insertion order", settings.optimize_tries);
+      renderer.run([&](uint32_t done, uint32_t) { progress.step_done(done); });
+    } else {
+      renderer.run();
+    }
+  };
+  AnnotatedStill annotated;
+  std::optional<Annotations> notes;
+  if (o.notes.any()) {
+    notes.emplace(o.notes, settings, glm::uvec2(size.width, size.height));
+    annotated = annotated_still(renderer, *notes, scene, run);
   } else {
-    renderer.run();
+    run();
+    annotated.frame = renderer.result();
   }
-  const LabelledFrame frame = renderer.result();
+  LabelledFrame& frame = annotated.frame;
   if (vector) {
-    write_vector_picture(still.image,
-                         labelled_picture(frame, scene, settings, renderer.download_layers()));
+    VectorPicture picture = labelled_picture(frame, scene, settings, renderer.download_layers());
+    add_annotations(picture, annotated.layout);
+    write_vector_picture(still.image, picture);
   } else {
+    if (notes) notes->draw(frame.image, annotated.layout);
     write_image(still.image, size.width, size.height, frame.image);
   }
   uint32_t shown = 0, placed = 0;
@@ -315,6 +330,7 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--internal", o->internal, "internal labelling: labels drawn on their anchors");
   add_label_look_options(cmd, o->look);
   add_background_option(cmd, o->background);
+  add_annotation_options(cmd, o->notes);
   cmd->add_option("--order", o->order,
                   "insertion order: scene, apollonius (Stein & Decoret, innermost first) or "
                   "optimized (random orders, the best kept)")
@@ -341,6 +357,9 @@ void add_render_command(CLI::App& app, DeviceOptions& device) {
                        ": JPEG has no alpha; write a PNG, SVG or PDF");
     check_options_apply(cmd, !o->scene.file.empty(), {"--output", "--size", "--dump-graph"},
                         {"--blur"});
+    if (o->no_labels && o->notes.any()) {
+      throw UsageError("--title and --legend: a picture without labels (--no-labels) has none");
+    }
     if (o->scene.file.empty()) {
       render_test_pattern(device, *o);
     } else if (o->no_labels) {

@@ -14,6 +14,7 @@
 #include <memory>
 #include <optional>
 
+#include "app/annotation_options.h"
 #include "app/commands.h"
 #include "app/output_files.h"
 #include "app/progress.h"
@@ -46,6 +47,7 @@ struct VideoOptions {
   bool plan = true;  // --plan: the labels' ranges planned over the whole path first
   LabelLookOptions look;
   Background background;
+  AnnotationOptions notes;
   ForceSettings forces;
   float layer_margin = LayerHysteresis{}.margin;
   uint32_t tidy_rounds = PlacementSettings{}.tidy_rounds;
@@ -292,7 +294,17 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   const Scene scene = load_scene_reporting(o.scene, ctx);
   const std::vector<Camera> cameras = sampled_cameras(camera_path(scene, o), o.fps);
   prepare_outputs(o, video_file, cameras.size());
-  const PathDrawing drawing{ctx, scene, cameras, size, labelling_settings(scene, o), o};
+  // --title, --legend: one layout for every frame, the legend of all the scene's labels (so it
+  // stays the same while labels come and go).
+  LabellingSettings settings = labelling_settings(scene, o);
+  std::optional<Annotations> notes;
+  AnnotationLayout notes_layout;
+  if (o.notes.any()) {
+    notes.emplace(o.notes, settings, glm::uvec2(size.width, size.height));
+    notes_layout = notes->layout(legend_entries(scene));
+    keep_labels_off(settings, notes_layout);
+  }
+  const PathDrawing drawing{ctx, scene, cameras, size, settings, o};
   std::optional<PlanFollower> follower;
   if (o.plan) follower.emplace(plan_video(drawing), label_ids(scene));
 
@@ -310,6 +322,7 @@ void video(DeviceOptions& device, const VideoOptions& o) {
   std::vector<Layout> frame_layouts, still_layouts;  // for the report
   draw_path(drawing, follower ? &*follower : nullptr, measured,
             [&](size_t f, LabelledFrame& frame, const Layout* layout) {
+              if (notes) notes->draw(frame.image, notes_layout);
               writer.write(std::move(frame.image));  // (the picture is the frame's own copy)
               if (measured)
                 record_layout(o.layout_dir, f, frame, *layout, o.report ? &frame_layouts : nullptr);
@@ -378,6 +391,7 @@ void add_placement_options(CLI::App* cmd, const std::shared_ptr<VideoOptions>& o
   add_greedy_option(cmd, o->greedy);
   add_label_look_options(cmd, o->look);
   add_background_option(cmd, o->background);
+  add_annotation_options(cmd, o->notes);
 }
 
 // How the labels move from frame to frame (labeling/forces.h).

@@ -13,6 +13,7 @@
 
 #include <backends/imgui_impl_glfw.h>
 
+#include "app/annotation_options.h"
 #include "app/commands.h"
 #include "app/output_files.h"
 #include "app/viewer/viewer.h"
@@ -30,6 +31,7 @@ namespace {
 
 struct ViewOptions {
   SceneInput scene;
+  AnnotationOptions notes;
   std::string camera;
   std::string size = "960x720";
   std::string script;
@@ -248,6 +250,8 @@ void view_scene(DeviceOptions& device, const ViewOptions& o, graph::Extent size)
   options.optimize_on_idle = !o.no_optimize;
   options.ui_scale = std::max(scale_x, scale_y);
   options.show_panel = !o.no_panel;
+  options.title = o.notes.title;
+  options.legend = o.notes.legend;
   options.placement_beside = placement_beside(o.placement, ctx);
   options.frame_budget_ms = o.frame_budget.value_or(default_frame_budget_ms(ctx));
   WindowOutput output(ctx, window.handle, o.frames_in_flight);
@@ -341,6 +345,7 @@ void add_view_command(CLI::App& app, DeviceOptions& device) {
   cmd->add_flag("--no-optimize", o->no_optimize,
                 "do not try random insertion orders when the camera rests");
   cmd->add_flag("--no-panel", o->no_panel, "start with the panel hidden (h shows it)");
+  add_annotation_options(cmd, o->notes);
   add_placement_option(cmd, o->placement);
   cmd->add_option("--frame-budget", o->frame_budget,
                   "ms a frame may take while the camera moves: rays for fewer pixels then, full "

@@ -324,6 +324,7 @@ void LabelledRenderer::prepare_frame(double seconds, bool trial) {
   release_retired(false);
   parts_->forces.set_frame(forces, units(), seconds, settings_.placement.hard,
                            parts_->placement.order_count());
+  parts_->forces.set_keep_out(settings_.placement.keep_out);
   if (beside_) {
     beside_->take_trial([this] { trial_cost_ = total_cost(); });
     beside_->set_frame_number(frame_number_);
@@ -606,6 +607,7 @@ void LabelledRenderer::run(const std::function<void(uint32_t done, uint32_t tota
   const auto run_still = [this] {
     set_placement_frame(false, within_);
     parts_->forces.reset();
+    parts_->forces.set_keep_out(settings_.placement.keep_out);
     parts_->forces.set_frame(settings_.forces, units(), 0.0, settings_.placement.hard);
     frame_seconds_.reset();
     run_frame();
@@ -656,6 +658,7 @@ LabelledFrame LabelledRenderer::result(bool measure_visibility) const {
   frame.size = size_;
   frame.seconds = frame_seconds_;
   frame.layering = layering_;
+  frame.annotations = settings_.annotations;
   frame.render_stats = stats_;
   frame.timings = runner_->timings();
   if (!extension_) {
@@ -772,10 +775,21 @@ std::string layout_json(const LabelledFrame& frame) {
   }
   ordered_json seconds;  // (null: a still)
   if (frame.seconds) seconds = *frame.seconds;
-  const ordered_json layout = {{"width", frame.size.width},
-                               {"height", frame.size.height},
-                               {"seconds", seconds},
-                               {"labels", labels}};
+  ordered_json layout = {{"width", frame.size.width},
+                         {"height", frame.size.height},
+                         {"seconds", seconds},
+                         {"labels", labels}};
+  if (!frame.annotations.empty()) {
+    ordered_json annotations = ordered_json::array();
+    for (const NamedBox& a : frame.annotations) {
+      annotations.push_back(
+          {{"name", a.name},
+           {"box",
+            {shortest_double(a.rect.x), shortest_double(a.rect.y),
+             shortest_double(a.rect.z - a.rect.x), shortest_double(a.rect.w - a.rect.y)}}});
+    }
+    layout["annotations"] = std::move(annotations);
+  }
   // Label texts come from scene files: bytes that are not UTF-8 are replaced, never thrown on.
   return layout.dump(2, ' ', false, ordered_json::error_handler_t::replace) + "\n";
 }

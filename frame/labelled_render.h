@@ -17,6 +17,7 @@
 #include "engine/scene/scene.h"
 #include "frame/label_slots.h"
 #include "frame/placement_beside.h"
+#include "labeling/annotations.h"
 #include "labeling/layering.h"
 #include "labeling/text_layout.h"
 #include "passes/label_forces.h"
@@ -68,6 +69,10 @@ struct LabellingSettings {
   // The picture's, under the labels' composite; the placement reads the scene over
   // render.background (black), so a layout is the same on any picture background.
   Background background;
+  // A title's and a legend's boxes drawn over the picture after the frame
+  // (labeling/annotation_drawing.h), recorded in every frame's layout; the labels keep off them
+  // through placement.keep_out.
+  std::vector<NamedBox> annotations;
 };
 
 // A layer image array (rgba16f, premultiplied) read back after the frame: layer after layer.
@@ -124,6 +129,7 @@ struct LabelledFrame {
   std::optional<double> seconds;
   std::vector<uint8_t> image;  // rgba8, the labelled picture
   std::vector<LabelLayout> labels;
+  std::vector<NamedBox> annotations;  // LabellingSettings::annotations
   Layering layering;
   RenderStats render_stats;
   std::vector<graph::PassTiming> timings;
@@ -384,7 +390,8 @@ LabelledFrame render_labelled(Context& ctx, const Scene& scene, const Camera& ca
                               graph::Extent size, const LabellingSettings& settings);
 
 // The layout as JSON (docs/layout-metrics.md): the frame's size and seconds, and per label id,
-// text, layer, anchor, box (x, y, width, height), shown, placed, visible, cost, opacity, target.
+// text, layer, anchor, box (x, y, width, height), shown, placed, visible, cost, opacity, target;
+// and the annotations' boxes (name, box) where the frame has a title or legend.
 std::string layout_json(const LabelledFrame& frame);
 
 }  // namespace strata

@@ -3,6 +3,7 @@
 // group at its opacity.
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 
 #include "engine/core/error.h"
@@ -95,7 +96,7 @@ VectorShape faded(VectorShape shape, float share) {
 // A stretch of the connector solid (label_frame) or dashed with a dark halo under the dashes,
 // the dashes counted from the anchor's mark's reach (label_dashed_connector), `share` as opaque.
 void add_leader(std::vector<VectorItem>& items, glm::vec2 anchor, glm::vec2 end, Stretch stretch,
-                bool dashed, float share) {
+                bool dashed, float share, bool halo) {
   const float length = glm::length(end - anchor);
   const float from = dashed ? std::max(stretch.from, gpu::LABEL_ANCHOR_REACH) : stretch.from;
   if (share <= 1.0f / 512.0f || length <= 0.0f || stretch.to <= from) return;
@@ -103,6 +104,10 @@ void add_leader(std::vector<VectorItem>& items, glm::vec2 anchor, glm::vec2 end,
   const glm::vec2 b = anchor + (end - anchor) * (stretch.to / length);
   const float half = gpu::LABEL_LINE_HALF_WIDTH;
   if (!dashed) {
+    if (halo) {
+      items.push_back(
+          faded(line(a, b, gpu::LABEL_HALO_COLOR, 2.0f * (half + gpu::LABEL_HALO_WIDTH)), share));
+    }
     items.push_back(faded(line(a, b, gpu::LABEL_LINE_COLOR, 2.0f * half), share));
     return;
   }
@@ -149,11 +154,12 @@ float behind_share(float front) {
 // A label's connector and anchor mark, in its layer (`own`, seen as far as the front lets it
 // through: solid, dashed as far as the anchor is hidden) and on top (`on_top`, label_behind).
 void add_connector(std::vector<VectorItem>& own, std::vector<VectorItem>& on_top,
-                   const LabelLayout& l, glm::vec2 end, float hidden, const FrontCover& cover) {
+                   const LabelLayout& l, glm::vec2 end, float hidden, const FrontCover& cover,
+                   bool halo) {
   for (const Stretch& s : connector_stretches(cover, l.anchor, end, l.layer)) {
-    add_leader(own, l.anchor, end, s, false, (1.0f - s.front) * (1.0f - hidden));
-    add_leader(own, l.anchor, end, s, true, (1.0f - s.front) * hidden);
-    if (l.layer > 0) add_leader(on_top, l.anchor, end, s, true, behind_share(s.front));
+    add_leader(own, l.anchor, end, s, false, (1.0f - s.front) * (1.0f - hidden), halo);
+    add_leader(own, l.anchor, end, s, true, (1.0f - s.front) * hidden, halo);
+    if (l.layer > 0) add_leader(on_top, l.anchor, end, s, true, behind_share(s.front), halo);
   }
 }
 
@@ -216,7 +222,8 @@ std::vector<VectorGroup> label_groups(const LabelLayout& l, const Label& label, 
   groups[1].opacity *= box_seen(look.front, top_left, box.size, l.layer);
   if (!internal) {
     const glm::vec2 end = glm::clamp(l.anchor, top_left, top_left + box.size);
-    add_connector(groups[0].items, behind.items, l, end, hidden, look.front);
+    add_connector(groups[0].items, behind.items, l, end, hidden, look.front,
+                  connector_halos(look.settings.background));
   }
   add_box(groups[1].items, top_left, box.size,
           gpu::label_border_color(l.layer, look.settings.layer_colors));
@@ -272,6 +279,39 @@ VectorPicture labelled_picture(const LabelledFrame& frame, const Scene& scene,
     if (!group.items.empty()) picture.groups.push_back(std::move(group));
   }
   return picture;
+}
+
+void add_annotations(VectorPicture& picture, const AnnotationLayout& layout) {
+  VectorGroup group;
+  std::map<float, std::shared_ptr<const Font>> fonts;  // by size: the title's, the legend's
+  const auto add_text = [&](const TextRun& run) {
+    std::shared_ptr<const Font>& font = fonts[run.font_pixels];
+    if (!font) font = std::make_shared<const Font>(run.font_pixels);
+    group.items.push_back(VectorText{font, font->shape(run.text), run.origin, run.colour});
+  };
+  const auto add_rect_box = [&](glm::vec4 r) {
+    add_box(group.items, {r.x, r.y}, {r.z - r.x, r.w - r.y}, gpu::LABEL_BORDER_COLOR);
+  };
+  if (layout.title) {
+    add_rect_box(layout.title->box.rect);
+    add_text(layout.title->text);
+  }
+  if (layout.legend) {
+    add_rect_box(layout.legend->box.rect);
+    for (const LegendRow& row : layout.legend->rows) {
+      if (row.swatch) {
+        const glm::vec4 r = *row.swatch;  // (its one-pixel rim a stroke along the rim's middle)
+        VectorShape swatch{VectorShape::Kind::box, {r.x + 0.5f, r.y + 0.5f},
+                           {r.z - r.x - 1.0f, r.w - r.y - 1.0f}};
+        swatch.fill = glm::vec4(row.colour, 1.0f);
+        swatch.stroke = gpu::LABEL_BORDER_COLOR;
+        swatch.stroke_width = 1.0f;
+        group.items.push_back(swatch);
+      }
+      add_text(row.text);
+    }
+  }
+  if (!group.items.empty()) picture.groups.push_back(std::move(group));
 }
 
 }  // namespace strata

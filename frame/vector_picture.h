@@ -22,6 +22,7 @@
 #include "engine/core/png.h"
 #include "engine/scene/scene.h"
 #include "frame/labelled_render.h"
+#include "labeling/annotations.h"
 
 namespace strata {
 
@@ -94,5 +95,9 @@ VectorPicture image_picture(uint32_t width, uint32_t height, std::span<const uin
 VectorPicture labelled_picture(const LabelledFrame& frame, const Scene& scene,
                                const LabellingSettings& settings,
                                std::span<const glm::vec4> layers = {});
+
+// A title and a legend (labeling/annotations.h) over everything, as the raster draws them
+// (labeling/annotation_drawing.h): boxes like the labels', colour swatches, lines of text.
+void add_annotations(VectorPicture& picture, const AnnotationLayout& layout);
 
 }  // namespace strata

@@ -111,6 +111,17 @@ LayoutLabel read_label(const json& object, const Field& field) {
   return label;
 }
 
+// A title's or legend's box: {"name": "title", "box": [x, y, width, height]}.
+LayoutAnnotation read_annotation(const json& object, const Field& field) {
+  if (!object.is_object()) field.fail("expected an object");
+  LayoutAnnotation a;
+  const json& name = required(object, field, "name");
+  if (!name.is_string()) (field / "name").fail("expected a string");
+  a.name = name.get<std::string>();
+  a.box = box(required(object, field, "box"), field / "box");
+  return a;
+}
+
 // Ids match labels across frames, so one id twice in a frame would make matching ambiguous.
 void check_unique_ids(const std::vector<LayoutLabel>& labels, const Field& field) {
   std::unordered_map<int, size_t> first;
@@ -142,6 +153,13 @@ Layout parse_layout(const json& root, const std::filesystem::path& source) {
     layout.labels.push_back(read_label(labels[i], labels_field[i]));
   }
   check_unique_ids(layout.labels, labels_field);
+  if (const json* annotations = optional(root, "annotations")) {
+    const Field field = top / "annotations";
+    if (!annotations->is_array()) field.fail("expected an array");
+    for (size_t i = 0; i < annotations->size(); ++i) {
+      layout.annotations.push_back(read_annotation((*annotations)[i], field[i]));
+    }
+  }
   return layout;
 }
 

@@ -132,6 +132,14 @@ bool outside_image(const LayoutLabel& label, const Layout& layout) {
          box.max.y > double(layout.height);
 }
 
+// Drawn (placed, at any opacity) over a title's or legend's box.
+bool over_annotation(const LayoutLabel& label, const Layout& layout) {
+  if (!label.placed || !(label.opacity > 0.0)) return false;
+  return std::any_of(
+      layout.annotations.begin(), layout.annotations.end(),
+      [&](const LayoutAnnotation& a) { return intersection_area(box_of(label), a.box) > 0.0; });
+}
+
 bool opaque(const LayoutLabel& label) {
   return label.opacity >= opaque_opacity;
 }
@@ -190,6 +198,7 @@ FrameMetrics frame_metrics(const Layout& layout) {
   }
   for (const LayoutLabel& label : layout.labels) {
     if (anchor_covered(label, shown)) ++m.anchors_covered;
+    if (over_annotation(label, layout)) ++m.over_annotations;
   }
   measure_leaders(layout, shown, m);
   double front_sum = 0.0;
@@ -223,6 +232,7 @@ FrameMetrics sum_frame_metrics(const std::vector<FrameMetrics>& frames) {
     total.leaders_through_boxes += f.leaders_through_boxes;
     total.anchors_covered += f.anchors_covered;
     total.outside_image += f.outside_image;
+    total.over_annotations += f.over_annotations;
     total.leaders += f.leaders;
     total.opaque += f.opaque;
     total.apparent_overlaps += f.apparent_overlaps;
@@ -402,6 +412,7 @@ ordered_json to_json(const FrameMetrics& m, const FrameMetrics* still) {
                       {"leaders_through_boxes", m.leaders_through_boxes},
                       {"anchors_covered", m.anchors_covered},
                       {"outside_image", m.outside_image},
+                      {"over_annotations", m.over_annotations},
                       {"leaders", m.leaders},
                       {"leader_length_mean_of_diagonal", m.leader_length_mean},
                       {"leader_length_max_of_diagonal", m.leader_length_max},

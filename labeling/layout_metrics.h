@@ -55,6 +55,13 @@ struct LayoutLabel {
   std::optional<bool> anchor_hidden;
 };
 
+// A box drawn over the picture that is not a label's: a title, a legend (the file's
+// "annotations"; labels keep off them).
+struct LayoutAnnotation {
+  std::string name;
+  Rect box;
+};
+
 struct Layout {
   std::filesystem::path source;  // for messages
   uint32_t width = 0;
@@ -62,12 +69,14 @@ struct Layout {
   // The frame's time step (the file's "seconds"); none for a still or an older file.
   std::optional<double> seconds;
   std::vector<LayoutLabel> labels;
+  std::vector<LayoutAnnotation> annotations;
 };
 
 // A layout file. Every error is "<file>: <field>: <reason>", e.g.
 // "a.json: labels[3].box: expected 4 numbers". Required: width, height, labels, and per label
 // id (unique), anchor, box (size >= 0) and shown; text, layer, cost, placed, opacity, target,
-// front_alpha, anchor_hidden and the top level's seconds are optional (defaults above). Unknown
+// front_alpha, anchor_hidden and the top level's seconds and annotations (each a name and a box)
+// are optional (defaults above). Unknown
 // keys are ignored, so files from later versions still read.
 Layout read_layout(const std::filesystem::path& path);
 // The same from JSON already parsed (`strata video --report` reads the layouts it writes);
@@ -121,7 +130,10 @@ struct FrameMetrics {
   // Anchors (each once) of any label, shown or not, strictly inside another shown label's box.
   size_t anchors_covered = 0;
   size_t outside_image = 0;  // boxes not entirely inside [0, width] x [0, height]
-  size_t leaders = 0;        // shown labels with a leader
+  // Drawn labels (placed, opacity > 0) whose box shares a positive area with an annotation's box
+  // (a title, a legend): each label once.
+  size_t over_annotations = 0;
+  size_t leaders = 0;  // shown labels with a leader
   // Leader length / image diagonal, over the shown labels (no leader = length 0).
   double leader_length_mean = 0.0;
   double leader_length_max = 0.0;

@@ -123,11 +123,6 @@ void LabelDrawing::bind(graph::GraphRunner& runner) const {
   }
 }
 
-bool connector_halos(const Background& background) {
-  const float luminance = glm::dot(background.color, glm::vec3(0.2126f, 0.7152f, 0.0722f));
-  return background.transparent || luminance > 0.5f;
-}
-
 gpu::LabelDrawParams LabelDrawing::params(graph::Extent viewport) const {
   return {viewport.width,
           viewport.height,

@@ -43,10 +43,6 @@ struct GhostSettings {
 gpu::GhostParams ghost_params(const GhostSettings& ghost, graph::Extent size, uint32_t layer_count,
                               uint32_t label_count);
 
-// Whether solid connectors get a dark halo on this background: on a light one (or none, which any
-// page may show through) a white line alone is lost. Black keeps the thesis's look.
-bool connector_halos(const Background& background);
-
 class LabelDrawing {
  public:
   // Uploads the font's atlas and the labels' pictures once.

@@ -64,6 +64,21 @@ gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
   return p;
 }
 
+void set_keep_out(gpu::ForcesParams& params, std::span<const glm::uvec4> rects) {
+  params.keep_out_count = 0;
+  for (const glm::uvec4& r : rects) {
+    if (r.x >= r.z || r.y >= r.w) continue;
+    if (params.keep_out_count == PLACEMENT_KEEP_OUT_MAX) {
+      throw Error("forces: more than " + std::to_string(PLACEMENT_KEEP_OUT_MAX) +
+                  " keep-out rectangles");
+    }
+    const glm::uvec4 k = glm::min(r, glm::uvec4(0xFFFFu));
+    params.keep_out[2 * params.keep_out_count] = k.x | k.y << 16u;
+    params.keep_out[2 * params.keep_out_count + 1] = k.z | k.w << 16u;
+    ++params.keep_out_count;
+  }
+}
+
 LabelForces::LabelForces(Context& ctx, uint32_t label_count, LabelForces* from)
     : ctx_(ctx),
       label_count_(label_count),
@@ -88,6 +103,12 @@ void LabelForces::reset() {
 void LabelForces::set_frame(const ForceSettings& settings, LabelUnits units, double seconds,
                             bool hard, uint32_t order_count) {
   params_ = forces_params(settings, units, active_, seconds, hard, order_count);
+  strata::set_keep_out(params_, keep_out_);
+}
+
+void LabelForces::set_keep_out(std::span<const glm::uvec4> rects) {
+  strata::set_keep_out(params_, rects);
+  keep_out_.assign(rects.begin(), rects.end());
 }
 
 std::vector<gpu::LabelStateGpu> LabelForces::state() const {

@@ -79,6 +79,10 @@ gpu::ForcesParams forces_params(const ForceSettings& settings, LabelUnits units,
                                 uint32_t label_count, double seconds, bool hard = false,
                                 uint32_t order_count = 0);
 
+// `rects` (x0, y0, x1, y1 in pixels; empty ones count for nothing) as the keep-out rectangles
+// drawn boxes keep off (shared/keep_apart.h); more than PLACEMENT_KEEP_OUT_MAX is an Error.
+void set_keep_out(gpu::ForcesParams& params, std::span<const glm::uvec4> rects);
+
 class LabelForces {
  public:
   struct Inputs {
@@ -118,6 +122,8 @@ class LabelForces {
   // The frame's count of labels in the insertion order the forces read (a placement's older than
   // the frame: frame/placement_beside.h).
   void set_order_count(uint32_t count) { params_.order_count = std::min(count, label_count_); }
+  // The keep-out rectangles of this frame and the next ones (the placement's).
+  void set_keep_out(std::span<const glm::uvec4> rects);
   // Marks the frame set last as a trial (ForcesParams::trial): labels are drawn where they were
   // and the state is not written, so several trial placements start from the same state.
   void set_trial(bool trial) { params_.trial = trial ? 1u : 0u; }
@@ -136,6 +142,7 @@ class LabelForces {
   uint32_t label_count_;
   uint32_t active_;  // labels the frames move (set_active)
   gpu::ForcesParams params_{};
+  std::vector<glm::uvec4> keep_out_;
   ComputePipeline forces_, previous_, follow_;
   Buffer state_;
   graph::Readback readback_;

@@ -47,6 +47,18 @@ std::vector<uint32_t> rounds_ranks(uint32_t label_count, std::span<const uint32_
   return ranks;
 }
 
+std::vector<glm::uvec4> keep_out_rectangles(const PlacementSettings& s) {
+  std::vector<glm::uvec4> rects;
+  for (const glm::uvec4& k : s.keep_out) {
+    if (k.x < k.z && k.y < k.w) rects.push_back(k);
+  }
+  if (rects.size() > PLACEMENT_KEEP_OUT_MAX) {
+    throw Error("placement: " + std::to_string(rects.size()) + " keep-out rectangles; at most " +
+                std::to_string(PLACEMENT_KEEP_OUT_MAX));
+  }
+  return rects;
+}
+
 gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent viewport,
                                       uint32_t layer_count, uint32_t label_count, uint32_t step) {
   gpu::PlacementParams p{};
@@ -63,11 +75,7 @@ gpu::PlacementParams placement_params(const PlacementSettings& s, graph::Extent 
   p.write_constraints = s.write_constraints ? 1u : 0u;
   p.margin = margin_pixels(s);
   p.edge = s.edge_em * s.text_pixels;
-  const glm::uvec4 k = glm::min(s.keep_out, glm::uvec4(0xFFFFu));
-  if (k.x < k.z && k.y < k.w) {
-    p.keep_out_lo = k.x | k.y << 16u;
-    p.keep_out_hi = k.z | k.w << 16u;
-  }
+  p.keep_out_count = uint32_t(keep_out_rectangles(s).size());
   p.saliency_weight = s.saliency_weight;
   p.occlusion_weight = s.occlusion_weight;
   p.single_saliency_weight = s.single_saliency_weight;
@@ -174,6 +182,7 @@ void Placement::set_frame(std::vector<gpu::LabelGpu> labels, std::vector<uint32_
   labels_ = std::move(labels);
   order_ = std::move(order);
   ranks_ = rounds_ranks(label_count_, order_, group_first);
+  keep_out_rectangles(settings);  // (checked here, not while recording)
   settings_ = settings;
 }
 
@@ -255,6 +264,8 @@ Placement::Buffers Placement::add_buffers(graph::Graph& graph) {
       "placement.round_bits", fixed(VkDeviceSize{n} * gpu::rounds_row_words(n) * sizeof(uint32_t)));
   b.round_done = graph.add_buffer("placement.round_done", fixed(ROUNDS_MAX * sizeof(uint32_t)));
   b.round_wide = graph.add_buffer("placement.round_wide", fixed(n * sizeof(uint32_t)));
+  b.keep_out =
+      graph.add_buffer("placement.keep_out", fixed(PLACEMENT_KEEP_OUT_MAX * sizeof(glm::uvec4)));
   b.readback = readback_.import(graph, "placement.readback");
   return b;
 }
@@ -265,6 +276,7 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                   graph::PassKind::transfer,
                   {{b.labels, Use::transfer_dst},
                    {b.order, Use::transfer_dst},
+                   {b.keep_out, Use::transfer_dst},
                    {b.results, Use::transfer_dst},
                    {b.constraints, Use::transfer_dst},
                    {b.buckets, Use::transfer_dst},
@@ -280,6 +292,10 @@ void Placement::add_upload(graph::Graph& graph, const Buffers& b) {
                   [this, b](graph::PassContext& pc) {
                     record_update(pc.cmd, pc.buffer(b.labels), 0, as_bytes(labels_));
                     record_update(pc.cmd, pc.buffer(b.order), 0, as_bytes(order_));
+                    // (the whole buffer: a shader's binding is read only up to keep_out_count)
+                    std::vector<glm::uvec4> keep_out = keep_out_rectangles(settings_);
+                    keep_out.resize(PLACEMENT_KEEP_OUT_MAX, glm::uvec4(0u));
+                    record_update(pc.cmd, pc.buffer(b.keep_out), 0, as_bytes(keep_out));
                     const auto fill = [&pc](ResourceId id, uint32_t value) {
                       vkCmdFillBuffer(pc.cmd, pc.buffer(id), 0, VK_WHOLE_SIZE, value);
                     };
@@ -384,6 +400,7 @@ graph::PassId Placement::add_label_loop(graph::Graph& graph, const Buffers& b) {
   std::vector<graph::ResourceUse> uses{
       {b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
       {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+      {b.keep_out, Use::storage_read, PLACEMENT_BINDING_KEEP_OUT},
       {b.order, Use::storage_read, PLACEMENT_BINDING_ORDER},
       {b.results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
       {b.constraints, Use::storage_read_write, PLACEMENT_BINDING_CONSTRAINTS},
@@ -435,6 +452,7 @@ graph::PassId Placement::add_rounds(graph::Graph& graph, const Buffers& b) {
   std::vector<graph::ResourceUse> uses{
       {b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
       {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+      {b.keep_out, Use::storage_read, PLACEMENT_BINDING_KEEP_OUT},
       {b.results, Use::storage_read_write, PLACEMENT_BINDING_RESULTS},
       {b.constraints, Use::storage_write, PLACEMENT_BINDING_CONSTRAINTS},
       {b.buckets, Use::storage_read, PLACEMENT_BINDING_BUCKETS},
@@ -529,6 +547,7 @@ void Placement::add_tidy(graph::Graph& graph, const Buffers& b) {
   std::vector<graph::ResourceUse> uses = {
       {b.tables, Use::storage_read, PLACEMENT_BINDING_TABLES},
       {b.labels, Use::storage_read, PLACEMENT_BINDING_LABELS},
+      {b.keep_out, Use::storage_read, PLACEMENT_BINDING_KEEP_OUT},
       {b.order, Use::storage_read, PLACEMENT_BINDING_ORDER},
       {b.results, Use::storage_read, PLACEMENT_BINDING_RESULTS},
       {b.tidy, Use::storage_write, PLACEMENT_BINDING_TIDY},

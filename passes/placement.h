@@ -53,9 +53,10 @@ struct PlacementSettings {
   // LabelledRenderer keeps the margin here too, so that a label whose anchor moves outward has
   // room to slide before the edge would cut it.
   float edge_em = 0.0f;
-  // A rectangle of the image no box may touch, x0, y0, x1, y1 in pixels (the viewer's panel);
-  // empty (x0 >= x1 or y0 >= y1): none. Labels whose boxes fit nowhere else are hidden.
-  glm::uvec4 keep_out{0u};
+  // Rectangles of the image no box may touch, x0, y0, x1, y1 in pixels (the viewer's panel, a
+  // picture's title and legend); empty ones (x0 >= x1 or y0 >= y1) count for nothing, and at most
+  // PLACEMENT_KEEP_OUT_MAX others. Labels whose boxes fit nowhere else are hidden.
+  std::vector<glm::uvec4> keep_out;
   bool hard = false;                    // forbid constraint violations (labels may end up hidden)
   float saliency_weight = 0.5f;         // eq. 3.3: how much saliency modulates the occlusion behind
   float occlusion_weight = 0.5f;        // eq. 3.4 (one layer)
@@ -79,6 +80,10 @@ struct PlacementSettings {
 // (`group_first`, per position; empty: 0) << 16; all bits for a label not in the order.
 std::vector<uint32_t> rounds_ranks(uint32_t label_count, std::span<const uint32_t> order,
                                    std::span<const uint32_t> group_first = {});
+
+// The settings' keep-out rectangles that are not empty, as the placement's buffer holds them;
+// more than PLACEMENT_KEEP_OUT_MAX is an Error.
+std::vector<glm::uvec4> keep_out_rectangles(const PlacementSettings& s);
 
 // The margin in pixels.
 inline float margin_pixels(const PlacementSettings& s) {
@@ -212,6 +217,7 @@ class Placement {
         tidy_rounds, tidy_args;
     graph::ResourceId ranks, round_of, round_list, round_args, round_counts, round_bits, round_done,
         round_wide;
+    graph::ResourceId keep_out;
     graph::ResourceId readback;
   };
   Buffers add_buffers(graph::Graph& graph);

@@ -32,7 +32,9 @@ struct Placer {
   std::vector<uint64_t> results;
   std::vector<PairRegionsGpu> regions;  // the label being placed against each placed label
 
-  std::vector<vec2> anchors;  // every shown label's anchor
+  std::vector<vec2> anchors;     // every shown label's anchor
+  std::vector<uvec4> keep_outs;  // PLACEMENT_BINDING_KEEP_OUT
+  uvec4 keep_out_at(uint i) const { return keep_outs[i]; }
 
   // Every label placed so far, every anchor: the GPU's tile culling only skips what cannot matter.
   uint placed_count() const { return params.step; }
@@ -64,7 +66,9 @@ struct Tidier {
   std::vector<float> frees;
   std::vector<uint64_t> bests;
   std::vector<uint> partners;
-  std::vector<ivec4> currents;  // each label's conflicts this round
+  std::vector<ivec4> currents;   // each label's conflicts this round
+  std::vector<uvec4> keep_outs;  // PLACEMENT_BINDING_KEEP_OUT
+  uvec4 keep_out_at(uint i) const { return keep_outs[i]; }
 
   float table_at(uint layer, int x, int y) const {
     return table_value(tables, params, layer, x, y);
@@ -155,6 +159,7 @@ std::vector<gpu::PlacementGpu> tidy_reference(std::span<const gpu::LabelGpu> lab
                      {},
                      {},
                      std::vector<uint32_t>(n, TIDY_NO_PARTNER)};
+  tidier.keep_outs = keep_out_rectangles(settings);
   for (uint32_t k = 0; k < order.size(); ++k) tidier.ranks[order[k]] = k;
   for (uint32_t i = 0; i < n; ++i) {
     tidier.states.push_back(tidier.tidy_label(labels[i], results[i]));
@@ -250,6 +255,7 @@ std::vector<uint64_t> greedy_reference(ReferencePlacement& out,
                      std::vector<uint64_t>(labels.size(), PLACEMENT_NONE),
                      std::vector<gpu::PairRegionsGpu>(labels.size()),
                      {}};
+  placer.keep_outs = keep_out_rectangles(settings);
   for (const gpu::LabelGpu& l : labels) {
     if ((l.flags & LABEL_ENABLED) != 0u) placer.anchors.push_back(l.anchor);
   }
@@ -299,6 +305,8 @@ struct Rounder {
   const std::vector<float>& tables;
   std::vector<PairRegionsGpu> decided;  // the regions of the shown labels decided before the round
   std::vector<vec2> anchors;            // every enabled label's anchor
+  std::vector<uvec4> keep_outs;         // PLACEMENT_BINDING_KEEP_OUT
+  uvec4 keep_out_at(uint i) const { return keep_outs[i]; }
 
   uint placed_count() const { return uint(decided.size()); }
   PairRegionsGpu placed_regions(uint k) const { return decided[k]; }
@@ -375,6 +383,7 @@ bool rounds_conflict_reference(const gpu::LabelGpu& a, uint64_t ka, const gpu::L
                                uint64_t kb, const PlacementSettings& settings, graph::Extent size) {
   const std::vector<float> no_tables;
   gpu::Rounder rounder{placement_params(settings, size, 1, 2, 0), {}, no_tables, {}, {}};
+  rounder.keep_outs = keep_out_rectangles(settings);
   return rounder.rounds_conflict(a, ka, b, kb);
 }
 
@@ -384,6 +393,7 @@ ReferenceRounds rounds_reference(std::span<const gpu::LabelGpu> labels,
                                  uint32_t layer_count, std::span<const uint32_t> group_first) {
   const auto n = uint32_t(labels.size());
   gpu::Rounder rounder{placement_params(settings, size, layer_count, n, 0), labels, tables, {}, {}};
+  rounder.keep_outs = keep_out_rectangles(settings);
   for (const gpu::LabelGpu& l : labels) {
     if ((l.flags & LABEL_ENABLED) != 0u) rounder.anchors.push_back(l.anchor);
   }

@@ -50,6 +50,7 @@ layout(binding = PLACEMENT_BINDING_SPECULATIVE, std430) coherent buffer Speculat
 layout(binding = PLACEMENT_BINDING_REGIONS, std430) buffer Regions { PairRegionsGpu regions[]; };
 // The classification's cheapest sample per list entry of label j, read by the last workgroup.
 layout(binding = PLACEMENT_BINDING_SAMPLES, std430) coherent buffer Samples { uint64_t samples[]; };
+layout(binding = PLACEMENT_BINDING_KEEP_OUT, std430) readonly buffer KeepOut { uvec4 keep_out[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
 // The order position this workgroup places, and the placed ones it tests against (0 .. placed - 1).
@@ -89,6 +90,9 @@ uint placed_count() { return tile_placed_count; }
 PairRegionsGpu placed_regions(uint k) { return regions_of(position, tile_placed[k]); }
 uint anchor_count() { return tile_anchor_count; }
 vec2 anchor_at(uint k) { return tile_anchors[k]; }
+uvec4 keep_out_at(uint i) {
+  return keep_out[i];
+}
 // (The load does not depend on the test, so a candidate's four are issued together; clamped, so
 // a candidate off screen reads inside the table.)
 float table_at(uint layer, int x, int y) {

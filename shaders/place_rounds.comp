@@ -40,6 +40,7 @@ layout(binding = PLACEMENT_BINDING_ROUND_COUNTS, std430) buffer RoundCounts { ui
 layout(binding = PLACEMENT_BINDING_ROUND_BITS, std430) coherent buffer RoundBits { uint round_bits[]; };
 layout(binding = PLACEMENT_BINDING_ROUND_DONE, std430) coherent buffer RoundDone { uint round_done[]; };
 layout(binding = PLACEMENT_BINDING_ROUND_WIDE, std430) coherent buffer RoundWide { uint round_wide[]; };
+layout(binding = PLACEMENT_BINDING_KEEP_OUT, std430) readonly buffer KeepOut { uvec4 keep_out[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
 // (PlacementParams has no room left: the rounds recorded ride in `label`, the tiles a label
@@ -72,6 +73,9 @@ shared uint select_waiting;
 shared uint finishing;
 shared uint64_t round_best;  // EVALUATE: the label's best when the workgroup takes a tile
 
+uvec4 keep_out_at(uint i) {
+  return keep_out[i];
+}
 float table_at(uint layer, int x, int y) {
   const uint column = uint(clamp(x, 0, int(params.width) - 1));
   const uint row = uint(clamp(y, 0, int(params.height) - 1));

@@ -33,6 +33,7 @@ layout(binding = PLACEMENT_BINDING_TIDY_ROUNDS, std430) buffer Rounds { uint rou
 // workgroups for a round after one that changed nothing. Untouched where the rounds are direct.
 layout(binding = PLACEMENT_BINDING_TIDY_ARGS, std430) buffer Args { uint tidy_args[]; };
 
+layout(binding = PLACEMENT_BINDING_KEEP_OUT, std430) readonly buffer KeepOut { uvec4 keep_out[]; };
 layout(push_constant) uniform Push { PlacementParams params; };
 
 // Round r runs: its steps' dispatch sizes, where they are indirect.
@@ -47,6 +48,9 @@ void write_round_args(uint r) {
   }
 }
 
+uvec4 keep_out_at(uint i) {
+  return keep_out[i];
+}
 float table_at(uint layer, int x, int y) {
   if (x < 0 || y < 0) return 0.0f;
   return tables[(layer * params.height + uint(y)) * params.width + uint(x)];

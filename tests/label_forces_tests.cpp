@@ -165,11 +165,13 @@ class GpuForces {
   std::vector<gpu::PlacementGpu> frame(const std::vector<gpu::LabelGpu>& labels,
                                        const std::vector<gpu::PlacementGpu>& targets,
                                        const ForceSettings& settings, LabelUnits units,
-                                       double seconds, const std::vector<uint32_t>& order = {}) {
+                                       double seconds, const std::vector<uint32_t>& order = {},
+                                       std::span<const glm::uvec4> keep_out = {}) {
     upload(ctx_, labels_, as_bytes(labels));
     upload(ctx_, targets_, as_bytes(targets));
     if (!order.empty()) upload(ctx_, order_, as_bytes(order));
     forces_.set_frame(settings, units, seconds, false, uint32_t(order.size()));
+    forces_.set_keep_out(keep_out);
     runner_->run_now();
     return as<gpu::PlacementGpu>(runner_->download_buffer(drawn_));
   }
@@ -458,63 +460,72 @@ TEST_SUITE("cpu") {
     }
   }
 
-  // Many labels on random paths: no two drawn boxes ever overlap, none is cut, and the forces'
-  // speed still bounds every move of a drawn label.
+  // Many labels on random paths: no two drawn boxes ever overlap, none is cut, none reaches over
+  // a keep-out rectangle (a title, a legend), and the forces' speed still bounds every move of a
+  // drawn label.
   TEST_CASE("kept_apart_no_drawn_boxes_overlap_or_leave_the_image_in_any_frame") {
-    const uint32_t count = 40;
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-    std::vector<glm::vec2> start(count), velocity(count), offset(count);
-    for (uint32_t i = 0; i < count; ++i) {
-      start[i] = {100.0f + 824.0f * unit(rng), 100.0f + 824.0f * unit(rng)};
-      velocity[i] = {200.0f * unit(rng) - 100.0f, 200.0f * unit(rng) - 100.0f};
-      offset[i] = {160.0f * unit(rng) - 80.0f, 160.0f * unit(rng) - 80.0f};
-    }
-    std::vector<uint32_t> order(count);
-    for (uint32_t i = 0; i < count; ++i) order[i] = (i * 7) % count;
-    std::vector<gpu::LabelStateGpu> state(count);
-    const gpu::ForcesParams p = forces_params({}, kUnits, count, 1.0 / 30.0, false, count);
-    std::vector<gpu::PlacementGpu> last;
-    int shown = 0;
-    for (int f = 0; f < 120; ++f) {
-      const float t = float(f) / 30.0f;
-      std::vector<gpu::LabelGpu> labels;
-      std::vector<gpu::PlacementGpu> targets;
+    for (const bool margins : {false, true}) {
+      CAPTURE(margins);
+      const std::vector<glm::uvec4> keep_out =
+          margins ? std::vector<glm::uvec4>{{0u, 0u, 1024u, 120u}, {700u, 800u, 1024u, 1024u}}
+                  : std::vector<glm::uvec4>{};
+      const uint32_t count = 40;
+      std::mt19937 rng(5);
+      std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+      std::vector<glm::vec2> start(count), velocity(count), offset(count);
       for (uint32_t i = 0; i < count; ++i) {
-        labels.push_back(label_at(start[i] + t * velocity[i]));
-        // a new offset every second
-        const float turn = float(f / 30) * 1.3f + float(i);
-        targets.push_back(target_at(labels.back().anchor + offset[i] +
-                                    40.0f * glm::vec2(std::cos(turn), std::sin(turn))));
+        start[i] = {100.0f + 824.0f * unit(rng), 100.0f + 824.0f * unit(rng)};
+        velocity[i] = {200.0f * unit(rng) - 100.0f, 200.0f * unit(rng) - 100.0f};
+        offset[i] = {160.0f * unit(rng) - 80.0f, 160.0f * unit(rng) - 80.0f};
       }
-      const auto drawn =
-          forces_reference(labels, targets, state,
-                           f == 0 ? forces_params({}, kUnits, count, 0.0, false, count) : p, order);
-      for (uint32_t i = 0; i < count && f > 0; ++i) {
-        if (!(drawn[i].opacity > 0.0f)) continue;
-        ++shown;
-        const glm::vec4 a = gpu::box_around(drawn[i].position, labels[i].size);
-        CHECK(gpu::box_inside(a, p));
-        for (uint32_t j = i + 1; j < count; ++j) {
-          if (drawn[j].opacity > 0.0f) {
-            const glm::vec4 b = gpu::box_around(drawn[j].position, labels[j].size);
-            CHECK_FALSE(gpu::boxes_clash(a, b, p.clearance));
+      std::vector<uint32_t> order(count);
+      for (uint32_t i = 0; i < count; ++i) order[i] = (i * 7) % count;
+      std::vector<gpu::LabelStateGpu> state(count);
+      gpu::ForcesParams p = forces_params({}, kUnits, count, 1.0 / 30.0, false, count);
+      gpu::ForcesParams still = forces_params({}, kUnits, count, 0.0, false, count);
+      set_keep_out(p, keep_out);
+      set_keep_out(still, keep_out);
+      std::vector<gpu::PlacementGpu> last;
+      int shown = 0;
+      for (int f = 0; f < 120; ++f) {
+        const float t = float(f) / 30.0f;
+        std::vector<gpu::LabelGpu> labels;
+        std::vector<gpu::PlacementGpu> targets;
+        for (uint32_t i = 0; i < count; ++i) {
+          labels.push_back(label_at(start[i] + t * velocity[i]));
+          // a new offset every second
+          const float turn = float(f / 30) * 1.3f + float(i);
+          targets.push_back(target_at(labels.back().anchor + offset[i] +
+                                      40.0f * glm::vec2(std::cos(turn), std::sin(turn))));
+        }
+        const auto drawn = forces_reference(labels, targets, state, f == 0 ? still : p, order);
+        for (uint32_t i = 0; i < count && f > 0; ++i) {
+          if (!(drawn[i].opacity > 0.0f)) continue;
+          ++shown;
+          const glm::vec4 a = gpu::box_around(drawn[i].position, labels[i].size);
+          CHECK(gpu::box_inside(a, p));
+          for (const glm::uvec4& k : keep_out) CHECK_FALSE(gpu::boxes_clash(a, glm::vec4(k), 0.0f));
+          for (uint32_t j = i + 1; j < count; ++j) {
+            if (drawn[j].opacity > 0.0f) {
+              const glm::vec4 b = gpu::box_around(drawn[j].position, labels[j].size);
+              CHECK_FALSE(gpu::boxes_clash(a, b, p.clearance));
+            }
+          }
+          // Relative to its anchor, a label drawn in both frames moves at most the forces' speed,
+          // and as much again where the image's edge pushes it in.
+          if (last[i].opacity > 0.0f && drawn[i].opacity < 1.0f && last[i].opacity < 1.0f) continue;
+          if (last[i].opacity > 0.0f) {
+            const glm::vec2 moved =
+                (drawn[i].position - labels[i].anchor) -
+                (last[i].position - (start[i] + (t - 1.0f / 30.0f) * velocity[i]));
+            CHECK(glm::length(moved) <= 2.0f * p.speed / 30.0f + 1e-3f);
           }
         }
-        // Relative to its anchor, a label drawn in both frames moves at most the forces' speed,
-        // and as much again where the image's edge pushes it in.
-        if (last[i].opacity > 0.0f && drawn[i].opacity < 1.0f && last[i].opacity < 1.0f) continue;
-        if (last[i].opacity > 0.0f) {
-          const glm::vec2 moved =
-              (drawn[i].position - labels[i].anchor) -
-              (last[i].position - (start[i] + (t - 1.0f / 30.0f) * velocity[i]));
-          CHECK(glm::length(moved) <= 2.0f * p.speed / 30.0f + 1e-3f);
-        }
+        last = drawn;
       }
-      last = drawn;
+      MESSAGE("drawn labels per frame: " << double(shown) / 119.0);
+      CHECK(shown > 119 * int(count) / (margins ? 3 : 2));  // most labels stay drawn
     }
-    MESSAGE("drawn labels per frame: " << double(shown) / 119.0);
-    CHECK(shown > 119 * int(count) / 2);  // most labels stay drawn
   }
 }
 
@@ -531,9 +542,14 @@ TEST_SUITE("gpu") {
       if (i % 7 != 0) order.push_back(i);
     }
     std::shuffle(order.begin(), order.end(), rng);
+    // (with keep-out rectangles where kept apart and anchored: a title and a legend)
     for (const auto& [anchored, apart] : {std::pair{true, true}, {false, true}, {true, false}}) {
       CAPTURE(anchored);
       CAPTURE(apart);
+      const std::vector<glm::uvec4> keep_out =
+          anchored && apart
+              ? std::vector<glm::uvec4>{{0u, 0u, 1024u, 90u}, {800u, 700u, 1000u, 1024u}}
+              : std::vector<glm::uvec4>{};
       GpuForces forces(ctx, count);
       std::vector<gpu::LabelStateGpu> state(count);
       for (int frame = 0; frame < 10; ++frame) {
@@ -550,10 +566,13 @@ TEST_SUITE("gpu") {
         const double seconds = frame == 3 ? 0.0 : 0.02 * (frame + 1);
         const ForceSettings settings{
             .anchor_relative = anchored, .speed_widths = widths(900.0f), .keep_apart = apart};
-        const auto drawn = forces.frame(labels, targets, settings, kUnits, seconds, order);
-        const std::vector<gpu::PlacementGpu> expected = forces_reference(
-            labels, targets, state,
-            forces_params(settings, kUnits, count, seconds, false, uint32_t(order.size())), order);
+        const auto drawn =
+            forces.frame(labels, targets, settings, kUnits, seconds, order, keep_out);
+        gpu::ForcesParams params =
+            forces_params(settings, kUnits, count, seconds, false, uint32_t(order.size()));
+        set_keep_out(params, keep_out);
+        const std::vector<gpu::PlacementGpu> expected =
+            forces_reference(labels, targets, state, params, order);
         const std::vector<gpu::LabelStateGpu> gpu_state = forces.state();
         // Bit for bit on a CPU device (lavapipe rounds as the C++ does); elsewhere within 1e-3 px:
         // Vulkan lets a GPU divide and take square roots to a few ulps, and fuse multiply-adds.

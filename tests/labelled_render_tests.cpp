@@ -233,7 +233,7 @@ TEST_SUITE("gpu") {
       const graph::GraphRunner& runner = renderer.runner();
       // (with picking, labels.ghost, .anchor_cover, the sequential loop's and the rounds' passes)
       CHECK(runner.graph().passes().size() == 26);
-      CHECK(graph::barrier_count(runner.compiled()) == 69);
+      CHECK(graph::barrier_count(runner.compiled()) == 70);
       const graph::PassInfo& loop = runner.graph().passes()[renderer.placement().label_loop];
       CHECK(loop.name == "placement.labels");
       CHECK(runner.graph().passes()[renderer.placement().rounds].name == "placement.rounds");

@@ -13,6 +13,7 @@
 
 #include <glm/gtc/packing.hpp>
 
+#include "engine/core/error.h"
 #include "engine/gpu/resources.h"
 #include "engine/graph/graph_runner.h"
 #include "frame/labelled_render.h"
@@ -239,6 +240,12 @@ Inputs crowded_scene(graph::Extent size, float margin, uint32_t count, glm::vec2
     in.order.push_back(i);
   }
   return in;
+}
+
+// Whether a box (centre, size) touches the rectangle k ([lo, hi) pixels).
+bool touches(glm::vec2 centre, glm::vec2 size, glm::uvec4 k) {
+  const glm::vec2 lo = centre - 0.5f * size, hi = centre + 0.5f * size;
+  return lo.x < float(k.z) && lo.y < float(k.w) && float(k.x) < hi.x && float(k.y) < hi.y;
 }
 
 }  // namespace
@@ -483,14 +490,18 @@ TEST_SUITE("gpu") {
     }
   }
 
-  // A keep-out rectangle (the viewer's panel): no box touches it, and the GPU still equals the
-  // reference, which places at least one label elsewhere than without it.
-  TEST_CASE_FIXTURE(test::GpuTest, "no_box_is_placed_on_the_keep_out_rectangle") {
+  // Keep-out rectangles (the viewer's panel, a title, a legend; an empty one counts for nothing):
+  // no box touches any, in the sequential loop with its tidy-up and in the rounds, and the GPU
+  // equals the reference, which places labels elsewhere than without them.
+  TEST_CASE_FIXTURE(test::GpuTest, "no_box_is_placed_on_any_keep_out_rectangle") {
     const Inputs in = disc_scene(6);
     const ReferencePlacement free = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                     in.labels, in.order, {}, in.size);
     PlacementSettings settings;
-    settings.keep_out = {0u, 0u, in.size.width / 2u, in.size.height};
+    settings.keep_out = {{0u, 0u, 30u, in.size.height},               // a panel on the left
+                         {30u, 0u, in.size.width, 16u},               // a title along the top
+                         {5u, 5u, 5u, 9u},                            // empty
+                         {70u, 50u, in.size.width, in.size.height}};  // a legend
     const GpuPlacement gpu = place_on_gpu(ctx, in, settings);
     const ReferencePlacement cpu = place_reference(in.final_rgba8, in.layers, in.layer_count,
                                                    in.labels, in.order, settings, in.size);
@@ -501,10 +512,27 @@ TEST_SUITE("gpu") {
       moved += glm::length(p.position - free.placements[i].position) > 0.5f;
       if (p.shown != PLACEMENT_SHOWN) continue;
       ++shown;
-      CHECK(p.position.x - in.labels[i].size.x * 0.5f >= float(settings.keep_out.z));
+      for (const glm::uvec4& k : settings.keep_out)
+        CHECK_FALSE(touches(p.position, in.labels[i].size, k));
     }
     CHECK(shown >= 3);
-    CHECK(moved >= 1);
+    CHECK(moved >= 2);
+
+    settings.method = PlacementMethod::rounds;
+    settings.tidy_rounds = 0;
+    const GpuPlacement rounds = place_on_gpu(ctx, in, settings);
+    const ReferenceRounds reference =
+        rounds_reference(in.labels, in.order, rounds.tables, settings, in.size, in.layer_count, {});
+    for (size_t i = 0; i < in.labels.size(); ++i) {
+      CHECK(uint32_t(rounds.results[i]) == uint32_t(reference.results[i]));
+      if (rounds.placements[i].shown != PLACEMENT_SHOWN) continue;
+      for (const glm::uvec4& k : settings.keep_out) {
+        CHECK_FALSE(touches(rounds.placements[i].position, in.labels[i].size, k));
+      }
+    }
+
+    settings.keep_out.assign(PLACEMENT_KEEP_OUT_MAX + 1, glm::uvec4(0u, 0u, 1u, 1u));
+    CHECK_THROWS_AS(keep_out_rectangles(settings), Error);
   }
 
   // Eq. 3.1's eta with last frame's drawn positions (from the forces' state, on the GPU) gives

@@ -583,6 +583,47 @@ TEST_SUITE("window") {
     CHECK(bare_drawn >= open_drawn);
   }
 
+  // A title and a legend with the panel open: no drawn label touches any of them, the layout
+  // records the title's and legend's boxes, and `set legend off` gives the legend's room back.
+  TEST_CASE("viewer_places_no_label_under_its_panel_title_or_legend") {
+    const auto dir = test::fresh_folder("viewer", "annotations");
+    const auto d = [&](const char* name) { return (dir / name).string(); };
+    const auto script = test::write_file(
+        dir / "script.txt", "report " + d("report.json") + "\nlayout " + d("layout.json") +
+                                "\nscreenshot " + d("shot.png") + "\nset legend off\nlayout " +
+                                d("no-legend.json") + "\nquit\n");
+    const auto r = run_strata("--validate view " + kScene + " --size 640x360 --title Head --legend " +
+                              "--script " + script.string());
+    INFO(r.output);
+    REQUIRE(r.exit_code == 0);
+    const auto panel = nlohmann::json::parse(test::read_file(d("report.json"))).at("panel");
+    REQUIRE(panel.size() == 4);
+    // Drawn boxes (opacity above 0) touching the panel, the title or the legend.
+    const auto layout = nlohmann::json::parse(test::read_file(d("layout.json")));
+    std::vector<glm::vec4> kept{{panel[0].get<float>(), panel[1].get<float>(),
+                                 panel[2].get<float>(), panel[3].get<float>()}};
+    REQUIRE(layout.at("annotations").size() == 2);
+    for (const auto& a : layout.at("annotations")) {
+      const auto& b = a.at("box");
+      const float x = b[0].get<float>(), y = b[1].get<float>();
+      kept.push_back({x, y, x + b[2].get<float>(), y + b[3].get<float>()});
+    }
+    int drawn = 0, touching = 0;
+    for (const auto& l : layout.at("labels")) {
+      if (l.value("opacity", 1.0) <= 0.0) continue;
+      ++drawn;
+      const auto& b = l.at("box");
+      const float x = b[0].get<float>(), y = b[1].get<float>();
+      const float w = b[2].get<float>(), h = b[3].get<float>();
+      for (const glm::vec4& k : kept) touching += x < k.z && k.x < x + w && y < k.w && k.y < y + h;
+    }
+    CHECK(touching == 0);
+    CHECK(drawn >= 2);
+    const auto no_legend = nlohmann::json::parse(test::read_file(d("no-legend.json")));
+    REQUIRE(no_legend.at("annotations").size() == 1);
+    CHECK(no_legend.at("annotations")[0].at("name") == "title");
+  }
+
   // The placement beside the frames (on lavapipe's one queue: its own submissions after the
   // frames that feed it): the frames draw the newest finished placement's layout, which follows
   // the camera and settles as clean as the placement in each frame does.

@@ -161,6 +161,7 @@ void Viewer::panel_labelling() {
               static_cast<unsigned long long>(summary_.adopted));
   checkbox(*this, "hard constraints", "hard", s.placement.hard);
   checkbox(*this, "internal labelling", "internal", s.internal);
+  checkbox(*this, "legend", "legend", options_.legend);
   checkbox(*this, "borders in layer colours", "layer_colors", s.layer_colors);
   float ghost = s.ghost.strength;
   ImGui::SliderFloat("ghosting", &ghost, 0.0f, 1.0f, "%.2f");

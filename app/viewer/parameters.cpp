@@ -133,6 +133,8 @@ const std::vector<Parameter>& parameters() {
        [](S s) { return &s.labels.forces.wait_seconds; }},
       {"optimize", "on: try random insertion orders when the camera rests", 0.0f, 0.0f, nullptr,
        [](S s) { return &s.viewer.optimize_on_idle; }},
+      {"legend", "on: a legend of the scene's labels in the bottom-right corner", 0.0f, 0.0f,
+       nullptr, [](S s) { return &s.viewer.legend; }},
       {"render.step",
        "world units between ray samples (0: half the finest voxel; else at least a sixteenth of "
        "it)",

@@ -24,7 +24,8 @@ std::filesystem::path Viewer::screenshot(const std::filesystem::path& path) {
       out = options_.screenshot_dir / (stem + name);
     } while (std::filesystem::exists(out));
   }
-  const std::vector<uint8_t> pixels = download(labelled_->labelled_image());
+  std::vector<uint8_t> pixels = download(labelled_->labelled_image());
+  if (annotations_) annotations_->draw(pixels, annotation_layout_);
   write_png(out.string(), labelled_->size().width, labelled_->size().height, pixels);
   message_ = "wrote " + out.string();
   std::printf("view: screenshot %s\n", out.string().c_str());

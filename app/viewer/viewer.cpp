@@ -218,10 +218,17 @@ void Viewer::draw_frame(std::optional<double> step) {
   panel_ = glm::uvec4(0u);
   if (options_.show_panel) build_panel();
   draw_cut_aways();
+  update_annotations(extent);
+  draw_annotations();
   ui_.end_frame();
   apply_submitted();
-  if (panel_ != labelled_->settings().placement.keep_out) {
-    labelled_->settings().placement.keep_out = panel_;  // (the panel moved, or was shown or hidden)
+  std::vector<glm::uvec4> keep_out{panel_};
+  keep_out.insert(keep_out.end(), annotation_layout_.keep_out.begin(),
+                  annotation_layout_.keep_out.end());
+  if (keep_out != labelled_->settings().placement.keep_out) {
+    // (the panel moved, or was shown or hidden; the title or legend changed)
+    labelled_->settings().placement.keep_out = keep_out;
+    labelled_->settings().annotations = annotation_layout_.boxes();
     changed();
   }
   if (ui_frames_ > 0) --ui_frames_;

@@ -22,6 +22,7 @@
 
 #include <glm/glm.hpp>
 
+#include "app/annotation_options.h"
 #include "app/viewer/camera_control.h"
 #include "app/viewer/idle_optimisation.h"
 #include "app/viewer/label_history.h"
@@ -115,6 +116,10 @@ struct ViewerOptions {
   double frame_budget_ms = 0.0;
   // Labels placed are printed ("view: placed ..."); off where stdout holds a report (bench view).
   bool print_actions = true;
+  // A title along the top (--title) and a legend of the scene's labels (--legend, `set legend`),
+  // drawn over the picture and kept free of labels (labeling/annotations.h).
+  std::string title;
+  bool legend = false;
 };
 
 // Totals over a run, printed when the viewer closes and by `strata bench view`.
@@ -392,6 +397,13 @@ class Viewer {
   void apply_cuts(const ViewerCuts& cuts);
   void panel_cut_aways();
   void draw_cut_aways();
+  // The title and legend: their layout for this frame's size, font and labels (the same as the
+  // last frame's unless one of those changed), drawn over the picture (and into screenshots).
+  void update_annotations(graph::Extent extent);
+  void draw_annotations() const;
+  std::unique_ptr<Annotations> annotations_;
+  std::string annotations_key_;  // what annotation_layout_ was made for
+  AnnotationLayout annotation_layout_;
   char label_filter_[64] = "";
   char position_name_[64] = "";
   std::string message_;

@@ -17,4 +17,11 @@ inline glm::vec4 background_rgba(const Background& background) {
   return background.transparent ? glm::vec4(0.0f) : glm::vec4(background.color, 1.0f);
 }
 
+// Whether solid connectors get the dashed ones' dark halo: on a light background (or none, which
+// any page may show through) a white line alone is lost. Black keeps the thesis's look.
+inline bool connector_halos(const Background& background) {
+  const float luminance = glm::dot(background.color, glm::vec3(0.2126f, 0.7152f, 0.0722f));
+  return background.transparent || luminance > 0.5f;
+}
+
 }  // namespace strata

@@ -117,6 +117,9 @@ struct Label {
   // Higher is placed first, so when labels must be hidden (hard constraints, crowding) a lower
   // priority goes first; equal priorities keep the insertion order's own rule.
   float priority = 0.0f;
+  // RGB 0..1 of what it names, where that has one (a segmentation region's colour): a legend's
+  // swatch. Not in scene files.
+  std::optional<glm::vec3> colour;
 };
 
 // One label written to a label file and read back: the same text and anchor (a label file

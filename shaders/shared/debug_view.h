@@ -120,6 +120,10 @@ vec2 anchor_at(uint k) {
 float table_at(uint, int, int) {
   return 0.0f;
 }
+// (the constraint image shows every candidate the rules allow, the viewer's panel's too)
+uvec4 keep_out_at(uint) {
+  return uvec4(0u);
+}
 
 #include "placement_cost.h"
 
@@ -135,8 +139,7 @@ void view_setup() {
   params.label_count = view.label_count;
   params.margin = view.margin;
   params.edge = 0.0f;  // (a still's candidates)
-  params.keep_out_lo = 0u;
-  params.keep_out_hi = 0u;
+  params.keep_out_count = 0u;
   view_position = view.order_count;
   if (view.label >= view.label_count) return;
   view_label = label_at(view.label);

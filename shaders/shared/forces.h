@@ -58,7 +58,8 @@ struct ForcesParams {
   float appear_margin;  // pixels of room a label needs around its box to appear (keep_apart.h)
   float min_hidden;     // seconds a label that was drawn stays hidden before it appears again
   float clearance;      // pixels two drawn boxes keep apart (keep_apart.h: boxes_clash)
-  uint pad;
+  uint keep_out_count;  // rectangles drawn boxes keep off, as off the image's edges (keep_apart.h):
+  uint keep_out[2u * PLACEMENT_KEEP_OUT_MAX];  // each x0 | y0 << 16, then x1 | y1 << 16, in pixels
 };
 
 // An opacity moved by `change`, kept in [0, 1]; within 1/512 of either end (less than a step of

@@ -1,7 +1,8 @@
 // Keeping drawn labels apart: the drawn layout is a constraint. After the forces propose where
 // each label moves this frame, the labels are settled one at a time in a priority order against
 // the boxes drawn so far: a label moves only where its box is free of every drawn box and inside
-// the image; where its way is taken it stays, and after ForcesParams::wait seconds of waiting it
+// the image (and off the keep-out rectangles: a picture's title and legend, the viewer's panel);
+// where its way is taken it stays, and after ForcesParams::wait seconds of waiting it
 // fades out where it is and fades in at its target once that is free. A label whose box now
 // clashes with one settled before it (anchors moving on screen bring boxes together) or leaves
 // the image goes at once. So no two drawn boxes overlap and none is cut, in any frame. A label
@@ -70,9 +71,21 @@ STRATA_INLINE bool boxes_clash(vec4 a, vec4 b, float clearance) {
          a.x <= a.z && b.x <= b.z;
 }
 
+// Keep-out rectangle i of params (x0, y0, x1, y1).
+STRATA_INLINE vec4 keep_out_box(ForcesParams params, uint i) {
+  uint lo = params.keep_out[2u * i], hi = params.keep_out[2u * i + 1u];
+  return vec4(float(lo & 0xFFFFu), float(lo >> 16u), float(hi & 0xFFFFu), float(hi >> 16u));
+}
+
+// Inside the image and off the keep-out rectangles. A box may reach into a rectangle by the
+// clearance: the placement puts boxes touching one, and rounding must not make them clash.
 STRATA_INLINE bool box_inside(vec4 box, ForcesParams params) {
-  return box.x >= 0.0f && box.y >= 0.0f && box.z <= params.image_width &&
-         box.w <= params.image_height;
+  bool inside =
+      box.x >= 0.0f && box.y >= 0.0f && box.z <= params.image_width && box.w <= params.image_height;
+  for (uint i = 0u; i < params.keep_out_count; ++i) {
+    if (boxes_clash(box, keep_out_box(params, i), -params.clearance)) inside = false;
+  }
+  return inside;
 }
 
 // (An internal label, drawn on its anchor, takes no part: it has no other place to go.)

@@ -68,6 +68,9 @@
 #define PLACEMENT_BINDING_ROUND_DONE 27    // uint per round: its COMMIT workgroups finished
 #define PLACEMENT_BINDING_ROUND_WIDE 28    // uint per label: EVALUATE's workgroups finished, then
                                            // whether WIDE searches on (ROUNDS_GROUPS + 1)
+#define PLACEMENT_BINDING_KEEP_OUT 29  // uvec4 per rectangle no box may touch (x0, y0, x1, y1 in
+                                      // pixels, [lo, hi)): PlacementParams::keep_out_count of them
+#define PLACEMENT_KEEP_OUT_MAX 4u     // the viewer's panel, a picture's title and legend, one spare
 
 // PlacementParams.phase of placement_tidy.comp: the tidy-up's start, the four steps of each
 // round (params.step), and the placements' output. The changes a round applies are taken up by
@@ -182,8 +185,9 @@ struct PlacementParams {
   uint tidy_rounds;     // placement_tidy: rounds of the tidy-up at most (0: none)
   uint indirect;        // 1: the tidy-up rounds are indirect dispatches (PlacementPlan)
   float edge;           // pixels a box keeps clear of the image's edges
-  uint keep_out_lo;  // a rectangle no box may touch (the viewer's panel): its corners x | y << 16,
-  uint keep_out_hi;  // [lo, hi) in pixels; lo == hi: none
+  uint keep_out_count;  // rectangles no box may touch (PLACEMENT_BINDING_KEEP_OUT): the viewer's
+                        // panel, a picture's title and legend
+  uint pad;
 };
 
 // placement.integral_costs's own push constants (PlacementParams fills the 128 bytes every device

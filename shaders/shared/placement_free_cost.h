@@ -29,15 +29,19 @@ bool box_legible(LabelGpu me, vec2 origin) {
   return on_screen - hidden >= LEGIBLE_SHARE * float(int(me.size.x) * int(me.size.y));
 }
 
-// Whether the box at origin o touches the keep-out rectangle (params.keep_out_*).
+// Whether the box at origin o touches a keep-out rectangle (keep_out_at, [lo, hi) pixels).
 bool box_kept_out(LabelGpu me, vec2 o) {
-  vec2 lo = vec2(float(params.keep_out_lo & 0xFFFFu), float(params.keep_out_lo >> 16u));
-  vec2 hi = vec2(float(params.keep_out_hi & 0xFFFFu), float(params.keep_out_hi >> 16u));
-  return all(lessThan(lo, hi)) && all(lessThan(o, hi)) && all(lessThan(lo, o + me.size));
+  for (uint i = 0u; i < params.keep_out_count; ++i) {
+    uvec4 k = keep_out_at(i);
+    vec2 lo = vec2(float(k.x), float(k.y));
+    vec2 hi = vec2(float(k.z), float(k.w));
+    if (all(lessThan(o, hi)) && all(lessThan(lo, o + me.size))) return true;
+  }
+  return false;
 }
 
 // Whether pixel p may hold the label at all: its box lies on screen, params.edge clear of its
-// edges (internal labels: only the anchor's own pixel), off the keep-out rectangle and, in hard
+// edges (internal labels: only the anchor's own pixel), off the keep-out rectangles and, in hard
 // mode, is legible.
 bool candidate_allowed(LabelGpu me, uvec2 p) {
   if (box_kept_out(me, box_origin(p, me.size))) return false;

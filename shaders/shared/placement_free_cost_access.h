@@ -18,10 +18,13 @@ concept PlacementFreeCostAccess = requires(const T& t, uint layer, int x, int y)
   // summed-area table of the layer's integral costs (layer < layer_count) or hidden pixels
   // (layer_count + layer); 0 left of and above the image
   { t.table_at(layer, x, y) } -> std::same_as<float>;
+  // keep-out rectangle i < params.keep_out_count (PLACEMENT_BINDING_KEEP_OUT)
+  { t.keep_out_at(layer) } -> std::same_as<uvec4>;
 };
 STRATA_END
 #else
 float table_at(uint layer, int x, int y);
+uvec4 keep_out_at(uint i);
 #endif
 
 #endif

@@ -101,6 +101,7 @@ void add_region(Scene& scene, const Segmentation& segmentation, const SegmentReg
     label.id = id;
     label.text = spaced(region.name);
     label.anchor = summary.anchor;
+    label.colour = colour;
     scene.labels.push_back(std::move(label));
   }
   if (entry.masks) {
