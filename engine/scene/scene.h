@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -203,7 +204,12 @@ struct Scene {
   std::string source_json;
 };
 
-// The scene's camera, or its named position `name` (an Error listing the names if there is none).
+// The scene's position `name`, or, where it has none of that name, the standard view the name
+// means (standard_view_name: `front`, `oblique`, `ars`); nullptr if neither.
+const CameraPose* find_position(const Scene& scene, std::string_view name);
+
+// The scene's camera, or its named position `name` (find_position; an Error listing the names
+// if there is none).
 Camera camera_for(const Scene& scene, const std::string& name);
 
 // For each point (world), whether it lies in the volume's box (its voxels', in its own index

@@ -621,7 +621,7 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
                   std::to_string(volume.cut.size()) + " cut-away planes, at most " +
                   std::to_string(kMaxCutPlanes));
   }
-  complete_scene(scene, options.preset, options.window);
+  complete_scene(scene, options.preset, options.window, options.fit);
   return scene;
 }
 
@@ -726,9 +726,41 @@ void check_fitted_camera(const Scene& scene, const Camera& camera) {
     throw Error(scene.source.string() + ": the camera fitted to the content: " + problem);
 }
 
+// Every scene has the standard views as named positions besides its own (an own position of the
+// same name wins), fitted to its content (or what its cut-aways keep) with its lens.
+void complete_camera(Scene& scene, FitTo fit) {
+  std::vector<CameraPose> views;
+  if (scene.has_camera) {
+    const AnatomicalPositions fitted =
+        anatomical_positions(scene, scene.camera.fov_y_degrees, fit);
+    views = fitted.positions;
+    // (the planes hold the content from those views too)
+    if (fitted.nearest > 0.0f)
+      scene.camera.near_plane = std::min(scene.camera.near_plane, fitted.nearest);
+    scene.camera.far_plane = std::max(scene.camera.far_plane, fitted.farthest);
+    if (fit == FitTo::kept) {  // the file's own camera and positions: the same way, closer
+      const float fov = scene.camera.fov_y_degrees;
+      scene.camera.view = refitted_view(scene, scene.camera.view, fov, fit);
+      for (CameraPose& pose : scene.camera_positions)
+        pose.view = refitted_view(scene, pose.view, fov, fit);
+    }
+  } else {
+    FittedCamera fitted = fitted_camera(scene, fit);
+    check_fitted_camera(scene, fitted.camera);
+    scene.camera = fitted.camera;
+    views = std::move(fitted.positions);
+  }
+  for (CameraPose& pose : views) {
+    const bool taken = std::any_of(scene.camera_positions.begin(), scene.camera_positions.end(),
+                                   [&](const CameraPose& p) { return p.name == pose.name; });
+    if (!taken) scene.camera_positions.push_back(std::move(pose));
+  }
+}
+
 }  // namespace
 
-void complete_scene(Scene& scene, const std::string& preset, std::optional<glm::vec2> window) {
+void complete_scene(Scene& scene, const std::string& preset, std::optional<glm::vec2> window,
+                    std::optional<bool> fit) {
   for (Volume& volume : scene.volumes) {
     if (!(volume.value_range.y > volume.value_range.x)) {
       scene.warnings.push_back("volume '" + volume.name + "' holds the one value " +
@@ -769,27 +801,7 @@ void complete_scene(Scene& scene, const std::string& preset, std::optional<glm::
     volume.transfer_function = int(scene.transfer_functions.size()) - 1;
   }
   check_content_bounds(scene);
-  // Every scene has the six anatomical views as named positions besides its own (an own
-  // position of the same name wins), fitted to its content with its lens.
-  std::vector<CameraPose> views;
-  if (scene.has_camera) {
-    const AnatomicalPositions fitted = anatomical_positions(scene, scene.camera.fov_y_degrees);
-    views = fitted.positions;
-    // (the planes hold the content from those views too)
-    if (fitted.nearest > 0.0f)
-      scene.camera.near_plane = std::min(scene.camera.near_plane, fitted.nearest);
-    scene.camera.far_plane = std::max(scene.camera.far_plane, fitted.farthest);
-  } else {
-    FittedCamera fitted = fitted_camera(scene);
-    check_fitted_camera(scene, fitted.camera);
-    scene.camera = fitted.camera;
-    views = std::move(fitted.positions);
-  }
-  for (CameraPose& pose : views) {
-    const bool taken = std::any_of(scene.camera_positions.begin(), scene.camera_positions.end(),
-                                   [&](const CameraPose& p) { return p.name == pose.name; });
-    if (!taken) scene.camera_positions.push_back(std::move(pose));
-  }
+  complete_camera(scene, fit.value_or(!scene.has_camera) ? FitTo::kept : FitTo::content);
 }
 
 }  // namespace strata

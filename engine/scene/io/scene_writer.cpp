@@ -7,7 +7,6 @@
 #include "engine/core/error.h"
 #include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
-#include "engine/scene/fitted_camera.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
 
@@ -114,17 +113,9 @@ void write_positions(ordered_json& root, const Scene& scene) {
   ordered_json read =
       camera && camera->contains("positions") ? (*camera)["positions"] : ordered_json::array();
   std::vector<bool> used(read.size(), false);
-  // The anatomical views complete_scene appends: the loader appends them again, so those at the
-  // end of the list are not written (ones before a saved position are, to keep the order that
-  // the keys 1 to 9 follow).
-  const std::vector<CameraPose> fitted =
-      scene.has_camera ? anatomical_positions(scene, scene.camera.fov_y_degrees).positions
-                       : fitted_camera(scene).positions;
-  const auto is_fitted = [&](const CameraPose& pose) {
-    return std::any_of(fitted.begin(), fitted.end(), [&](const CameraPose& p) {
-      return p.name == pose.name && p.view == pose.view;
-    });
-  };
+  // The standard views complete_scene appends (CameraPose::fitted): the loader appends them
+  // again, so those at the end of the list are not written (ones before a saved position are, to
+  // keep the order that the keys 1 to 9 follow).
   ordered_json positions = ordered_json::array();
   size_t kept = 0;  // positions up to the last one that is not fitted
   for (const CameraPose& pose : scene.camera_positions) {
@@ -135,7 +126,7 @@ void write_positions(ordered_json& root, const Scene& scene) {
       positions.push_back(read[i]);
     }
     if (!found) positions.push_back(position_json(pose));
-    if (found || !is_fitted(pose)) kept = positions.size();
+    if (found || !pose.fitted) kept = positions.size();
   }
   positions.erase(positions.begin() + std::ptrdiff_t(kept), positions.end());
   if (positions.empty() && !(camera && camera->contains("positions"))) return;
