@@ -154,6 +154,78 @@ TEST_SUITE("loaders") {
     }
   }
 
+  // A volume's "preset" is that preset made for its values, as --preset makes it; the scene
+  // writer writes a preset or a window back by name and values, and a function of no file in the
+  // volume's values, never 0..1 of one scan's range.
+  TEST_CASE("a_volume_preset_key_applies_the_preset_and_is_written_back") {
+    const fs::path folder = output_folder("preset_key");
+    const std::string ct5n = (cache / "dicom/CT5N").string();
+    const auto scene_with = [&](const std::string& name, const std::string& keys) {
+      return write_file(folder / name, R"({"strata_scene": 1, "volumes": [{"file": ")" + ct5n +
+                                           R"(", )" + keys + "}]}");
+    };
+    const strata::Scene keyed = strata::load_scene(scene_with("bone.json", R"("preset": "ct-bone")"));
+    strata::SceneOpenOptions option;
+    option.preset = "ct-bone";
+    const strata::Scene given = strata::load_scene(ct5n, option);
+    const strata::Volume& v = keyed.volumes[0];
+    CHECK(v.preset == "ct-bone");
+    CHECK(keyed.warnings.empty());
+    const strata::TransferFunction& tf = keyed.transfer_functions[size_t(v.transfer_function)];
+    const strata::TransferFunction& want =
+        given.transfer_functions[size_t(given.volumes[0].transfer_function)];
+    REQUIRE(tf.stops.size() == want.stops.size());
+    for (size_t i = 0; i < tf.stops.size(); ++i) {
+      CHECK(tf.stops[i].position == want.stops[i].position);
+      CHECK(tf.stops[i].color == want.stops[i].color);
+    }
+    // The command line's --window wins over the file's preset.
+    strata::SceneOpenOptions window;
+    window.window = glm::vec2(900.0f, 1200.0f);
+    const strata::Scene grey = strata::load_scene(scene_with("bone.json", R"("preset": "ct-bone")"),
+                                                  window);
+    CHECK(grey.volumes[0].preset.empty());
+    CHECK(grey.volumes[0].window == glm::vec2(900.0f, 1200.0f));
+
+    const auto error = [&](const std::string& keys) {
+      const fs::path path = scene_with("bad.json", keys);
+      return error_of([&] { strata::load_scene(path); }).substr(path.string().size());
+    };
+    CHECK(error(R"("preset": "ct-bones")") ==
+          ": volumes[0].preset: no preset 'ct-bones' (ct-skin, ct-soft-tissue, ct-bone, ct-lung, "
+          "mr-head, mr-brain)");
+    CHECK(error(R"("preset": 3)").starts_with(": volumes[0].preset: "));
+    CHECK(error(R"("preset": "ct-bone", "window": [40, 400])") ==
+          ": volumes[0].window: give one of transfer_function, preset and window");
+    CHECK(error(R"("preset": "ct-bone", "transfer_function": "x.json")") ==
+          ": volumes[0].preset: give one of transfer_function, preset and window");
+
+    // A volume opened directly and saved: its preset and window by name and values.
+    const fs::path saved = folder / "saved.json";
+    strata::save_scene_json(saved, given);
+    CHECK(strata::test::read_file(saved).find(R"("preset": "ct-bone")") != std::string::npos);
+    CHECK(strata::load_scene(saved).volumes[0].preset == "ct-bone");
+    strata::save_scene_json(saved, strata::load_scene(ct5n, window));
+    CHECK(strata::test::read_file(saved).find(R"("window": [)") != std::string::npos);
+    CHECK(strata::load_scene(saved).volumes[0].window == glm::vec2(900.0f, 1200.0f));
+    // A function of no file, edited (as the viewer does): written in HU.
+    strata::Scene edited = strata::load_scene(ct5n);
+    edited.volumes[0].preset.clear();
+    edited.volumes[0].look_edited = true;
+    strata::save_scene_json(saved, edited);
+    const std::string text = strata::test::read_file(saved);
+    CHECK(text.find(R"("units": "HU")") != std::string::npos);
+    const strata::Scene back = strata::load_scene(saved);
+    const strata::TransferFunction& a =
+        edited.transfer_functions[size_t(edited.volumes[0].transfer_function)];
+    const strata::TransferFunction& b =
+        back.transfer_functions[size_t(back.volumes[0].transfer_function)];
+    for (float t : {0.0f, 0.3f, 0.6f, 1.0f}) {
+      const glm::vec4 d = a.sample(t) - b.sample(t);
+      CHECK(glm::length(d) < 1e-4f);
+    }
+  }
+
   // A volume's window and a transfer function in HU are made 0..1 of its value range; HU on a
   // volume whose values are not Hounsfield units warns.
   TEST_CASE("windows_and_functions_in_the_volumes_values_map_to_its_range") {
@@ -176,7 +248,7 @@ TEST_SUITE("loaders") {
                                           R"({"strata_scene": 1, "volumes": [{"file": ")" + ct5n +
                                               R"(", "window": [40, 80], "transfer_function": {
               "stops": [{"position": 0, "color": [1, 1, 1, 1]}]}}]})"));
-          }).find("volumes[0].window: give a transfer_function or a window, not both") !=
+          }).find("volumes[0].window: give one of transfer_function, preset and window") !=
           std::string::npos);
 
     strata::Scene mr;

@@ -116,8 +116,8 @@ TEST_SUITE("loaders") {
       const char* first_text;
     };
     for (const Expected& e :
-         {Expected{"jet-engine.xml", "assets/models/jet_engine1.dae", 10, 6 + 6, "Fan"},
-          Expected{"sponza.xml", "assets/models/crytek-sponza/sponza.obj", 10, 5 + 6, nullptr}}) {
+         {Expected{"jet-engine.xml", "assets/models/jet_engine1.dae", 10, 6 + 14, "Fan"},
+          Expected{"sponza.xml", "assets/models/crytek-sponza/sponza.obj", 10, 5 + 14, nullptr}}) {
       CAPTURE(e.file);
       const fs::path path = voly_scenes / e.file;
       const strata::Scene scene = strata::load_scene(path);
@@ -241,7 +241,7 @@ TEST_SUITE("loaders") {
     CHECK(scene.camera.near_plane == 0.5f);
     CHECK(scene.camera.far_plane == 50.0f);
     CHECK(scene.camera.view[3] == glm::vec4(0.0f, 0.0f, -10.0f, 1.0f));
-    REQUIRE(scene.camera_positions.size() == 2 + 6);  // (and the six anatomical views)
+    REQUIRE(scene.camera_positions.size() == 2 + 14);  // (and the fourteen standard views)
     CHECK(scene.camera_positions[0].name == "side");
     const glm::vec4 side_eye = glm::inverse(scene.camera_positions[0].view)[3];
     CHECK(side_eye.x == doctest::Approx(10.0));
@@ -346,7 +346,7 @@ TEST_SUITE("loaders") {
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "trasform": []}]})") ==
           prefix +
               "volumes[0]: unknown key 'trasform' (expected name, file, frame, series, "
-              "transfer_function, window, crop, clip, transform)");
+              "transfer_function, preset, window, crop, clip, transform)");
     CHECK(
         load(
             R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "crop": [0, 0, 5, 1, 1, 4]}]})") ==

@@ -36,6 +36,12 @@ struct Volume {
   std::vector<std::byte> voxels;  // i fastest, then j, then k; rescale slope/intercept applied
   glm::vec2 value_range{0.0f};    // min and max voxel value (transfer functions normalise by it)
   int transfer_function = -1;     // index into Scene::transfer_functions, -1 for none
+  // How its transfer function was chosen, which the scene writer writes back: a preset by name
+  // (transfer_function_presets.h) or a grey window (center, width in its values); neither for a
+  // function of its own.
+  std::string preset;
+  std::optional<glm::vec2> window;
+  bool look_edited = false;  // changed since read (the viewer): saved from the model, not the file
   // Cut-aways: planes in world space (xyz the normal, w the offset); a point p of the volume is
   // shown where dot(xyz, p) + w >= 0 for every plane. A crop box is six of them
   // (crop_planes); at most kMaxCutPlanes.

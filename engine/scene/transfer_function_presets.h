@@ -35,6 +35,11 @@ PresetChoice choose_transfer_function_preset(const Volume& volume);
 // of 0..1 of `volume`'s value range, which the renderer takes.
 TransferFunction in_value_range(const TransferFunction& in_values, const Volume& volume);
 
+// The other way: a function in 0..1 of `volume`'s value range made one in its values, units "HU"
+// where the values are Hounsfield units (choose_transfer_function_preset), else "raw"; what a
+// scene file saves, so it shows the same tissue on another scan.
+TransferFunction in_volume_values(const TransferFunction& in_range, const Volume& volume);
+
 // Window and level as radiology sets them, in the volume's values (HU for CT: brain 40/80, bone
 // 400/1800): a grey ramp over [center - width / 2, center + width / 2], transparent black below
 // it, opaque white above (units "raw").

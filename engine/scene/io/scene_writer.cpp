@@ -9,6 +9,7 @@
 #include "engine/core/text_file.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
+#include "engine/scene/transfer_function_presets.h"
 
 namespace strata {
 namespace {
@@ -73,6 +74,22 @@ ordered_json meshes_json(const std::vector<Mesh>& meshes, const auto& relative) 
     result.push_back(std::move(entry));
   }
   return result;
+}
+
+// A volume's look in its entry: a preset by name, a window, or its transfer function by file or
+// inline in the volume's values (HU for CT), never in 0..1 of one scan's value range.
+void look_json(ordered_json& entry, const Volume& volume, const Scene& scene, const auto& relative) {
+  for (const char* key : {"transfer_function", "preset", "window"}) entry.erase(key);
+  if (!volume.preset.empty()) {
+    entry["preset"] = volume.preset;
+  } else if (volume.window) {
+    entry["window"] = vector_json(&volume.window->x, 2);
+  } else if (volume.transfer_function >= 0) {
+    const TransferFunction& tf = scene.transfer_functions.at(size_t(volume.transfer_function));
+    entry["transfer_function"] = tf.source.empty() || volume.look_edited
+                                     ? transfer_function_to_json(in_volume_values(tf, volume))
+                                     : ordered_json(relative(tf.source));
+  }
 }
 
 // A path as the file at `from` wrote it, as the file at `to` must write it: unchanged within one
@@ -165,6 +182,11 @@ ordered_json as_read(const std::filesystem::path& path, const Scene& scene) {
   rebase.each(root, "segmentations", {"file", "names"});
   rebase.key(root, "labels");
   rebase.each(root, "labels", {"image"});
+  // (the file's volumes come first in the scene, in its order)
+  if (root.contains("volumes") && root["volumes"].is_array()) {
+    for (size_t i = 0; i < root["volumes"].size() && i < scene.volumes.size(); ++i)
+      if (scene.volumes[i].look_edited) look_json(root["volumes"][i], scene.volumes[i], scene, rebase);
+  }
   write_positions(root, scene);
   return root;
 }
@@ -176,11 +198,7 @@ ordered_json from_model(const std::filesystem::path& path, const Scene& scene) {
   for (const Volume& volume : scene.volumes) {
     if (volume.source.empty()) continue;
     ordered_json entry = {{"name", volume.name}, {"file", relative(volume.source)}};
-    if (volume.transfer_function >= 0) {
-      const TransferFunction& tf = scene.transfer_functions.at(size_t(volume.transfer_function));
-      entry["transfer_function"] =
-          tf.source.empty() ? transfer_function_to_json(tf) : ordered_json(relative(tf.source));
-    }
+    look_json(entry, volume, scene, relative);
     if (!volume.series.empty()) entry["series"] = volume.series;
     if (volume.transform != glm::mat4(1.0f)) entry["transform"] = matrix_json(volume.transform);
     volumes.push_back(std::move(entry));
