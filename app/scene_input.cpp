@@ -166,8 +166,10 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
                   "a 4-D volume's frame or a DICOM series' time point, from 0 (default: the first)")
       ->check(whole_range(0, 1e6));
   cmd->add_option("--window", in.window,
-                  "CENTER,WIDTH: every volume shown as a grey ramp over these values (Hounsfield "
-                  "units for CT: 40,80 brain, 400,1800 bone), in place of its transfer function");
+                  "CENTER,WIDTH: every volume shown as a grey ramp from CENTER - WIDTH/2 "
+                  "(transparent) to CENTER + WIDTH/2 (opaque white) in its values, in place of its "
+                  "transfer function (Hounsfield units for CT: 900,1200 bone alone, 40,400 the "
+                  "skin)");
   cmd->add_option("--crop", in.crop,
                   "X0,Y0,Z0,X1,Y1,Z1: show only this box of every volume (world mm, LPS)");
   cmd->add_option("--clip", in.clip,
