@@ -176,14 +176,12 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
                   "PX,PY,PZ,NX,NY,NZ: cut every volume at the plane through P, keeping the side "
                   "N points to (world mm, LPS); up to six")
       ->allow_extra_args(false);  // one plane an --clip: the next word is not a second plane
-  CLI::Option* fit = cmd->add_flag_callback(
+  cmd->add_flag_callback(
       "--fit", [&in] { in.fit = true; },
       "fit the camera and the named views to what --crop and --clip keep (the default for a "
       "scene without a camera: a volume file or DICOM folder)");
-  cmd->add_flag_callback(
-         "--no-fit", [&in] { in.fit = false; },
-         "keep the camera and the named views fitted to the whole content")
-      ->excludes(fit);
+  cmd->add_flag_callback("--no-fit", [&in] { in.fit = false; },
+                         "keep the camera and the named views fitted to the whole content");
   cmd->add_option("--series", in.series,
                   "a DICOM folder holding several series: the one with this SeriesNumber or "
                   "SeriesInstanceUID (default: the largest 3-D image series; strata info FOLDER "
