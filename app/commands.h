@@ -82,8 +82,8 @@ struct SceneInput {
   // The depth layers asked for: --layers, else the scene's.
   uint32_t layer_count(const Scene& scene) const;
 };
-// --preset, --labels, --frame, --window, --crop, --clip, --fit, --series and --layers (the positional
-// FILE is the command's own).
+// --preset, --labels, --frame, --window, --crop, --clip, --fit, --series and --layers (the
+// positional FILE is the command's own).
 void add_scene_input_options(CLI::App* cmd, SceneInput& in);
 
 // Loads the scene (load_scene with the input's options) and prints its warnings (missing data

@@ -180,8 +180,9 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
       "--fit", [&in] { in.fit = true; },
       "fit the camera and the named views to what --crop and --clip keep (the default for a "
       "scene without a camera: a volume file or DICOM folder)");
-  cmd->add_flag_callback("--no-fit", [&in] { in.fit = false; },
-                         "keep the camera and the named views fitted to the whole content");
+  cmd->add_flag_callback(
+      "--no-fit", [&in] { in.fit = false; },
+      "keep the camera and the named views fitted to the whole content");
   cmd->add_option("--series", in.series,
                   "a DICOM folder holding several series: the one with this SeriesNumber or "
                   "SeriesInstanceUID (default: the largest 3-D image series; strata info FOLDER "

@@ -42,7 +42,8 @@ Volume ct_head_phantom(bool with_bone = true) {
         int16_t value = -1000;
         if (p.z > -40.0f && r <= 1.0f) {
           value = r < 0.82f ? 35 : r <= 0.92f ? (with_bone ? 1000 : 40) : 40;
-        } else if (p.z <= -40.0f && p.z > -90.0f && glm::length(glm::vec2(p.x, p.y - 10.0f)) < 40.0f) {
+        } else if (p.z <= -40.0f && p.z > -90.0f &&
+                   glm::length(glm::vec2(p.x, p.y - 10.0f)) < 40.0f) {
           value = 40;  // the neck
         }
         if (glm::length(p - glm::vec3(0.0f, -85.0f, 0.0f)) < 14.0f) value = 40;  // the nose
@@ -107,9 +108,10 @@ Rgba8Image render(const std::string& args, const std::string& name) {
 
 TEST_SUITE("cli") {
   TEST_CASE("a_bare_ct_opens_the_oblique_views_and_the_short_names") {
-    const auto r = run_strata("render " + phantom_file() +
-                              " --size 64 --window 40,400 --camera front,oblique,als,posterior-right-inferior -o " +
-                              out_path("names.png"));
+    const auto r = run_strata(
+        "render " + phantom_file() +
+        " --size 64 --window 40,400 --camera front,oblique,als,posterior-right-inferior -o " +
+        out_path("names.png"));
     INFO(r.output);
     REQUIRE(r.exit_code == 0);
     for (const char* name : {"front", "oblique", "als", "posterior-right-inferior"}) {
@@ -151,7 +153,8 @@ TEST_SUITE("cli") {
       test::write_file(scene, R"({"strata_scene": 1, "volumes": [{"file": ")" + phantom_file() +
                                   R"(", )" + key + "}]}");
       const Rgba8Image keyed = render(scene + " --camera oblique", "keyed.png");
-      const Rgba8Image given = render(phantom_file() + " " + option + " --camera oblique", "given.png");
+      const Rgba8Image given =
+          render(phantom_file() + " " + option + " --camera oblique", "given.png");
       CHECK(keyed.pixels == given.pixels);
       CHECK(content_pixels(keyed) > 500);
     }
@@ -182,7 +185,8 @@ TEST_SUITE("window") {
     const std::filesystem::path volume = folder / "ct.mha";
     std::filesystem::copy_file(phantom_file(), volume);
     const auto view = [&](const std::string& lines) {
-      const std::filesystem::path script = test::write_file(folder / "script.txt", lines + "quit\n");
+      const std::filesystem::path script =
+          test::write_file(folder / "script.txt", lines + "quit\n");
       const auto r = run_strata("view " + volume.string() + " --size 64 --no-panel --script " +
                                 script.string());
       INFO(r.output);

@@ -84,7 +84,9 @@ TEST_SUITE("loaders") {
         CHECK(glm::dot(eye, glm::vec3(strata::side_of(*view).eye_direction)) > 0.999f);
         continue;
       }
-      const auto named = [&](const char* word) { return pose.name.find(word) != std::string::npos; };
+      const auto named = [&](const char* word) {
+        return pose.name.find(word) != std::string::npos;
+      };
       CHECK((named("anterior") ? eye.y < -0.5f : eye.y > 0.5f));
       CHECK((named("left") ? eye.x > 0.5f : eye.x < -0.5f));
       CHECK((named("superior") ? eye.z > 0.4f : eye.z < -0.4f));
@@ -164,7 +166,8 @@ TEST_SUITE("loaders") {
       return write_file(folder / name, R"({"strata_scene": 1, "volumes": [{"file": ")" + ct5n +
                                            R"(", )" + keys + "}]}");
     };
-    const strata::Scene keyed = strata::load_scene(scene_with("bone.json", R"("preset": "ct-bone")"));
+    const strata::Scene keyed =
+        strata::load_scene(scene_with("bone.json", R"("preset": "ct-bone")"));
     strata::SceneOpenOptions option;
     option.preset = "ct-bone";
     const strata::Scene given = strata::load_scene(ct5n, option);
@@ -182,8 +185,8 @@ TEST_SUITE("loaders") {
     // The command line's --window wins over the file's preset.
     strata::SceneOpenOptions window;
     window.window = glm::vec2(900.0f, 1200.0f);
-    const strata::Scene grey = strata::load_scene(scene_with("bone.json", R"("preset": "ct-bone")"),
-                                                  window);
+    const strata::Scene grey =
+        strata::load_scene(scene_with("bone.json", R"("preset": "ct-bone")"), window);
     CHECK(grey.volumes[0].preset.empty());
     CHECK(grey.volumes[0].window == glm::vec2(900.0f, 1200.0f));
 

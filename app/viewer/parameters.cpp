@@ -36,7 +36,6 @@ TransferFunction looked(const TransferFunction& tf, const Volume& volume, float 
   return windowed(tf, (level - lo) / span, window / span, opacity);
 }
 
-
 float parse_float(const std::string& name, const std::string& value) {
   try {
     size_t used = 0;

@@ -46,16 +46,23 @@ double fitting_distance(const Bounds& bounds, const ViewSide& side, double half_
   return distance;
 }
 
+// The words of an oblique view's name, by axis (front, side, height), each pair's first the
+// positive sense of `oblique`'s arguments.
+constexpr const char* kSideWords[3][2] = {
+    {"anterior", "posterior"}, {"left", "right"}, {"superior", "inferior"}};
+
+// "anterior-right-superior" for the words' indices {0, 1, 0}.
+std::string oblique_name(const int (&which)[3]) {
+  return std::string(kSideWords[0][which[0]]) + "-" + kSideWords[1][which[1]] + "-" +
+         kSideWords[2][which[2]];
+}
+
 // A three-quarter view: `front` (+-1: anterior or posterior), `side` (+-1: left or right) and
 // `height` (+-1: superior or inferior) in LPS, 45 degrees round and 30 up or down.
 StandardView oblique(int front, int side, int height) {
-  static const char* const words[3][2] = {
-      {"anterior", "posterior"}, {"left", "right"}, {"superior", "inferior"}};
   const double round = std::sqrt(0.5) * std::cos(glm::radians(30.0));
   const glm::dvec3 eye(side * round, -front * round, height * std::sin(glm::radians(30.0)));
-  const std::string name = std::string(words[0][front < 0]) + "-" + words[1][side < 0] + "-" +
-                           words[2][height < 0];
-  return {name, {eye, glm::dvec3(0, 0, 1)}};
+  return {oblique_name({front < 0, side < 0, height < 0}), {eye, glm::dvec3(0, 0, 1)}};
 }
 
 glm::mat4 look_from(const Bounds& bounds, const ViewSide& side, float fov_y_degrees) {
@@ -67,8 +74,6 @@ glm::mat4 look_from(const Bounds& bounds, const ViewSide& side, float fov_y_degr
 // "ars", "right-superior-anterior": an oblique view's initials or words, one of each pair, in
 // any order; "" for anything else.
 std::string oblique_named(std::string_view name) {
-  static const char* const words[3][2] = {
-      {"anterior", "posterior"}, {"left", "right"}, {"superior", "inferior"}};
   std::vector<std::string_view> parts;
   if (name.size() == 3) {
     for (size_t i = 0; i < 3; ++i) parts.push_back(name.substr(i, 1));
@@ -86,7 +91,7 @@ std::string oblique_named(std::string_view name) {
     bool found = false;
     for (int axis = 0; axis < 3 && !found; ++axis) {
       for (int which = 0; which < 2 && !found; ++which) {
-        const std::string_view word = words[axis][which];
+        const std::string_view word = kSideWords[axis][which];
         if ((part.size() == 1 ? word.substr(0, 1) : word) != part || chosen[axis] >= 0) continue;
         chosen[axis] = which;
         found = true;
@@ -94,8 +99,7 @@ std::string oblique_named(std::string_view name) {
     }
     if (!found) return "";
   }
-  return std::string(words[0][chosen[0]]) + "-" + words[1][chosen[1]] + "-" +
-         words[2][chosen[2]];
+  return oblique_name(chosen);
 }
 
 }  // namespace

@@ -752,8 +752,7 @@ void check_fitted_camera(const Scene& scene, const Camera& camera) {
 void complete_camera(Scene& scene, FitTo fit) {
   std::vector<CameraPose> views;
   if (scene.has_camera) {
-    const AnatomicalPositions fitted =
-        anatomical_positions(scene, scene.camera.fov_y_degrees, fit);
+    const AnatomicalPositions fitted = anatomical_positions(scene, scene.camera.fov_y_degrees, fit);
     views = fitted.positions;
     // (the planes hold the content from those views too)
     if (fitted.nearest > 0.0f)

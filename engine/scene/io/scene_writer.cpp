@@ -78,7 +78,8 @@ ordered_json meshes_json(const std::vector<Mesh>& meshes, const auto& relative) 
 
 // A volume's look in its entry: a preset by name, a window, or its transfer function by file or
 // inline in the volume's values (HU for CT), never in 0..1 of one scan's value range.
-void look_json(ordered_json& entry, const Volume& volume, const Scene& scene, const auto& relative) {
+void look_json(ordered_json& entry, const Volume& volume, const Scene& scene,
+               const auto& relative) {
   for (const char* key : {"transfer_function", "preset", "window"}) entry.erase(key);
   if (!volume.preset.empty()) {
     entry["preset"] = volume.preset;
@@ -185,7 +186,8 @@ ordered_json as_read(const std::filesystem::path& path, const Scene& scene) {
   // (the file's volumes come first in the scene, in its order)
   if (root.contains("volumes") && root["volumes"].is_array()) {
     for (size_t i = 0; i < root["volumes"].size() && i < scene.volumes.size(); ++i)
-      if (scene.volumes[i].look_edited) look_json(root["volumes"][i], scene.volumes[i], scene, rebase);
+      if (scene.volumes[i].look_edited)
+        look_json(root["volumes"][i], scene.volumes[i], scene, rebase);
   }
   write_positions(root, scene);
   return root;
