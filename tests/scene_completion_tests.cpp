@@ -105,6 +105,48 @@ TEST_SUITE("loaders") {
     CHECK(flat.camera.view == flat.positions[4].view);
   }
 
+  // What a crop box and a clipping plane keep of a volume's box, and the views fitted to it: by
+  // default without a camera, with fit on for a scene's own camera (turned no other way).
+  TEST_CASE("views_are_fitted_to_what_the_cut_aways_keep") {
+    strata::Scene scene;
+    scene.volumes.push_back(ct_block());  // voxel centres 0..14 mm on each axis
+    scene.volumes[0].cut =
+        strata::crop_planes(glm::vec3(-5.0f, 2.0f, 4.0f), glm::vec3(7.0f, 30.0f, 9.0f));
+    strata::Bounds kept = strata::kept_bounds(scene);
+    CHECK(kept.lo == glm::vec3(0.0f, 2.0f, 4.0f));
+    CHECK(kept.hi == glm::vec3(7.0f, 14.0f, 9.0f));
+    // A plane x + y >= 14 cuts the corner (0, 2) off: x runs from 0 to 7 where y reaches 14.
+    scene.volumes[0].cut.push_back(
+        strata::clip_plane(glm::vec3(7.0f, 7.0f, 0.0f), glm::vec3(1, 1, 0)));
+    kept = strata::kept_bounds(scene);
+    CHECK(kept.lo.x == doctest::Approx(0.0f));
+    CHECK(kept.lo.y == doctest::Approx(7.0f));
+    CHECK(kept.hi.y == doctest::Approx(14.0f));
+
+    strata::Scene bare = scene;
+    strata::complete_scene(bare);
+    const glm::vec3 centre = kept.centre();
+    const glm::vec3 eye = bare.camera.eye();
+    CHECK(eye.x == doctest::Approx(centre.x));  // from the front, at the kept part's centre
+    CHECK(eye.z == doctest::Approx(centre.z));
+    strata::Scene whole = scene;
+    strata::complete_scene(whole, "", std::nullopt, false);
+    CHECK(whole.camera.eye().x == doctest::Approx(7.0f));  // --no-fit: the whole box's centre
+
+    strata::Scene own = scene;
+    own.has_camera = true;
+    own.camera.view = glm::lookAt(glm::vec3(7, -500, 7), glm::vec3(7, 7, 7), glm::vec3(0, 0, 1));
+    own.camera_positions.push_back({"mine", own.camera.view});
+    strata::Scene kept_own = own;
+    strata::complete_scene(own);
+    CHECK(own.camera.view == kept_own.camera.view);  // (fit is off for a scene's own camera)
+    strata::complete_scene(kept_own, "", std::nullopt, true);
+    CHECK(kept_own.camera.eye().x == doctest::Approx(centre.x));
+    CHECK(kept_own.camera.eye().y > -500.0f);
+    CHECK(glm::mat3(kept_own.camera.view) == glm::mat3(own.camera.view));
+    CHECK(kept_own.camera_positions[0].view == kept_own.camera.view);
+  }
+
   TEST_CASE("presets_follow_hounsfield_units_and_are_chosen_from_the_values") {
     const strata::Volume ct = ct_block();
     const strata::PresetChoice choice = strata::choose_transfer_function_preset(ct);

@@ -760,9 +760,21 @@ void complete_camera(Scene& scene, FitTo fit) {
     scene.camera.far_plane = std::max(scene.camera.far_plane, fitted.farthest);
     if (fit == FitTo::kept) {  // the file's own camera and positions: the same way, closer
       const float fov = scene.camera.fov_y_degrees;
-      scene.camera.view = refitted_view(scene, scene.camera.view, fov, fit);
-      for (CameraPose& pose : scene.camera_positions)
-        pose.view = refitted_view(scene, pose.view, fov, fit);
+      const Bounds kept = kept_bounds(scene);
+      // (the near plane before the kept part, seen closer now)
+      const auto refit = [&](glm::mat4& view) {
+        view = refitted_view(scene, view, fov, fit);
+        for (int corner = 0; corner < 8 && !kept.empty(); ++corner) {
+          const glm::vec3 p((corner & 1) ? kept.hi.x : kept.lo.x,
+                            (corner & 2) ? kept.hi.y : kept.lo.y,
+                            (corner & 4) ? kept.hi.z : kept.lo.z);
+          const float depth = -(view * glm::vec4(p, 1.0f)).z;
+          if (depth > 0.0f)
+            scene.camera.near_plane = std::min(scene.camera.near_plane, 0.5f * depth);
+        }
+      };
+      refit(scene.camera.view);
+      for (CameraPose& pose : scene.camera_positions) refit(pose.view);
     }
   } else {
     FittedCamera fitted = fitted_camera(scene, fit);
