@@ -78,12 +78,13 @@ struct SceneInput {
   std::string window;             // --window CENTER,WIDTH: a grey ramp in the volumes' values
   std::string crop;               // --crop X0,Y0,Z0,X1,Y1,Z1 (world, mm)
   std::vector<std::string> clip;  // --clip PX,PY,PZ,NX,NY,NZ, up to six
+  std::optional<bool> fit;        // --fit, --no-fit: views fitted to what the cut-aways keep
   uint32_t layers = 0;            // --layers: 0 keeps the scene's settings.layers
   // The depth layers asked for: --layers, else the scene's.
   uint32_t layer_count(const Scene& scene) const;
 };
-// --preset, --labels, --frame, --window, --crop, --clip, --series and --layers (the positional
-// FILE is the command's own).
+// --preset, --labels, --frame, --window, --crop, --clip, --fit, --series and --layers (the
+// positional FILE is the command's own).
 void add_scene_input_options(CLI::App* cmd, SceneInput& in);
 
 // Loads the scene (load_scene with the input's options) and prints its warnings (missing data

@@ -33,8 +33,8 @@ std::vector<float> parse_numbers(const std::string& text, size_t count, const ch
 
 glm::vec2 parse_window(const std::string& text) {
   const char* form =
-      "CENTER,WIDTH (the volume's values, e.g. 40,80 for brain or 400,1800 for bone in HU; "
-      "width > 0)";
+      "CENTER,WIDTH (the volume's values, a ramp from CENTER - WIDTH/2 to CENTER + WIDTH/2; in HU "
+      "e.g. 900,1200 for bone alone or 40,400 for the skin; width > 0)";
   const std::vector<float> v = parse_numbers(text, 2, "--window", form);
   if (!(v[1] > 0.0f)) throw UsageError("--window: '" + text + "' is not " + form);
   return {v[0], v[1]};

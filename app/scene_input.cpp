@@ -75,6 +75,7 @@ Scene load_scene_reporting(const SceneInput& in, const VolumeLimits& limits) {
                        "': the normal (NX,NY,NZ) must not be zero (a length above 1e-6)");
     options.cut.push_back(clip_plane(glm::vec3(v[0], v[1], v[2]), normal));
   }
+  options.fit = in.fit;
   if (!in.window.empty()) {
     if (!in.preset.empty()) throw UsageError("give --preset or --window, not both");
     options.window = parse_window(in.window);
@@ -165,14 +166,23 @@ void add_scene_input_options(CLI::App* cmd, SceneInput& in) {
                   "a 4-D volume's frame or a DICOM series' time point, from 0 (default: the first)")
       ->check(whole_range(0, 1e6));
   cmd->add_option("--window", in.window,
-                  "CENTER,WIDTH: every volume shown as a grey ramp over these values (Hounsfield "
-                  "units for CT: 40,80 brain, 400,1800 bone), in place of its transfer function");
+                  "CENTER,WIDTH: every volume shown as a grey ramp from CENTER - WIDTH/2 "
+                  "(transparent) to CENTER + WIDTH/2 (opaque white) in its values, in place of its "
+                  "transfer function (Hounsfield units for CT: 900,1200 bone alone, 40,400 the "
+                  "skin)");
   cmd->add_option("--crop", in.crop,
                   "X0,Y0,Z0,X1,Y1,Z1: show only this box of every volume (world mm, LPS)");
   cmd->add_option("--clip", in.clip,
                   "PX,PY,PZ,NX,NY,NZ: cut every volume at the plane through P, keeping the side "
                   "N points to (world mm, LPS); up to six")
       ->allow_extra_args(false);  // one plane an --clip: the next word is not a second plane
+  cmd->add_flag_callback(
+      "--fit", [&in] { in.fit = true; },
+      "fit the camera and the named views to what --crop and --clip keep (the default for a "
+      "scene without a camera: a volume file or DICOM folder)");
+  cmd->add_flag_callback(
+      "--no-fit", [&in] { in.fit = false; },
+      "keep the camera and the named views fitted to the whole content");
   cmd->add_option("--series", in.series,
                   "a DICOM folder holding several series: the one with this SeriesNumber or "
                   "SeriesInstanceUID (default: the largest 3-D image series; strata info FOLDER "

@@ -93,8 +93,7 @@ glm::vec3 up_axis(const Camera& camera) {
 }
 
 bool scene_names(const Scene& scene, const std::string& name) {
-  return std::any_of(scene.camera_positions.begin(), scene.camera_positions.end(),
-                     [&](const CameraPose& pose) { return pose.name == name; });
+  return find_position(scene, name) != nullptr;
 }
 
 bool has_position(const Scene& scene, const std::string& name) {

@@ -60,7 +60,7 @@ TEST_SUITE("loaders") {
     scene.volumes.push_back(ct_block());
     scene.volumes[0].origin = {-100.0f, 20.0f, 5.0f};
     const strata::FittedCamera fitted = strata::fitted_camera(scene);
-    REQUIRE(fitted.positions.size() == 6);
+    REQUIRE(fitted.positions.size() == 14);
     const strata::Bounds bounds = strata::scene_bounds(scene);
     const glm::vec3 centre = bounds.centre();
     for (const strata::CameraPose& pose : fitted.positions) {
@@ -77,12 +77,20 @@ TEST_SUITE("loaders") {
         widest = std::max(widest, glm::length(projected.pixel - glm::vec2(50.0f)));
       }
       CHECK(widest > 40.0f);
-      // The eye is on the named side of the centre (LPS: anterior is -y, left +x, superior +z).
-      const glm::vec3 eye = camera.eye() - centre;
+      // The eye is on the named sides of the centre (LPS: anterior is -y, left +x, superior +z).
+      const glm::vec3 eye = glm::normalize(camera.eye() - centre);
       const auto view = strata::anatomical_view_named(pose.name);
-      REQUIRE(view);
-      const glm::vec3 side(strata::side_of(*view).eye_direction);
-      CHECK(glm::dot(glm::normalize(eye), side) > 0.999f);
+      if (view) {
+        CHECK(glm::dot(eye, glm::vec3(strata::side_of(*view).eye_direction)) > 0.999f);
+        continue;
+      }
+      const auto named = [&](const char* word) {
+        return pose.name.find(word) != std::string::npos;
+      };
+      CHECK((named("anterior") ? eye.y < -0.5f : eye.y > 0.5f));
+      CHECK((named("left") ? eye.x > 0.5f : eye.x < -0.5f));
+      CHECK((named("superior") ? eye.z > 0.4f : eye.z < -0.4f));
+      CHECK(std::abs(eye.z) < 0.6f);  // 30 degrees up or down
     }
     CHECK(fitted.camera.view == fitted.positions[0].view);  // anterior first
     CHECK(fitted.positions[0].name == "anterior");
@@ -95,6 +103,48 @@ TEST_SUITE("loaders") {
     const strata::FittedCamera flat = strata::fitted_camera(slice);
     CHECK(flat.positions[4].name == "superior");
     CHECK(flat.camera.view == flat.positions[4].view);
+  }
+
+  // What a crop box and a clipping plane keep of a volume's box, and the views fitted to it: by
+  // default without a camera, with fit on for a scene's own camera (turned no other way).
+  TEST_CASE("views_are_fitted_to_what_the_cut_aways_keep") {
+    strata::Scene scene;
+    scene.volumes.push_back(ct_block());  // voxel centres 0..14 mm on each axis
+    scene.volumes[0].cut =
+        strata::crop_planes(glm::vec3(-5.0f, 2.0f, 4.0f), glm::vec3(7.0f, 30.0f, 9.0f));
+    strata::Bounds kept = strata::kept_bounds(scene);
+    CHECK(kept.lo == glm::vec3(0.0f, 2.0f, 4.0f));
+    CHECK(kept.hi == glm::vec3(7.0f, 14.0f, 9.0f));
+    // A plane x + y >= 14 cuts the corner (0, 2) off: x runs from 0 to 7 where y reaches 14.
+    scene.volumes[0].cut.push_back(
+        strata::clip_plane(glm::vec3(7.0f, 7.0f, 0.0f), glm::vec3(1, 1, 0)));
+    kept = strata::kept_bounds(scene);
+    CHECK(kept.lo.x == doctest::Approx(0.0f));
+    CHECK(kept.lo.y == doctest::Approx(7.0f));
+    CHECK(kept.hi.y == doctest::Approx(14.0f));
+
+    strata::Scene bare = scene;
+    strata::complete_scene(bare);
+    const glm::vec3 centre = kept.centre();
+    const glm::vec3 eye = bare.camera.eye();
+    CHECK(eye.x == doctest::Approx(centre.x));  // from the front, at the kept part's centre
+    CHECK(eye.z == doctest::Approx(centre.z));
+    strata::Scene whole = scene;
+    strata::complete_scene(whole, "", std::nullopt, false);
+    CHECK(whole.camera.eye().x == doctest::Approx(7.0f));  // --no-fit: the whole box's centre
+
+    strata::Scene own = scene;
+    own.has_camera = true;
+    own.camera.view = glm::lookAt(glm::vec3(7, -500, 7), glm::vec3(7, 7, 7), glm::vec3(0, 0, 1));
+    own.camera_positions.push_back({"mine", own.camera.view});
+    strata::Scene kept_own = own;
+    strata::complete_scene(own);
+    CHECK(own.camera.view == kept_own.camera.view);  // (fit is off for a scene's own camera)
+    strata::complete_scene(kept_own, "", std::nullopt, true);
+    CHECK(kept_own.camera.eye().x == doctest::Approx(centre.x));
+    CHECK(kept_own.camera.eye().y > -500.0f);
+    CHECK(glm::mat3(kept_own.camera.view) == glm::mat3(own.camera.view));
+    CHECK(kept_own.camera_positions[0].view == kept_own.camera.view);
   }
 
   TEST_CASE("presets_follow_hounsfield_units_and_are_chosen_from_the_values") {
@@ -148,6 +198,79 @@ TEST_SUITE("loaders") {
     }
   }
 
+  // A volume's "preset" is that preset made for its values, as --preset makes it; the scene
+  // writer writes a preset or a window back by name and values, and a function of no file in the
+  // volume's values, never 0..1 of one scan's range.
+  TEST_CASE("a_volume_preset_key_applies_the_preset_and_is_written_back") {
+    const fs::path folder = output_folder("preset_key");
+    const std::string ct5n = (cache / "dicom/CT5N").string();
+    const auto scene_with = [&](const std::string& name, const std::string& keys) {
+      return write_file(folder / name, R"({"strata_scene": 1, "volumes": [{"file": ")" + ct5n +
+                                           R"(", )" + keys + "}]}");
+    };
+    const strata::Scene keyed =
+        strata::load_scene(scene_with("bone.json", R"("preset": "ct-bone")"));
+    strata::SceneOpenOptions option;
+    option.preset = "ct-bone";
+    const strata::Scene given = strata::load_scene(ct5n, option);
+    const strata::Volume& v = keyed.volumes[0];
+    CHECK(v.preset == "ct-bone");
+    CHECK(keyed.warnings.empty());
+    const strata::TransferFunction& tf = keyed.transfer_functions[size_t(v.transfer_function)];
+    const strata::TransferFunction& want =
+        given.transfer_functions[size_t(given.volumes[0].transfer_function)];
+    REQUIRE(tf.stops.size() == want.stops.size());
+    for (size_t i = 0; i < tf.stops.size(); ++i) {
+      CHECK(tf.stops[i].position == want.stops[i].position);
+      CHECK(tf.stops[i].color == want.stops[i].color);
+    }
+    // The command line's --window wins over the file's preset.
+    strata::SceneOpenOptions window;
+    window.window = glm::vec2(900.0f, 1200.0f);
+    const strata::Scene grey =
+        strata::load_scene(scene_with("bone.json", R"("preset": "ct-bone")"), window);
+    CHECK(grey.volumes[0].preset.empty());
+    CHECK(grey.volumes[0].window == glm::vec2(900.0f, 1200.0f));
+
+    const auto error = [&](const std::string& keys) {
+      const fs::path path = scene_with("bad.json", keys);
+      return error_of([&] { strata::load_scene(path); }).substr(path.string().size());
+    };
+    CHECK(error(R"("preset": "ct-bones")") ==
+          ": volumes[0].preset: no preset 'ct-bones' (ct-skin, ct-soft-tissue, ct-bone, ct-lung, "
+          "mr-head, mr-brain)");
+    CHECK(error(R"("preset": 3)").starts_with(": volumes[0].preset: "));
+    CHECK(error(R"("preset": "ct-bone", "window": [40, 400])") ==
+          ": volumes[0].window: give one of transfer_function, preset and window");
+    CHECK(error(R"("preset": "ct-bone", "transfer_function": "x.json")") ==
+          ": volumes[0].preset: give one of transfer_function, preset and window");
+
+    // A volume opened directly and saved: its preset and window by name and values.
+    const fs::path saved = folder / "saved.json";
+    strata::save_scene_json(saved, given);
+    CHECK(strata::test::read_file(saved).find(R"("preset": "ct-bone")") != std::string::npos);
+    CHECK(strata::load_scene(saved).volumes[0].preset == "ct-bone");
+    strata::save_scene_json(saved, strata::load_scene(ct5n, window));
+    CHECK(strata::test::read_file(saved).find(R"("window": [)") != std::string::npos);
+    CHECK(strata::load_scene(saved).volumes[0].window == glm::vec2(900.0f, 1200.0f));
+    // A function of no file, edited (as the viewer does): written in HU.
+    strata::Scene edited = strata::load_scene(ct5n);
+    edited.volumes[0].preset.clear();
+    edited.volumes[0].look_edited = true;
+    strata::save_scene_json(saved, edited);
+    const std::string text = strata::test::read_file(saved);
+    CHECK(text.find(R"("units": "HU")") != std::string::npos);
+    const strata::Scene back = strata::load_scene(saved);
+    const strata::TransferFunction& a =
+        edited.transfer_functions[size_t(edited.volumes[0].transfer_function)];
+    const strata::TransferFunction& b =
+        back.transfer_functions[size_t(back.volumes[0].transfer_function)];
+    for (float t : {0.0f, 0.3f, 0.6f, 1.0f}) {
+      const glm::vec4 d = a.sample(t) - b.sample(t);
+      CHECK(glm::length(d) < 1e-4f);
+    }
+  }
+
   // A volume's window and a transfer function in HU are made 0..1 of its value range; HU on a
   // volume whose values are not Hounsfield units warns.
   TEST_CASE("windows_and_functions_in_the_volumes_values_map_to_its_range") {
@@ -170,7 +293,7 @@ TEST_SUITE("loaders") {
                                           R"({"strata_scene": 1, "volumes": [{"file": ")" + ct5n +
                                               R"(", "window": [40, 80], "transfer_function": {
               "stops": [{"position": 0, "color": [1, 1, 1, 1]}]}}]})"));
-          }).find("volumes[0].window: give a transfer_function or a window, not both") !=
+          }).find("volumes[0].window: give one of transfer_function, preset and window") !=
           std::string::npos);
 
     strata::Scene mr;
@@ -269,8 +392,8 @@ TEST_SUITE("loaders") {
     CHECK(scene.has_camera);
     CHECK(scene.camera.view ==
           glm::lookAt(glm::vec3(0, -500, 0), glm::vec3(0), glm::vec3(0, 0, 1)));
-    // The six anatomical views besides its own positions; its own "left" wins.
-    REQUIRE(scene.camera_positions.size() == 6);
+    // The standard views besides its own positions; its own "left" wins.
+    REQUIRE(scene.camera_positions.size() == 14);
     CHECK(scene.camera_positions[0].name == "left");
     CHECK(scene.camera_positions[0].view ==
           glm::lookAt(glm::vec3(9, 0, 0), glm::vec3(0), glm::vec3(0, 0, 1)));

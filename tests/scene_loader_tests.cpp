@@ -81,9 +81,10 @@ TEST_SUITE("loaders") {
           doctest::Approx(2.0 * std::atan(1.0 / 2.414213419) * 180.0 / std::numbers::pi));
     CHECK(camera.fov_y_degrees == doctest::Approx(45.0).epsilon(1e-6));
     CHECK(camera.near_plane == doctest::Approx(-1.434267998 / (-1.513750076 - 1.0)));
-    CHECK(camera.far_plane == doctest::Approx(-1.434267998 / (-1.513750076 + 1.0)));
-    // Its own six, then the six anatomical views every scene has.
-    REQUIRE(scene.camera_positions.size() == 12);
+    // (widened: the dice seen from a corner, as the oblique views see them, reach further)
+    CHECK(camera.far_plane > -1.434267998 / (-1.513750076 + 1.0));
+    // Its own six, then the six anatomical and the eight oblique views every scene has.
+    REQUIRE(scene.camera_positions.size() == 6 + 14);
     for (size_t i = 0; i < 6; ++i) CHECK(scene.camera_positions[i].name == "S" + std::to_string(i));
     CHECK(scene.camera_positions[6].name == "anterior");
     const glm::mat4& s5 = scene.camera_positions[5].view;
@@ -115,8 +116,8 @@ TEST_SUITE("loaders") {
       const char* first_text;
     };
     for (const Expected& e :
-         {Expected{"jet-engine.xml", "assets/models/jet_engine1.dae", 10, 6 + 6, "Fan"},
-          Expected{"sponza.xml", "assets/models/crytek-sponza/sponza.obj", 10, 5 + 6, nullptr}}) {
+         {Expected{"jet-engine.xml", "assets/models/jet_engine1.dae", 10, 6 + 14, "Fan"},
+          Expected{"sponza.xml", "assets/models/crytek-sponza/sponza.obj", 10, 5 + 14, nullptr}}) {
       CAPTURE(e.file);
       const fs::path path = voly_scenes / e.file;
       const strata::Scene scene = strata::load_scene(path);
@@ -240,7 +241,7 @@ TEST_SUITE("loaders") {
     CHECK(scene.camera.near_plane == 0.5f);
     CHECK(scene.camera.far_plane == 50.0f);
     CHECK(scene.camera.view[3] == glm::vec4(0.0f, 0.0f, -10.0f, 1.0f));
-    REQUIRE(scene.camera_positions.size() == 2 + 6);  // (and the six anatomical views)
+    REQUIRE(scene.camera_positions.size() == 2 + 14);  // (and the fourteen standard views)
     CHECK(scene.camera_positions[0].name == "side");
     const glm::vec4 side_eye = glm::inverse(scene.camera_positions[0].view)[3];
     CHECK(side_eye.x == doctest::Approx(10.0));
@@ -345,7 +346,7 @@ TEST_SUITE("loaders") {
     CHECK(load(R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "trasform": []}]})") ==
           prefix +
               "volumes[0]: unknown key 'trasform' (expected name, file, frame, series, "
-              "transfer_function, window, crop, clip, transform)");
+              "transfer_function, preset, window, crop, clip, transform)");
     CHECK(
         load(
             R"({"strata_scene": 1, "volumes": [{"file": "x.nii", "crop": [0, 0, 5, 1, 1, 4]}]})") ==
@@ -514,8 +515,9 @@ TEST_SUITE("loaders") {
     CHECK(back.camera.view == scene.camera.view);
     CHECK(back.camera.fov_y_degrees == scene.camera.fov_y_degrees);
     CHECK(back.camera.near_plane == scene.camera.near_plane);
-    CHECK(back.camera.far_plane == scene.camera.far_plane);
-    REQUIRE(back.camera_positions.size() == 6 + 6);
+    // (the mesh added widens it for the oblique views that see it)
+    CHECK(back.camera.far_plane >= scene.camera.far_plane);
+    REQUIRE(back.camera_positions.size() == 6 + 14);
     CHECK(back.camera_positions[5].name == "S5");
     CHECK(back.camera_positions[5].view == scene.camera_positions[5].view);
     REQUIRE(back.meshes.size() == 1);

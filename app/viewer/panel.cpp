@@ -263,19 +263,15 @@ void Viewer::panel_rendering() {
       ImGui::EndCombo();
     }
     // Level and window in the volume's own values (Hounsfield units for CT), as radiology sets
-    // them; the look keeps them as shares of the value range.
+    // them.
     const glm::vec2 range = scene_.volumes[v].value_range;
     const float span = std::max(range.y - range.x, 1e-6f);
-    float level = range.x + look.level * span, window = look.window * span;
-    bool edited = ImGui::SliderFloat("level", &level, range.x, range.y, "%.5g");
-    edited |= ImGui::SliderFloat("window", &window, 0.01f * span, 2.0f * span, "%.5g");
-    if (edited) {
-      look.level = (level - range.x) / span;
-      look.window = std::max(window / span, 0.01f);
-    }
+    bool edited = ImGui::SliderFloat("level", &look.level, range.x, range.y, "%.5g");
+    edited |= ImGui::SliderFloat("window", &look.window, 0.01f * span, 2.0f * span, "%.5g");
+    look.window = std::max(look.window, 0.01f * span);
     edited |= ImGui::SliderFloat("opacity", &look.opacity, 0.0f, 4.0f, "%.2f");
     if (ImGui::Button("Reset")) {
-      look = {};
+      look = default_look(scene_.volumes[v]);
       edited = true;
     }
     if (edited) set_transfer(uint32_t(v));

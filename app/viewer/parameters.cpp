@@ -17,7 +17,8 @@ namespace strata::app {
 namespace {
 
 // A transfer function seen through a window of intensities: the function's [0, 1] spread over
-// [level - window / 2, level + window / 2], its opacity times `opacity`.
+// [level - window / 2, level + window / 2] (shares of the value range), its opacity times
+// `opacity`.
 TransferFunction windowed(const TransferFunction& tf, float level, float window, float opacity) {
   TransferFunction out = tf;
   for (auto& stop : out.stops) {
@@ -25,6 +26,14 @@ TransferFunction windowed(const TransferFunction& tf, float level, float window,
     stop.color.a = std::clamp(stop.color.a * opacity, 0.0f, 1.0f);
   }
   return out;
+}
+
+// The function `volume` is drawn with under `look` (level and window in its values), in 0..1 of
+// its value range as the renderer takes it.
+TransferFunction looked(const TransferFunction& tf, const Volume& volume, float level, float window,
+                        float opacity) {
+  const float lo = volume.value_range.x, span = std::max(volume.value_range.y - lo, 1e-6f);
+  return windowed(tf, (level - lo) / span, window / span, opacity);
 }
 
 float parse_float(const std::string& name, const std::string& value) {
@@ -275,17 +284,51 @@ void Viewer::set_preset(uint32_t volume, const std::string& name) {
                 std::to_string(scene_.volumes.size()) + ")");
   }
   original_tfs_[volume] = make_transfer_function_preset(name, scene_.volumes[volume]);
+  scene_.volumes[volume].preset = name;
+  scene_.volumes[volume].window.reset();
+  scene_.volumes[volume].look_edited = true;
   set_transfer(volume);
   message_ = "volume '" + scene_.volumes[volume].name + "': preset " + name;
 }
 
+void Viewer::set_window(uint32_t volume, float level, float window) {
+  if (volume >= scene_.volumes.size()) {
+    throw Error("no volume " + std::to_string(volume) + " (the scene has " +
+                std::to_string(scene_.volumes.size()) + ")");
+  }
+  const Volume& v = scene_.volumes[volume];
+  const float span = std::max(v.value_range.y - v.value_range.x, 1e-6f);
+  looks_[volume].level = level;
+  looks_[volume].window = std::clamp(window, 0.01f * span, 2.0f * span);
+  set_transfer(volume);
+}
+
+Viewer::VolumeLook Viewer::default_look(const Volume& volume) {
+  const glm::vec2 range = volume.value_range;
+  return {0.5f * (range.x + range.y), std::max(range.y - range.x, 1e-6f), 1.0f};
+}
+
 void Viewer::set_transfer(uint32_t volume) {
   const VolumeLook& look = looks_[volume];
+  Volume& v = scene_.volumes[volume];
+  const TransferFunction tf =
+      looked(original_tfs_[volume], v, look.level, look.window, look.opacity);
+  // What a saved scene writes (scene_writer.cpp, in the volume's values): a preset by its name
+  // while the look is its own, else the function as drawn.
+  const VolumeLook plain = default_look(v);
+  const bool own = look.level == plain.level && look.window == plain.window && look.opacity == 1.0f;
+  if (v.transfer_function >= 0) {
+    scene_.transfer_functions[size_t(v.transfer_function)] = tf;
+    if (!own) {
+      v.preset.clear();
+      v.window.reset();
+      v.look_edited = true;
+    }
+  }
   // (the table goes with each frame; the empty-space grid is copied at the start of the next,
   // after the frames in flight: a slider dragged waits for no frame)
   Uploads uploads;
-  labelled_->renderer().set_transfer_function(
-      volume, windowed(original_tfs_[volume], look.level, look.window, look.opacity), &uploads);
+  labelled_->renderer().set_transfer_function(volume, tf, &uploads);
   labelled_->runner().upload_in_next_frame(std::move(uploads));
   settings_changed(false);
 }

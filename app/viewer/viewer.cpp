@@ -69,7 +69,7 @@ Viewer::Viewer(Context& ctx, Scene& scene, const Camera& camera, const Labelling
     original_tfs_.push_back(v.transfer_function >= 0 ? scene.transfer_functions[v.transfer_function]
                                                      : TransferFunction{});
   }
-  looks_.resize(scene.volumes.size());
+  for (const Volume& v : scene.volumes) looks_.push_back(default_look(v));
   const size_t own = scene.labels.size() - std::min(scene.added_labels, scene.labels.size());
   for (size_t i = 0; i < own; ++i) {
     scene_labels_.push_back(

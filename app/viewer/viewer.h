@@ -204,6 +204,8 @@ class Viewer {
   // Volume `volume`'s transfer function becomes the preset `name` (transfer_function_presets.h),
   // seen through the volume's level, window and opacity.
   void set_preset(uint32_t volume, const std::string& name);
+  // Volume `volume`'s level and window (centre and width in its own values: HU for CT).
+  void set_window(uint32_t volume, float level, float window);
   // The labelled picture without the UI (PNG); the path written.
   std::filesystem::path screenshot(const std::filesystem::path& path = {});
   // The window's picture, UI included (PNG).
@@ -374,9 +376,12 @@ class Viewer {
 
   // Panel state.
   std::vector<TransferFunction> original_tfs_;  // per volume: the scene's, or the preset chosen
+  // The transfer function's 0..1 spread over [level - window / 2, level + window / 2] in the
+  // volume's own values (HU for CT), as radiology sets them; the default spans its value range.
   struct VolumeLook {
-    float level = 0.5f, window = 1.0f, opacity = 1.0f;
+    float level = 0.0f, window = 0.0f, opacity = 1.0f;
   };
+  static VolumeLook default_look(const Volume& volume);
   std::vector<VolumeLook> looks_;
   std::vector<std::vector<glm::vec4>> scene_cuts_;  // each volume's cut-aways from the scene
   ViewerCuts cuts_;

@@ -36,6 +36,7 @@ std::optional<LensProblem> lens_problem(const Camera& camera);
 struct CameraPose {
   std::string name;
   glm::mat4 view{1.0f};
+  bool fitted = false;  // a standard view complete_scene fitted (fitted_camera.h), not the file's
 };
 
 // Where a world point lands in an image of `size` pixels: its pixel position (x right, y down,

@@ -7,6 +7,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "engine/core/error.h"
+#include "engine/scene/fitted_camera.h"
 
 namespace strata {
 
@@ -139,17 +140,27 @@ std::vector<bool> anchors_cut_away(const Scene& scene, const std::vector<glm::ve
   return cut;
 }
 
+const CameraPose* find_position(const Scene& scene, std::string_view name) {
+  const auto named = [&](std::string_view wanted) -> const CameraPose* {
+    for (const CameraPose& pose : scene.camera_positions)
+      if (pose.name == wanted) return &pose;
+    return nullptr;
+  };
+  if (const CameraPose* pose = named(name)) return pose;
+  const std::optional<std::string> standard = standard_view_name(name);
+  return standard ? named(*standard) : nullptr;
+}
+
 Camera camera_for(const Scene& scene, const std::string& name) {
   Camera camera = scene.camera;
   if (name.empty()) return camera;
-  std::string names;
-  for (const CameraPose& pose : scene.camera_positions) {
-    if (pose.name == name) {
-      camera.view = pose.view;
-      return camera;
-    }
-    names += (names.empty() ? "" : ", ") + pose.name;
+  if (const CameraPose* pose = find_position(scene, name)) {
+    camera.view = pose->view;
+    return camera;
   }
+  std::string names;
+  for (const CameraPose& pose : scene.camera_positions)
+    names += (names.empty() ? "" : ", ") + pose.name;
   throw Error(scene.source.string() + ": no camera position named '" + name +
               "' (the scene has: " + (names.empty() ? "none" : names) + ")");
 }

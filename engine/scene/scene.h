@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -35,6 +36,12 @@ struct Volume {
   std::vector<std::byte> voxels;  // i fastest, then j, then k; rescale slope/intercept applied
   glm::vec2 value_range{0.0f};    // min and max voxel value (transfer functions normalise by it)
   int transfer_function = -1;     // index into Scene::transfer_functions, -1 for none
+  // How its transfer function was chosen, which the scene writer writes back: a preset by name
+  // (transfer_function_presets.h) or a grey window (center, width in its values); neither for a
+  // function of its own.
+  std::string preset;
+  std::optional<glm::vec2> window;
+  bool look_edited = false;  // changed since read (the viewer): saved from the model, not the file
   // Cut-aways: planes in world space (xyz the normal, w the offset); a point p of the volume is
   // shown where dot(xyz, p) + w >= 0 for every plane. A crop box is six of them
   // (crop_planes); at most kMaxCutPlanes.
@@ -206,7 +213,12 @@ struct Scene {
   std::string source_json;
 };
 
-// The scene's camera, or its named position `name` (an Error listing the names if there is none).
+// The scene's position `name`, or, where it has none of that name, the standard view the name
+// means (standard_view_name: `front`, `oblique`, `ars`); nullptr if neither.
+const CameraPose* find_position(const Scene& scene, std::string_view name);
+
+// The scene's camera, or its named position `name` (find_position; an Error listing the names
+// if there is none).
 Camera camera_for(const Scene& scene, const std::string& name);
 
 // For each point (world), whether it lies in the volume's box (its voxels', in its own index

@@ -24,4 +24,8 @@ struct Bounds {
 // mesh's transform. Labels are left out: they annotate the content and never widen it.
 Bounds scene_bounds(const Scene& scene);
 
+// The same with each volume's box cut by its cut-aways (crop box, clipping planes): the box around
+// what they keep. A volume they cut away whole adds nothing.
+Bounds kept_bounds(const Scene& scene);
+
 }  // namespace strata

@@ -170,6 +170,15 @@ TransferFunction in_value_range(const TransferFunction& in_values, const Volume&
   return tf;
 }
 
+TransferFunction in_volume_values(const TransferFunction& in_range, const Volume& volume) {
+  TransferFunction out = in_range;
+  const float lo = volume.value_range.x, span = volume.value_range.y - lo;
+  for (TransferFunction::Stop& stop : out.stops) stop.position = lo + stop.position * span;
+  out.units = preset_is_ct(choose_transfer_function_preset(volume).name) ? "HU" : "raw";
+  out.source.clear();
+  return out;
+}
+
 TransferFunction window_transfer_function(float center, float width) {
   TransferFunction tf;
   char name[64];

@@ -35,9 +35,15 @@ PresetChoice choose_transfer_function_preset(const Volume& volume);
 // of 0..1 of `volume`'s value range, which the renderer takes.
 TransferFunction in_value_range(const TransferFunction& in_values, const Volume& volume);
 
-// Window and level as radiology sets them, in the volume's values (HU for CT: brain 40/80, bone
-// 400/1800): a grey ramp over [center - width / 2, center + width / 2], transparent black below
-// it, opaque white above (units "raw").
+// The other way: a function in 0..1 of `volume`'s value range made one in its values, units "HU"
+// where the values are Hounsfield units (choose_transfer_function_preset), else "raw"; what a
+// scene file saves, so it shows the same tissue on another scan.
+TransferFunction in_volume_values(const TransferFunction& in_range, const Volume& volume);
+
+// Window and level in the volume's values: a grey ramp over [center - width / 2, center + width /
+// 2], transparent black below it, opaque white above (units "raw"). In a volume rendering all
+// above the ramp's start shows, so a bone window starts above soft tissue (HU: 900/1200, 300 to
+// 1500), unlike radiology's slice windows (bone 400/1800 shows the skin).
 TransferFunction window_transfer_function(float center, float width);
 
 // Whether the preset named `name` is one for CT (false for an MR preset or no preset).

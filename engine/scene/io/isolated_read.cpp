@@ -48,7 +48,7 @@ constexpr uint64_t kGiB = uint64_t{1} << 30;
 // The result crosses the process boundary field by field (mesh_fields, volume_fields): a field
 // added to Mesh or Volume must be added there too, or it is silently lost for meshes and DICOM.
 static_assert(sizeof(Mesh) == 224, "Mesh changed: update mesh_fields (isolated_read.cpp)");
-static_assert(sizeof(Volume) == 312, "Volume changed: update volume_fields (isolated_read.cpp)");
+static_assert(sizeof(Volume) == 360, "Volume changed: update volume_fields (isolated_read.cpp)");
 static_assert(sizeof(SegmentRegion) == 64,
               "SegmentRegion changed: update region_fields (isolated_read.cpp)");
 
@@ -497,6 +497,9 @@ void volume_fields(Io& io, V& volume) {
   io.field(volume.voxels);
   io.field(volume.value_range);
   io.field(volume.transfer_function);
+  io.field(volume.preset);
+  io.field(volume.window);
+  io.field(volume.look_edited);
   io.field(volume.series);
   io.field(volume.cut);
 }

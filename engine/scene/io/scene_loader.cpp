@@ -235,11 +235,28 @@ std::vector<glm::vec4> cut_planes(const json& object, const Field& field) {
   return planes;
 }
 
+// A volume's "preset": one of transfer_function_presets(), not beside a transfer_function ("" for
+// none; complete_scene makes it for the volume's values).
+std::string volume_preset(const json& object, const Field& field) {
+  const json* preset = optional(object, "preset");
+  if (!preset) return "";
+  const Field at = field / "preset";
+  if (optional(object, "transfer_function"))
+    at.fail("give one of transfer_function, preset and window");
+  const std::string name = string(*preset, at);
+  std::string names;
+  for (const TransferFunctionPreset& p : transfer_function_presets()) {
+    if (name == p.name) return name;
+    names += std::string(names.empty() ? "" : ", ") + p.name;
+  }
+  at.fail("no preset '" + name + "' (" + names + ")");
+}
+
 // Every field is checked before the (slow) file is read, so a typo is reported at once.
 void SceneReader::volume(const json& object, const Field& field) {
   check_keys(object, field,
-             {"name", "file", "frame", "series", "transfer_function", "window", "crop", "clip",
-              "transform"});
+             {"name", "file", "frame", "series", "transfer_function", "preset", "window", "crop",
+              "clip", "transform"});
   const std::filesystem::path path = resolve(required(object, field, "file"), field / "file");
   VolumeReadOptions options{.limits = limits_};
   if (const json* frame = optional(object, "frame")) {
@@ -254,15 +271,17 @@ void SceneReader::volume(const json& object, const Field& field) {
   const std::string volume_name = name ? string(*name, field / "name") : base_name(path);
   const json* transform = optional(object, "transform");
   const glm::mat4 placement = transform ? matrix(*transform, field / "transform") : glm::mat4(1.0f);
+  const std::string preset = volume_preset(object, field);
   const json* tf = optional(object, "transfer_function");
   int tf_index = tf ? transfer_function(*tf, field / "transfer_function") : -1;
-  if (const json* window = optional(object, "window")) {
-    if (tf) (field / "window").fail("give a transfer_function or a window, not both");
-    const std::vector<float> v = numbers(*window, field / "window", 2);
+  std::optional<glm::vec2> window;
+  if (const json* w = optional(object, "window")) {
+    if (tf || !preset.empty())
+      (field / "window").fail("give one of transfer_function, preset and window");
+    const std::vector<float> v = numbers(*w, field / "window", 2);
     if (!(std::abs(v[0]) <= 1e9f && v[1] > 0.0f && v[1] <= 1e9f))
       (field / "window").fail("expected [center, width] in the volume's values, width > 0");
-    scene_.transfer_functions.push_back(window_transfer_function(v[0], v[1]));
-    tf_index = int(scene_.transfer_functions.size()) - 1;
+    window = glm::vec2(v[0], v[1]);
   }
   const std::vector<glm::vec4> cut = cut_planes(object, field);
   Volume volume =
@@ -271,6 +290,8 @@ void SceneReader::volume(const json& object, const Field& field) {
   volume.name = volume_name;
   volume.transform = placement;
   volume.transfer_function = tf_index;
+  volume.preset = preset;
+  volume.window = window;
   scene_.volumes.push_back(std::move(volume));
 }
 
@@ -621,7 +642,7 @@ Scene load_scene(const std::filesystem::path& path, const SceneOpenOptions& opti
                   std::to_string(volume.cut.size()) + " cut-away planes, at most " +
                   std::to_string(kMaxCutPlanes));
   }
-  complete_scene(scene, options.preset, options.window);
+  complete_scene(scene, options.preset, options.window, options.fit);
   return scene;
 }
 
@@ -726,61 +747,37 @@ void check_fitted_camera(const Scene& scene, const Camera& camera) {
     throw Error(scene.source.string() + ": the camera fitted to the content: " + problem);
 }
 
-}  // namespace
-
-void complete_scene(Scene& scene, const std::string& preset, std::optional<glm::vec2> window) {
-  for (Volume& volume : scene.volumes) {
-    if (!(volume.value_range.y > volume.value_range.x)) {
-      scene.warnings.push_back("volume '" + volume.name + "' holds the one value " +
-                               json(volume.value_range.x).dump() +
-                               " everywhere: no transfer function can show it");
-    }
-    if (window) {
-      scene.transfer_functions.push_back(
-          in_value_range(window_transfer_function(window->x, window->y), volume));
-      volume.transfer_function = int(scene.transfer_functions.size()) - 1;
-      continue;
-    }
-    if (preset.empty() && volume.transfer_function >= 0) {
-      // A function in the volume's own values: made one of its value range (each volume its own).
-      const TransferFunction tf = scene.transfer_functions[size_t(volume.transfer_function)];
-      if (tf.units.empty()) continue;
-      const PresetChoice suits = choose_transfer_function_preset(volume);
-      if (tf.units == "HU" && !preset_is_ct(suits.name))
-        scene.warnings.push_back("volume '" + volume.name + "': transfer function " + tf.name +
-                                 " is in Hounsfield units, but " + suits.reason);
-      scene.transfer_functions.push_back(in_value_range(tf, volume));
-      volume.transfer_function = int(scene.transfer_functions.size()) - 1;
-      continue;
-    }
-    std::string name = preset;
-    const PresetChoice choice = choose_transfer_function_preset(volume);
-    if (name.empty()) {
-      name = choice.name;
-      scene.warnings.push_back("volume '" + volume.name + "' has no transfer function; preset " +
-                               name + " (" + choice.reason + "; --preset NAME to choose)");
-    } else if (preset_is_ct(name) != preset_is_ct(choice.name)) {
-      // (a preset for the other modality maps the values to nothing or to everything)
-      scene.warnings.push_back("volume '" + volume.name + "': preset " + name + " is for " +
-                               (preset_is_ct(name) ? "CT" : "MR") + ", but " + choice.reason +
-                               "; it may show nothing (" + choice.name + " would suit it)");
-    }
-    scene.transfer_functions.push_back(make_transfer_function_preset(name, volume));
-    volume.transfer_function = int(scene.transfer_functions.size()) - 1;
-  }
-  check_content_bounds(scene);
-  // Every scene has the six anatomical views as named positions besides its own (an own
-  // position of the same name wins), fitted to its content with its lens.
+// Every scene has the standard views as named positions besides its own (an own position of the
+// same name wins), fitted to its content (or what its cut-aways keep) with its lens.
+void complete_camera(Scene& scene, FitTo fit) {
   std::vector<CameraPose> views;
   if (scene.has_camera) {
-    const AnatomicalPositions fitted = anatomical_positions(scene, scene.camera.fov_y_degrees);
+    const AnatomicalPositions fitted = anatomical_positions(scene, scene.camera.fov_y_degrees, fit);
     views = fitted.positions;
     // (the planes hold the content from those views too)
     if (fitted.nearest > 0.0f)
       scene.camera.near_plane = std::min(scene.camera.near_plane, fitted.nearest);
     scene.camera.far_plane = std::max(scene.camera.far_plane, fitted.farthest);
+    if (fit == FitTo::kept) {  // the file's own camera and positions: the same way, closer
+      const float fov = scene.camera.fov_y_degrees;
+      const Bounds kept = kept_bounds(scene);
+      // (the near plane before the kept part, seen closer now)
+      const auto refit = [&](glm::mat4& view) {
+        view = refitted_view(scene, view, fov, fit);
+        for (int corner = 0; corner < 8 && !kept.empty(); ++corner) {
+          const glm::vec3 p((corner & 1) ? kept.hi.x : kept.lo.x,
+                            (corner & 2) ? kept.hi.y : kept.lo.y,
+                            (corner & 4) ? kept.hi.z : kept.lo.z);
+          const float depth = -(view * glm::vec4(p, 1.0f)).z;
+          if (depth > 0.0f)
+            scene.camera.near_plane = std::min(scene.camera.near_plane, 0.5f * depth);
+        }
+      };
+      refit(scene.camera.view);
+      for (CameraPose& pose : scene.camera_positions) refit(pose.view);
+    }
   } else {
-    FittedCamera fitted = fitted_camera(scene);
+    FittedCamera fitted = fitted_camera(scene, fit);
     check_fitted_camera(scene, fitted.camera);
     scene.camera = fitted.camera;
     views = std::move(fitted.positions);
@@ -790,6 +787,65 @@ void complete_scene(Scene& scene, const std::string& preset, std::optional<glm::
                                    [&](const CameraPose& p) { return p.name == pose.name; });
     if (!taken) scene.camera_positions.push_back(std::move(pose));
   }
+}
+
+// A volume's transfer function: the command line's window or preset, else the file's window,
+// preset or own function (made one of its value range), else the preset that suits its values.
+void complete_transfer_function(Scene& scene, Volume& volume, const std::string& preset,
+                                std::optional<glm::vec2> window) {
+  if (!(volume.value_range.y > volume.value_range.x)) {
+    scene.warnings.push_back("volume '" + volume.name + "' holds the one value " +
+                             json(volume.value_range.x).dump() +
+                             " everywhere: no transfer function can show it");
+  }
+  // (the command line's choice before the file's)
+  const std::optional<glm::vec2> grey =
+      window ? window : (preset.empty() ? volume.window : std::nullopt);
+  if (grey) {
+    scene.transfer_functions.push_back(
+        in_value_range(window_transfer_function(grey->x, grey->y), volume));
+    volume.transfer_function = int(scene.transfer_functions.size()) - 1;
+    volume.window = grey;
+    volume.preset.clear();
+    return;
+  }
+  if (preset.empty() && volume.preset.empty() && volume.transfer_function >= 0) {
+    // A function in the volume's own values: made one of its value range (each volume its own).
+    const TransferFunction tf = scene.transfer_functions[size_t(volume.transfer_function)];
+    if (tf.units.empty()) return;
+    const PresetChoice suits = choose_transfer_function_preset(volume);
+    if (tf.units == "HU" && !preset_is_ct(suits.name))
+      scene.warnings.push_back("volume '" + volume.name + "': transfer function " + tf.name +
+                               " is in Hounsfield units, but " + suits.reason);
+    scene.transfer_functions.push_back(in_value_range(tf, volume));
+    volume.transfer_function = int(scene.transfer_functions.size()) - 1;
+    return;
+  }
+  std::string name = preset.empty() ? volume.preset : preset;
+  const PresetChoice choice = choose_transfer_function_preset(volume);
+  if (name.empty()) {
+    name = choice.name;
+    scene.warnings.push_back("volume '" + volume.name + "' has no transfer function; preset " +
+                             name + " (" + choice.reason + "; --preset NAME to choose)");
+  } else if (preset_is_ct(name) != preset_is_ct(choice.name)) {
+    // (a preset for the other modality maps the values to nothing or to everything)
+    scene.warnings.push_back("volume '" + volume.name + "': preset " + name + " is for " +
+                             (preset_is_ct(name) ? "CT" : "MR") + ", but " + choice.reason +
+                             "; it may show nothing (" + choice.name + " would suit it)");
+  }
+  volume.preset = name;
+  volume.window.reset();
+  scene.transfer_functions.push_back(make_transfer_function_preset(name, volume));
+  volume.transfer_function = int(scene.transfer_functions.size()) - 1;
+}
+
+}  // namespace
+
+void complete_scene(Scene& scene, const std::string& preset, std::optional<glm::vec2> window,
+                    std::optional<bool> fit) {
+  for (Volume& volume : scene.volumes) complete_transfer_function(scene, volume, preset, window);
+  check_content_bounds(scene);
+  complete_camera(scene, fit.value_or(!scene.has_camera) ? FitTo::kept : FitTo::content);
 }
 
 }  // namespace strata

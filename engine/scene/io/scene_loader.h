@@ -24,6 +24,7 @@ struct SceneOpenOptions {
   std::string series;               // a DICOM folder opened directly: this series (number or UID)
   std::optional<glm::vec2> window;  // every volume: a grey ramp at (center, width), its values
   std::vector<glm::vec4> cut;       // every volume: these cut-away planes added (Volume::cut)
+  std::optional<bool> fit;          // complete_scene's `fit`
   VolumeLimits limits;              // every volume read, checked from its header (volume_loader.h)
 };
 
@@ -37,12 +38,14 @@ Scene scene_from_volume(const std::filesystem::path& path, const SceneOpenOption
 // What a scene needs to render that its file may not give: each volume without a transfer
 // function gets the preset that suits its data (transfer_function_presets.h) and a warning
 // saying which; `preset`, when given, replaces every volume's. A scene without a camera gets the
-// fitted one and the six anatomical views as named positions (fitted_camera.h).
+// fitted one, and every scene the standard views as named positions (fitted_camera.h).
 // `window` (center, width in the volume's values), when given, replaces every volume's
 // transfer function with that grey ramp (window_transfer_function). A transfer function in the
-// volume's values (units HU or raw) is made one of its value range here.
+// volume's values (units HU or raw) is made one of its value range here. `fit` (by default for a
+// scene without a camera): the standard views, and the file's camera and positions turned no
+// other way, fitted to what the volumes' cut-aways keep rather than to the whole content.
 void complete_scene(Scene& scene, const std::string& preset = "",
-                    std::optional<glm::vec2> window = {});
+                    std::optional<glm::vec2> window = {}, std::optional<bool> fit = {});
 
 // The labels of a label file (load_label_file) added to the scene's, with the lowest ids no
 // label has, but for those the scene has already (same_label): a warning names the file and

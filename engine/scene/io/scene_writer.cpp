@@ -7,9 +7,9 @@
 #include "engine/core/error.h"
 #include "engine/core/json_field.h"
 #include "engine/core/text_file.h"
-#include "engine/scene/fitted_camera.h"
 #include "engine/scene/io/scene_loader.h"
 #include "engine/scene/io/transfer_function_loader.h"
+#include "engine/scene/transfer_function_presets.h"
 
 namespace strata {
 namespace {
@@ -76,6 +76,23 @@ ordered_json meshes_json(const std::vector<Mesh>& meshes, const auto& relative) 
   return result;
 }
 
+// A volume's look in its entry: a preset by name, a window, or its transfer function by file or
+// inline in the volume's values (HU for CT), never in 0..1 of one scan's value range.
+void look_json(ordered_json& entry, const Volume& volume, const Scene& scene,
+               const auto& relative) {
+  for (const char* key : {"transfer_function", "preset", "window"}) entry.erase(key);
+  if (!volume.preset.empty()) {
+    entry["preset"] = volume.preset;
+  } else if (volume.window) {
+    entry["window"] = vector_json(&volume.window->x, 2);
+  } else if (volume.transfer_function >= 0) {
+    const TransferFunction& tf = scene.transfer_functions.at(size_t(volume.transfer_function));
+    entry["transfer_function"] = tf.source.empty() || volume.look_edited
+                                     ? transfer_function_to_json(in_volume_values(tf, volume))
+                                     : ordered_json(relative(tf.source));
+  }
+}
+
 // A path as the file at `from` wrote it, as the file at `to` must write it: unchanged within one
 // folder or when absolute, else relative to the new folder (absolute where there is no relative).
 class Rebase {
@@ -114,17 +131,9 @@ void write_positions(ordered_json& root, const Scene& scene) {
   ordered_json read =
       camera && camera->contains("positions") ? (*camera)["positions"] : ordered_json::array();
   std::vector<bool> used(read.size(), false);
-  // The anatomical views complete_scene appends: the loader appends them again, so those at the
-  // end of the list are not written (ones before a saved position are, to keep the order that
-  // the keys 1 to 9 follow).
-  const std::vector<CameraPose> fitted =
-      scene.has_camera ? anatomical_positions(scene, scene.camera.fov_y_degrees).positions
-                       : fitted_camera(scene).positions;
-  const auto is_fitted = [&](const CameraPose& pose) {
-    return std::any_of(fitted.begin(), fitted.end(), [&](const CameraPose& p) {
-      return p.name == pose.name && p.view == pose.view;
-    });
-  };
+  // The standard views complete_scene appends (CameraPose::fitted): the loader appends them
+  // again, so those at the end of the list are not written (ones before a saved position are, to
+  // keep the order that the keys 1 to 9 follow).
   ordered_json positions = ordered_json::array();
   size_t kept = 0;  // positions up to the last one that is not fitted
   for (const CameraPose& pose : scene.camera_positions) {
@@ -135,7 +144,7 @@ void write_positions(ordered_json& root, const Scene& scene) {
       positions.push_back(read[i]);
     }
     if (!found) positions.push_back(position_json(pose));
-    if (found || !is_fitted(pose)) kept = positions.size();
+    if (found || !pose.fitted) kept = positions.size();
   }
   positions.erase(positions.begin() + std::ptrdiff_t(kept), positions.end());
   if (positions.empty() && !(camera && camera->contains("positions"))) return;
@@ -174,6 +183,12 @@ ordered_json as_read(const std::filesystem::path& path, const Scene& scene) {
   rebase.each(root, "segmentations", {"file", "names"});
   rebase.key(root, "labels");
   rebase.each(root, "labels", {"image"});
+  // (the file's volumes come first in the scene, in its order)
+  if (root.contains("volumes") && root["volumes"].is_array()) {
+    for (size_t i = 0; i < root["volumes"].size() && i < scene.volumes.size(); ++i)
+      if (scene.volumes[i].look_edited)
+        look_json(root["volumes"][i], scene.volumes[i], scene, rebase);
+  }
   write_positions(root, scene);
   return root;
 }
@@ -185,11 +200,7 @@ ordered_json from_model(const std::filesystem::path& path, const Scene& scene) {
   for (const Volume& volume : scene.volumes) {
     if (volume.source.empty()) continue;
     ordered_json entry = {{"name", volume.name}, {"file", relative(volume.source)}};
-    if (volume.transfer_function >= 0) {
-      const TransferFunction& tf = scene.transfer_functions.at(size_t(volume.transfer_function));
-      entry["transfer_function"] =
-          tf.source.empty() ? transfer_function_to_json(tf) : ordered_json(relative(tf.source));
-    }
+    look_json(entry, volume, scene, relative);
     if (!volume.series.empty()) entry["series"] = volume.series;
     if (volume.transform != glm::mat4(1.0f)) entry["transform"] = matrix_json(volume.transform);
     volumes.push_back(std::move(entry));
