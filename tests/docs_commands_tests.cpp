@@ -7,6 +7,7 @@
 
 #include <glob.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <regex>
@@ -74,10 +75,20 @@ std::vector<DocCommand> doc_commands(const fs::path& page) {
   return out;
 }
 
+// Words as the shell splits them, a "quoted phrase" one word (its quotes kept, for the shell that
+// runs it).
 std::vector<std::string> words(const std::string& text) {
   std::istringstream in(text);
   std::vector<std::string> out;
-  for (std::string w; in >> w;) out.push_back(w);
+  bool quoted = false;
+  for (std::string w; in >> w;) {
+    if (quoted) {
+      out.back() += " " + w;
+    } else {
+      out.push_back(w);
+    }
+    quoted ^= std::count(w.begin(), w.end(), '"') % 2 == 1;
+  }
   return out;
 }
 
