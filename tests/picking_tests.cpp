@@ -38,9 +38,11 @@ Picked pick_both(Context& ctx, const Scene& scene, const Camera& camera, graph::
   return r;
 }
 
+// Half a voxel, and 1e-3 mm for float arithmetic: a GPU's ray math (fused multiply-adds, its own
+// division) lands a few ulps of a 100 mm coordinate away from the reference's.
 float half_voxel(const Scene& scene) {
   const glm::vec3 s = scene.volumes[0].spacing;
-  return 0.5f * std::min({s.x, s.y, s.z});
+  return 0.5f * std::min({s.x, s.y, s.z}) + 1e-3f;
 }
 
 // Every GPU pick hits where the reference's does, within `tolerance` of it.
