@@ -301,8 +301,8 @@ void add_annotations(VectorPicture& picture, const AnnotationLayout& layout) {
     for (const LegendRow& row : layout.legend->rows) {
       if (row.swatch) {
         const glm::vec4 r = *row.swatch;  // (its one-pixel rim a stroke along the rim's middle)
-        VectorShape swatch{VectorShape::Kind::box, {r.x + 0.5f, r.y + 0.5f},
-                           {r.z - r.x - 1.0f, r.w - r.y - 1.0f}};
+        VectorShape swatch{
+            VectorShape::Kind::box, {r.x + 0.5f, r.y + 0.5f}, {r.z - r.x - 1.0f, r.w - r.y - 1.0f}};
         swatch.fill = glm::vec4(row.colour, 1.0f);
         swatch.stroke = gpu::LABEL_BORDER_COLOR;
         swatch.stroke_width = 1.0f;

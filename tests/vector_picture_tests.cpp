@@ -221,6 +221,37 @@ TEST_SUITE("cli") {
     check_text_is_kept(r);
   }
 
+  // A title and a legend: drawn where the PNG has them, as text (the title and each
+  // legend row one <text>; pdftotext finds the title), and the labels still where the PNG has
+  // them.
+  TEST_CASE("vector_stills_draw_the_title_and_legend_as_text_where_the_png_has_them") {
+    const auto folder = test::fresh_folder("cli", "vector_notes");
+    const Rendered r = render_three(kHead, "--camera oblique --title Brain --legend", 256, folder);
+    const InkDifference d = compare_ink(r);
+    CHECK(d.svg <= 1);
+    CHECK(d.pdf <= 1);
+    REQUIRE(r.layout.contains("annotations"));
+    REQUIRE(r.layout["annotations"].size() == 2);
+    for (const nlohmann::json& a : r.layout["annotations"]) {
+      CAPTURE(a["name"].get<std::string>());
+      const PixelBox png = ink_box(r.png, a["box"]);
+      CHECK(!png.empty());
+      CHECK(ink_distance(png, ink_box(r.svg, a["box"])) <= 1);
+      CHECK(ink_distance(png, ink_box(r.pdf, a["box"])) <= 1);
+    }
+    const std::vector<std::string> texts = svg_texts(r.svg_file);
+    CHECK(std::count(texts.begin(), texts.end(), "Brain") == 1);
+    CHECK(r.pdf_text.find("Brain") != std::string::npos);
+    // Every shown label's line in its box (and in the legend, unless shortened to fit), and the
+    // legend's rows besides.
+    const std::vector<std::string> lines = shown_lines(r.layout);
+    for (const std::string& line : lines) {
+      CAPTURE(line);
+      CHECK(std::count(texts.begin(), texts.end(), line) >= 1);
+    }
+    CHECK(texts.size() > lines.size() + 1);
+  }
+
   TEST_CASE("vector_stills_keep_hebrew_and_cjk_label_text_as_written") {
     const auto folder = test::fresh_folder("cli", "vector_bidi");
     // (Hebrew words, a Hebrew word inside left-to-right text, Chinese with Latin, a right-to-left
@@ -264,7 +295,7 @@ TEST_SUITE("cli") {
                        "--camera oblique", 1024, folder);
       const InkDifference d = compare_ink(r);
       MESSAGE(std::string(name) << ": " << d.labels << " shown labels, text ink within " << d.svg
-                   << " px (SVG) and " << d.pdf << " px (PDF) of the PNG's");
+                                << " px (SVG) and " << d.pdf << " px (PDF) of the PNG's");
       CHECK(d.svg <= 1);
       CHECK(d.pdf <= 1);
       check_text_is_kept(r);
